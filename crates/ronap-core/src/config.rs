@@ -1,0 +1,434 @@
+//! The simulation configuration: every default of SPEC.md as a field, with its unit.
+//!
+//! [`SimConfig`] is what a user writes (TOML, flags, keyword arguments); [`ValidConfig`] is the
+//! same data after [`SimConfig::validate`] has checked every field. The rest of the core only takes
+//! a `ValidConfig`, so it never re-checks a value.
+
+use serde::{Deserialize, Serialize};
+use std::ops::Deref;
+
+/// A configuration value that is out of its range or malformed.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum ConfigError {
+    /// A field holds a value outside its allowed range.
+    #[error("{field} = {value}: {expected}")]
+    OutOfRange {
+        /// Dotted field name, as in the TOML file (`maze.cols`).
+        field: &'static str,
+        /// The offending value, as written.
+        value: String,
+        /// What the field accepts.
+        expected: &'static str,
+    },
+    /// The TOML text could not be read into a configuration (syntax, type or unknown key).
+    #[error("{0}")]
+    Toml(String),
+}
+
+/// Maze generation (SPEC "Scene: maze").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MazeConfig {
+    /// Number of cell columns. Default 10.
+    pub cols: u32,
+    /// Number of cell rows. Default 10.
+    pub rows: u32,
+    /// Side of a square cell, px. Default 100.
+    pub cell_px: f64,
+    /// Fraction of the interior walls left by the perfect maze that are then removed, in [0, 1].
+    /// Default 0.4; 0 gives a perfect maze.
+    pub loops: f64,
+    /// Wall thickness, px. Default 2.
+    pub wall_thickness_px: f64,
+}
+
+impl Default for MazeConfig {
+    fn default() -> Self {
+        Self {
+            cols: 10,
+            rows: 10,
+            cell_px: 100.0,
+            loops: 0.4,
+            wall_thickness_px: 2.0,
+        }
+    }
+}
+
+/// How an image becomes a scene (SPEC "maze loaded as a picture").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MapConfig {
+    /// Grey value at or below which a pixel is an obstacle, 0-255. Default 127.
+    pub threshold: u8,
+    /// Scene px per image pixel. Default 1.
+    pub resolution_px: f64,
+}
+
+impl Default for MapConfig {
+    fn default() -> Self {
+        Self {
+            threshold: 127,
+            resolution_px: 1.0,
+        }
+    }
+}
+
+/// What a step that would touch an obstacle does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum OnCollision {
+    /// The pose stays where it was and the episode goes on (the paper's behaviour).
+    Revert,
+    /// The pose stays where it was and the episode ends as a collision.
+    Terminate,
+}
+
+/// The robot disc and its actions (SPEC "Robot").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RobotConfig {
+    /// Disc radius, px. Default 5.
+    pub radius_px: f64,
+    /// Distance of one AHEAD step, px (v_m). Default 5.
+    pub move_speed_px: f64,
+    /// Heading change of one LEFT or RIGHT step, degrees (v_r). Default 15.
+    pub turn_speed_deg: f64,
+    /// Continuous actions: largest |v|, px per step. Default 5.
+    pub max_linear_speed_px: f64,
+    /// Continuous actions: largest |w|, degrees per step. Default 15.
+    pub max_angular_speed_deg: f64,
+    /// `revert` (default, the paper) or `terminate`.
+    pub on_collision: OnCollision,
+}
+
+impl Default for RobotConfig {
+    fn default() -> Self {
+        Self {
+            radius_px: 5.0,
+            move_speed_px: 5.0,
+            turn_speed_deg: 15.0,
+            max_linear_speed_px: 5.0,
+            max_angular_speed_deg: 15.0,
+            on_collision: OnCollision::Revert,
+        }
+    }
+}
+
+/// The laser range finder (SPEC "Sensors").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LaserConfig {
+    /// Number of beams m. Default 17.
+    pub beams: u32,
+    /// Angle covered by the beams, centred on the heading, degrees. Default 180.
+    pub fov_deg: f64,
+    /// Largest reading d_max, px. Default 50.
+    pub range_px: f64,
+    /// Standard deviation of Gaussian reading noise, px. Default 0 (no noise).
+    pub noise_sigma_px: f64,
+}
+
+impl Default for LaserConfig {
+    fn default() -> Self {
+        Self {
+            beams: 17,
+            fov_deg: 180.0,
+            range_px: 50.0,
+            noise_sigma_px: 0.0,
+        }
+    }
+}
+
+/// Start, goal and the end of an episode (SPEC "Episode").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct EpisodeConfig {
+    /// Success when the goal distance D falls below this, px (epsilon). Default 10.
+    pub goal_tolerance_px: f64,
+    /// Steps before a time-out. Default 2000.
+    pub max_steps: u32,
+    /// End the episode when the summed reward falls to this value (R_min). Default: none.
+    pub reward_min: Option<f64>,
+    /// Least straight-line distance between a sampled start and goal, px. Default 200.
+    pub min_goal_distance_px: f64,
+    /// Fixed start pose `[x px, y px, z deg]`. Default: drawn from the seed.
+    pub start: Option<[f64; 3]>,
+    /// Fixed goal `[x px, y px]`. Default: drawn from the seed.
+    pub goal: Option<[f64; 2]>,
+    /// Cell side of the free-space grid used to find connected regions (and by planners), px.
+    /// Default 5.
+    pub grid_px: f64,
+}
+
+impl Default for EpisodeConfig {
+    fn default() -> Self {
+        Self {
+            goal_tolerance_px: 10.0,
+            max_steps: 2000,
+            reward_min: None,
+            min_goal_distance_px: 200.0,
+            start: None,
+            goal: None,
+            grid_px: 5.0,
+        }
+    }
+}
+
+/// The four reward terms `r = r_a + r_b + r_c + r_d` (SPEC "Observation and reward").
+///
+/// The paper gives no numbers. The defaults make one AHEAD step straight at the goal worth +0.5,
+/// a collision cost as much as two such steps, a turn cost a tenth of one, and arriving worth
+/// twenty: large enough that a learned policy prefers arriving to wandering.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct RewardConfig {
+    /// r_a, added on a step that collided. Default -1.
+    pub collision: f64,
+    /// r_b per px of progress `D_prev - D` (negative when moving away). Default 0.1.
+    pub progress_per_px: f64,
+    /// r_c, added on LEFT and RIGHT (scaled by |w| / w_max for continuous actions). Default -0.05.
+    pub turn: f64,
+    /// r_d, added on success. Default 10.
+    pub success: f64,
+}
+
+impl Default for RewardConfig {
+    fn default() -> Self {
+        Self {
+            collision: -1.0,
+            progress_per_px: 0.1,
+            turn: -0.05,
+            success: 10.0,
+        }
+    }
+}
+
+/// The whole simulation configuration, as a user writes it.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SimConfig {
+    /// Maze generation.
+    pub maze: MazeConfig,
+    /// Image scenes.
+    pub map: MapConfig,
+    /// The robot.
+    pub robot: RobotConfig,
+    /// The laser.
+    pub laser: LaserConfig,
+    /// Start, goal, episode end.
+    pub episode: EpisodeConfig,
+    /// Reward terms.
+    pub reward: RewardConfig,
+}
+
+/// A [`SimConfig`] whose every field has been checked. Dereferences to the `SimConfig`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ValidConfig(SimConfig);
+
+impl Deref for ValidConfig {
+    type Target = SimConfig;
+    fn deref(&self) -> &SimConfig {
+        &self.0
+    }
+}
+
+impl Default for ValidConfig {
+    fn default() -> Self {
+        Self(SimConfig::default())
+    }
+}
+
+impl ValidConfig {
+    /// The configuration as written, for saving next to results.
+    pub fn as_sim_config(&self) -> &SimConfig {
+        &self.0
+    }
+}
+
+fn check(
+    ok: bool,
+    field: &'static str,
+    value: impl ToString,
+    expected: &'static str,
+) -> Result<(), ConfigError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(ConfigError::OutOfRange {
+            field,
+            value: value.to_string(),
+            expected,
+        })
+    }
+}
+
+fn positive(field: &'static str, v: f64) -> Result<(), ConfigError> {
+    check(
+        v.is_finite() && v > 0.0,
+        field,
+        v,
+        "must be a positive number",
+    )
+}
+
+fn non_negative(field: &'static str, v: f64) -> Result<(), ConfigError> {
+    check(
+        v.is_finite() && v >= 0.0,
+        field,
+        v,
+        "must be zero or positive",
+    )
+}
+
+fn finite(field: &'static str, v: f64) -> Result<(), ConfigError> {
+    check(v.is_finite(), field, v, "must be a finite number")
+}
+
+/// Largest maze side in cells: keeps a generated scene (and its pictures) within memory.
+pub const MAX_MAZE_CELLS_PER_SIDE: u32 = 1000;
+/// Largest number of laser beams.
+pub const MAX_BEAMS: u32 = 360;
+
+impl SimConfig {
+    /// Reads a configuration from TOML text; missing fields keep their defaults and an unknown
+    /// key is an error that names it.
+    pub fn from_toml_str(text: &str) -> Result<Self, ConfigError> {
+        toml::from_str(text).map_err(|e| ConfigError::Toml(e.to_string()))
+    }
+
+    /// Checks every field, naming the first one that is out of range.
+    pub fn validate(self) -> Result<ValidConfig, ConfigError> {
+        let m = &self.maze;
+        let side = "must be between 1 and 1000";
+        check(
+            (1..=MAX_MAZE_CELLS_PER_SIDE).contains(&m.cols),
+            "maze.cols",
+            m.cols,
+            side,
+        )?;
+        check(
+            (1..=MAX_MAZE_CELLS_PER_SIDE).contains(&m.rows),
+            "maze.rows",
+            m.rows,
+            side,
+        )?;
+        positive("maze.cell_px", m.cell_px)?;
+        check(
+            (0.0..=1.0).contains(&m.loops),
+            "maze.loops",
+            m.loops,
+            "must be between 0 and 1",
+        )?;
+        positive("maze.wall_thickness_px", m.wall_thickness_px)?;
+        check(
+            m.wall_thickness_px < m.cell_px,
+            "maze.wall_thickness_px",
+            m.wall_thickness_px,
+            "must be smaller than maze.cell_px",
+        )?;
+        positive("map.resolution_px", self.map.resolution_px)?;
+
+        let r = &self.robot;
+        positive("robot.radius_px", r.radius_px)?;
+        non_negative("robot.move_speed_px", r.move_speed_px)?;
+        finite("robot.turn_speed_deg", r.turn_speed_deg)?;
+        non_negative("robot.max_linear_speed_px", r.max_linear_speed_px)?;
+        non_negative("robot.max_angular_speed_deg", r.max_angular_speed_deg)?;
+
+        let l = &self.laser;
+        check(
+            (1..=MAX_BEAMS).contains(&l.beams),
+            "laser.beams",
+            l.beams,
+            "must be between 1 and 360",
+        )?;
+        check(
+            l.fov_deg.is_finite() && (0.0..=360.0).contains(&l.fov_deg),
+            "laser.fov_deg",
+            l.fov_deg,
+            "must be between 0 and 360",
+        )?;
+        positive("laser.range_px", l.range_px)?;
+        non_negative("laser.noise_sigma_px", l.noise_sigma_px)?;
+
+        let e = &self.episode;
+        positive("episode.goal_tolerance_px", e.goal_tolerance_px)?;
+        check(
+            e.max_steps >= 1,
+            "episode.max_steps",
+            e.max_steps,
+            "must be at least 1",
+        )?;
+        if let Some(v) = e.reward_min {
+            finite("episode.reward_min", v)?;
+        }
+        non_negative("episode.min_goal_distance_px", e.min_goal_distance_px)?;
+        if let Some(s) = e.start {
+            check(
+                s.iter().all(|v| v.is_finite()),
+                "episode.start",
+                format!("{s:?}"),
+                "must be three finite numbers [x, y, z]",
+            )?;
+        }
+        if let Some(g) = e.goal {
+            check(
+                g.iter().all(|v| v.is_finite()),
+                "episode.goal",
+                format!("{g:?}"),
+                "must be two finite numbers [x, y]",
+            )?;
+        }
+        positive("episode.grid_px", e.grid_px)?;
+
+        let w = &self.reward;
+        finite("reward.collision", w.collision)?;
+        finite("reward.progress_per_px", w.progress_per_px)?;
+        finite("reward.turn", w.turn)?;
+        finite("reward.success", w.success)?;
+        Ok(ValidConfig(self))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_the_spec_values_and_valid() {
+        let c = SimConfig::default();
+        assert_eq!((c.maze.cols, c.maze.rows, c.maze.cell_px), (10, 10, 100.0));
+        assert_eq!(c.maze.loops, 0.4);
+        assert_eq!(
+            (c.laser.beams, c.laser.fov_deg, c.laser.range_px),
+            (17, 180.0, 50.0)
+        );
+        assert_eq!((c.robot.move_speed_px, c.robot.turn_speed_deg), (5.0, 15.0));
+        assert_eq!(c.episode.goal_tolerance_px, 10.0);
+        assert!(c.validate().is_ok());
+    }
+
+    #[test]
+    fn out_of_range_names_the_field_and_value() {
+        let mut c = SimConfig::default();
+        c.maze.loops = 1.5;
+        let e = c.validate().unwrap_err();
+        assert_eq!(e.to_string(), "maze.loops = 1.5: must be between 0 and 1");
+        let mut c = SimConfig::default();
+        c.maze.cols = 0;
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("maze.cols = 0"));
+    }
+
+    #[test]
+    fn toml_unknown_key_is_named() {
+        let e = SimConfig::from_toml_str("[maze]\ncolz = 3\n").unwrap_err();
+        assert!(e.to_string().contains("colz"), "{e}");
+        let c = SimConfig::from_toml_str("[maze]\ncols = 3\n").unwrap();
+        assert_eq!(c.maze.cols, 3);
+        assert_eq!(c.maze.rows, 10);
+    }
+}

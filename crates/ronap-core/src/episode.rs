@@ -1,0 +1,583 @@
+//! Episodes: a robot, a goal and a scene, stepped until success, a time-out or an early end.
+//!
+//! Everything random in an episode (maze, start, goal, noise) comes from its seed through separate
+//! streams ([`crate::rng`]), so the same seed gives the same run bit for bit.
+
+use crate::config::{OnCollision, ValidConfig};
+use crate::freespace::FreeGrid;
+use crate::geometry::{wrap_deg, Point, Vector};
+use crate::lidar::Laser;
+use crate::maze::Maze;
+use crate::rng::{stream, Rng, Stream};
+use crate::robot::{Action, DiscreteAction, Pose, Robot};
+use crate::scene::Scene;
+use rand::Rng as _;
+use std::sync::Arc;
+
+/// Attempts at drawing a start (and, for each, a goal) before giving up on a scene.
+const PLACEMENT_TRIES: usize = 64;
+
+/// An episode that cannot start.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum EpisodeError {
+    /// The scene has no free space for the robot.
+    #[error("the scene has no free space for a robot of radius {radius_px} px")]
+    NoFreeSpace {
+        /// Robot radius, px.
+        radius_px: f64,
+    },
+    /// No start and goal at least `min_goal_distance_px` apart were found in one region.
+    #[error(
+        "seed {seed}: found no start and goal {min_goal_distance_px} px apart in one free region \
+         (largest region spans {span_px:.0} px); lower episode.min_goal_distance_px"
+    )]
+    NoPlacement {
+        /// The episode seed.
+        seed: u64,
+        /// The distance asked for, px.
+        min_goal_distance_px: f64,
+        /// Diagonal of the largest region's bounding box, px.
+        span_px: f64,
+    },
+    /// A fixed start or goal touches an obstacle or lies outside the scene.
+    #[error("episode.{which} = ({x}, {y}) is not free: a robot of radius {radius_px} px there touches an obstacle or leaves the scene")]
+    Blocked {
+        /// `start` or `goal`.
+        which: &'static str,
+        /// x, px.
+        x: f64,
+        /// y, px.
+        y: f64,
+        /// Robot radius, px.
+        radius_px: f64,
+    },
+}
+
+/// Where an episode starts and where it must go.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    /// Start pose.
+    pub start: Pose,
+    /// Goal position.
+    pub goal: Point,
+}
+
+/// How an episode stands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Status {
+    /// Still going.
+    Running,
+    /// Reached the goal: D < epsilon ("TaskComplete").
+    Success,
+    /// Ran `max_steps` steps.
+    TimeOut,
+    /// The summed reward fell to `reward_min`.
+    RewardMin,
+    /// Collided with `on_collision = terminate`.
+    Collision,
+}
+
+impl Status {
+    /// Whether the episode is over.
+    pub fn is_done(self) -> bool {
+        self != Status::Running
+    }
+
+    /// The name used in logs: `running`, `success`, `timeout`, `reward_min`, `collision`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Status::Running => "running",
+            Status::Success => "success",
+            Status::TimeOut => "timeout",
+            Status::RewardMin => "reward_min",
+            Status::Collision => "collision",
+        }
+    }
+}
+
+/// What one step did: everything a caller needs, borrowed from the episode.
+#[derive(Clone, Copy, Debug)]
+pub struct StepResult<'a> {
+    /// The observation after the step: `[d_1/d_max, ..., d_m/d_max, direction/360]`.
+    pub observation: &'a [f32],
+    /// The laser readings after the step, px.
+    pub readings: &'a [f64],
+    /// This step's reward `r_a + r_b + r_c + r_d`.
+    pub reward: f64,
+    /// Whether the step's motion would have touched an obstacle (and so did not happen).
+    pub collided: bool,
+    /// The episode's status after the step.
+    pub status: Status,
+    /// The pose after the step.
+    pub pose: Pose,
+    /// Distance to the goal D after the step, px.
+    pub distance_px: f64,
+    /// Number of steps taken so far, this one included.
+    pub step: u32,
+}
+
+/// The scene for an episode seed: a maze drawn from the seed's scene stream.
+pub fn maze_scene(config: &ValidConfig, scene_seed: u64) -> Scene {
+    let maze = Maze::from_config(&config.maze, &mut stream(scene_seed, Stream::Scene));
+    Scene::from_maze(maze, &config.maze, reach_px(config))
+}
+
+/// The query distance scenes for `config` are indexed for: the laser range or a step plus the
+/// robot radius, whichever is longer.
+pub fn reach_px(config: &ValidConfig) -> f64 {
+    let step = config
+        .robot
+        .move_speed_px
+        .max(config.robot.max_linear_speed_px);
+    config.laser.range_px.max(step + config.robot.radius_px)
+}
+
+/// Bearing from `from` to `to`, degrees in [0, 360); 0 when the points coincide.
+pub fn bearing_deg(from: Point, to: Point) -> f64 {
+    let d = to - from;
+    wrap_deg(d.y.atan2(d.x).to_degrees())
+}
+
+/// Draws a start and goal for `seed` in the largest free region of `grid`: the start anywhere with
+/// clearance, the goal at least `min_goal_distance_px` from it.
+pub fn sample_placement(
+    config: &ValidConfig,
+    scene: &Scene,
+    grid: &FreeGrid,
+    seed: u64,
+) -> Result<Placement, EpisodeError> {
+    let radius = config.robot.radius_px;
+    let cells = grid.region_cells(0);
+    if cells.is_empty() {
+        return Err(EpisodeError::NoFreeSpace { radius_px: radius });
+    }
+    let (cols, _) = grid.size();
+    let cell = grid.cell_px();
+    let mut rng = stream(seed, Stream::Placement);
+    let draw = |rng: &mut Rng| -> Option<Point> {
+        let k = cells[rng.random_range(0..cells.len())] as usize;
+        let c = grid.center(k % cols, k / cols);
+        let p = c + Vector::new(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5)) * cell;
+        (scene.disc_clear(p, radius) && grid.region_at(p) == Some(0)).then_some(p)
+    };
+    let min_d = config.episode.min_goal_distance_px;
+    for _ in 0..PLACEMENT_TRIES {
+        let Some(start) = draw(&mut rng) else {
+            continue;
+        };
+        for _ in 0..PLACEMENT_TRIES {
+            if let Some(goal) = draw(&mut rng).filter(|g| (g - start).norm() >= min_d) {
+                let z = rng.random_range(0.0..360.0);
+                return Ok(Placement {
+                    start: Pose::new(start.x, start.y, z),
+                    goal,
+                });
+            }
+        }
+    }
+    let (lo, hi) = cells.iter().fold(
+        (
+            Point::new(f64::MAX, f64::MAX),
+            Point::new(f64::MIN, f64::MIN),
+        ),
+        |(lo, hi), &k| {
+            let p = grid.center(k as usize % cols, k as usize / cols);
+            (
+                Point::new(lo.x.min(p.x), lo.y.min(p.y)),
+                Point::new(hi.x.max(p.x), hi.y.max(p.y)),
+            )
+        },
+    );
+    Err(EpisodeError::NoPlacement {
+        seed,
+        min_goal_distance_px: min_d,
+        span_px: (hi - lo).norm(),
+    })
+}
+
+/// One episode in progress.
+#[derive(Clone, Debug)]
+pub struct Episode {
+    scene: Arc<Scene>,
+    config: ValidConfig,
+    robot: Robot,
+    laser: Laser,
+    seed: u64,
+    start: Pose,
+    pose: Pose,
+    goal: Point,
+    noise_rng: Rng,
+    readings: Vec<f64>,
+    observation: Vec<f32>,
+    distance_px: f64,
+    steps: u32,
+    collisions: u32,
+    total_reward: f64,
+    path_length_px: f64,
+    status: Status,
+}
+
+impl Episode {
+    /// An episode in `scene` for `seed`, with the start and goal the configuration fixes or, where
+    /// it does not, drawn from the seed.
+    pub fn new(config: &ValidConfig, scene: Arc<Scene>, seed: u64) -> Result<Self, EpisodeError> {
+        let e = &config.episode;
+        let placement = match (e.start, e.goal) {
+            (Some(s), Some(g)) => Placement {
+                start: Pose::new(s[0], s[1], s[2]),
+                goal: Point::new(g[0], g[1]),
+            },
+            _ => {
+                let grid = FreeGrid::new(&scene, config.robot.radius_px, e.grid_px);
+                let mut p = sample_placement(config, &scene, &grid, seed)?;
+                if let Some(s) = e.start {
+                    p.start = Pose::new(s[0], s[1], s[2]);
+                }
+                if let Some(g) = e.goal {
+                    p.goal = Point::new(g[0], g[1]);
+                }
+                p
+            }
+        };
+        Self::with_placement(config, scene, seed, placement)
+    }
+
+    /// An episode with a given start and goal; both must leave the robot clear of obstacles.
+    pub fn with_placement(
+        config: &ValidConfig,
+        scene: Arc<Scene>,
+        seed: u64,
+        placement: Placement,
+    ) -> Result<Self, EpisodeError> {
+        let radius = config.robot.radius_px;
+        let inside = |p: Point| scene.bounds().contains(p) && scene.disc_clear(p, radius);
+        for (which, p) in [
+            ("start", placement.start.position()),
+            ("goal", placement.goal),
+        ] {
+            if !inside(p) {
+                return Err(EpisodeError::Blocked {
+                    which,
+                    x: p.x,
+                    y: p.y,
+                    radius_px: radius,
+                });
+            }
+        }
+        let laser = Laser::new(&config.laser);
+        let beams = laser.beams();
+        let mut episode = Self {
+            robot: Robot::new(&config.robot),
+            laser,
+            config: config.clone(),
+            seed,
+            start: placement.start,
+            pose: placement.start,
+            goal: placement.goal,
+            noise_rng: stream(seed, Stream::Noise),
+            readings: vec![0.0; beams],
+            observation: vec![0.0; beams + 1],
+            distance_px: 0.0,
+            steps: 0,
+            collisions: 0,
+            total_reward: 0.0,
+            path_length_px: 0.0,
+            status: Status::Running,
+            scene,
+        };
+        episode.sense();
+        if episode.distance_px < config.episode.goal_tolerance_px {
+            episode.status = Status::Success;
+        }
+        Ok(episode)
+    }
+
+    /// Reads the laser and goal sensors at the current pose and refreshes the observation.
+    fn sense(&mut self) {
+        let p = self.pose.position();
+        self.laser
+            .scan(&self.scene, p, self.pose.z_deg, &mut self.readings);
+        self.laser
+            .add_noise(&mut self.readings, &mut self.noise_rng);
+        self.distance_px = (self.goal - p).norm();
+        let range = self.laser.range_px();
+        for (o, r) in self.observation.iter_mut().zip(&self.readings) {
+            *o = (r / range) as f32;
+        }
+        let last = self.readings.len();
+        self.observation[last] = (self.direction_deg() / 360.0) as f32;
+    }
+
+    /// Takes one step. On a finished episode nothing moves and the reward is 0.
+    pub fn step(&mut self, action: impl Into<Action>) -> StepResult<'_> {
+        if self.status.is_done() {
+            return self.result(0.0, false);
+        }
+        let action = action.into();
+        let before = self.distance_px;
+        let motion = self.robot.motion(self.pose, action);
+        let collided = !self.robot.motion_clear(&self.scene, self.pose, &motion);
+        if collided {
+            self.collisions += 1;
+        } else {
+            self.path_length_px += (motion.end.position() - self.pose.position()).norm();
+            self.pose = motion.end;
+        }
+        self.steps += 1;
+        self.sense();
+
+        let w = &self.config.reward;
+        let success = self.distance_px < self.config.episode.goal_tolerance_px;
+        let mut reward =
+            w.progress_per_px * (before - self.distance_px) + w.turn * motion.turn_fraction;
+        if collided {
+            reward += w.collision;
+        }
+        if success {
+            reward += w.success;
+        }
+        self.total_reward += reward;
+        self.status = if success {
+            Status::Success
+        } else if collided && self.config.robot.on_collision == OnCollision::Terminate {
+            Status::Collision
+        } else if self
+            .config
+            .episode
+            .reward_min
+            .is_some_and(|m| self.total_reward <= m)
+        {
+            Status::RewardMin
+        } else if self.steps >= self.config.episode.max_steps {
+            Status::TimeOut
+        } else {
+            Status::Running
+        };
+        self.result(reward, collided)
+    }
+
+    fn result(&self, reward: f64, collided: bool) -> StepResult<'_> {
+        StepResult {
+            observation: &self.observation,
+            readings: &self.readings,
+            reward,
+            collided,
+            status: self.status,
+            pose: self.pose,
+            distance_px: self.distance_px,
+            step: self.steps,
+        }
+    }
+
+    /// Takes a discrete action by index (0 LEFT, 1 AHEAD, 2 RIGHT); `None` for another index.
+    pub fn step_index(&mut self, index: usize) -> Option<StepResult<'_>> {
+        DiscreteAction::from_index(index).map(|a| self.step(a))
+    }
+
+    /// The scene.
+    pub fn scene(&self) -> &Arc<Scene> {
+        &self.scene
+    }
+
+    /// The validated configuration the episode runs with.
+    pub fn config(&self) -> &ValidConfig {
+        &self.config
+    }
+
+    /// The laser.
+    pub fn laser(&self) -> &Laser {
+        &self.laser
+    }
+
+    /// The episode seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// Start pose.
+    pub fn start(&self) -> Pose {
+        self.start
+    }
+
+    /// Current pose.
+    pub fn pose(&self) -> Pose {
+        self.pose
+    }
+
+    /// Goal position.
+    pub fn goal(&self) -> Point {
+        self.goal
+    }
+
+    /// Current laser readings, px.
+    pub fn readings(&self) -> &[f64] {
+        &self.readings
+    }
+
+    /// Current observation `[d_1/d_max, ..., d_m/d_max, direction/360]`.
+    pub fn observation(&self) -> &[f32] {
+        &self.observation
+    }
+
+    /// Distance to the goal D, px.
+    pub fn distance_px(&self) -> f64 {
+        self.distance_px
+    }
+
+    /// Bearing to the goal theta, degrees in [0, 360).
+    pub fn bearing_deg(&self) -> f64 {
+        bearing_deg(self.pose.position(), self.goal)
+    }
+
+    /// Goal direction relative to the heading, `(theta - z) mod 360`: 0 straight ahead, 90 left.
+    pub fn direction_deg(&self) -> f64 {
+        wrap_deg(self.bearing_deg() - self.pose.z_deg)
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u32 {
+        self.steps
+    }
+
+    /// Steps that collided.
+    pub fn collisions(&self) -> u32 {
+        self.collisions
+    }
+
+    /// Summed reward.
+    pub fn total_reward(&self) -> f64 {
+        self.total_reward
+    }
+
+    /// Distance driven, px.
+    pub fn path_length_px(&self) -> f64 {
+        self.path_length_px
+    }
+
+    /// Current status.
+    pub fn status(&self) -> Status {
+        self.status
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::SimConfig;
+
+    fn default_episode(seed: u64) -> Episode {
+        let config = ValidConfig::default();
+        let scene = Arc::new(maze_scene(&config, seed));
+        Episode::new(&config, scene, seed).expect("default scene places")
+    }
+
+    #[test]
+    fn placement_respects_clearance_and_distance() {
+        for seed in 0..50 {
+            let e = default_episode(seed);
+            let r = e.config().robot.radius_px;
+            assert!(e.scene().disc_clear(e.start().position(), r));
+            assert!(e.scene().disc_clear(e.goal(), r));
+            assert!((e.goal() - e.start().position()).norm() >= 200.0);
+            assert!((0.0..360.0).contains(&e.start().z_deg));
+        }
+    }
+
+    #[test]
+    fn bearing_follows_the_papers_cases() {
+        let o = Point::new(10.0, 10.0);
+        assert_eq!(bearing_deg(o, Point::new(20.0, 10.0)), 0.0);
+        assert_eq!(bearing_deg(o, Point::new(10.0, 20.0)), 90.0);
+        assert_eq!(bearing_deg(o, Point::new(0.0, 10.0)), 180.0);
+        assert_eq!(bearing_deg(o, Point::new(10.0, 0.0)), 270.0);
+        assert!((bearing_deg(o, Point::new(20.0, 0.0)) - 315.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn reward_terms_add_up() {
+        let mut sim = SimConfig::default();
+        sim.episode.start = Some([150.0, 150.0, 0.0]);
+        sim.episode.goal = Some([450.0, 150.0]);
+        let config = sim.validate().unwrap();
+        let scene = Arc::new(Scene::from_boxes(1000.0, 1000.0, vec![], 50.0));
+        let mut e = Episode::new(&config, scene, 0).unwrap();
+        let r = e.step(DiscreteAction::Ahead);
+        assert!((r.reward - 0.5).abs() < 1e-9, "{}", r.reward);
+        assert_eq!(r.observation.len(), 18);
+        assert_eq!(r.observation[17], 0.0);
+        let r = e.step(DiscreteAction::Left);
+        assert!((r.reward - -0.05).abs() < 1e-9);
+        // Goal now 15 deg to the right of the heading: direction 345.
+        assert!((e.direction_deg() - 345.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn timeout_and_reward_min_end_episodes() {
+        let mut sim = SimConfig::default();
+        sim.episode.max_steps = 3;
+        let config = sim.clone().validate().unwrap();
+        let scene = Arc::new(maze_scene(&config, 1));
+        let mut e = Episode::new(&config, scene.clone(), 1).unwrap();
+        let statuses: Vec<_> = (0..4)
+            .map(|_| e.step(DiscreteAction::Left).status)
+            .collect();
+        assert_eq!(
+            statuses,
+            [
+                Status::Running,
+                Status::Running,
+                Status::TimeOut,
+                Status::TimeOut
+            ]
+        );
+        assert_eq!(e.steps(), 3);
+
+        sim.episode.max_steps = 100;
+        sim.episode.reward_min = Some(-0.12);
+        let config = sim.validate().unwrap();
+        let mut e = Episode::new(&config, scene, 1).unwrap();
+        let statuses: Vec<_> = (0..3)
+            .map(|_| e.step(DiscreteAction::Left).status)
+            .collect();
+        assert_eq!(
+            statuses,
+            [Status::Running, Status::Running, Status::RewardMin]
+        );
+    }
+
+    #[test]
+    fn reaching_the_goal_succeeds() {
+        let mut sim = SimConfig::default();
+        sim.episode.start = Some([100.0, 100.0, 0.0]);
+        sim.episode.goal = Some([118.0, 100.0]);
+        let config = sim.validate().unwrap();
+        let scene = Arc::new(Scene::from_boxes(1000.0, 1000.0, vec![], 50.0));
+        let mut e = Episode::new(&config, scene, 0).unwrap();
+        assert_eq!(e.step(DiscreteAction::Ahead).status, Status::Running);
+        let r = e.step(DiscreteAction::Ahead);
+        assert_eq!(r.status, Status::Success);
+        assert!((r.reward - (0.5 + 10.0)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn blocked_fixed_start_is_named() {
+        let mut sim = SimConfig::default();
+        sim.episode.start = Some([100.0, 52.0, 0.0]);
+        sim.episode.goal = Some([450.0, 450.0]);
+        let config = sim.validate().unwrap();
+        let scene = Arc::new(Scene::from_boxes(
+            1000.0,
+            1000.0,
+            vec![crate::geometry::Aabb::from_corners(
+                Point::new(0.0, 49.0),
+                Point::new(1000.0, 51.0),
+            )],
+            50.0,
+        ));
+        let e = Episode::new(&config, scene, 0).unwrap_err();
+        assert!(
+            matches!(e, EpisodeError::Blocked { which: "start", .. }),
+            "{e}"
+        );
+    }
+}
