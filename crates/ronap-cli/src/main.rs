@@ -1,1 +1,75 @@
-fn main() {}
+//! `ronap`: the command-line front of ronap-core. Parses arguments, writes files, reports errors;
+//! the model itself lives in the core.
+
+mod bench;
+mod maze;
+mod output;
+mod sim_args;
+
+use clap::{Parser, Subcommand};
+use std::io::Write;
+use std::process::ExitCode;
+
+/// Exit code for bad input: arguments, config files, maps, output paths.
+const EXIT_BAD_INPUT: u8 = 2;
+
+/// Fast robot-navigation analysis on the RoNAP model: seeded mazes, a 17-beam laser, discrete
+/// actions, random start and goal.
+#[derive(Parser, Debug)]
+#[command(
+    name = "ronap",
+    version,
+    about,
+    propagate_version = true,
+    allow_negative_numbers = true
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Draw a scene: a PNG (white floor, black walls) with --out, else the maze as text.
+    Maze(maze::MazeArgs),
+    /// Measure how fast this machine steps the default scene.
+    Bench(bench::BenchArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            use clap::error::ErrorKind;
+            if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+                let _ = e.print();
+                return ExitCode::SUCCESS;
+            }
+            // One line that names the flag and the value; usage only when nothing was given.
+            let text = e.render().to_string();
+            if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+                eprint!("{text}");
+            } else {
+                eprintln!(
+                    "{}",
+                    text.lines().next().unwrap_or("error: invalid arguments")
+                );
+            }
+            return ExitCode::from(EXIT_BAD_INPUT);
+        }
+    };
+    let result = match cli.command {
+        Command::Maze(args) => maze::run(args),
+        Command::Bench(args) => bench::run(args),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) if output::is_broken_pipe(&e) => ExitCode::SUCCESS,
+        Err(e) => {
+            let mut stderr = std::io::stderr().lock();
+            let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();
+            let _ = writeln!(stderr, "error: {}", chain.join(": "));
+            ExitCode::from(EXIT_BAD_INPUT)
+        }
+    }
+}

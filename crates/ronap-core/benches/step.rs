@@ -1,1 +1,100 @@
-fn main() {}
+//! Criterion benchmarks of the model's hot paths on the default scene (10 x 10 maze, 17 beams).
+//!
+//! `cargo bench -p ronap-core --bench step`. Target: one step under 1 us (1,000,000 steps/s on one
+//! core); `scan/parry2d` is the same scan through parry2d's general ray cast, for comparison.
+
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
+use ronap_core::episode::maze_scene;
+use ronap_core::freespace::FreeGrid;
+use ronap_core::geometry::unit;
+use ronap_core::reference::ParryScene;
+use ronap_core::{Episode, Laser, ValidConfig};
+use std::hint::black_box;
+use std::sync::Arc;
+
+/// The action pattern `ronap bench` uses too: mostly ahead, some turns.
+const PATTERN: [usize; 8] = [1, 1, 1, 0, 1, 1, 2, 1];
+
+fn step(c: &mut Criterion) {
+    // Long episodes, so the figure is the step and not the occasional new episode.
+    let mut sim = ronap_core::SimConfig::default();
+    sim.episode.max_steps = 1_000_000;
+    let config = sim.validate().expect("valid");
+    let scene = Arc::new(maze_scene(&config, 0));
+    let mut seed = 0;
+    let mut episode = Episode::new(&config, scene.clone(), seed).expect("default scene");
+    let mut k = 0;
+    let mut group = c.benchmark_group("step");
+    group.throughput(Throughput::Elements(1));
+    group.bench_function("default", |b| {
+        b.iter(|| {
+            k += 1;
+            let done = episode
+                .step_index(PATTERN[k % PATTERN.len()])
+                .map(|r| r.status.is_done())
+                .unwrap_or(true);
+            if done {
+                seed += 1;
+                episode = Episode::new(&config, scene.clone(), seed).expect("default scene");
+            }
+        })
+    });
+    group.finish();
+}
+
+fn scan(c: &mut Criterion) {
+    let config = ValidConfig::default();
+    let scene = maze_scene(&config, 0);
+    let laser = Laser::new(&config.laser);
+    let episode = Episode::new(&config, Arc::new(scene.clone()), 0).expect("default scene");
+    let pose = episode.start();
+    let mut out = vec![0.0; laser.beams()];
+    let mut group = c.benchmark_group("scan");
+    group.bench_function("default", |b| {
+        b.iter(|| {
+            laser.scan(
+                &scene,
+                black_box(pose.position()),
+                black_box(pose.z_deg),
+                &mut out,
+            )
+        })
+    });
+    let parry = ParryScene::new(&scene).expect("walls");
+    group.bench_function("parry2d", |b| {
+        b.iter(|| {
+            for (i, o) in out.iter_mut().enumerate() {
+                let dir = unit(laser.beam_angle_deg(i, pose.z_deg));
+                *o = parry
+                    .cast_ray(black_box(pose.position()), dir, 50.0)
+                    .unwrap_or(50.0);
+            }
+        })
+    });
+    group.finish();
+}
+
+fn setup(c: &mut Criterion) {
+    let config = ValidConfig::default();
+    let mut group = c.benchmark_group("episode_setup");
+    group.bench_function("maze_scene", |b| {
+        b.iter(|| maze_scene(&config, black_box(3)))
+    });
+    group.bench_function("free_grid", |b| {
+        b.iter_batched(
+            || maze_scene(&config, 3),
+            |scene| FreeGrid::new(&scene, 5.0, 5.0),
+            BatchSize::SmallInput,
+        )
+    });
+    group.finish();
+}
+
+// The macro defines an undocumented `benches` function.
+#[allow(missing_docs)]
+mod group {
+    use super::*;
+    criterion_group!(benches, step, scan, setup);
+}
+use group::benches;
+criterion_main!(benches);

@@ -222,19 +222,14 @@ pub struct SimConfig {
 }
 
 /// A [`SimConfig`] whose every field has been checked. Dereferences to the `SimConfig`.
-#[derive(Clone, Debug, PartialEq)]
+/// The default is the (valid) default configuration.
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct ValidConfig(SimConfig);
 
 impl Deref for ValidConfig {
     type Target = SimConfig;
     fn deref(&self) -> &SimConfig {
         &self.0
-    }
-}
-
-impl Default for ValidConfig {
-    fn default() -> Self {
-        Self(SimConfig::default())
     }
 }
 
@@ -293,7 +288,18 @@ impl SimConfig {
     /// Reads a configuration from TOML text; missing fields keep their defaults and an unknown
     /// key is an error that names it.
     pub fn from_toml_str(text: &str) -> Result<Self, ConfigError> {
-        toml::from_str(text).map_err(|e| ConfigError::Toml(e.to_string()))
+        toml::from_str(text).map_err(|e| {
+            let message = e.message().trim().replace('\n', " ");
+            match e.span() {
+                Some(span) => {
+                    let before = &text[..span.start.min(text.len())];
+                    let line = before.matches('\n').count() + 1;
+                    let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+                    ConfigError::Toml(format!("line {line}, column {column}: {message}"))
+                }
+                None => ConfigError::Toml(message),
+            }
+        })
     }
 
     /// Checks every field, naming the first one that is out of range.
@@ -426,7 +432,13 @@ mod tests {
     #[test]
     fn toml_unknown_key_is_named() {
         let e = SimConfig::from_toml_str("[maze]\ncolz = 3\n").unwrap_err();
-        assert!(e.to_string().contains("colz"), "{e}");
+        assert!(
+            e.to_string()
+                .starts_with("line 2, column 1: unknown field `colz`"),
+            "{e}"
+        );
+        let e = SimConfig::from_toml_str("[laser]\nbeams = \"many\"\n").unwrap_err();
+        assert!(e.to_string().starts_with("line 2, column 9:"), "{e}");
         let c = SimConfig::from_toml_str("[maze]\ncols = 3\n").unwrap();
         assert_eq!(c.maze.cols, 3);
         assert_eq!(c.maze.rows, 10);

@@ -51,19 +51,20 @@ impl FreeGrid {
                 }
             }
         }
+        // Label regions by flood fill, numbering them in the order their first cell is met.
         let mut region = vec![u32::MAX; cols * rows];
-        let mut regions: Vec<Vec<u32>> = Vec::new();
+        let mut sizes: Vec<usize> = Vec::new();
         let mut stack = Vec::new();
         for seed in 0..cols * rows {
             if !free[seed] || region[seed] != u32::MAX {
                 continue;
             }
-            let label = regions.len() as u32;
-            let mut cells = Vec::new();
+            let label = sizes.len() as u32;
+            let mut size = 0;
             region[seed] = label;
             stack.push(seed);
             while let Some(i) = stack.pop() {
-                cells.push(i as u32);
+                size += 1;
                 let (c, r) = (i % cols, i / cols);
                 let mut visit = |j: usize| {
                     if free[j] && region[j] == u32::MAX {
@@ -84,22 +85,25 @@ impl FreeGrid {
                     visit(i + cols);
                 }
             }
-            cells.sort_unstable();
-            regions.push(cells);
+            sizes.push(size);
         }
-        // Largest first; among equals the one found first, so the order is deterministic.
-        let mut order: Vec<usize> = (0..regions.len()).collect();
-        order.sort_by_key(|&k| std::cmp::Reverse(regions[k].len()));
-        let mut relabel = vec![0u32; regions.len()];
+        // Renumber largest first (ties keep discovery order, so the result is deterministic) and
+        // list each region's cells in increasing index order with one pass over the grid.
+        let mut order: Vec<usize> = (0..sizes.len()).collect();
+        order.sort_by_key(|&k| std::cmp::Reverse(sizes[k]));
+        let mut relabel = vec![0u32; sizes.len()];
         for (new, &old) in order.iter().enumerate() {
             relabel[old] = new as u32;
         }
-        for l in region.iter_mut().filter(|l| **l != u32::MAX) {
-            *l = relabel[*l as usize];
-        }
-        let mut sorted = vec![Vec::new(); regions.len()];
-        for (old, cells) in regions.into_iter().enumerate() {
-            sorted[relabel[old] as usize] = cells;
+        let mut regions: Vec<Vec<u32>> = order
+            .iter()
+            .map(|&k| Vec::with_capacity(sizes[k]))
+            .collect();
+        for (i, l) in region.iter_mut().enumerate() {
+            if *l != u32::MAX {
+                *l = relabel[*l as usize];
+                regions[*l as usize].push(i as u32);
+            }
         }
         Self {
             cell_px,
@@ -107,7 +111,7 @@ impl FreeGrid {
             rows,
             free,
             region,
-            regions: sorted,
+            regions,
         }
     }
 

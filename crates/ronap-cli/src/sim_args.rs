@@ -1,0 +1,77 @@
+//! The flags that set simulation fields, shared by the commands, and how they combine with a
+//! config file into one validated configuration (flags win over the file, the file over defaults).
+
+use anyhow::{Context, Result};
+use clap::Args;
+use ronap_core::{SimConfig, ValidConfig};
+use std::path::PathBuf;
+
+/// Parses a positive, finite number of px.
+pub fn positive(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err("must be a positive number".into())
+    }
+}
+
+/// Parses a fraction in [0, 1].
+pub fn fraction(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err("must be between 0 and 1".into())
+    }
+}
+
+/// Scene and model flags.
+#[derive(Args, Debug, Clone, Default)]
+pub struct SimArgs {
+    /// TOML file setting any model field (see SPEC.md); the flags below override it.
+    #[arg(long, value_name = "FILE")]
+    pub config: Option<PathBuf>,
+    /// Maze columns [default: 10].
+    #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub cols: Option<u32>,
+    /// Maze rows [default: 10].
+    #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub rows: Option<u32>,
+    /// Cell side, px [default: 100].
+    #[arg(long, allow_negative_numbers = true, value_name = "PX", value_parser = positive)]
+    pub cell: Option<f64>,
+    /// Fraction of the perfect maze's interior walls removed afterwards, 0 to 1 (0: perfect maze)
+    /// [default: 0.4].
+    #[arg(long, allow_negative_numbers = true, value_name = "F", value_parser = fraction)]
+    pub loops: Option<f64>,
+    /// Wall thickness, px [default: 2].
+    #[arg(long, allow_negative_numbers = true, value_name = "PX", value_parser = positive)]
+    pub wall_thickness: Option<f64>,
+}
+
+impl SimArgs {
+    /// The configuration: defaults, then the file, then the flags; checked.
+    pub fn config(&self) -> Result<ValidConfig> {
+        let mut sim = match &self.config {
+            Some(path) => {
+                let text = std::fs::read_to_string(path)
+                    .with_context(|| format!("cannot read config file {}", path.display()))?;
+                SimConfig::from_toml_str(&text)
+                    .with_context(|| format!("invalid config file {}", path.display()))?
+            }
+            None => SimConfig::default(),
+        };
+        let m = &mut sim.maze;
+        m.cols = self.cols.unwrap_or(m.cols);
+        m.rows = self.rows.unwrap_or(m.rows);
+        m.cell_px = self.cell.unwrap_or(m.cell_px);
+        m.loops = self.loops.unwrap_or(m.loops);
+        m.wall_thickness_px = self.wall_thickness.unwrap_or(m.wall_thickness_px);
+        let source = self.config.as_ref().map_or("flags".to_string(), |p| {
+            format!("config file {} and flags", p.display())
+        });
+        sim.validate()
+            .with_context(|| format!("invalid configuration from {source}"))
+    }
+}

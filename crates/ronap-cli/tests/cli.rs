@@ -1,0 +1,262 @@
+//! End-to-end tests of the `ronap` binary: outputs read back and checked, bad input rejected.
+
+// Test helpers may panic on setup failures: that is a failed test, as intended.
+#![allow(clippy::unwrap_used)]
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn ronap(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ronap"))
+        .args(args)
+        .output()
+        .expect("ronap runs")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn maze_prints_text_by_default() {
+    let o = ronap(&["maze", "--seed", "7"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    insta::assert_snapshot!("maze_seed_7", stdout(&o));
+}
+
+#[test]
+fn maze_text_marks_start_and_goal() {
+    let o = ronap(&[
+        "maze",
+        "--seed",
+        "7",
+        "--cols",
+        "6",
+        "--rows",
+        "4",
+        "--loops",
+        "0",
+        "--start-goal",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    assert_eq!(text.matches('S').count(), 2, "{text}"); // the mark and the legend
+    assert!(text.contains('G'));
+    // 4 rows: 9 maze lines plus the legend.
+    assert_eq!(text.lines().count(), 10);
+    assert_eq!(text.lines().next().map(str::len), Some(6 * 3 + 1));
+}
+
+fn colour_count(img: &image::RgbImage, pred: impl Fn(&image::Rgb<u8>) -> bool) -> usize {
+    img.pixels().filter(|p| pred(p)).count()
+}
+
+#[test]
+fn maze_png_has_walls_floor_start_and_goal() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("maze.png");
+    let o = ronap(&[
+        "maze",
+        "--seed",
+        "7",
+        "--start-goal",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(&out).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (1000, 1000));
+    let black = colour_count(&img, |p| p.0 == [0, 0, 0]);
+    let white = colour_count(&img, |p| p.0 == [255, 255, 255]);
+    let red = colour_count(&img, |p| p.0[0] > 200 && p.0[1] < 60);
+    let green = colour_count(&img, |p| p.0[1] > 150 && p.0[0] < 60);
+    // The outer frame alone is about 4000 wall pixels; the floor is most of the picture.
+    assert!(
+        black > 4000 && white > 900_000,
+        "black {black} white {white}"
+    );
+    assert!(red > 20 && green > 200, "red {red} green {green}");
+    // The same seed draws the same picture; another seed another.
+    let again = dir.path().join("again.png");
+    ronap(&[
+        "maze",
+        "--seed",
+        "7",
+        "--start-goal",
+        "--out",
+        again.to_str().unwrap(),
+    ]);
+    assert_eq!(std::fs::read(&out).unwrap(), std::fs::read(&again).unwrap());
+    let other = dir.path().join("other.png");
+    ronap(&["maze", "--seed", "8", "--out", other.to_str().unwrap()]);
+    assert_ne!(std::fs::read(&out).unwrap(), std::fs::read(&other).unwrap());
+}
+
+#[test]
+fn maze_flags_shape_the_picture() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("small.pgm");
+    let o = ronap(&[
+        "maze",
+        "--cols",
+        "4",
+        "--rows",
+        "3",
+        "--cell",
+        "50",
+        "--wall-thickness",
+        "4",
+        "--loops",
+        "0",
+        "--scale",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(&out).unwrap().to_luma8();
+    assert_eq!(img.dimensions(), (400, 300));
+    // The bottom-left corner of the frame: 4 px walls, half inside the scene, at 2 pixels a px.
+    assert_eq!(img.get_pixel(0, 299).0[0], 0);
+    assert_eq!(img.get_pixel(3, 296).0[0], 0);
+    assert_eq!(img.get_pixel(4, 295).0[0], 255);
+}
+
+fn assert_rejected(args: &[&str], names: &[&str], out: Option<&Path>) {
+    let o = ronap(args);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+    let err = stderr(&o);
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "{args:?}: not one line: {err}"
+    );
+    for n in names {
+        assert!(err.contains(n), "{args:?}: {err:?} does not name {n:?}");
+    }
+    assert!(!err.contains("panicked"));
+    if let Some(out) = out {
+        assert!(!out.exists(), "{args:?} left {}", out.display());
+        let leftovers: Vec<_> = std::fs::read_dir(out.parent().unwrap()).unwrap().collect();
+        assert!(leftovers.is_empty(), "{args:?} left {leftovers:?}");
+    }
+}
+
+#[test]
+fn bad_input_is_named_with_exit_code_2_and_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("m.png");
+    let o = out.to_str().unwrap();
+    assert_rejected(
+        &["maze", "--cols", "0", "--out", o],
+        &["--cols", "0"],
+        Some(&out),
+    );
+    assert_rejected(
+        &["maze", "--rows", "-2", "--out", o],
+        &["--rows", "-2"],
+        Some(&out),
+    );
+    assert_rejected(
+        &["maze", "--cell", "-5", "--out", o],
+        &["--cell", "-5"],
+        Some(&out),
+    );
+    assert_rejected(
+        &["maze", "--wall-thickness", "0", "--out", o],
+        &["--wall-thickness", "0"],
+        Some(&out),
+    );
+    assert_rejected(
+        &["maze", "--loops", "1.5", "--out", o],
+        &["--loops", "1.5"],
+        Some(&out),
+    );
+    assert_rejected(
+        &["maze", "--loops", "-0.1", "--out", o],
+        &["--loops", "-0.1"],
+        Some(&out),
+    );
+    assert_rejected(
+        &["maze", "--scale", "nan", "--out", o],
+        &["--scale", "nan"],
+        Some(&out),
+    );
+    assert_rejected(
+        &["maze", "--out", "/nonexistent-dir/m.png"],
+        &["/nonexistent-dir/m.png"],
+        None,
+    );
+    let txt = dir.path().join("m.txt");
+    assert_rejected(
+        &["maze", "--out", txt.to_str().unwrap()],
+        &["m.txt"],
+        Some(&txt),
+    );
+    assert_rejected(&["maze", "--bogus"], &["--bogus"], None);
+}
+
+#[test]
+fn config_file_errors_name_the_file_and_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("c.toml");
+    std::fs::write(&cfg, "[maze]\ncolz = 3\n").unwrap();
+    assert_rejected(
+        &["maze", "--config", cfg.to_str().unwrap()],
+        &["c.toml", "colz"],
+        None,
+    );
+    std::fs::write(&cfg, "[maze]\nloops = 2.0\n").unwrap();
+    assert_rejected(
+        &["maze", "--config", cfg.to_str().unwrap()],
+        &["c.toml", "maze.loops", "2"],
+        None,
+    );
+    assert_rejected(
+        &["maze", "--config", "/no/such.toml"],
+        &["/no/such.toml"],
+        None,
+    );
+    // A valid file is used, and flags override it.
+    std::fs::write(&cfg, "[maze]\ncols = 3\nrows = 2\n").unwrap();
+    let o = ronap(&["maze", "--config", cfg.to_str().unwrap(), "--rows", "1"]);
+    assert!(o.status.success());
+    assert_eq!(
+        stdout(&o).lines().collect::<Vec<_>>(),
+        [
+            "+--+--+--+",
+            stdout(&o).lines().nth(1).unwrap(),
+            "+--+--+--+"
+        ]
+    );
+}
+
+#[test]
+fn bench_reports_steps_per_second_and_scan_time() {
+    let o = ronap(&["bench", "--seconds", "0.2", "--threads", "2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    let figure = |label: &str| -> f64 {
+        let line = text
+            .lines()
+            .find(|l| l.contains(label))
+            .unwrap_or_else(|| panic!("{label} in {text}"));
+        line.split_whitespace()
+            .find_map(|w| w.replace(',', "").parse::<f64>().ok().filter(|v| *v > 10.0))
+            .unwrap_or_else(|| panic!("no figure in {line:?}"))
+    };
+    assert!(figure("one thread") > 0.0);
+    assert!(figure("2 threads") > 0.0);
+    assert!(figure("laser scan") > 0.0);
+}
+
+#[test]
+fn help_explains_every_flag_with_its_default() {
+    let o = ronap(&["maze", "--help"]);
+    assert!(o.status.success());
+    insta::assert_snapshot!("maze_help", stdout(&o));
+}
