@@ -3,7 +3,7 @@
 use crate::sim_args::{positive, SimArgs};
 use anyhow::{Context, Result};
 use clap::Args;
-use ronap_core::episode::{maze_scene, sample_placement};
+use ronap_core::episode::{free_grid, maze_scene, needs_region_grid, sample_placement};
 use ronap_core::freespace::FreeGrid;
 use ronap_core::{Episode, Laser, Scene, ValidConfig};
 use std::sync::Arc;
@@ -31,7 +31,7 @@ pub struct BenchArgs {
 fn step_for(
     config: &ValidConfig,
     scene: &Arc<Scene>,
-    grid: &FreeGrid,
+    grid: Option<&FreeGrid>,
     first_seed: u64,
     duration: Duration,
 ) -> Result<u64> {
@@ -74,14 +74,14 @@ pub fn run(args: BenchArgs) -> Result<std::process::ExitCode> {
     );
     let duration = Duration::from_secs_f64(args.seconds);
     let scene = Arc::new(maze_scene(&config, 0));
-    let grid = FreeGrid::new(&scene, config.robot.radius_px, config.episode.grid_px);
+    let grid = needs_region_grid(&config, &scene).then(|| free_grid(&config, &scene));
     println!(
         "ronap bench: {} x {} maze of {} px cells, {} beams, {} s per figure",
         config.maze.cols, config.maze.rows, config.maze.cell_px, config.laser.beams, args.seconds
     );
 
     let start = Instant::now();
-    let steps = step_for(&config, &scene, &grid, 0, duration)?;
+    let steps = step_for(&config, &scene, grid.as_ref(), 0, duration)?;
     let single = steps as f64 / start.elapsed().as_secs_f64();
     println!("  one thread       {:>14} steps/s", group(single));
 
@@ -89,7 +89,7 @@ pub fn run(args: BenchArgs) -> Result<std::process::ExitCode> {
     let total: u64 = std::thread::scope(|s| {
         let handles: Vec<_> = (0..threads)
             .map(|t| {
-                let (config, scene, grid) = (&config, &scene, &grid);
+                let (config, scene, grid) = (&config, &scene, grid.as_ref());
                 s.spawn(move || step_for(config, scene, grid, t as u64 * 1_000_000, duration))
             })
             .collect();
@@ -113,7 +113,7 @@ pub fn run(args: BenchArgs) -> Result<std::process::ExitCode> {
         &config,
         scene.clone(),
         0,
-        sample_placement(&config, &scene, &grid, 0)?,
+        sample_placement(&config, &scene, grid.as_ref(), 0)?,
     )?;
     let mut readings = vec![0.0; laser.beams()];
     let scans = 200_000;

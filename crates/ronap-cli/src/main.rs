@@ -4,6 +4,7 @@
 mod bench;
 mod maze;
 mod output;
+mod run;
 mod sim_args;
 
 use clap::{Parser, Subcommand};
@@ -32,6 +33,8 @@ struct Cli {
 enum Command {
     /// Draw a scene: a PNG (white floor, black walls) with --out, else the maze as text.
     Maze(maze::MazeArgs),
+    /// Evaluate a policy over many seeded episodes: summary table, CSV logs, PNG trajectories.
+    Run(run::RunArgs),
     /// Measure how fast this machine steps the default scene.
     Bench(bench::BenchArgs),
 }
@@ -60,6 +63,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Maze(args) => maze::run(args),
+        Command::Run(args) => run::run(args),
         Command::Bench(args) => bench::run(args),
     };
     match result {

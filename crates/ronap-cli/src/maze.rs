@@ -1,11 +1,9 @@
 //! `ronap maze`: draw a seeded maze as a picture or as text.
 
-use crate::output;
 use crate::sim_args::{positive, SimArgs};
 use anyhow::{Context, Result};
 use clap::Args;
 use ronap_core::episode::{maze_scene, sample_placement};
-use ronap_core::freespace::FreeGrid;
 use ronap_core::render::{Canvas, GOAL, START};
 use std::io::Write;
 use std::path::PathBuf;
@@ -36,9 +34,8 @@ pub fn run(args: MazeArgs) -> Result<ExitCode> {
     let config = args.sim.config()?;
     let scene = maze_scene(&config, args.seed);
     let placement = if args.start_goal {
-        let grid = FreeGrid::new(&scene, config.robot.radius_px, config.episode.grid_px);
         Some(
-            sample_placement(&config, &scene, &grid, args.seed)
+            sample_placement(&config, &scene, None, args.seed)
                 .context("cannot place start and goal")?,
         )
     } else {
@@ -59,7 +56,7 @@ pub fn run(args: MazeArgs) -> Result<ExitCode> {
                 canvas.fill_disc(p.goal, config.episode.goal_tolerance_px.max(least), GOAL);
                 canvas.robot(p.start, config.robot.radius_px.max(least), START);
             }
-            output::save_image(path, &canvas.into_image())?;
+            ronap_core::output::save_image(path, &canvas.into_image())?;
         }
         None => {
             let (maze, cell) = scene.maze().context("the scene is not a maze")?;

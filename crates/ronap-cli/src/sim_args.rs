@@ -53,6 +53,11 @@ pub struct SimArgs {
 impl SimArgs {
     /// The configuration: defaults, then the file, then the flags; checked.
     pub fn config(&self) -> Result<ValidConfig> {
+        self.config_with(|_| {})
+    }
+
+    /// Like [`SimArgs::config`], with a command's own flags applied by `more` before the check.
+    pub fn config_with(&self, more: impl FnOnce(&mut SimConfig)) -> Result<ValidConfig> {
         let mut sim = match &self.config {
             Some(path) => {
                 let text = std::fs::read_to_string(path)
@@ -68,6 +73,7 @@ impl SimArgs {
         m.cell_px = self.cell.unwrap_or(m.cell_px);
         m.loops = self.loops.unwrap_or(m.loops);
         m.wall_thickness_px = self.wall_thickness.unwrap_or(m.wall_thickness_px);
+        more(&mut sim);
         let source = self.config.as_ref().map_or("flags".to_string(), |p| {
             format!("config file {} and flags", p.display())
         });

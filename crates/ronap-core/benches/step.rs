@@ -83,9 +83,23 @@ fn setup(c: &mut Criterion) {
     group.bench_function("free_grid", |b| {
         b.iter_batched(
             || maze_scene(&config, 3),
-            |scene| FreeGrid::new(&scene, 5.0, 5.0),
+            |scene| FreeGrid::new(&scene, 5.0, 5.0, 5.0),
             BatchSize::SmallInput,
         )
+    });
+    let world = ronap_core::World::maze(config.clone(), 3);
+    let episode = world.episode(3).expect("placement");
+    let (start, goal) = (episode.start().position(), episode.goal());
+    let grid = world.grid();
+    group.bench_function("distance_field", |b| {
+        b.iter(|| ronap_core::planning::DistanceField::new(world.scene(), grid, goal, 5.0, 4.0))
+    });
+    let field = ronap_core::planning::DistanceField::new(world.scene(), grid, goal, 5.0, 1.0);
+    let path = field
+        .path(world.scene(), grid, start, 5.0)
+        .expect("connected");
+    group.bench_function("smooth", |b| {
+        b.iter(|| ronap_core::planning::smooth(world.scene(), &path, 5.0))
     });
     group.finish();
 }

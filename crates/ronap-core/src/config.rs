@@ -203,6 +203,37 @@ impl Default for RewardConfig {
     }
 }
 
+/// The artificial potential field policy (SPEC "Algorithms", Algorithm 3).
+///
+/// `U = 1/2 xi d^2(q, goal) + 1/2 eta (1/c - 1/d0)^2` where `c <= d0`, with `c` the clearance of
+/// the robot disc at `q` (distance to the nearest obstacle minus the radius). The paper gives no
+/// gains; these keep the descent a few px off walls while the goal still pulls from across the
+/// scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ApfConfig {
+    /// Attraction gain xi, per px^2. Default 1.
+    pub gravity_gain: f64,
+    /// Repulsion gain eta, px^2. Default 50000.
+    pub repulsion_gain: f64,
+    /// Distance d0 beyond which obstacles do not repel, px. Default 20.
+    pub influence_px: f64,
+    /// Spacing of the positions the descent steps between (the paper's image pixels), px.
+    /// Default 1.
+    pub lattice_px: f64,
+}
+
+impl Default for ApfConfig {
+    fn default() -> Self {
+        Self {
+            gravity_gain: 1.0,
+            repulsion_gain: 50_000.0,
+            influence_px: 20.0,
+            lattice_px: 1.0,
+        }
+    }
+}
+
 /// The whole simulation configuration, as a user writes it.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -219,6 +250,8 @@ pub struct SimConfig {
     pub episode: EpisodeConfig,
     /// Reward terms.
     pub reward: RewardConfig,
+    /// The artificial potential field policy.
+    pub apf: ApfConfig,
 }
 
 /// A [`SimConfig`] whose every field has been checked. Dereferences to the `SimConfig`.
@@ -257,15 +290,6 @@ fn check(
     }
 }
 
-fn positive(field: &'static str, v: f64) -> Result<(), ConfigError> {
-    check(
-        v.is_finite() && v > 0.0,
-        field,
-        v,
-        "must be a positive number",
-    )
-}
-
 fn non_negative(field: &'static str, v: f64) -> Result<(), ConfigError> {
     check(
         v.is_finite() && v >= 0.0,
@@ -276,11 +300,32 @@ fn non_negative(field: &'static str, v: f64) -> Result<(), ConfigError> {
 }
 
 fn finite(field: &'static str, v: f64) -> Result<(), ConfigError> {
-    check(v.is_finite(), field, v, "must be a finite number")
+    check(
+        v.is_finite(),
+        field,
+        format!("{v:?}"),
+        "must be a finite number",
+    )
 }
 
 /// Largest maze side in cells: keeps a generated scene (and its pictures) within memory.
 pub const MAX_MAZE_CELLS_PER_SIDE: u32 = 1000;
+/// Largest length any field may give, px: scene sides, ranges, radii and speeds.
+pub const MAX_LENGTH_PX: f64 = 100_000.0;
+
+fn length(field: &'static str, v: f64, zero_ok: bool) -> Result<(), ConfigError> {
+    let low_ok = if zero_ok { v >= 0.0 } else { v > 0.0 };
+    check(
+        v.is_finite() && low_ok && v <= MAX_LENGTH_PX,
+        field,
+        format!("{v:?}"),
+        if zero_ok {
+            "must be between 0 and 100000 px"
+        } else {
+            "must be a positive length of at most 100000 px"
+        },
+    )
+}
 /// Largest number of laser beams.
 pub const MAX_BEAMS: u32 = 360;
 
@@ -318,27 +363,35 @@ impl SimConfig {
             m.rows,
             side,
         )?;
-        positive("maze.cell_px", m.cell_px)?;
+        length("maze.cell_px", m.cell_px, false)?;
+        let side = "the scene side (cells x maze.cell_px) must be at most 100000 px";
+        let widest = m.cols.max(m.rows) as f64 * m.cell_px;
+        check(
+            widest <= MAX_LENGTH_PX,
+            "maze.cell_px",
+            format!("{:?}", m.cell_px),
+            side,
+        )?;
         check(
             (0.0..=1.0).contains(&m.loops),
             "maze.loops",
-            m.loops,
+            format!("{:?}", m.loops),
             "must be between 0 and 1",
         )?;
-        positive("maze.wall_thickness_px", m.wall_thickness_px)?;
+        length("maze.wall_thickness_px", m.wall_thickness_px, false)?;
         check(
             m.wall_thickness_px < m.cell_px,
             "maze.wall_thickness_px",
-            m.wall_thickness_px,
+            format!("{:?}", m.wall_thickness_px),
             "must be smaller than maze.cell_px",
         )?;
-        positive("map.resolution_px", self.map.resolution_px)?;
+        length("map.resolution_px", self.map.resolution_px, false)?;
 
         let r = &self.robot;
-        positive("robot.radius_px", r.radius_px)?;
-        non_negative("robot.move_speed_px", r.move_speed_px)?;
+        length("robot.radius_px", r.radius_px, false)?;
+        length("robot.move_speed_px", r.move_speed_px, true)?;
         finite("robot.turn_speed_deg", r.turn_speed_deg)?;
-        non_negative("robot.max_linear_speed_px", r.max_linear_speed_px)?;
+        length("robot.max_linear_speed_px", r.max_linear_speed_px, true)?;
         non_negative("robot.max_angular_speed_deg", r.max_angular_speed_deg)?;
 
         let l = &self.laser;
@@ -351,14 +404,14 @@ impl SimConfig {
         check(
             l.fov_deg.is_finite() && (0.0..=360.0).contains(&l.fov_deg),
             "laser.fov_deg",
-            l.fov_deg,
+            format!("{:?}", l.fov_deg),
             "must be between 0 and 360",
         )?;
-        positive("laser.range_px", l.range_px)?;
-        non_negative("laser.noise_sigma_px", l.noise_sigma_px)?;
+        length("laser.range_px", l.range_px, false)?;
+        length("laser.noise_sigma_px", l.noise_sigma_px, true)?;
 
         let e = &self.episode;
-        positive("episode.goal_tolerance_px", e.goal_tolerance_px)?;
+        length("episode.goal_tolerance_px", e.goal_tolerance_px, false)?;
         check(
             e.max_steps >= 1,
             "episode.max_steps",
@@ -368,7 +421,7 @@ impl SimConfig {
         if let Some(v) = e.reward_min {
             finite("episode.reward_min", v)?;
         }
-        non_negative("episode.min_goal_distance_px", e.min_goal_distance_px)?;
+        length("episode.min_goal_distance_px", e.min_goal_distance_px, true)?;
         if let Some(s) = e.start {
             check(
                 s.iter().all(|v| v.is_finite()),
@@ -385,13 +438,19 @@ impl SimConfig {
                 "must be two finite numbers [x, y]",
             )?;
         }
-        positive("episode.grid_px", e.grid_px)?;
+        length("episode.grid_px", e.grid_px, false)?;
 
         let w = &self.reward;
         finite("reward.collision", w.collision)?;
         finite("reward.progress_per_px", w.progress_per_px)?;
         finite("reward.turn", w.turn)?;
         finite("reward.success", w.success)?;
+
+        let a = &self.apf;
+        non_negative("apf.gravity_gain", a.gravity_gain)?;
+        non_negative("apf.repulsion_gain", a.repulsion_gain)?;
+        length("apf.influence_px", a.influence_px, false)?;
+        length("apf.lattice_px", a.lattice_px, false)?;
         Ok(ValidConfig(self))
     }
 }

@@ -18,7 +18,7 @@ use std::sync::Arc;
 const PLACEMENT_TRIES: usize = 64;
 
 /// An episode that cannot start.
-#[derive(Debug, thiserror::Error, PartialEq)]
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
 pub enum EpisodeError {
     /// The scene has no free space for the robot.
     #[error("the scene has no free space for a robot of radius {radius_px} px")]
@@ -29,14 +29,14 @@ pub enum EpisodeError {
     /// No start and goal at least `min_goal_distance_px` apart were found in one region.
     #[error(
         "seed {seed}: found no start and goal {min_goal_distance_px} px apart in one free region \
-         (largest region spans {span_px:.0} px); lower episode.min_goal_distance_px"
+         of the scene ({span_px:.0} px across); lower episode.min_goal_distance_px"
     )]
     NoPlacement {
         /// The episode seed.
         seed: u64,
         /// The distance asked for, px.
         min_goal_distance_px: f64,
-        /// Diagonal of the largest region's bounding box, px.
+        /// Diagonal of the scene, px.
         span_px: f64,
     },
     /// A fixed start or goal touches an obstacle or lies outside the scene.
@@ -138,60 +138,124 @@ pub fn bearing_deg(from: Point, to: Point) -> f64 {
     wrap_deg(d.y.atan2(d.x).to_degrees())
 }
 
-/// Draws a start and goal for `seed` in the largest free region of `grid`: the start anywhere with
-/// clearance, the goal at least `min_goal_distance_px` from it.
+/// Whether start and goal must be drawn through a [`FreeGrid`] to land in one connected region.
+///
+/// A maze whose corridors and openings (`cell - wall thickness` wide) are wider than the robot is
+/// one region by construction (every cell is reachable, property-tested), so its start and goal are
+/// drawn uniformly over the scene with no grid; any other scene needs the grid.
+pub fn needs_region_grid(config: &ValidConfig, scene: &Scene) -> bool {
+    match scene.maze() {
+        Some((_, cell)) => cell - config.maze.wall_thickness_px <= 2.0 * config.robot.radius_px,
+        None => true,
+    }
+}
+
+/// The free-space grid of `scene` for the configured robot: the one placement and planners use.
+pub fn free_grid(config: &ValidConfig, scene: &Scene) -> FreeGrid {
+    FreeGrid::new(
+        scene,
+        config.robot.radius_px,
+        config.episode.grid_px,
+        config.robot.radius_px,
+    )
+}
+
+/// The start and goal of episode `seed`: each one the configuration fixes, the others drawn from
+/// the seed. A drawn start goes anywhere the robot fits, a drawn goal at least
+/// `min_goal_distance_px` from the start, and both in one connected free region: the fixed
+/// point's region, or else the largest region of `grid` when [`needs_region_grid`] says so (and
+/// anywhere in the maze when it does not). `grid`, when given, must be [`free_grid`] of the scene;
+/// it is built here if needed and not given.
 pub fn sample_placement(
     config: &ValidConfig,
     scene: &Scene,
-    grid: &FreeGrid,
+    grid: Option<&FreeGrid>,
     seed: u64,
 ) -> Result<Placement, EpisodeError> {
     let radius = config.robot.radius_px;
-    let cells = grid.region_cells(0);
-    if cells.is_empty() {
+    let e = &config.episode;
+    let fixed_start = e.start.map(|s| Pose::new(s[0], s[1], s[2]));
+    let fixed_goal = e.goal.map(|g| Point::new(g[0], g[1]));
+    if let (Some(start), Some(goal)) = (fixed_start, fixed_goal) {
+        return Ok(Placement { start, goal });
+    }
+    let owned;
+    let grid = if needs_region_grid(config, scene) {
+        match grid {
+            Some(g) => Some(g),
+            None => {
+                owned = free_grid(config, scene);
+                Some(&owned)
+            }
+        }
+    } else {
+        None
+    };
+    let blocked = |which: &'static str, p: Point| EpisodeError::Blocked {
+        which,
+        x: p.x,
+        y: p.y,
+        radius_px: radius,
+    };
+    // The region everything must share.
+    let region = match (grid, fixed_start, fixed_goal) {
+        (None, _, _) => 0,
+        (Some(g), Some(s), _) => g
+            .region_at(s.position())
+            .ok_or_else(|| blocked("start", s.position()))?,
+        (Some(g), None, Some(p)) => g.region_at(p).ok_or_else(|| blocked("goal", p))?,
+        (Some(_), None, None) => 0,
+    };
+    let cells = grid.map_or(&[][..], |g| g.region_cells(region));
+    if grid.is_some() && cells.is_empty() {
         return Err(EpisodeError::NoFreeSpace { radius_px: radius });
     }
-    let (cols, _) = grid.size();
-    let cell = grid.cell_px();
     let mut rng = stream(seed, Stream::Placement);
     let draw = |rng: &mut Rng| -> Option<Point> {
-        let k = cells[rng.random_range(0..cells.len())] as usize;
-        let c = grid.center(k % cols, k / cols);
-        let p = c + Vector::new(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5)) * cell;
-        (scene.disc_clear(p, radius) && grid.region_at(p) == Some(0)).then_some(p)
+        let p = match grid {
+            Some(g) => {
+                let (cols, _) = g.size();
+                let k = cells[rng.random_range(0..cells.len())] as usize;
+                let c = g.center(k % cols, k / cols);
+                c + Vector::new(rng.random_range(-0.5..0.5), rng.random_range(-0.5..0.5))
+                    * g.cell_px()
+            }
+            None => Point::new(
+                rng.random_range(radius..scene.width() - radius),
+                rng.random_range(radius..scene.height() - radius),
+            ),
+        };
+        let in_region = grid.is_none_or(|g| g.region_at(p) == Some(region));
+        (in_region && scene.disc_clear(p, radius)).then_some(p)
     };
-    let min_d = config.episode.min_goal_distance_px;
+    let min_d = e.min_goal_distance_px;
     for _ in 0..PLACEMENT_TRIES {
-        let Some(start) = draw(&mut rng) else {
-            continue;
+        let start = match fixed_start {
+            Some(s) => s.position(),
+            None => match draw(&mut rng) {
+                Some(p) => p,
+                None => continue,
+            },
         };
         for _ in 0..PLACEMENT_TRIES {
-            if let Some(goal) = draw(&mut rng).filter(|g| (g - start).norm() >= min_d) {
-                let z = rng.random_range(0.0..360.0);
-                return Ok(Placement {
-                    start: Pose::new(start.x, start.y, z),
-                    goal,
-                });
+            let goal = match fixed_goal {
+                Some(g) => Some(g),
+                None => draw(&mut rng),
+            };
+            if let Some(goal) = goal.filter(|g| (g - start).norm() >= min_d) {
+                let start = fixed_start
+                    .unwrap_or_else(|| Pose::new(start.x, start.y, rng.random_range(0.0..360.0)));
+                return Ok(Placement { start, goal });
+            }
+            if fixed_goal.is_some() {
+                break;
             }
         }
     }
-    let (lo, hi) = cells.iter().fold(
-        (
-            Point::new(f64::MAX, f64::MAX),
-            Point::new(f64::MIN, f64::MIN),
-        ),
-        |(lo, hi), &k| {
-            let p = grid.center(k as usize % cols, k as usize / cols);
-            (
-                Point::new(lo.x.min(p.x), lo.y.min(p.y)),
-                Point::new(hi.x.max(p.x), hi.y.max(p.y)),
-            )
-        },
-    );
     Err(EpisodeError::NoPlacement {
         seed,
         min_goal_distance_px: min_d,
-        span_px: (hi - lo).norm(),
+        span_px: scene.width().hypot(scene.height()),
     })
 }
 
@@ -221,25 +285,7 @@ impl Episode {
     /// An episode in `scene` for `seed`, with the start and goal the configuration fixes or, where
     /// it does not, drawn from the seed.
     pub fn new(config: &ValidConfig, scene: Arc<Scene>, seed: u64) -> Result<Self, EpisodeError> {
-        let e = &config.episode;
-        let placement = match (e.start, e.goal) {
-            (Some(s), Some(g)) => Placement {
-                start: Pose::new(s[0], s[1], s[2]),
-                goal: Point::new(g[0], g[1]),
-            },
-            _ => {
-                let grid = FreeGrid::new(&scene, config.robot.radius_px, e.grid_px);
-                let mut p = sample_placement(config, &scene, &grid, seed)?;
-                if let Some(s) = e.start {
-                    p.start = Pose::new(s[0], s[1], s[2]);
-                }
-                if let Some(g) = e.goal {
-                    p.goal = Point::new(g[0], g[1]);
-                }
-                p
-            }
-        };
-        Self::with_placement(config, scene, seed, placement)
+        crate::world::World::new(config.clone(), scene).episode(seed)
     }
 
     /// An episode with a given start and goal; both must leave the robot clear of obstacles.
@@ -557,6 +603,30 @@ mod tests {
         let r = e.step(DiscreteAction::Ahead);
         assert_eq!(r.status, Status::Success);
         assert!((r.reward - (0.5 + 10.0)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_fixed_start_gets_a_goal_far_enough_in_its_region() {
+        let mut sim = SimConfig::default();
+        sim.episode.start = Some([150.0, 150.0, 0.0]);
+        let config = sim.validate().unwrap();
+        for seed in 0..200 {
+            let scene = Arc::new(maze_scene(&config, seed));
+            let e = Episode::new(&config, scene, seed).unwrap();
+            assert_eq!(e.start(), Pose::new(150.0, 150.0, 0.0));
+            assert!(
+                (e.goal() - e.start().position()).norm() >= 200.0,
+                "seed {seed}"
+            );
+        }
+        let mut sim = SimConfig::default();
+        sim.episode.goal = Some([850.0, 850.0]);
+        let config = sim.validate().unwrap();
+        for seed in 0..50 {
+            let e = Episode::new(&config, Arc::new(maze_scene(&config, seed)), seed).unwrap();
+            assert_eq!(e.goal(), Point::new(850.0, 850.0));
+            assert!((e.goal() - e.start().position()).norm() >= 200.0);
+        }
     }
 
     #[test]

@@ -1,12 +1,21 @@
 //! The free-space grid: where the robot's centre may stand, on square cells of `grid_px`.
 //!
 //! A cell is free when a disc of the robot's radius centred on the cell centre touches no obstacle
-//! (the configuration space, sampled). Connected regions use 4-neighbour moves between free cells,
-//! so two cells in one region are joined by a path the robot can drive. Start and goal are drawn
-//! from one region; planners search this grid.
+//! (the configuration space, sampled). Two neighbouring free cells are linked when the disc can
+//! drive straight from one centre to the other; connected regions follow 4-neighbour links, so two
+//! cells in one region are joined by a path the robot can drive. Start and goal are drawn from one
+//! region; planners search this grid.
+//!
+//! Checking a link costs a swept-disc query, so it is done only where it can fail: between two
+//! cells that are both within the margin of an obstacle (elsewhere the straight line between the
+//! centres keeps the clearance), and not at all in a maze whose walls are too thick for two free
+//! centres to lie on either side of one.
 
 use crate::geometry::Point;
 use crate::scene::Scene;
+
+/// Most cells a grid has (about 150 MB with its labels).
+pub const MAX_CELLS: usize = 25_000_000;
 
 /// Free cells of a scene for a disc of a given radius.
 #[derive(Clone, Debug)]
@@ -16,6 +25,10 @@ pub struct FreeGrid {
     rows: usize,
     /// `free[row * cols + col]`, row 0 at the bottom.
     free: Vec<bool>,
+    /// Free cells whose centre is within `margin_px` of touching an obstacle.
+    close: Vec<bool>,
+    /// Links that are blocked, per cell: bit 0 to the east, 1 north, 2 north-east, 3 north-west.
+    unlinked: Vec<u8>,
     /// Region label of each free cell (`u32::MAX` for blocked cells).
     region: Vec<u32>,
     /// Cells of each region, largest region first.
@@ -23,16 +36,22 @@ pub struct FreeGrid {
 }
 
 impl FreeGrid {
-    /// The grid of `scene` for a disc of `radius` px, with cells of `cell_px`.
-    pub fn new(scene: &Scene, radius: f64, cell_px: f64) -> Self {
+    /// The grid of `scene` for a disc of `radius` px, with cells of `cell_px`; free cells within
+    /// `margin_px` of touching an obstacle are also marked [close](FreeGrid::is_close).
+    ///
+    /// Cells grow as needed to keep their number under [`MAX_CELLS`].
+    pub fn new(scene: &Scene, radius: f64, cell_px: f64, margin_px: f64) -> Self {
+        let cell_px = cell_px.max((scene.width() * scene.height() / MAX_CELLS as f64).sqrt());
         let cols = ((scene.width() / cell_px).floor() as usize).max(1);
         let rows = ((scene.height() / cell_px).floor() as usize).max(1);
         let mut free = vec![true; cols * rows];
+        let mut close = vec![false; cols * rows];
         let r2 = radius * radius;
+        let close2 = (radius + margin_px).powi(2);
         // Block the cells whose centres are within `radius` of each box: a pass per box over the
         // cells of its grown bounding box, exact at the rounded corners.
         for b in scene.boxes() {
-            let g = b.inflated(radius);
+            let g = b.inflated(radius + margin_px);
             let lo = |v: f64| ((v / cell_px - 0.5).ceil().max(0.0)) as usize;
             let hi = |v: f64, n: usize| -> Option<usize> {
                 let k = (v / cell_px - 0.5).floor();
@@ -45,13 +64,61 @@ impl FreeGrid {
             for r in r0..=r1 {
                 for c in c0..=c1 {
                     let p = Point::new((c as f64 + 0.5) * cell_px, (r as f64 + 0.5) * cell_px);
-                    if b.distance_squared(p) < r2 {
+                    let d2 = b.distance_squared(p);
+                    if d2 < r2 {
                         free[r * cols + c] = false;
+                    } else if d2 < close2 {
+                        close[r * cols + c] = true;
                     }
                 }
             }
         }
         // Label regions by flood fill, numbering them in the order their first cell is met.
+        let mut unlinked = vec![0u8; cols * rows];
+        let maze_is_safe = match scene.source() {
+            crate::scene::SceneSource::Maze {
+                wall_thickness_px, ..
+            } => 2.0 * radius + wall_thickness_px > cell_px * std::f64::consts::SQRT_2,
+            _ => false,
+        };
+        // A link between centres both at least radius + cell/sqrt 2 clear cannot fail: every point
+        // of it is within cell/sqrt 2 of one of them. The margin must cover that to skip a check.
+        let exact = !maze_is_safe && margin_px * 2.0 >= cell_px * std::f64::consts::SQRT_2;
+        for r in 0..rows {
+            for c in 0..cols {
+                let i = r * cols + c;
+                if !free[i] {
+                    continue;
+                }
+                let links = [
+                    (0u8, c + 1 < cols, i + 1),
+                    (1, r + 1 < rows, i + cols),
+                    (2, c + 1 < cols && r + 1 < rows, i + cols + 1),
+                    (3, c > 0 && r + 1 < rows, (i + cols).wrapping_sub(1)),
+                ];
+                for (bit, inside, j) in links {
+                    if !inside || !free[j] {
+                        continue;
+                    }
+                    let must_check = if exact {
+                        close[i] && close[j]
+                    } else {
+                        !maze_is_safe
+                    };
+                    if must_check {
+                        let a = Point::new((c as f64 + 0.5) * cell_px, (r as f64 + 0.5) * cell_px);
+                        let b = Point::new(
+                            ((j % cols) as f64 + 0.5) * cell_px,
+                            ((j / cols) as f64 + 0.5) * cell_px,
+                        );
+                        if !scene.sweep_clear(a, b, radius) {
+                            unlinked[i] |= 1 << bit;
+                        }
+                    }
+                }
+            }
+        }
+        let linked = |i: usize, j: usize| link_open(&unlinked, cols, i, j);
         let mut region = vec![u32::MAX; cols * rows];
         let mut sizes: Vec<usize> = Vec::new();
         let mut stack = Vec::new();
@@ -67,7 +134,7 @@ impl FreeGrid {
                 size += 1;
                 let (c, r) = (i % cols, i / cols);
                 let mut visit = |j: usize| {
-                    if free[j] && region[j] == u32::MAX {
+                    if free[j] && region[j] == u32::MAX && linked(i, j) {
                         region[j] = label;
                         stack.push(j);
                     }
@@ -110,9 +177,27 @@ impl FreeGrid {
             cols,
             rows,
             free,
+            close,
+            unlinked,
             region,
             regions,
         }
+    }
+
+    /// Whether the disc can drive straight between the centres of neighbouring cells `i` and `j`
+    /// (both free; `true` for cells that are not neighbours).
+    pub fn linked(&self, i: usize, j: usize) -> bool {
+        link_open(&self.unlinked, self.cols, i, j)
+    }
+
+    /// Whether free cell `index` (`row * cols + col`) is within the margin of an obstacle.
+    pub fn is_close(&self, index: usize) -> bool {
+        self.close[index] && self.free[index]
+    }
+
+    /// Whether cell `index` (`row * cols + col`) is free.
+    pub fn is_free_index(&self, index: usize) -> bool {
+        self.free[index]
     }
 
     /// Cell side, px.
@@ -169,6 +254,19 @@ impl FreeGrid {
     }
 }
 
+/// Whether the link between neighbouring cells `i` and `j` is open in `unlinked`.
+fn link_open(unlinked: &[u8], cols: usize, i: usize, j: usize) -> bool {
+    let (lo, hi) = (i.min(j), i.max(j));
+    let bit = match hi - lo {
+        1 => 0,
+        d if d == cols => 1,
+        d if d == cols + 1 => 2,
+        d if d + 1 == cols => 3,
+        _ => return true,
+    };
+    unlinked[lo] & (1 << bit) == 0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -182,7 +280,7 @@ mod tests {
         let mut boxes = frame.boxes().to_vec();
         boxes.push(wall);
         let scene = Scene::from_boxes(100.0, 100.0, boxes, 50.0);
-        let grid = FreeGrid::new(&scene, 5.0, 5.0);
+        let grid = FreeGrid::new(&scene, 5.0, 5.0, 5.0);
         assert_eq!(grid.region_count(), 2);
         assert_ne!(
             grid.region_at(Point::new(20.0, 50.0)),
@@ -193,5 +291,44 @@ mod tests {
         assert_eq!(grid.region_at(Point::new(50.0, 50.0)), None);
         assert!(grid.is_free(1, 1));
         assert!(!grid.is_free(0, 1));
+        // Centre 7.5 px from the frame: clearance 2.5 px, within the 5 px margin. 12.5 px: not.
+        assert!(grid.is_close(5 * 20 + 1));
+        assert!(!grid.is_close(5 * 20 + 2));
+    }
+
+    #[test]
+    fn a_gap_narrower_than_the_robot_does_not_join_regions() {
+        // A 0.2 px wall across a room with a 9 px gap: a disc of radius 5 cannot pass, although
+        // cell centres on both sides of the gap are clear.
+        let frame = Scene::from_occupancy(100, 100, &vec![false; 100 * 100], 1.0, 50.0);
+        let mut boxes = frame.boxes().to_vec();
+        boxes.push(Aabb::from_corners(
+            Point::new(0.0, 49.9),
+            Point::new(48.0, 50.1),
+        ));
+        boxes.push(Aabb::from_corners(
+            Point::new(57.0, 49.9),
+            Point::new(100.0, 50.1),
+        ));
+        let scene = Scene::from_boxes(100.0, 100.0, boxes, 50.0);
+        let grid = FreeGrid::new(&scene, 5.0, 5.0, 5.0);
+        assert_eq!(grid.region_count(), 2);
+        assert_ne!(
+            grid.region_at(Point::new(50.0, 20.0)),
+            grid.region_at(Point::new(50.0, 80.0))
+        );
+        // Widen the gap to 15 px and the robot fits through. (The grid is conservative: a gap the
+        // disc just fits through may stay closed when no column of cell centres lines up with it.)
+        let mut boxes = frame.boxes().to_vec();
+        boxes.push(Aabb::from_corners(
+            Point::new(0.0, 49.9),
+            Point::new(43.0, 50.1),
+        ));
+        boxes.push(Aabb::from_corners(
+            Point::new(58.0, 49.9),
+            Point::new(100.0, 50.1),
+        ));
+        let scene = Scene::from_boxes(100.0, 100.0, boxes, 50.0);
+        assert_eq!(FreeGrid::new(&scene, 5.0, 5.0, 5.0).region_count(), 1);
     }
 }

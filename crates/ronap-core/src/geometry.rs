@@ -59,14 +59,23 @@ impl Aabb {
     /// given `inv_dir = 1 / dir` per component. `Some(0.0)` when the origin is inside.
     #[inline]
     pub fn ray_hit(&self, origin: Point, inv_dir: Vector, max_t: f64) -> Option<f64> {
-        let tx1 = (self.min.x - origin.x) * inv_dir.x;
-        let tx2 = (self.max.x - origin.x) * inv_dir.x;
-        let ty1 = (self.min.y - origin.y) * inv_dir.y;
-        let ty2 = (self.max.y - origin.y) * inv_dir.y;
-        // `f64::min`/`max` ignore a NaN operand (0 * inf when the ray runs along a face), which
-        // is the behaviour wanted: that axis then constrains nothing.
-        let enter = tx1.min(tx2).max(ty1.min(ty2)).max(0.0);
-        let exit = tx1.max(tx2).min(ty1.max(ty2)).min(max_t);
+        // A ray parallel to an axis that starts exactly on a face gives 0 * inf = NaN for that
+        // face; the ray then runs along the face, which counts as touching: that slab spans the
+        // whole line, so NaN reads as -inf where the slab is entered and +inf where it is left.
+        let slab = |lo: f64, hi: f64, o: f64, inv: f64| {
+            let (t1, t2) = ((lo - o) * inv, (hi - o) * inv);
+            let enter = t1.min(t2);
+            let exit = t1.max(t2);
+            if t1.is_nan() || t2.is_nan() {
+                (f64::NEG_INFINITY, f64::INFINITY)
+            } else {
+                (enter, exit)
+            }
+        };
+        let (ex, xx) = slab(self.min.x, self.max.x, origin.x, inv_dir.x);
+        let (ey, xy) = slab(self.min.y, self.max.y, origin.y, inv_dir.y);
+        let enter = ex.max(ey).max(0.0);
+        let exit = xx.min(xy).min(max_t);
         (enter <= exit).then_some(enter)
     }
 
@@ -147,6 +156,17 @@ mod tests {
             b.ray_hit(Point::new(11.0, 0.0), inv(Vector::new(0.0, 1.0)), 5.0),
             Some(0.0)
         );
+    }
+
+    #[test]
+    fn ray_along_a_face_touches_it() {
+        let b = Aabb::from_corners(Point::new(10.0, 20.0), Point::new(12.0, 30.0));
+        let up = inv(Vector::new(0.0, 1.0));
+        assert_eq!(b.ray_hit(Point::new(10.0, 0.0), up, 50.0), Some(20.0));
+        assert_eq!(b.ray_hit(Point::new(12.0, 0.0), up, 50.0), Some(20.0));
+        assert_eq!(b.ray_hit(Point::new(12.5, 0.0), up, 50.0), None);
+        let right = inv(Vector::new(1.0, 0.0));
+        assert_eq!(b.ray_hit(Point::new(0.0, 30.0), right, 50.0), Some(10.0));
     }
 
     #[test]

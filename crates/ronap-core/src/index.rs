@@ -7,6 +7,9 @@
 
 use crate::geometry::{Aabb, Point};
 
+/// Most bins an index has (16 MB of bin starts).
+pub const MAX_BINS: usize = 4_000_000;
+
 /// Bins over a set of boxes.
 #[derive(Clone, Debug)]
 pub struct BinIndex {
@@ -22,10 +25,12 @@ pub struct BinIndex {
 }
 
 impl BinIndex {
-    /// Bins of side `bin_px` over `bounds` grown by `reach_px`, for `boxes`.
+    /// Bins of side `bin_px` over `bounds` grown by `reach_px`, for `boxes`. Bins grow as needed
+    /// to keep their number under [`MAX_BINS`].
     pub fn new(boxes: &[Aabb], bounds: Aabb, reach_px: f64, bin_px: f64) -> Self {
         let area = bounds.inflated(reach_px);
         let size = area.extents();
+        let bin_px = bin_px.max((size.x * size.y / MAX_BINS as f64).sqrt());
         let cols = ((size.x / bin_px).ceil() as usize).max(1);
         let rows = ((size.y / bin_px).ceil() as usize).max(1);
         let bin_of = |v: f64, lo: f64, n: usize| -> usize {

@@ -7,16 +7,24 @@
 
 pub mod config;
 pub mod episode;
+pub mod evaluate;
 pub mod freespace;
 pub mod geometry;
 pub mod index;
 pub mod lidar;
+pub mod map;
 pub mod maze;
+pub mod output;
+pub mod planning;
+pub mod policy;
 pub mod reference;
 pub mod render;
+pub mod report;
 pub mod rng;
 pub mod robot;
 pub mod scene;
+pub mod summary;
+pub mod world;
 
 pub use config::{ConfigError, SimConfig, ValidConfig};
 pub use episode::{Episode, EpisodeError, Placement, Status, StepResult};
@@ -25,3 +33,4 @@ pub use lidar::Laser;
 pub use maze::Maze;
 pub use robot::{Action, DiscreteAction, Pose, Robot};
 pub use scene::{Scene, SceneError};
+pub use world::World;

@@ -221,6 +221,17 @@ mod tests {
     }
 
     #[test]
+    fn beam_along_a_wall_face_reads_it() {
+        // Heading exactly 0: beam 8 runs along y = 50, the bottom face of the box.
+        let s = scene(vec![Aabb::from_corners(
+            Point::new(40.0, 50.0),
+            Point::new(42.0, 90.0),
+        )]);
+        let r = read(&s, Point::new(20.0, 50.0), 0.0);
+        assert_eq!(r[8], 20.0);
+    }
+
+    #[test]
     fn nothing_in_range_reads_exactly_range() {
         let s = scene(vec![Aabb::from_corners(
             Point::new(900.0, 900.0),

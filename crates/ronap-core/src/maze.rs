@@ -39,9 +39,13 @@ impl Maze {
     }
 
     /// Generates a maze: a perfect maze by recursive backtracking from the top-left cell, then
-    /// `loops` of the interior walls it left removed at random.
+    /// `loops` of the interior walls it left removed at random. A grid with no cells (`cols` or
+    /// `rows` 0) stays empty.
     pub fn generate(cols: usize, rows: usize, loops: f64, rng: &mut impl rand::Rng) -> Self {
         let mut maze = Self::closed(cols, rows);
+        if cols == 0 || rows == 0 {
+            return maze;
+        }
         let mut visited = vec![false; cols * rows];
         let start = (0, rows - 1);
         visited[start.1 * cols + start.0] = true;

@@ -186,7 +186,8 @@ impl Robot {
             return scene.sweep_clear(pose.position(), motion.end.position(), r);
         }
         // Follow the arc by chords short enough that the arc stays within ARC_TOLERANCE_PX of
-        // them, and check each with the radius grown by that much.
+        // them (at most 1024 chords), and check each with the radius grown by the arc's actual
+        // distance from its chords, so the check errs on the side of a collision.
         let arc_radius = (motion.v / w).abs();
         let max_angle = if arc_radius > ARC_TOLERANCE_PX {
             2.0 * (1.0 - ARC_TOLERANCE_PX / arc_radius).acos()
@@ -194,11 +195,16 @@ impl Robot {
             std::f64::consts::PI
         };
         let chords = ((w.abs() / max_angle).ceil() as usize).clamp(1, 1024);
+        let sagitta = arc_radius * (1.0 - (w.abs() / chords as f64 / 2.0).cos());
         let mut from = pose;
         for k in 1..=chords {
             let part = k as f64 / chords as f64;
             let to = arc_end(pose, motion.v * part, motion.w_deg * part);
-            if !scene.sweep_clear(from.position(), to.position(), r + ARC_TOLERANCE_PX) {
+            if !scene.sweep_clear(
+                from.position(),
+                to.position(),
+                r + sagitta.max(ARC_TOLERANCE_PX),
+            ) {
                 return false;
             }
             from = to;

@@ -46,6 +46,8 @@ pub enum SceneSource {
         maze: Maze,
         /// Cell side, px.
         cell_px: f64,
+        /// Wall thickness, px.
+        wall_thickness_px: f64,
     },
     /// An image, `resolution_px` scene px per pixel.
     Image {
@@ -56,6 +58,28 @@ pub enum SceneSource {
     },
     /// Boxes given directly.
     Boxes,
+}
+
+/// Reads and decodes an image file (PNG, PGM, or any format the decoder recognises), refusing
+/// an empty one.
+pub fn read_image(path: &Path) -> Result<image::DynamicImage, SceneError> {
+    let read_error = |message: String| SceneError::ImageRead {
+        path: path.to_path_buf(),
+        message,
+    };
+    let reader = image::ImageReader::open(path)
+        .map_err(|e| read_error(e.to_string()))?
+        .with_guessed_format()
+        .map_err(|e| read_error(e.to_string()))?;
+    let image = reader.decode().map_err(|e| read_error(e.to_string()))?;
+    if image.width() == 0 || image.height() == 0 {
+        return Err(SceneError::EmptyImage {
+            path: path.to_path_buf(),
+            width: image.width(),
+            height: image.height(),
+        });
+    }
+    Ok(image)
 }
 
 /// Obstacles and the queries the sensors and collision checks need.
@@ -102,6 +126,7 @@ impl Scene {
         let source = SceneSource::Maze {
             maze,
             cell_px: config.cell_px,
+            wall_thickness_px: config.wall_thickness_px,
         };
         Self::build(width, height, boxes, reach_px, source)
     }
@@ -198,23 +223,7 @@ impl Scene {
 
     /// Reads a PNG or PGM file (any format the decoder knows) as a scene.
     pub fn load_image(path: &Path, config: &MapConfig, reach_px: f64) -> Result<Self, SceneError> {
-        let read_error = |message: String| SceneError::ImageRead {
-            path: path.to_path_buf(),
-            message,
-        };
-        let reader = image::ImageReader::open(path)
-            .map_err(|e| read_error(e.to_string()))?
-            .with_guessed_format()
-            .map_err(|e| read_error(e.to_string()))?;
-        let image = reader.decode().map_err(|e| read_error(e.to_string()))?;
-        if image.width() == 0 || image.height() == 0 {
-            return Err(SceneError::EmptyImage {
-                path: path.to_path_buf(),
-                width: image.width(),
-                height: image.height(),
-            });
-        }
-        Ok(Self::from_image(&image, config, reach_px))
+        Ok(Self::from_image(&read_image(path)?, config, reach_px))
     }
 
     /// Width, px.
@@ -245,7 +254,7 @@ impl Scene {
     /// The maze, for maze scenes.
     pub fn maze(&self) -> Option<(&Maze, f64)> {
         match &self.source {
-            SceneSource::Maze { maze, cell_px } => Some((maze, *cell_px)),
+            SceneSource::Maze { maze, cell_px, .. } => Some((maze, *cell_px)),
             _ => None,
         }
     }
@@ -256,19 +265,42 @@ impl Scene {
         self.index.near(p, radius)
     }
 
+    /// Length of the pieces long queries are cut into, so that each piece (grown by `radius`) is
+    /// answered by one bin of the index; `None` when the index cannot serve `radius` at all.
+    fn piece_px(&self, radius: f64) -> Option<f64> {
+        let piece = self.index.reach_px() - radius;
+        (piece >= 1.0).then_some(piece)
+    }
+
     /// Distance from `origin` along the unit direction `dir` to the first obstacle, if one lies
     /// within `max_px`. `Some(0.0)` when `origin` is inside an obstacle.
     pub fn cast_ray(&self, origin: Point, dir: Vector, max_px: f64) -> Option<f64> {
         let inv = Vector::new(1.0 / dir.x, 1.0 / dir.y);
-        let mut best = max_px;
-        let mut hit = false;
-        for &i in self.index.near(origin, max_px) {
-            if let Some(t) = self.boxes[i as usize].ray_hit(origin, inv, best) {
-                best = t;
-                hit = true;
+        let first_hit = |from: Point, reach: f64, limit: f64| -> Option<f64> {
+            let mut best = limit;
+            let mut hit = false;
+            for &i in self.index.near(from, reach) {
+                if let Some(t) = self.boxes[i as usize].ray_hit(origin, inv, best) {
+                    best = t;
+                    hit = true;
+                }
             }
+            hit.then_some(best)
+        };
+        let Some(piece) = self.piece_px(0.0).filter(|&p| max_px > p) else {
+            return first_hit(origin, max_px, max_px);
+        };
+        // A hit at distance t lies within `piece` of the start of the piece holding t, so the
+        // first piece with a hit inside it has the first hit.
+        let mut start = 0.0;
+        while start < max_px {
+            let end = (start + piece).min(max_px);
+            if let Some(t) = first_hit(origin + dir * start, end - start, end) {
+                return Some(t);
+            }
+            start = end;
         }
-        hit.then_some(best)
+        None
     }
 
     /// Whether a disc of `radius` at `p` touches no obstacle (a tangent disc does not touch).
@@ -284,11 +316,23 @@ impl Scene {
     /// the whole swept capsule is checked, so no step length passes through an obstacle.
     pub fn sweep_clear(&self, a: Point, b: Point, radius: f64) -> bool {
         let r2 = radius * radius;
-        let reach = (b - a).norm() + radius;
-        self.index
-            .near(a, reach)
-            .iter()
-            .all(|&i| self.boxes[i as usize].segment_distance_squared(a, b) >= r2)
+        let piece_clear = |a: Point, b: Point| {
+            let reach = (b - a).norm() + radius;
+            self.index
+                .near(a, reach)
+                .iter()
+                .all(|&i| self.boxes[i as usize].segment_distance_squared(a, b) >= r2)
+        };
+        let length = (b - a).norm();
+        let Some(piece) = self.piece_px(radius).filter(|&p| length > p) else {
+            return piece_clear(a, b);
+        };
+        let pieces = (length / piece).ceil() as usize;
+        (0..pieces).all(|k| {
+            let from = a + (b - a) * (k as f64 / pieces as f64);
+            let to = a + (b - a) * ((k + 1) as f64 / pieces as f64);
+            piece_clear(from, to)
+        })
     }
 
     /// Whether `p` lies inside an obstacle or outside the scene.

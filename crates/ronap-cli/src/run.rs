@@ -1,0 +1,357 @@
+//! `ronap run`: evaluate a policy over many seeded episodes and write what happened.
+
+use crate::sim_args::{fraction, SimArgs};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use ronap_core::evaluate::{EpisodeRecord, Evaluator, Outcome, Recording, RunResult, Scenes};
+use ronap_core::map::MapSource;
+use ronap_core::output::{save_image, write_atomic};
+use ronap_core::policy::{Builtin, PolicyFactory};
+use ronap_core::report;
+use ronap_core::summary::Summary;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::str::FromStr;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+
+/// Which trajectory pictures to draw.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PngChoice {
+    /// The first N seeds of the range.
+    First(u64),
+    /// Every episode that did not succeed.
+    Failures,
+    /// Every episode.
+    All,
+}
+
+impl FromStr for PngChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "failures" => Ok(Self::Failures),
+            "all" => Ok(Self::All),
+            n => n
+                .parse()
+                .map(Self::First)
+                .map_err(|_| format!("{n:?}: expected a number, `failures` or `all`")),
+        }
+    }
+}
+
+/// Arguments of `ronap run`.
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    /// Policy to evaluate: apf (the paper's potential field, Algorithm 3), geodesic (shortest-path
+    /// follower, no local minima) or random.
+    #[arg(long, value_name = "NAME")]
+    policy: String,
+    /// Number of episodes; episode i has seed seed-start + i.
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 1000, value_parser = clap::value_parser!(u64).range(1..))]
+    seeds: u64,
+    /// First seed.
+    #[arg(long, value_name = "SEED", default_value_t = 0)]
+    seed_start: u64,
+    /// Worker threads [default: all cores].
+    #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    threads: Option<u32>,
+    /// Use the maze of this seed for every episode [default: each seed its own maze].
+    #[arg(long, value_name = "SEED", conflicts_with = "map")]
+    maze_seed: Option<u64>,
+    /// Run on an image scene (PNG/PGM: dark pixels are obstacles) or a ROS map_server YAML file;
+    /// start and goal are drawn per seed.
+    #[arg(long, value_name = "FILE")]
+    map: Option<PathBuf>,
+    #[command(flatten)]
+    sim: SimArgs,
+    /// Steps before a time-out [default: 2000].
+    #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    max_steps: Option<u32>,
+    /// Output directory [default: runs/<policy>-<UTC time>].
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+    /// Also write each episode's steps to steps/seed-<seed>.csv (the data-log format).
+    #[arg(long)]
+    log_steps: bool,
+    /// Trajectory pictures in png/: the first N seeds, `failures` or `all` [default: none].
+    #[arg(long, value_name = "N|failures|all")]
+    png: Option<PngChoice>,
+    /// Exit with code 1 when the success rate is below this fraction (a gate for CI).
+    #[arg(long, allow_negative_numbers = true, value_name = "F", value_parser = fraction)]
+    min_success: Option<f64>,
+}
+
+/// `2026-11-21T10:31:05Z` style UTC parts from the system clock.
+pub fn utc_now() -> (i64, u32, u32, u32, u32, u32) {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs() as i64);
+    let (days, rem) = (secs.div_euclid(86_400), secs.rem_euclid(86_400));
+    // Howard Hinnant's civil-from-days.
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = (doy - (153 * mp + 2) / 5 + 1) as u32;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    (
+        year,
+        month,
+        day,
+        (rem / 3600) as u32,
+        (rem / 60 % 60) as u32,
+        (rem % 60) as u32,
+    )
+}
+
+fn policy_factory(name: &str) -> Result<Box<dyn PolicyFactory>> {
+    match Builtin::from_name(name) {
+        Some(b) => Ok(Box::new(b)),
+        None => {
+            let known: Vec<&str> = Builtin::ALL.iter().map(|(_, n, _)| *n).collect();
+            bail!(
+                "--policy {name:?}: unknown policy (expected one of: {})",
+                known.join(", ")
+            )
+        }
+    }
+}
+
+/// Runs `ronap run`.
+pub fn run(args: RunArgs) -> Result<ExitCode> {
+    // Everything that can be wrong with the input is checked before anything is written.
+    let factory = policy_factory(&args.policy)?;
+    let config = args.sim.config_with(|sim| {
+        if let Some(n) = args.max_steps {
+            sim.episode.max_steps = n;
+        }
+    })?;
+    let (scenes, map_source) = match (&args.map, args.maze_seed) {
+        (Some(path), _) => {
+            let reach = ronap_core::episode::reach_px(&config);
+            let (scene, source) = ronap_core::map::load(path, &config.map, reach)?;
+            (Scenes::Fixed(Arc::new(scene)), Some(source))
+        }
+        (None, Some(seed)) => (Scenes::Maze(seed), None),
+        (None, None) => (Scenes::MazePerSeed, None),
+    };
+    let evaluator = Evaluator::new(config.clone(), scenes);
+    let first = args.seed_start;
+    let end = first.checked_add(args.seeds).with_context(|| {
+        format!(
+            "--seed-start {first} --seeds {}: the seed range passes 2^64",
+            args.seeds
+        )
+    })?;
+    // A scene with no room for a start and goal fails the same way for every seed: say so now.
+    evaluator
+        .world(first)
+        .episode(first)
+        .with_context(|| format!("cannot start episodes in this scene (seed {first})"))?;
+    let threads = args.threads.map_or_else(
+        || std::thread::available_parallelism().map_or(1, |n| n.get()),
+        |n| n as usize,
+    );
+    let out_dir = match &args.out {
+        Some(d) => d.clone(),
+        None => {
+            let (y, mo, d, h, mi, s) = utc_now();
+            PathBuf::from(format!(
+                "runs/{}-{y:04}{mo:02}{d:02}-{h:02}{mi:02}{s:02}",
+                args.policy
+            ))
+        }
+    };
+    std::fs::create_dir_all(&out_dir)
+        .with_context(|| format!("cannot create output directory {}", out_dir.display()))?;
+    if args.png.is_some() {
+        std::fs::create_dir_all(out_dir.join("png"))
+            .with_context(|| format!("cannot create {}/png", out_dir.display()))?;
+    }
+    if args.log_steps {
+        std::fs::create_dir_all(out_dir.join("steps"))
+            .with_context(|| format!("cannot create {}/steps", out_dir.display()))?;
+    }
+
+    let cancel = Arc::new(AtomicBool::new(false));
+    {
+        let cancel = cancel.clone();
+        // A second Ctrl-C stops at once; the first lets running episodes finish and keeps them.
+        let _ = ctrlc::set_handler(move || {
+            if cancel.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+            eprintln!("\nronap: interrupted; finishing running episodes and writing what is done (Ctrl-C again to quit now)");
+        });
+    }
+    let bar = if std::io::stderr().is_terminal() {
+        ProgressBar::with_draw_target(Some(args.seeds), ProgressDrawTarget::stderr())
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{prefix} {wide_bar} {pos}/{len} episodes, {per_sec}, eta {eta}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar.set_prefix(format!("ronap run {}", args.policy));
+
+    let png = args.png;
+    let wants_png = |r: &EpisodeRecord| match png {
+        None => false,
+        Some(PngChoice::All) => true,
+        Some(PngChoice::Failures) => r.outcome != Outcome::Success,
+        Some(PngChoice::First(n)) => r.seed - first < n,
+    };
+    let recording = Recording {
+        trajectory: png.is_some(),
+        steps: args.log_steps,
+    };
+    let write_errors = std::sync::Mutex::new(Vec::<String>::new());
+    let on_record = |r: &EpisodeRecord| {
+        let mut errors = Vec::new();
+        if wants_png(r) {
+            let path =
+                out_dir
+                    .join("png")
+                    .join(format!("seed-{:06}-{}.png", r.seed, r.outcome.name()));
+            match report::trajectory_image(r, 1.0) {
+                Some(img) => {
+                    if let Err(e) = save_image(&path, &img) {
+                        errors.push(e.to_string());
+                    }
+                }
+                None => errors.push(format!("seed {}: no trajectory to draw", r.seed)),
+            }
+        }
+        if args.log_steps {
+            let path = out_dir
+                .join("steps")
+                .join(format!("seed-{:06}.csv", r.seed));
+            if let Err(e) = write_atomic(&path, |out| report::write_steps(r, out)) {
+                errors.push(e.to_string());
+            }
+        }
+        if !errors.is_empty() {
+            if let Ok(mut all) = write_errors.lock() {
+                all.extend(errors);
+            }
+        }
+        bar.inc(1);
+    };
+    let seeds: Vec<u64> = (first..end).collect();
+    let result = evaluator.run(
+        factory.as_ref(),
+        &seeds,
+        threads,
+        recording,
+        &cancel,
+        &on_record,
+    )?;
+    bar.finish_and_clear();
+
+    let summary = Summary::new(&result.records, result.wall_time_s);
+    write_outputs(
+        &out_dir,
+        &args,
+        &config,
+        map_source.as_ref(),
+        &result,
+        &summary,
+        threads,
+        first,
+    )?;
+
+    let mut stdout = std::io::stdout().lock();
+    use std::io::Write;
+    writeln!(
+        stdout,
+        "ronap run: policy {}, seeds {first}..{}, {threads} threads",
+        args.policy,
+        end - 1
+    )?;
+    write!(stdout, "{}", summary.table())?;
+    writeln!(stdout, "outputs in {}", out_dir.display())?;
+    let write_errors = write_errors.into_inner().unwrap_or_default();
+    if let Some(e) = write_errors.first() {
+        bail!(
+            "{} output file(s) could not be written; first: {e}",
+            write_errors.len()
+        );
+    }
+    if let Some(e) = &result.error {
+        bail!(
+            "run stopped: {e} (the {} finished episodes are saved)",
+            result.records.len()
+        );
+    }
+    if result.cancelled {
+        writeln!(
+            stdout,
+            "interrupted: {} of {} episodes finished and saved",
+            result.records.len(),
+            args.seeds
+        )?;
+        return Ok(ExitCode::from(130));
+    }
+    if let Some(min) = args.min_success {
+        if summary.success_rate < min {
+            eprintln!(
+                "ronap run: success rate {:.1}% is below --min-success {:.1}%",
+                100.0 * summary.success_rate,
+                100.0 * min
+            );
+            return Ok(ExitCode::from(1));
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn write_outputs(
+    dir: &Path,
+    args: &RunArgs,
+    config: &ronap_core::ValidConfig,
+    map: Option<&MapSource>,
+    result: &RunResult,
+    summary: &Summary,
+    threads: usize,
+    first: u64,
+) -> Result<()> {
+    write_atomic(&dir.join("episodes.csv"), |out| {
+        report::write_episodes(&result.records, out)
+    })?;
+    write_atomic(&dir.join("timing.csv"), |out| {
+        report::write_timing(&result.records, out)
+    })?;
+    let scenes = match (&args.map, args.maze_seed) {
+        (Some(p), _) => format!("map {}", p.display()),
+        (None, Some(s)) => format!("maze of seed {s}"),
+        (None, None) => "a maze per seed".to_string(),
+    };
+    let json = serde_json::json!({
+        "ronap_version": env!("CARGO_PKG_VERSION"),
+        "policy": args.policy,
+        "seed_start": first,
+        "seeds_requested": args.seeds,
+        "scenes": scenes,
+        "map": map,
+        "threads": threads,
+        "interrupted": result.cancelled,
+        "error": result.error.as_ref().map(|e| e.to_string()),
+        "summary": summary,
+        "config": config.as_sim_config(),
+    });
+    write_atomic(&dir.join("summary.json"), |out| {
+        serde_json::to_writer_pretty(&mut *out, &json)?;
+        out.write_all(b"\n")
+    })?;
+    Ok(())
+}

@@ -1,0 +1,225 @@
+//! The artificial potential field policy: the paper's Algorithm 3.
+//!
+//! From the start, the descent repeatedly moves to the lowest-potential of the 8 neighbouring
+//! lattice positions (`apf.lattice_px` apart, the paper's pixels) until within epsilon of the goal,
+//! with `U = 1/2 xi d^2(q, goal) + 1/2 eta (1/c - 1/d0)^2` for clearance `c <= d0` (the scene
+//! binarised into obstacles; `c` is the disc's clearance, so the robot's radius is accounted for).
+//! The robot then follows that path with discrete actions.
+//!
+//! Plain APF has local minima: in a maze the descent gets trapped against walls. Because it always
+//! moves to the lowest neighbour, a trapped descent returns to a position it visited; that is
+//! detected at once, the path is kept up to there, and the robot follows it into the trap and then
+//! gives up, so the run ends as a failure promptly instead of timing out.
+
+use super::follow::{FollowStep, Follower};
+use super::{Decision, Policy, PolicyError};
+use crate::config::ApfConfig;
+use crate::episode::Episode;
+use crate::geometry::{Point, Vector};
+use crate::scene::Scene;
+use crate::world::World;
+use std::collections::HashSet;
+
+/// The result of the descent.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ApfPlan {
+    /// Positions visited, start first.
+    pub path: Vec<Point>,
+    /// Whether the descent reached the goal (else it was trapped).
+    pub reached: bool,
+}
+
+/// The potential at `q`: attraction to `goal` plus repulsion from obstacles within `influence_px`
+/// of the disc's edge; infinite where the disc would touch an obstacle.
+pub fn potential(scene: &Scene, config: &ApfConfig, radius: f64, goal: Point, q: Point) -> f64 {
+    let d_goal2 = (q - goal).norm_squared();
+    let mut u = 0.5 * config.gravity_gain * d_goal2;
+    match scene.clearance(q, radius + config.influence_px) {
+        Some(d) if d <= radius => return f64::INFINITY,
+        Some(d) => {
+            let c = d - radius;
+            u += 0.5 * config.repulsion_gain * (1.0 / c - 1.0 / config.influence_px).powi(2);
+        }
+        None => {}
+    }
+    if scene.occupied(q) {
+        return f64::INFINITY;
+    }
+    u
+}
+
+/// Algorithm 3: descend the potential from `start` over the 8-neighbour lattice until within
+/// `tolerance` of `goal`, or until the descent revisits a position (a local minimum or an
+/// oscillation) or runs `max_positions` positions.
+pub fn plan(
+    scene: &Scene,
+    config: &ApfConfig,
+    radius: f64,
+    start: Point,
+    goal: Point,
+    tolerance: f64,
+    max_positions: usize,
+) -> ApfPlan {
+    let h = config.lattice_px;
+    let offsets: [(i64, i64); 8] = [
+        (1, 0),
+        (1, 1),
+        (0, 1),
+        (-1, 1),
+        (-1, 0),
+        (-1, -1),
+        (0, -1),
+        (1, -1),
+    ];
+    let at = |i: i64, j: i64| start + Vector::new(i as f64 * h, j as f64 * h);
+    let (mut i, mut j) = (0i64, 0i64);
+    let mut visited = HashSet::new();
+    let mut path = Vec::new();
+    loop {
+        let q = at(i, j);
+        path.push(q);
+        if (q - goal).norm() <= tolerance {
+            return ApfPlan {
+                path,
+                reached: true,
+            };
+        }
+        if !visited.insert((i, j)) || path.len() >= max_positions {
+            path.pop();
+            return ApfPlan {
+                path,
+                reached: false,
+            };
+        }
+        let best = offsets
+            .iter()
+            .map(|&(di, dj)| {
+                (
+                    (i + di, j + dj),
+                    potential(scene, config, radius, goal, at(i + di, j + dj)),
+                )
+            })
+            .filter(|(_, u)| u.is_finite())
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        match best {
+            Some(((ni, nj), _)) => (i, j) = (ni, nj),
+            None => {
+                return ApfPlan {
+                    path,
+                    reached: false,
+                }
+            }
+        }
+    }
+}
+
+/// The APF policy: plan with [`plan`], follow the path, give up at the end of a trapped path.
+#[derive(Debug, Default)]
+pub struct Apf {
+    follower: Option<Follower>,
+    reached: bool,
+}
+
+impl Apf {
+    /// The planned path, once planned.
+    pub fn path(&self) -> Option<&[Point]> {
+        self.follower.as_ref().map(Follower::path)
+    }
+}
+
+impl Policy for Apf {
+    fn reset(&mut self, world: &World, episode: &Episode) -> Result<(), PolicyError> {
+        let config = world.config();
+        let scene = world.scene();
+        let lattice = config.apf.lattice_px;
+        // A bound far above any path that does not loop: four times the scene's perimeter.
+        let max_positions = (8.0 * (scene.width() + scene.height()) / lattice).ceil() as usize + 16;
+        let plan = plan(
+            scene,
+            &config.apf,
+            config.robot.radius_px,
+            episode.pose().position(),
+            episode.goal(),
+            config.episode.goal_tolerance_px,
+            max_positions,
+        );
+        self.reached = plan.reached;
+        let mut path = plan.path;
+        if plan.reached {
+            path.push(episode.goal());
+        }
+        self.follower = Some(Follower::new(path, config.robot.move_speed_px * 2.0));
+        Ok(())
+    }
+
+    fn act(&mut self, episode: &Episode) -> Result<Decision, PolicyError> {
+        let Some(follower) = &mut self.follower else {
+            return Err(PolicyError::Failed("apf: act() before reset()".into()));
+        };
+        Ok(match follower.next(episode) {
+            FollowStep::Act(a) => Decision::Act(a.into()),
+            FollowStep::Arrived if self.reached => {
+                Decision::GiveUp("reached the end of the path short of the goal".into())
+            }
+            FollowStep::Arrived => {
+                Decision::GiveUp("trapped in a local minimum of the potential".into())
+            }
+            FollowStep::Stuck => Decision::GiveUp("stuck following the path".into()),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Aabb;
+
+    fn room(extra: Vec<Aabb>) -> Scene {
+        let mut boxes = Scene::from_occupancy(300, 200, &vec![false; 300 * 200], 1.0, 50.0)
+            .boxes()
+            .to_vec();
+        boxes.extend(extra);
+        Scene::from_boxes(300.0, 200.0, boxes, 50.0)
+    }
+
+    #[test]
+    fn open_room_descent_reaches_the_goal() {
+        let scene = room(vec![]);
+        let p = plan(
+            &scene,
+            &ApfConfig::default(),
+            5.0,
+            Point::new(30.0, 40.0),
+            Point::new(260.0, 170.0),
+            10.0,
+            10_000,
+        );
+        assert!(p.reached);
+        assert!((p.path.last().unwrap() - Point::new(260.0, 170.0)).norm() <= 10.0);
+    }
+
+    #[test]
+    fn a_cup_facing_the_goal_traps_the_descent_promptly() {
+        // A U-shaped cup open to the left, the start inside it, the goal to its right.
+        let cup = vec![
+            Aabb::from_corners(Point::new(140.0, 60.0), Point::new(142.0, 140.0)),
+            Aabb::from_corners(Point::new(80.0, 60.0), Point::new(142.0, 62.0)),
+            Aabb::from_corners(Point::new(80.0, 138.0), Point::new(142.0, 140.0)),
+        ];
+        let scene = room(cup);
+        let p = plan(
+            &scene,
+            &ApfConfig::default(),
+            5.0,
+            Point::new(110.0, 100.0),
+            Point::new(260.0, 100.0),
+            10.0,
+            10_000,
+        );
+        assert!(!p.reached);
+        // Trapped against the cup's back wall, well before the position bound.
+        let end = *p.path.last().unwrap();
+        assert!(end.x > 110.0 && end.x < 140.0, "{end:?}");
+        assert!(p.path.len() < 100, "{}", p.path.len());
+    }
+}

@@ -1,0 +1,109 @@
+//! Policies: what decides each step's action. Every policy implements [`Policy`], so the episode
+//! loop and the evaluator never know which one they run.
+
+pub mod apf;
+pub mod follow;
+pub mod geodesic;
+pub mod random;
+
+use crate::episode::Episode;
+use crate::robot::Action;
+use crate::world::World;
+
+/// A policy that could not decide.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum PolicyError {
+    /// The policy failed (a user policy raised, returned an invalid action or NaN, ...).
+    #[error("{0}")]
+    Failed(String),
+}
+
+/// What a policy does at a step.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Decision {
+    /// Take this action.
+    Act(Action),
+    /// Stop: the policy knows it cannot reach the goal (trapped in a local minimum, oscillating,
+    /// no path). The episode ends as a failure with this reason.
+    GiveUp(String),
+}
+
+/// Decides actions, one episode at a time.
+pub trait Policy: Send {
+    /// Prepares for a new episode (plans, clears state). Called before the first [`Policy::act`].
+    fn reset(&mut self, world: &World, episode: &Episode) -> Result<(), PolicyError>;
+
+    /// The decision for the episode's current state.
+    fn act(&mut self, episode: &Episode) -> Result<Decision, PolicyError>;
+}
+
+/// Makes policies: one per worker thread of an evaluation.
+pub trait PolicyFactory: Sync {
+    /// A fresh policy.
+    fn make(&self) -> Result<Box<dyn Policy>, PolicyError>;
+
+    /// The policy's name, for reports.
+    fn name(&self) -> String;
+}
+
+/// The built-in policies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Builtin {
+    /// The paper's artificial potential field (Algorithm 3), local minima and all.
+    Apf,
+    /// Descent on the geodesic distance to the goal: a navigation function with no local minima.
+    Geodesic,
+    /// Uniformly random discrete actions: the floor.
+    Random,
+}
+
+impl Builtin {
+    /// Every built-in policy with its name and a one-line description.
+    pub const ALL: [(Builtin, &'static str, &'static str); 3] = [
+        (
+            Builtin::Apf,
+            "apf",
+            "the paper's artificial potential field (Algorithm 3); trapped by local minima",
+        ),
+        (
+            Builtin::Geodesic,
+            "geodesic",
+            "follows the shortest path (descent on geodesic distance: no local minima)",
+        ),
+        (
+            Builtin::Random,
+            "random",
+            "uniformly random LEFT/AHEAD/RIGHT",
+        ),
+    ];
+
+    /// The policy named `name`.
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL
+            .iter()
+            .find(|(_, n, _)| *n == name)
+            .map(|(b, _, _)| *b)
+    }
+
+    /// The policy's name.
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(b, _, _)| *b == self)
+            .map_or("unknown", |(_, n, _)| n)
+    }
+}
+
+impl PolicyFactory for Builtin {
+    fn make(&self) -> Result<Box<dyn Policy>, PolicyError> {
+        Ok(match self {
+            Builtin::Apf => Box::new(apf::Apf::default()),
+            Builtin::Geodesic => Box::new(geodesic::Geodesic::default()),
+            Builtin::Random => Box::new(random::RandomPolicy::default()),
+        })
+    }
+
+    fn name(&self) -> String {
+        Builtin::name(*self).to_string()
+    }
+}
