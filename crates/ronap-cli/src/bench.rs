@@ -108,21 +108,20 @@ pub fn run(args: BenchArgs) -> Result<std::process::ExitCode> {
         group(all)
     );
 
+    // Scans from 1000 placements spread over the scene, so the figure is not one lucky pose.
     let laser = Laser::new(&config.laser);
-    let probe = Episode::with_placement(
-        &config,
-        scene.clone(),
-        0,
-        sample_placement(&config, &scene, grid.as_ref(), 0)?,
-    )?;
+    let poses: Vec<_> = (0..1000)
+        .map(|seed| sample_placement(&config, &scene, grid.as_ref(), seed).map(|p| p.start))
+        .collect::<Result<_, _>>()?;
     let mut readings = vec![0.0; laser.beams()];
-    let scans = 200_000;
+    let rounds = 200;
     let start = Instant::now();
-    for k in 0..scans {
-        let z = probe.start().z_deg + k as f64 * 1e-3;
-        laser.scan(&scene, probe.start().position(), z, &mut readings);
+    for _ in 0..rounds {
+        for pose in &poses {
+            laser.scan(&scene, pose.position(), pose.z_deg, &mut readings);
+        }
     }
-    let ns = start.elapsed().as_secs_f64() * 1e9 / scans as f64;
+    let ns = start.elapsed().as_secs_f64() * 1e9 / (rounds * poses.len()) as f64;
     println!(
         "  one laser scan   {:>14.0} ns ({} beams)",
         ns,

@@ -37,6 +37,24 @@ enum Command {
     Run(run::RunArgs),
     /// Measure how fast this machine steps the default scene.
     Bench(bench::BenchArgs),
+    /// Print the whole configuration as TOML, a comment on every field: a file to copy and edit
+    /// for --config.
+    Config(ConfigArgs),
+}
+
+/// Arguments of `ronap config`.
+#[derive(clap::Args, Debug)]
+struct ConfigArgs {
+    #[command(flatten)]
+    sim: sim_args::SimArgs,
+}
+
+/// Runs `ronap config`.
+fn print_config(args: ConfigArgs) -> anyhow::Result<ExitCode> {
+    let config = args.sim.config()?;
+    let mut stdout = std::io::stdout().lock();
+    stdout.write_all(config.to_documented_toml().as_bytes())?;
+    Ok(ExitCode::SUCCESS)
 }
 
 fn main() -> ExitCode {
@@ -65,6 +83,7 @@ fn main() -> ExitCode {
         Command::Maze(args) => maze::run(args),
         Command::Run(args) => run::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Config(args) => print_config(args),
     };
     match result {
         Ok(code) => code,

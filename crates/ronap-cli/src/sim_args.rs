@@ -29,7 +29,7 @@ pub fn fraction(s: &str) -> Result<f64, String> {
 /// Scene and model flags.
 #[derive(Args, Debug, Clone, Default)]
 pub struct SimArgs {
-    /// TOML file setting any model field (see SPEC.md); the flags below override it.
+    /// TOML file setting any model field (`ronap config` prints them all); flags override it.
     #[arg(long, value_name = "FILE")]
     pub config: Option<PathBuf>,
     /// Maze columns [default: 10].

@@ -259,4 +259,7 @@ fn help_explains_every_flag_with_its_default() {
     let o = ronap(&["maze", "--help"]);
     assert!(o.status.success());
     insta::assert_snapshot!("maze_help", stdout(&o));
+    let o = ronap(&["run", "--help"]);
+    assert!(o.status.success());
+    insta::assert_snapshot!("run_help", stdout(&o));
 }

@@ -1,0 +1,503 @@
+//! End-to-end tests of `ronap run`: every output file read back, determinism across thread
+//! counts, the success gate, bad input, maps, APF's local minima, and Ctrl-C.
+
+// Test helpers may panic on setup failures: that is a failed test, as intended.
+#![allow(clippy::unwrap_used)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn ronap(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ronap"))
+        .args(args)
+        .output()
+        .expect("ronap runs")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn rows(path: &Path) -> Vec<Vec<String>> {
+    let mut r = csv::Reader::from_path(path).unwrap();
+    let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+    let mut out = vec![header];
+    for rec in r.records() {
+        out.push(rec.unwrap().iter().map(String::from).collect());
+    }
+    out
+}
+
+fn col(table: &[Vec<String>], name: &str) -> usize {
+    table[0]
+        .iter()
+        .position(|h| h == name)
+        .unwrap_or_else(|| panic!("no column {name}"))
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+#[test]
+fn run_writes_episodes_summary_pictures_and_step_logs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = ronap(&[
+        "run",
+        "--policy",
+        "geodesic",
+        "--seeds",
+        "6",
+        "--seed-start",
+        "10",
+        "--out",
+        out.to_str().unwrap(),
+        "--png",
+        "2",
+        "--log-steps",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let table = text(&o.stdout);
+    for row in [
+        "episodes",
+        "success rate",
+        "95% CI",
+        "time-outs",
+        "collisions per episode",
+        "mean steps",
+        "mean path length",
+        "SPL",
+        "wall time",
+        "steps per second",
+    ] {
+        assert!(table.contains(row), "summary lacks {row}: {table}");
+    }
+
+    let episodes = rows(&out.join("episodes.csv"));
+    assert_eq!(episodes.len(), 7);
+    let (seed, outcome, steps, path, shortest, spl) = (
+        col(&episodes, "seed"),
+        col(&episodes, "outcome"),
+        col(&episodes, "steps"),
+        col(&episodes, "path_length_px"),
+        col(&episodes, "shortest_px"),
+        col(&episodes, "spl"),
+    );
+    for (k, r) in episodes[1..].iter().enumerate() {
+        assert_eq!(r[seed], (10 + k).to_string());
+        assert_eq!(r[outcome], "success");
+        let (p, s, v): (f64, f64, f64) = (
+            r[path].parse().unwrap(),
+            r[shortest].parse().unwrap(),
+            r[spl].parse().unwrap(),
+        );
+        // The driven path is no shorter than the shortest path, and SPL is their ratio.
+        assert!(p >= s * 0.99 && s >= 190.0, "path {p} shortest {s}");
+        assert!((v - s / p.max(s)).abs() < 1e-3, "spl {v}");
+
+        let log = rows(&out.join("steps").join(format!("seed-{:06}.csv", 10 + k)));
+        assert_eq!(log.len() - 1, r[steps].parse::<usize>().unwrap());
+        assert!(log[0].contains(&"d_17".to_string()) && log[0].contains(&"action".to_string()));
+        let action = col(&log, "action");
+        assert!(log[1..]
+            .iter()
+            .all(|l| ["LEFT", "AHEAD", "RIGHT"].contains(&l[action].as_str())));
+    }
+    let timing = rows(&out.join("timing.csv"));
+    assert_eq!(timing.len(), 7);
+
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(summary["summary"]["episodes"], 6);
+    assert_eq!(summary["summary"]["successes"], 6);
+    assert_eq!(summary["policy"], "geodesic");
+    assert_eq!(summary["config"]["laser"]["beams"], 17);
+    assert_eq!(summary["interrupted"], false);
+
+    let mut pngs: Vec<PathBuf> = std::fs::read_dir(out.join("png"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    pngs.sort();
+    assert_eq!(pngs.len(), 2);
+    assert!(pngs[0].ends_with("seed-000010-success.png"), "{pngs:?}");
+    let img = image::open(&pngs[0]).unwrap().to_rgb8();
+    assert_eq!(img.dimensions(), (1000, 1000));
+    let blue = img.pixels().filter(|p| p.0 == [40, 80, 230]).count();
+    assert!(blue > 200, "path pixels: {blue}");
+}
+
+#[test]
+fn episodes_csv_is_identical_on_one_and_two_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    for policy in ["random", "apf", "geodesic"] {
+        let a = dir.path().join(format!("{policy}-1"));
+        let b = dir.path().join(format!("{policy}-2"));
+        for (out, threads) in [(&a, "1"), (&b, "2")] {
+            let o = ronap(&[
+                "run",
+                "--policy",
+                policy,
+                "--seeds",
+                "24",
+                "--threads",
+                threads,
+                "--out",
+                out.to_str().unwrap(),
+            ]);
+            assert!(o.status.success(), "{}", text(&o.stderr));
+        }
+        let (x, y) = (
+            std::fs::read(a.join("episodes.csv")).unwrap(),
+            std::fs::read(b.join("episodes.csv")).unwrap(),
+        );
+        assert_eq!(
+            x, y,
+            "{policy}: episodes.csv differs between 1 and 2 threads"
+        );
+        assert_eq!(rows(&a.join("episodes.csv")).len(), 25);
+    }
+}
+
+#[test]
+fn min_success_gates_the_exit_code() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r");
+    let o = ronap(&[
+        "run",
+        "--policy",
+        "random",
+        "--seeds",
+        "10",
+        "--min-success",
+        "0.9",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
+    assert!(text(&o.stderr).contains("below --min-success"));
+    assert!(
+        out.join("episodes.csv").exists(),
+        "results are written before the gate"
+    );
+    let out = dir.path().join("g");
+    let o = ronap(&[
+        "run",
+        "--policy",
+        "geodesic",
+        "--seeds",
+        "10",
+        "--min-success",
+        "0.9",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+}
+
+fn assert_rejected(args: &[&str], names: &[&str], out: &Path) {
+    let o = ronap(args);
+    assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o.stderr));
+    let err = text(&o.stderr);
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "{args:?}: not one line: {err}"
+    );
+    for n in names {
+        assert!(err.contains(n), "{args:?}: {err:?} does not name {n:?}");
+    }
+    assert!(!out.exists(), "{args:?} created {}", out.display());
+}
+
+#[test]
+fn bad_input_is_named_and_leaves_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("never");
+    let o = out.to_str().unwrap();
+    assert_rejected(
+        &["run", "--policy", "teleport", "--out", o],
+        &["teleport", "apf"],
+        &out,
+    );
+    assert_rejected(
+        &["run", "--policy", "apf", "--seeds", "0", "--out", o],
+        &["--seeds", "0"],
+        &out,
+    );
+    assert_rejected(
+        &[
+            "run",
+            "--policy",
+            "apf",
+            "--map",
+            "/no/such/map.png",
+            "--out",
+            o,
+        ],
+        &["/no/such/map.png"],
+        &out,
+    );
+    let corrupt = dir.path().join("corrupt.png");
+    std::fs::write(&corrupt, b"\x89PNG not really").unwrap();
+    assert_rejected(
+        &[
+            "run",
+            "--policy",
+            "apf",
+            "--map",
+            corrupt.to_str().unwrap(),
+            "--out",
+            o,
+        ],
+        &["corrupt.png"],
+        &out,
+    );
+    let yaml = dir.path().join("bad.yaml");
+    std::fs::write(&yaml, "image: x.pgm\nresolution: fast\n").unwrap();
+    assert_rejected(
+        &[
+            "run",
+            "--policy",
+            "apf",
+            "--map",
+            yaml.to_str().unwrap(),
+            "--out",
+            o,
+        ],
+        &["bad.yaml", "line 2", "fast"],
+        &out,
+    );
+    let cfg = dir.path().join("c.toml");
+    std::fs::write(&cfg, "[robot]\nradius_px = -3\n").unwrap();
+    assert_rejected(
+        &[
+            "run",
+            "--policy",
+            "apf",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--out",
+            o,
+        ],
+        &["c.toml", "robot.radius_px", "-3"],
+        &out,
+    );
+    std::fs::write(&cfg, "[laser]\nbeams = 17\nbeam = 3\n").unwrap();
+    assert_rejected(
+        &[
+            "run",
+            "--policy",
+            "apf",
+            "--config",
+            cfg.to_str().unwrap(),
+            "--out",
+            o,
+        ],
+        &["c.toml", "line 3", "beam"],
+        &out,
+    );
+    // An output directory under a regular file cannot be created.
+    let file = dir.path().join("file");
+    std::fs::write(&file, "x").unwrap();
+    let under = file.join("out");
+    assert_rejected(
+        &[
+            "run",
+            "--policy",
+            "apf",
+            "--seeds",
+            "2",
+            "--out",
+            under.to_str().unwrap(),
+        ],
+        &["file/out"],
+        &under,
+    );
+}
+
+fn save_map(path: &Path, walls: &[(u32, u32, u32, u32)]) {
+    let mut img = image::GrayImage::from_pixel(300, 200, image::Luma([255]));
+    for &(x0, y0, x1, y1) in walls {
+        for y in y0..y1 {
+            for x in x0..x1 {
+                img.put_pixel(x, y, image::Luma([0]));
+            }
+        }
+    }
+    img.save(path).unwrap();
+}
+
+fn fixed(dir: &Path, start: [f64; 3], goal: [f64; 2]) -> PathBuf {
+    let cfg = dir.join("fixed.toml");
+    std::fs::write(
+        &cfg,
+        format!(
+            "[episode]\nstart = [{}, {}, {}]\ngoal = [{}, {}]\n",
+            start[0], start[1], start[2], goal[0], goal[1]
+        ),
+    )
+    .unwrap();
+    cfg
+}
+
+#[test]
+fn apf_fails_promptly_in_a_local_minimum_and_succeeds_in_the_open() {
+    let dir = tempfile::tempdir().unwrap();
+    // A cup open to the left (image rows from the top: y 60..140 in the scene is rows 60..140).
+    let cup = dir.path().join("cup.png");
+    save_map(
+        &cup,
+        &[(140, 60, 142, 140), (80, 60, 142, 62), (80, 138, 142, 140)],
+    );
+    let cfg = fixed(dir.path(), [110.0, 100.0, 0.0], [260.0, 100.0]);
+    let out = dir.path().join("cup-run");
+    let o = ronap(&[
+        "run",
+        "--policy",
+        "apf",
+        "--seeds",
+        "3",
+        "--map",
+        cup.to_str().unwrap(),
+        "--config",
+        cfg.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let episodes = rows(&out.join("episodes.csv"));
+    for r in &episodes[1..] {
+        assert_eq!(r[col(&episodes, "outcome")], "stuck");
+        assert!(r[col(&episodes, "reason")].contains("local minimum"));
+        let steps: u32 = r[col(&episodes, "steps")].parse().unwrap();
+        assert!(steps < 100, "took {steps} steps to give up");
+    }
+    // The same start and goal without the cup: APF goes straight there.
+    let open = dir.path().join("open.png");
+    save_map(&open, &[]);
+    let out = dir.path().join("open-run");
+    let o = ronap(&[
+        "run",
+        "--policy",
+        "apf",
+        "--seeds",
+        "3",
+        "--map",
+        open.to_str().unwrap(),
+        "--config",
+        cfg.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let episodes = rows(&out.join("episodes.csv"));
+    assert!(episodes[1..]
+        .iter()
+        .all(|r| r[col(&episodes, "outcome")] == "success"));
+    // The geodesic planner walks out of the cup.
+    let out = dir.path().join("cup-geodesic");
+    let o = ronap(&[
+        "run",
+        "--policy",
+        "geodesic",
+        "--seeds",
+        "1",
+        "--map",
+        cup.to_str().unwrap(),
+        "--config",
+        cfg.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let episodes = rows(&out.join("episodes.csv"));
+    assert_eq!(episodes[1][col(&episodes, "outcome")], "success");
+}
+
+#[test]
+fn ros_map_yaml_is_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let pgm = dir.path().join("room.pgm");
+    save_map(&pgm, &[(150, 0, 152, 150)]);
+    let yaml = dir.path().join("room.yaml");
+    std::fs::write(&yaml, "image: room.pgm\nresolution: 0.05\norigin: [-1.0, -2.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n").unwrap();
+    let out = dir.path().join("r");
+    let o = ronap(&[
+        "run",
+        "--policy",
+        "geodesic",
+        "--seeds",
+        "4",
+        "--map",
+        yaml.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(summary["map"]["Ros"]["resolution_m"], 0.05);
+    assert_eq!(summary["summary"]["successes"], 4);
+}
+
+#[cfg(unix)]
+#[test]
+fn ctrl_c_keeps_the_finished_episodes() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_ronap"))
+        .args([
+            "run",
+            "--policy",
+            "random",
+            "--seeds",
+            "1000000",
+            "--threads",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(130), "{}", text(&o.stderr));
+    let episodes = rows(&out.join("episodes.csv"));
+    let finished = episodes.len() - 1;
+    assert!(finished > 0 && finished < 1_000_000, "{finished}");
+    let summary = json(&out.join("summary.json"));
+    assert_eq!(summary["interrupted"], true);
+    assert_eq!(summary["summary"]["episodes"], finished);
+    assert!(text(&o.stdout).contains("interrupted"));
+}
+
+#[test]
+fn config_prints_a_file_that_run_accepts() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = ronap(&["config", "--cols", "5"]);
+    assert!(o.status.success());
+    let cfg = dir.path().join("c.toml");
+    std::fs::write(&cfg, &o.stdout).unwrap();
+    assert!(text(&o.stdout).contains("# Largest reading d_max, px.\nrange_px = 50.0"));
+    let out = dir.path().join("r");
+    let o = ronap(&[
+        "run",
+        "--policy",
+        "random",
+        "--seeds",
+        "2",
+        "--config",
+        cfg.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(json(&out.join("summary.json"))["config"]["maze"]["cols"], 5);
+}
