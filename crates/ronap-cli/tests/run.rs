@@ -445,7 +445,7 @@ fn ros_map_yaml_is_read() {
 fn ctrl_c_keeps_the_finished_episodes() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("r");
-    let mut child = Command::new(env!("CARGO_BIN_EXE_ronap"))
+    let child = Command::new(env!("CARGO_BIN_EXE_ronap"))
         .args([
             "run",
             "--policy",
