@@ -4,14 +4,12 @@ use crate::sim_args::{fraction, SimArgs};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use ronap_core::evaluate::{EpisodeRecord, Evaluator, Outcome, Recording, RunResult, Scenes};
-use ronap_core::map::MapSource;
-use ronap_core::output::{save_image, write_atomic};
+use ronap_core::evaluate::{EpisodeRecord, Evaluator, Outcome, Recording, Scenes};
 use ronap_core::policy::{Builtin, PolicyFactory};
 use ronap_core::report;
 use ronap_core::summary::Summary;
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::str::FromStr;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -216,32 +214,9 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     };
     let write_errors = std::sync::Mutex::new(Vec::<String>::new());
     let on_record = |r: &EpisodeRecord| {
-        let mut errors = Vec::new();
-        if wants_png(r) {
-            let path =
-                out_dir
-                    .join("png")
-                    .join(format!("seed-{:06}-{}.png", r.seed, r.outcome.name()));
-            match report::trajectory_image(r, 1.0) {
-                Some(img) => {
-                    if let Err(e) = save_image(&path, &img) {
-                        errors.push(e.to_string());
-                    }
-                }
-                None => errors.push(format!("seed {}: no trajectory to draw", r.seed)),
-            }
-        }
-        if args.log_steps {
-            let path = out_dir
-                .join("steps")
-                .join(format!("seed-{:06}.csv", r.seed));
-            if let Err(e) = write_atomic(&path, |out| report::write_steps(r, out)) {
-                errors.push(e.to_string());
-            }
-        }
-        if !errors.is_empty() {
+        if let Err(e) = report::write_episode_files(&out_dir, r, wants_png(r), args.log_steps) {
             if let Ok(mut all) = write_errors.lock() {
-                all.extend(errors);
+                all.push(e.to_string());
             }
         }
         bar.inc(1);
@@ -258,16 +233,21 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     bar.finish_and_clear();
 
     let summary = Summary::new(&result.records, result.wall_time_s);
-    write_outputs(
-        &out_dir,
-        &args,
-        &config,
-        map_source.as_ref(),
-        &result,
-        &summary,
-        threads,
-        first,
-    )?;
+    let scenes = match (&args.map, args.maze_seed) {
+        (Some(p), _) => format!("map {}", p.display()),
+        (None, Some(s)) => format!("maze of seed {s}"),
+        (None, None) => "a maze per seed".to_string(),
+    };
+    let meta = serde_json::json!({
+        "policy": args.policy,
+        "seed_start": first,
+        "seeds_requested": args.seeds,
+        "scenes": scenes,
+        "map": map_source,
+        "threads": threads,
+    });
+    let meta = meta.as_object().cloned().unwrap_or_default();
+    report::write_run(&out_dir, meta, &config, &result, &summary)?;
 
     let mut stdout = std::io::stdout().lock();
     use std::io::Write;
@@ -312,46 +292,4 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
-}
-
-#[allow(clippy::too_many_arguments)]
-fn write_outputs(
-    dir: &Path,
-    args: &RunArgs,
-    config: &ronap_core::ValidConfig,
-    map: Option<&MapSource>,
-    result: &RunResult,
-    summary: &Summary,
-    threads: usize,
-    first: u64,
-) -> Result<()> {
-    write_atomic(&dir.join("episodes.csv"), |out| {
-        report::write_episodes(&result.records, out)
-    })?;
-    write_atomic(&dir.join("timing.csv"), |out| {
-        report::write_timing(&result.records, out)
-    })?;
-    let scenes = match (&args.map, args.maze_seed) {
-        (Some(p), _) => format!("map {}", p.display()),
-        (None, Some(s)) => format!("maze of seed {s}"),
-        (None, None) => "a maze per seed".to_string(),
-    };
-    let json = serde_json::json!({
-        "ronap_version": env!("CARGO_PKG_VERSION"),
-        "policy": args.policy,
-        "seed_start": first,
-        "seeds_requested": args.seeds,
-        "scenes": scenes,
-        "map": map,
-        "threads": threads,
-        "interrupted": result.cancelled,
-        "error": result.error.as_ref().map(|e| e.to_string()),
-        "summary": summary,
-        "config": config.as_sim_config(),
-    });
-    write_atomic(&dir.join("summary.json"), |out| {
-        serde_json::to_writer_pretty(&mut *out, &json)?;
-        out.write_all(b"\n")
-    })?;
-    Ok(())
 }

@@ -455,55 +455,6 @@ impl SimConfig {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn defaults_are_the_spec_values_and_valid() {
-        let c = SimConfig::default();
-        assert_eq!((c.maze.cols, c.maze.rows, c.maze.cell_px), (10, 10, 100.0));
-        assert_eq!(c.maze.loops, 0.4);
-        assert_eq!(
-            (c.laser.beams, c.laser.fov_deg, c.laser.range_px),
-            (17, 180.0, 50.0)
-        );
-        assert_eq!((c.robot.move_speed_px, c.robot.turn_speed_deg), (5.0, 15.0));
-        assert_eq!(c.episode.goal_tolerance_px, 10.0);
-        assert!(c.validate().is_ok());
-    }
-
-    #[test]
-    fn out_of_range_names_the_field_and_value() {
-        let mut c = SimConfig::default();
-        c.maze.loops = 1.5;
-        let e = c.validate().unwrap_err();
-        assert_eq!(e.to_string(), "maze.loops = 1.5: must be between 0 and 1");
-        let mut c = SimConfig::default();
-        c.maze.cols = 0;
-        assert!(c
-            .validate()
-            .unwrap_err()
-            .to_string()
-            .starts_with("maze.cols = 0"));
-    }
-
-    #[test]
-    fn toml_unknown_key_is_named() {
-        let e = SimConfig::from_toml_str("[maze]\ncolz = 3\n").unwrap_err();
-        assert!(
-            e.to_string()
-                .starts_with("line 2, column 1: unknown field `colz`"),
-            "{e}"
-        );
-        let e = SimConfig::from_toml_str("[laser]\nbeams = \"many\"\n").unwrap_err();
-        assert!(e.to_string().starts_with("line 2, column 9:"), "{e}");
-        let c = SimConfig::from_toml_str("[maze]\ncols = 3\n").unwrap();
-        assert_eq!(c.maze.cols, 3);
-        assert_eq!(c.maze.rows, 10);
-    }
-}
-
 /// Every configuration field: section, name, and what it means with its unit. Fields that are
 /// unset by default carry an example value, written commented out.
 const FIELD_DOCS: &[(&str, &str, &str, Option<&str>)] = &[
@@ -594,5 +545,54 @@ mod documented_tests {
             }
         }
         assert_eq!(count, FIELD_DOCS.len());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_the_spec_values_and_valid() {
+        let c = SimConfig::default();
+        assert_eq!((c.maze.cols, c.maze.rows, c.maze.cell_px), (10, 10, 100.0));
+        assert_eq!(c.maze.loops, 0.4);
+        assert_eq!(
+            (c.laser.beams, c.laser.fov_deg, c.laser.range_px),
+            (17, 180.0, 50.0)
+        );
+        assert_eq!((c.robot.move_speed_px, c.robot.turn_speed_deg), (5.0, 15.0));
+        assert_eq!(c.episode.goal_tolerance_px, 10.0);
+        assert!(c.validate().is_ok());
+    }
+
+    #[test]
+    fn out_of_range_names_the_field_and_value() {
+        let mut c = SimConfig::default();
+        c.maze.loops = 1.5;
+        let e = c.validate().unwrap_err();
+        assert_eq!(e.to_string(), "maze.loops = 1.5: must be between 0 and 1");
+        let mut c = SimConfig::default();
+        c.maze.cols = 0;
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("maze.cols = 0"));
+    }
+
+    #[test]
+    fn toml_unknown_key_is_named() {
+        let e = SimConfig::from_toml_str("[maze]\ncolz = 3\n").unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("line 2, column 1: unknown field `colz`"),
+            "{e}"
+        );
+        let e = SimConfig::from_toml_str("[laser]\nbeams = \"many\"\n").unwrap_err();
+        assert!(e.to_string().starts_with("line 2, column 9:"), "{e}");
+        let c = SimConfig::from_toml_str("[maze]\ncols = 3\n").unwrap();
+        assert_eq!(c.maze.cols, 3);
+        assert_eq!(c.maze.rows, 10);
     }
 }

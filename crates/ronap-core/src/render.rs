@@ -159,6 +159,110 @@ impl Canvas {
     }
 }
 
+/// The whole scene with an episode drawn on it: `path` in blue, start red, goal green, the robot
+/// and its current laser scan.
+pub fn top_down(episode: &crate::episode::Episode, path: &[Point], scale: f64) -> RgbImage {
+    let config = episode.config();
+    let mut canvas = Canvas::new(episode.scene(), scale);
+    let least = 4.0 / scale;
+    canvas.fill_disc(
+        episode.goal(),
+        config.episode.goal_tolerance_px.max(least),
+        GOAL,
+    );
+    canvas.path(path, 2.0, PATH);
+    canvas.scan(episode.laser(), episode.pose(), episode.readings());
+    canvas.robot(episode.start(), config.robot.radius_px.max(least), START);
+    canvas.robot(episode.pose(), config.robot.radius_px.max(least), PATH);
+    canvas.into_image()
+}
+
+/// The paper's first-person view: the scene around the robot rotated so the heading points up,
+/// the circle of laser range, the rays in their colour classes and an arrow towards the goal.
+/// `size` is the picture's side in pixels; it shows a square of `2.4 * range` px.
+pub fn first_person(episode: &crate::episode::Episode, size: u32) -> RgbImage {
+    let size = size.max(16);
+    let laser = episode.laser();
+    let range = laser.range_px();
+    let pose = episode.pose();
+    let scene = episode.scene();
+    let px_per = size as f64 / (2.4 * range);
+    let centre = size as f64 / 2.0;
+    // Screen up is the heading: screen (u right, v up) maps to the scene by a rotation of z - 90.
+    let rot = crate::geometry::unit(pose.z_deg - 90.0);
+    let to_scene = |u: f64, v: f64| {
+        Point::new(
+            pose.x + (u * rot.x - v * rot.y) / px_per,
+            pose.y + (u * rot.y + v * rot.x) / px_per,
+        )
+    };
+    let to_screen = |p: Point| {
+        let d = p - pose.position();
+        let (u, v) = (d.x * rot.x + d.y * rot.y, -d.x * rot.y + d.y * rot.x);
+        (centre + u * px_per, centre - v * px_per)
+    };
+    let mut img = RgbImage::from_pixel(size, size, FLOOR);
+    for row in 0..size {
+        for col in 0..size {
+            let (u, v) = (col as f64 + 0.5 - centre, centre - (row as f64 + 0.5));
+            if scene.occupied(to_scene(u, v)) {
+                img.put_pixel(col, row, WALL);
+            }
+        }
+    }
+    let mut put = |x: f64, y: f64, c: Rgb<u8>| {
+        if x >= 0.0 && y >= 0.0 && x < size as f64 && y < size as f64 {
+            img.put_pixel(x as u32, y as u32, c);
+        }
+    };
+    let circle_steps = (2.0 * std::f64::consts::PI * range * px_per * 2.0) as usize;
+    for k in 0..circle_steps.max(64) {
+        let a = k as f64 / circle_steps.max(64) as f64 * std::f64::consts::TAU;
+        put(
+            centre + a.cos() * range * px_per,
+            centre + a.sin() * range * px_per,
+            Rgb([150, 150, 150]),
+        );
+    }
+    let line =
+        |put: &mut dyn FnMut(f64, f64, Rgb<u8>), a: (f64, f64), b: (f64, f64), c: Rgb<u8>| {
+            let n = ((b.0 - a.0).hypot(b.1 - a.1) * 2.0).ceil().max(1.0) as usize;
+            for k in 0..=n {
+                let t = k as f64 / n as f64;
+                put(a.0 + (b.0 - a.0) * t, a.1 + (b.1 - a.1) * t, c);
+            }
+        };
+    for (i, &d) in episode.readings().iter().enumerate() {
+        let dir = crate::geometry::unit(laser.beam_angle_deg(i, pose.z_deg));
+        let end = to_screen(pose.position() + dir * d);
+        line(&mut put, (centre, centre), end, ray_colour(laser.class(d)));
+    }
+    // The goal arrow: from the centre towards the goal, half the range long, with a head.
+    let to_goal = (episode.goal() - pose.position()).try_normalize(1e-12);
+    if let Some(g) = to_goal {
+        let tip = to_screen(pose.position() + g * range * 0.5);
+        line(&mut put, (centre, centre), tip, GOAL);
+        let back = (centre - tip.0, centre - tip.1);
+        let len = back.0.hypot(back.1).max(1e-9);
+        let (bx, by) = (back.0 / len * 6.0, back.1 / len * 6.0);
+        for s in [-0.5f64, 0.5] {
+            let (c, sn) = (s.cos(), s.sin());
+            let wing = (tip.0 + bx * c - by * sn, tip.1 + bx * sn + by * c);
+            line(&mut put, tip, wing, GOAL);
+        }
+    }
+    let robot_px = (episode.config().robot.radius_px * px_per).max(2.0);
+    for row in 0..size {
+        for col in 0..size {
+            let (dx, dy) = (col as f64 + 0.5 - centre, row as f64 + 0.5 - centre);
+            if dx * dx + dy * dy <= robot_px * robot_px {
+                img.put_pixel(col, row, PATH);
+            }
+        }
+    }
+    img
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

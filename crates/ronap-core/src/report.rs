@@ -113,3 +113,67 @@ pub fn trajectory_image(record: &EpisodeRecord, scale: f64) -> Option<image::Rgb
     canvas.robot(record.end, config.robot.radius_px.max(least), PATH);
     Some(canvas.into_image())
 }
+
+/// Writes a run's files into `dir`: `episodes.csv`, `timing.csv` and `summary.json`, the last
+/// being `meta` (what was run: policy, seeds, scenes...) with the summary figures and the full
+/// configuration added.
+pub fn write_run(
+    dir: &std::path::Path,
+    mut meta: serde_json::Map<String, serde_json::Value>,
+    config: &crate::config::ValidConfig,
+    result: &crate::evaluate::RunResult,
+    summary: &crate::summary::Summary,
+) -> Result<(), crate::output::OutputError> {
+    use crate::output::write_atomic;
+    write_atomic(&dir.join("episodes.csv"), |out| {
+        write_episodes(&result.records, out)
+    })?;
+    write_atomic(&dir.join("timing.csv"), |out| {
+        write_timing(&result.records, out)
+    })?;
+    meta.insert("ronap_version".into(), env!("CARGO_PKG_VERSION").into());
+    meta.insert("interrupted".into(), result.cancelled.into());
+    meta.insert(
+        "error".into(),
+        result.error.as_ref().map(|e| e.to_string()).into(),
+    );
+    meta.insert(
+        "summary".into(),
+        serde_json::to_value(summary).unwrap_or_default(),
+    );
+    meta.insert(
+        "config".into(),
+        serde_json::to_value(config.as_sim_config()).unwrap_or_default(),
+    );
+    write_atomic(&dir.join("summary.json"), |out| {
+        serde_json::to_writer_pretty(&mut *out, &meta)?;
+        out.write_all(b"\n")
+    })
+}
+
+/// Writes the per-episode files a record asks for: its trajectory picture (`png/`) and its step
+/// log (`steps/`), each when `picture` / `steps` say so and the record holds what they need.
+pub fn write_episode_files(
+    dir: &std::path::Path,
+    record: &EpisodeRecord,
+    picture: bool,
+    steps: bool,
+) -> Result<(), crate::output::OutputError> {
+    if picture {
+        if let Some(img) = trajectory_image(record, 1.0) {
+            let path = dir.join("png").join(format!(
+                "seed-{:06}-{}.png",
+                record.seed,
+                record.outcome.name()
+            ));
+            crate::output::save_image(&path, &img)?;
+        }
+    }
+    if steps {
+        let path = dir
+            .join("steps")
+            .join(format!("seed-{:06}.csv", record.seed));
+        crate::output::write_atomic(&path, |out| write_steps(record, out))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,52 @@
+"""ronap: fast robot-navigation analysis on the RoNAP model, from Python.
+
+- ``NavEnv`` / ``gymnasium.make("ronap/Nav-v0")``: one environment, Gymnasium API.
+- ``VecNavEnv(num_envs)``: a ``gymnasium.vector.VectorEnv`` stepped in Rust across cores.
+- ``evaluate(policy, seeds)``: the batch evaluator of ``ronap run`` with a Python callable or a
+  built-in policy.
+- ``maze_occupancy`` / ``maze_image``: scenes as numpy arrays; ``default_config()``, ``policies()``.
+
+Every error is a ``RonapError``; configuration errors (``ConfigError``) name the field and value.
+"""
+
+from ._ronap import (
+    ActionError,
+    ConfigError,
+    OutputError,
+    PolicyError,
+    RonapError,
+    SceneError,
+    __version__,
+)
+from .config import default_config, make_config
+from .env import NavEnv, VecNavEnv
+from .evaluate import evaluate
+from .scenes import maze_image, maze_occupancy, policies
+
+__all__ = [
+    "ActionError",
+    "ConfigError",
+    "NavEnv",
+    "OutputError",
+    "PolicyError",
+    "RonapError",
+    "SceneError",
+    "VecNavEnv",
+    "__version__",
+    "default_config",
+    "evaluate",
+    "make_config",
+    "maze_image",
+    "maze_occupancy",
+    "policies",
+]
+
+
+def _register() -> None:
+    import gymnasium
+
+    if "ronap/Nav-v0" not in gymnasium.registry:
+        gymnasium.register(id="ronap/Nav-v0", entry_point="ronap.env:NavEnv")
+
+
+_register()

@@ -1,0 +1,133 @@
+"""Gymnasium environments over the Rust model."""
+
+from __future__ import annotations
+
+import json
+from typing import Any, Mapping
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from . import _ronap
+from .config import config_json
+
+_SEED_LIMIT = 2**63
+
+
+class NavEnv(gym.Env):
+    """One RoNAP episode at a time.
+
+    Observation: ``float32[beams + 1]``, the laser readings over their range and the goal
+    direction over 360 (SPEC's 18 values by default). Actions: ``Discrete(3)`` (0 LEFT, 1 AHEAD,
+    2 RIGHT), or ``Box([-v_max, -w_max], [v_max, w_max])`` with ``continuous=True``.
+    ``terminated`` on success (and on collision with ``robot_on_collision="terminate"``, or at
+    ``episode_reward_min``); ``truncated`` on time-out. ``info`` holds distance, collided,
+    success, pose, goal, status, steps, collisions and the episode seed.
+
+    ``reset(seed=s)`` plays the episode of seed ``s`` (the same as ``ronap run`` seed ``s``);
+    ``reset()`` draws the next episode seed from the environment's generator.
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
+
+    def __init__(
+        self,
+        render_mode: str | None = None,
+        *,
+        config: Mapping[str, Any] | None = None,
+        continuous: bool = False,
+        maze_seed: int | None = None,
+        map: str | None = None,
+        render_view: str = "top",
+        render_scale: float = 0.5,
+        **fields: Any,
+    ) -> None:
+        if render_mode not in (None, "rgb_array"):
+            raise _ronap.ConfigError(f"render_mode {render_mode!r}: expected None or 'rgb_array'")
+        if render_view not in ("top", "first_person"):
+            raise _ronap.ConfigError(f"render_view {render_view!r}: expected 'top' or 'first_person'")
+        self._env = _ronap.Env(config_json(config, fields), maze_seed, None if map is None else str(map), continuous)
+        self.config = json.loads(self._env.config_json)
+        self.render_mode = render_mode
+        self.render_view = render_view
+        self.render_scale = render_scale
+        n = self._env.observation_size
+        self.observation_space = spaces.Box(0.0, 1.0, (n,), np.float32)
+        if continuous:
+            robot = self.config["robot"]
+            high = np.array([robot["max_linear_speed_px"], robot["max_angular_speed_deg"]], np.float32)
+            self.action_space = spaces.Box(-high, high, dtype=np.float32)
+        else:
+            self.action_space = spaces.Discrete(3)
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        super().reset(seed=seed)
+        episode_seed = seed if seed is not None else int(self.np_random.integers(0, _SEED_LIMIT))
+        return self._env.reset(int(episode_seed))
+
+    def step(self, action):
+        return self._env.step(action)
+
+    def render(self):
+        if self.render_mode != "rgb_array":
+            return None
+        if self.render_view == "top":
+            return self._env.render("top", self.render_scale)
+        return self._env.render("first_person", 400.0)
+
+
+class VecNavEnv(VectorEnv):
+    """``num_envs`` RoNAP environments stepped together in Rust, across cores, with the GIL
+    released; observations, rewards and flags come back as numpy arrays.
+
+    Next-step autoreset: the step after an episode ends resets that environment (its action is
+    ignored) and returns the new episode's first observation with reward 0. ``reset(seed=s)`` gives
+    environment ``i`` the episode seeds ``s + i``, ``s + i + n``, ``s + i + 2n``, ...
+    """
+
+    metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
+
+    def __init__(
+        self,
+        num_envs: int,
+        *,
+        config: Mapping[str, Any] | None = None,
+        maze_seed: int | None = None,
+        map: str | None = None,
+        threads: int = 0,
+        **fields: Any,
+    ) -> None:
+        self._vec = _ronap.VecEnv(num_envs, config_json(config, fields), maze_seed, None if map is None else str(map), threads)
+        self.num_envs = num_envs
+        n = self._vec.observation_size
+        self.single_observation_space = spaces.Box(0.0, 1.0, (n,), np.float32)
+        self.single_action_space = spaces.Discrete(3)
+        self.observation_space = batch_space(self.single_observation_space, num_envs)
+        self.action_space = batch_space(self.single_action_space, num_envs)
+        self._mask = np.ones(num_envs, dtype=bool)
+        self._rng = np.random.default_rng()
+
+    def _infos(self, infos: dict) -> dict:
+        for key in list(infos):
+            infos["_" + key] = self._mask
+        return infos
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        if seed is None:
+            seed = int(self._rng.integers(0, _SEED_LIMIT))
+        elif not isinstance(seed, (int, np.integer)):
+            raise _ronap.ConfigError(f"seed {seed!r}: VecNavEnv takes one int (environment i gets seed + i)")
+        else:
+            self._rng = np.random.default_rng(int(seed))
+        obs, infos = self._vec.reset(int(seed))
+        return obs, self._infos(infos)
+
+    def step(self, actions):
+        actions = np.asarray(actions)
+        if actions.dtype != np.int64:
+            actions = actions.astype(np.int64)
+        obs, rewards, terminated, truncated, infos = self._vec.step(actions)
+        return obs, rewards, terminated, truncated, self._infos(infos)

@@ -1,0 +1,50 @@
+"""The batch evaluator of ``ronap run``, with Python policies."""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Iterable, Mapping
+
+from . import _ronap
+from .config import config_json
+
+
+def evaluate(
+    policy: str | Callable[[Any], Any],
+    seeds: Iterable[int] = range(1000),
+    *,
+    config: Mapping[str, Any] | None = None,
+    maze_seed: int | None = None,
+    map: str | None = None,
+    threads: int = 0,
+    continuous: bool = False,
+    out: str | None = None,
+    png: int | str | None = None,
+    log_steps: bool = False,
+    **fields: Any,
+) -> dict[str, Any]:
+    """Runs ``policy`` over the episodes of ``seeds`` in parallel and returns
+    ``{"summary": {...}, "episodes": [{...}, ...]}``, the figures and rows ``ronap run`` reports.
+
+    ``policy`` is a built-in name (``"apf"``, ``"geodesic"``, ``"random"``) or a callable taking
+    the observation (``float32`` array) and returning an action: 0 LEFT, 1 AHEAD, 2 RIGHT (or
+    ``(v, w)`` with ``continuous=True``). Calls to a Python policy hold the GIL; the simulation runs
+    on ``threads`` threads (0: all cores) beside them. With ``out``, writes ``episodes.csv``,
+    ``timing.csv``, ``summary.json`` and, as asked, ``png/`` pictures (``png``: a count, ``"failures"``
+    or ``"all"``) and ``steps/`` logs, as ``ronap run`` does.
+
+    A policy that raises or returns an invalid action or NaN raises ``PolicyError`` naming the seed
+    and step.
+    """
+    seeds = [int(s) for s in seeds]
+    return _ronap.evaluate(
+        policy,
+        seeds,
+        config_json(config, fields),
+        maze_seed,
+        None if map is None else str(map),
+        threads,
+        continuous,
+        None if out is None else str(out),
+        None if png is None else str(png),
+        log_steps,
+    )

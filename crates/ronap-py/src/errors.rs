@@ -1,0 +1,57 @@
+//! The exception tree: everything ronap raises is a `ronap.RonapError`.
+
+use pyo3::prelude::*;
+
+pyo3::create_exception!(
+    _ronap,
+    RonapError,
+    pyo3::exceptions::PyException,
+    "Base of every error ronap raises."
+);
+pyo3::create_exception!(
+    _ronap,
+    ConfigError,
+    RonapError,
+    "A configuration value is out of range or unknown; the message names the field and value."
+);
+pyo3::create_exception!(
+    _ronap,
+    SceneError,
+    RonapError,
+    "A scene or episode cannot be built: unreadable map, no room for start and goal."
+);
+pyo3::create_exception!(
+    _ronap,
+    PolicyError,
+    RonapError,
+    "A policy failed: it raised, or returned an invalid action; the message names seed and step."
+);
+pyo3::create_exception!(
+    _ronap,
+    ActionError,
+    RonapError,
+    "An action passed to step() is not one the environment takes."
+);
+pyo3::create_exception!(
+    _ronap,
+    OutputError,
+    RonapError,
+    "An output file could not be written."
+);
+
+/// Adds the exception classes to the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("RonapError", py.get_type::<RonapError>())?;
+    m.add("ConfigError", py.get_type::<ConfigError>())?;
+    m.add("SceneError", py.get_type::<SceneError>())?;
+    m.add("PolicyError", py.get_type::<PolicyError>())?;
+    m.add("ActionError", py.get_type::<ActionError>())?;
+    m.add("OutputError", py.get_type::<OutputError>())?;
+    Ok(())
+}
+
+/// A scene or episode error as a `SceneError`.
+pub fn scene(e: impl std::fmt::Display) -> PyErr {
+    SceneError::new_err(e.to_string())
+}
