@@ -4,6 +4,7 @@
 mod bench;
 mod maze;
 mod output;
+mod py_policy;
 mod run;
 mod sim_args;
 
@@ -66,15 +67,21 @@ fn main() -> ExitCode {
                 let _ = e.print();
                 return ExitCode::SUCCESS;
             }
-            // One line that names the flag and the value; usage only when nothing was given.
+            // One line that names the flag and the value (and clap's tip, if any); the usage
+            // block only when nothing was given.
             let text = e.render().to_string();
             if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
                 eprint!("{text}");
             } else {
-                eprintln!(
-                    "{}",
-                    text.lines().next().unwrap_or("error: invalid arguments")
-                );
+                let line: Vec<&str> = text
+                    .lines()
+                    .take_while(|l| {
+                        !l.starts_with("Usage:") && !l.starts_with("For more information")
+                    })
+                    .map(str::trim)
+                    .filter(|l| !l.is_empty())
+                    .collect();
+                eprintln!("{}", line.join(" "));
             }
             return ExitCode::from(EXIT_BAD_INPUT);
         }
@@ -90,8 +97,17 @@ fn main() -> ExitCode {
         Err(e) if output::is_broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
             let mut stderr = std::io::stderr().lock();
-            let chain: Vec<String> = e.chain().map(|c| c.to_string()).collect();
-            let _ = writeln!(stderr, "error: {}", chain.join(": "));
+            // Each cause once: error types that already print their source are not repeated.
+            let mut message = String::new();
+            for cause in e.chain().map(|c| c.to_string()) {
+                if !message.contains(&cause) {
+                    if !message.is_empty() {
+                        message.push_str(": ");
+                    }
+                    message.push_str(&cause);
+                }
+            }
+            let _ = writeln!(stderr, "error: {message}");
             ExitCode::from(EXIT_BAD_INPUT)
         }
     }

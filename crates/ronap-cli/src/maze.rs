@@ -1,6 +1,6 @@
 //! `ronap maze`: draw a seeded maze as a picture or as text.
 
-use crate::sim_args::{positive, SimArgs};
+use crate::sim_args::{positive, seed, SimArgs};
 use anyhow::{Context, Result};
 use clap::Args;
 use ronap_core::episode::{maze_scene, sample_placement};
@@ -13,7 +13,7 @@ use std::process::ExitCode;
 #[derive(Args, Debug)]
 pub struct MazeArgs {
     /// Seed of the maze (and of the start and goal with --start-goal).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, allow_negative_numbers = true, default_value_t = 0, value_parser = seed)]
     seed: u64,
     #[command(flatten)]
     sim: SimArgs,

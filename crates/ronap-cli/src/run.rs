@@ -1,6 +1,6 @@
 //! `ronap run`: evaluate a policy over many seeded episodes and write what happened.
 
-use crate::sim_args::{fraction, SimArgs};
+use crate::sim_args::{count, fraction, seed, SimArgs};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -44,20 +44,21 @@ impl FromStr for PngChoice {
 #[derive(Args, Debug)]
 pub struct RunArgs {
     /// Policy to evaluate: apf (the paper's potential field, Algorithm 3), geodesic (shortest-path
-    /// follower, no local minima) or random.
+    /// follower, no local minima), random, or py:FILE.py:FUNCTION (a Python function: observation
+    /// in, action 0/1/2 out; run with $RONAP_PYTHON or python3).
     #[arg(long, value_name = "NAME")]
     policy: String,
     /// Number of episodes; episode i has seed seed-start + i.
-    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 1000, value_parser = clap::value_parser!(u64).range(1..))]
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 1000, value_parser = count)]
     seeds: u64,
     /// First seed.
-    #[arg(long, value_name = "SEED", default_value_t = 0)]
+    #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 0, value_parser = seed)]
     seed_start: u64,
     /// Worker threads [default: all cores].
     #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
     threads: Option<u32>,
     /// Use the maze of this seed for every episode [default: each seed its own maze].
-    #[arg(long, value_name = "SEED", conflicts_with = "map")]
+    #[arg(long, allow_negative_numbers = true, value_name = "SEED", conflicts_with = "map", value_parser = seed)]
     maze_seed: Option<u64>,
     /// Run on an image scene (PNG/PGM: dark pixels are obstacles) or a ROS map_server YAML file;
     /// start and goal are drawn per seed.
@@ -75,7 +76,7 @@ pub struct RunArgs {
     #[arg(long)]
     log_steps: bool,
     /// Trajectory pictures in png/: the first N seeds, `failures` or `all` [default: none].
-    #[arg(long, value_name = "N|failures|all")]
+    #[arg(long, allow_negative_numbers = true, value_name = "N|failures|all")]
     png: Option<PngChoice>,
     /// Exit with code 1 when the success rate is below this fraction (a gate for CI).
     #[arg(long, allow_negative_numbers = true, value_name = "F", value_parser = fraction)]
@@ -109,6 +110,11 @@ pub fn utc_now() -> (i64, u32, u32, u32, u32, u32) {
 }
 
 fn policy_factory(name: &str) -> Result<Box<dyn PolicyFactory>> {
+    if let Some(spec) = name.strip_prefix("py:") {
+        return Ok(Box::new(
+            crate::py_policy::PyPolicyFactory::new(spec).map_err(anyhow::Error::msg)?,
+        ));
+    }
     match Builtin::from_name(name) {
         Some(b) => Ok(Box::new(b)),
         None => {
@@ -160,14 +166,38 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         Some(d) => d.clone(),
         None => {
             let (y, mo, d, h, mi, s) = utc_now();
-            PathBuf::from(format!(
-                "runs/{}-{y:04}{mo:02}{d:02}-{h:02}{mi:02}{s:02}",
-                args.policy
-            ))
+            // A py:dir/file.py:act policy names its directory after the function.
+            let name: String = args
+                .policy
+                .rsplit(['/', ':'])
+                .next()
+                .unwrap_or("policy")
+                .chars()
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                        c
+                    } else {
+                        '_'
+                    }
+                })
+                .collect();
+            let base = format!("runs/{name}-{y:04}{mo:02}{d:02}-{h:02}{mi:02}{s:02}");
+            // Two runs started in the same second get their own directories.
+            (1..)
+                .map(|k| {
+                    if k == 1 {
+                        PathBuf::from(&base)
+                    } else {
+                        PathBuf::from(format!("{base}-{k}"))
+                    }
+                })
+                .find(|p| !p.exists())
+                .unwrap_or_else(|| PathBuf::from(base))
         }
     };
     std::fs::create_dir_all(&out_dir)
         .with_context(|| format!("cannot create output directory {}", out_dir.display()))?;
+    remove_stale_files(&out_dir)?;
     if args.png.is_some() {
         std::fs::create_dir_all(out_dir.join("png"))
             .with_context(|| format!("cannot create {}/png", out_dir.display()))?;
@@ -292,4 +322,23 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Removes the per-episode files an earlier run left in `dir` (`png/seed-*.png`,
+/// `steps/seed-*.csv`), so a reused output directory shows only this run. Nothing else is touched.
+fn remove_stale_files(dir: &std::path::Path) -> Result<()> {
+    for (sub, ext) in [("png", ".png"), ("steps", ".csv")] {
+        let Ok(entries) = std::fs::read_dir(dir.join(sub)) else {
+            continue;
+        };
+        for entry in entries.flatten() {
+            let name = entry.file_name();
+            let name = name.to_string_lossy();
+            if name.starts_with("seed-") && name.ends_with(ext) {
+                std::fs::remove_file(entry.path())
+                    .with_context(|| format!("cannot remove old {}", entry.path().display()))?;
+            }
+        }
+    }
+    Ok(())
 }

@@ -16,6 +16,20 @@ pub fn positive(s: &str) -> Result<f64, String> {
     }
 }
 
+/// Parses a whole number of at least 1.
+pub fn count(s: &str) -> Result<u64, String> {
+    match s.parse::<u64>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err("must be a whole number of at least 1".into()),
+    }
+}
+
+/// Parses a seed: a whole number from 0 to 2^64 - 1.
+pub fn seed(s: &str) -> Result<u64, String> {
+    s.parse::<u64>()
+        .map_err(|_| "a seed must be a whole number from 0 to 18446744073709551615".into())
+}
+
 /// Parses a fraction in [0, 1].
 pub fn fraction(s: &str) -> Result<f64, String> {
     let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;

@@ -360,39 +360,44 @@ impl Evaluator {
             .build()
             .map_err(|e| PolicyError::Failed(format!("cannot start worker threads: {e}")))?;
         let first_policy_error: Mutex<Option<PolicyError>> = Mutex::new(None);
+        // Policies are made at most once per worker and handed from episode to episode, so a
+        // costly policy (a Python process, a loaded network) is set up `threads` times, not once
+        // per seed.
+        let idle: Mutex<Vec<Box<dyn Policy>>> = Mutex::new(Vec::new());
         let results: Vec<Option<Result<EpisodeRecord, RunError>>> = pool.install(|| {
             seeds
                 .par_iter()
                 .with_max_len(1)
-                .map_init(
-                    || factory.make(),
-                    |policy, &seed| {
-                        if cancel.load(Ordering::Relaxed) {
+                .map(|&seed| {
+                    if cancel.load(Ordering::Relaxed) {
+                        return None;
+                    }
+                    let reused = idle.lock().ok().and_then(|mut v| v.pop());
+                    let mut policy = match reused.map_or_else(|| factory.make(), Ok) {
+                        Ok(p) => p,
+                        Err(e) => {
+                            cancel.store(true, Ordering::Relaxed);
+                            if let Ok(mut slot) = first_policy_error.lock() {
+                                slot.get_or_insert(e);
+                            }
                             return None;
                         }
-                        let policy = match policy {
-                            Ok(p) => p,
-                            Err(e) => {
-                                cancel.store(true, Ordering::Relaxed);
-                                if let Ok(mut slot) = first_policy_error.lock() {
-                                    slot.get_or_insert_with(|| e.clone());
-                                }
-                                return None;
-                            }
-                        };
-                        let result =
-                            self.run_episode(policy.as_mut(), seed, recording)
-                                .map(|mut record| {
-                                    on_record(&record);
-                                    record.strip();
-                                    record
-                                });
-                        if result.is_err() {
-                            cancel.store(true, Ordering::Relaxed);
-                        }
-                        Some(result)
-                    },
-                )
+                    };
+                    let result =
+                        self.run_episode(policy.as_mut(), seed, recording)
+                            .map(|mut record| {
+                                on_record(&record);
+                                record.strip();
+                                record
+                            });
+                    if result.is_err() {
+                        cancel.store(true, Ordering::Relaxed);
+                    }
+                    if let Ok(mut v) = idle.lock() {
+                        v.push(policy);
+                    }
+                    Some(result)
+                })
                 .collect()
         });
         if let Some(e) = first_policy_error.into_inner().ok().flatten() {

@@ -35,6 +35,14 @@ pub enum MapError {
     /// The image could not be used.
     #[error(transparent)]
     Scene(#[from] SceneError),
+    /// The image a YAML file names could not be used.
+    #[error("map file {}: {source}", yaml.display())]
+    YamlImage {
+        /// The YAML file.
+        yaml: PathBuf,
+        /// What is wrong with its image.
+        source: SceneError,
+    },
 }
 
 /// A ROS `map_server` map description.
@@ -190,7 +198,13 @@ pub fn load(
         .map(str::to_ascii_lowercase);
     if matches!(ext.as_deref(), Some("yaml") | Some("yml")) {
         let ros = RosMap::load(path)?;
-        let scene = ros.scene(config, reach_px)?;
+        let scene = ros.scene(config, reach_px).map_err(|e| match e {
+            MapError::Scene(source) => MapError::YamlImage {
+                yaml: path.to_path_buf(),
+                source,
+            },
+            other => other,
+        })?;
         Ok((scene, MapSource::Ros(ros)))
     } else {
         let scene = Scene::load_image(path, config, reach_px)?;

@@ -57,7 +57,16 @@ pub fn write_atomic(
     // Temporary files are private (0600); the finished output gets the usual 0644.
     #[cfg(unix)]
     builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
-    let mut temp = builder.tempfile_in(dir).map_err(io)?;
+    // tempfile's own error names its temporary path; the target path says more to a user.
+    let mut temp = builder.tempfile_in(dir).map_err(|e| {
+        let message = e.to_string();
+        let message = message
+            .split(" at path ")
+            .next()
+            .unwrap_or(&message)
+            .to_string();
+        io(std::io::Error::new(e.kind(), message))
+    })?;
     {
         let mut out = BufWriter::new(temp.as_file_mut());
         write(&mut out).map_err(io)?;

@@ -20,7 +20,7 @@ pub const EPISODE_COLUMNS: [&str; 14] = [
     "return",
     "start_x",
     "start_y",
-    "start_z",
+    "start_heading_deg",
     "goal_x",
     "goal_y",
     "reason",
