@@ -22,7 +22,7 @@ class NavEnv(gym.Env):
 
     Observation: ``float32[beams + 1]``, the laser readings over their range and the goal
     direction over 360 (SPEC's 18 values by default). Actions: ``Discrete(3)`` (0 LEFT, 1 AHEAD,
-    2 RIGHT), or ``Box([-v_max, -w_max], [v_max, w_max])`` with ``continuous=True``.
+    2 RIGHT), or with ``continuous=True`` ``Box(-1, 1, (2,))``: ``(v / v_max, w / w_max)``.
     ``terminated`` on success (and on collision with ``robot_on_collision="terminate"``, or at
     ``episode_reward_min``); ``truncated`` on time-out. ``info`` holds distance, collided,
     success, pose, goal, status, steps, collisions and the episode seed.
@@ -56,10 +56,12 @@ class NavEnv(gym.Env):
         self.render_scale = render_scale
         n = self._env.observation_size
         self.observation_space = spaces.Box(0.0, 1.0, (n,), np.float32)
+        self.continuous = continuous
         if continuous:
+            # Normalised, as learning libraries expect: (1, 1) is (v_max, w_max).
             robot = self.config["robot"]
-            high = np.array([robot["max_linear_speed_px"], robot["max_angular_speed_deg"]], np.float32)
-            self.action_space = spaces.Box(-high, high, dtype=np.float32)
+            self._action_scale = np.array([robot["max_linear_speed_px"], robot["max_angular_speed_deg"]], np.float64)
+            self.action_space = spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
         else:
             self.action_space = spaces.Discrete(3)
 
@@ -69,6 +71,11 @@ class NavEnv(gym.Env):
         return self._env.reset(int(episode_seed))
 
     def step(self, action):
+        if self.continuous:
+            scaled = np.asarray(action, dtype=np.float64)
+            if scaled.shape != (2,):
+                raise _ronap.ActionError(f"action {action!r}: expected two numbers in [-1, 1]")
+            action = (scaled * self._action_scale).tolist()
         return self._env.step(action)
 
     def render(self):

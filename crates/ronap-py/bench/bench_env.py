@@ -1,0 +1,49 @@
+"""Environment steps per second from Python: VecNavEnv with 1, 64 and 1024 environments and
+random actions, and one NavEnv.step() through gymnasium.make.
+
+    python crates/ronap-py/bench/bench_env.py [--seconds 3]
+"""
+
+import argparse
+import time
+
+import gymnasium as gym
+import numpy as np
+
+import ronap
+
+
+def vec_rate(n: int, seconds: float) -> float:
+    env = ronap.VecNavEnv(n)
+    env.reset(seed=0)
+    rng = np.random.default_rng(0)
+    steps, start = 0, time.perf_counter()
+    while time.perf_counter() - start < seconds:
+        env.step(rng.integers(0, 3, n))
+        steps += n
+    return steps / (time.perf_counter() - start)
+
+
+def single_step_us(seconds: float) -> float:
+    env = gym.make("ronap/Nav-v0")
+    env.reset(seed=0)
+    steps, start = 0, time.perf_counter()
+    while time.perf_counter() - start < seconds:
+        _, _, terminated, truncated, _ = env.step(1)
+        steps += 1
+        if terminated or truncated:
+            env.reset()
+    return (time.perf_counter() - start) / steps * 1e6
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seconds", type=float, default=3.0, help="seconds per figure (default 3)")
+    args = parser.parse_args()
+    for n in (1, 64, 1024):
+        print(f"VecNavEnv({n:>4}): {vec_rate(n, args.seconds):>14,.0f} env-steps/s")
+    print(f"gymnasium.make('ronap/Nav-v0').step(): {single_step_us(args.seconds):.2f} us")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,17 @@
+import os
+import pathlib
+import shutil
+
+import pytest
+
+
+@pytest.fixture(scope="session")
+def ronap_bin() -> str:
+    """The `ronap` binary: $RONAP_BIN (scripts/test sets it), else the workspace's release build."""
+    path = os.environ.get("RONAP_BIN") or str(pathlib.Path(__file__).resolve().parents[3] / "target" / "release" / "ronap")
+    if not pathlib.Path(path).is_file():
+        found = shutil.which("ronap")
+        if found is None:
+            pytest.fail(f"no ronap binary at {path}: build it with `cargo build --release -p ronap-cli`")
+        path = found
+    return path
