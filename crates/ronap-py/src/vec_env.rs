@@ -146,14 +146,26 @@ impl VecEnv {
         );
         let pool = &self.pool;
         py.allow_threads(|| {
-            pool.install(|| {
+            let start = |((slot, obs), out): ((&mut Slot, &mut [f32]), &mut Out)| {
+                Self::start(evaluator, slot, n, obs, out)
+            };
+            if slots.len() <= MIN_PER_TASK {
+                // Too little work to wake another thread for.
                 slots
-                    .par_iter_mut()
-                    .zip(obs.par_chunks_mut(d))
-                    .zip(outs.par_iter_mut())
-                    .with_min_len(MIN_PER_TASK)
-                    .try_for_each(|((slot, obs), out)| Self::start(evaluator, slot, n, obs, out))
-            })
+                    .iter_mut()
+                    .zip(obs.chunks_mut(d))
+                    .zip(outs.iter_mut())
+                    .try_for_each(start)
+            } else {
+                pool.install(|| {
+                    slots
+                        .par_iter_mut()
+                        .zip(obs.par_chunks_mut(d))
+                        .zip(outs.par_iter_mut())
+                        .with_min_len(MIN_PER_TASK)
+                        .try_for_each(start)
+                })
+            }
         })
         .map_err(errors::scene)?;
         self.arrays(py)
@@ -200,37 +212,48 @@ impl VecEnv {
         );
         let pool = &self.pool;
         let n64 = n as u64;
+        let step_one = |(((slot, obs), out), &a): (((&mut Slot, &mut [f32]), &mut Out), &usize)| {
+            if slot.needs_reset || slot.episode.is_none() {
+                return Self::start(evaluator, slot, n64, obs, out);
+            }
+            let Some(episode) = slot.episode.as_mut() else {
+                return Ok(());
+            };
+            let r = episode.step(DiscreteAction::ALL[a]);
+            let (terminated, truncated) = ends(r.status);
+            *out = Out {
+                reward: r.reward,
+                terminated,
+                truncated,
+                collided: r.collided,
+                success: r.status == Status::Success,
+                distance: r.distance_px,
+                pose: [r.pose.x, r.pose.y, r.pose.z_deg],
+            };
+            obs.copy_from_slice(r.observation);
+            slot.needs_reset = r.status.is_done();
+            Ok(())
+        };
         py.allow_threads(|| {
-            pool.install(|| {
+            if slots.len() <= MIN_PER_TASK {
+                // Too little work to wake another thread for.
                 slots
-                    .par_iter_mut()
-                    .zip(obs.par_chunks_mut(d))
-                    .zip(outs.par_iter_mut())
-                    .zip(actions.par_iter())
-                    .with_min_len(MIN_PER_TASK)
-                    .try_for_each(|(((slot, obs), out), &a)| {
-                        if slot.needs_reset || slot.episode.is_none() {
-                            return Self::start(evaluator, slot, n64, obs, out);
-                        }
-                        let Some(episode) = slot.episode.as_mut() else {
-                            return Ok(());
-                        };
-                        let r = episode.step(DiscreteAction::ALL[a]);
-                        let (terminated, truncated) = ends(r.status);
-                        *out = Out {
-                            reward: r.reward,
-                            terminated,
-                            truncated,
-                            collided: r.collided,
-                            success: r.status == Status::Success,
-                            distance: r.distance_px,
-                            pose: [r.pose.x, r.pose.y, r.pose.z_deg],
-                        };
-                        obs.copy_from_slice(r.observation);
-                        slot.needs_reset = r.status.is_done();
-                        Ok(())
-                    })
-            })
+                    .iter_mut()
+                    .zip(obs.chunks_mut(d))
+                    .zip(outs.iter_mut())
+                    .zip(actions.iter())
+                    .try_for_each(step_one)
+            } else {
+                pool.install(|| {
+                    slots
+                        .par_iter_mut()
+                        .zip(obs.par_chunks_mut(d))
+                        .zip(outs.par_iter_mut())
+                        .zip(actions.par_iter())
+                        .with_min_len(MIN_PER_TASK)
+                        .try_for_each(step_one)
+                })
+            }
         })
         .map_err(errors::scene)?;
         let rewards = PyArray1::from_iter(py, self.outs.iter().map(|o| o.reward));
