@@ -63,7 +63,16 @@ impl Policy for PyPolicy {
                         .map_or_else(|_| e.to_string(), |r| r.to_string())
                 ))
             })?;
+            let robot = &episode.config().robot;
             action_from(value.bind(py), self.continuous)
+                .map(|a| match a {
+                    // Continuous policies answer in [-1, 1], as NavEnv's action space.
+                    Action::Continuous { v, w_deg } => Action::Continuous {
+                        v: v * robot.max_linear_speed_px,
+                        w_deg: w_deg * robot.max_angular_speed_deg,
+                    },
+                    other => other,
+                })
                 .map(Decision::Act)
                 .map_err(PolicyError::Failed)
         })

@@ -35,6 +35,40 @@ struct Out {
     pose: [f64; 3],
 }
 
+/// Runs `f` on every environment with its observation row, output and action: on the calling
+/// thread for a small batch (too little work to wake another thread for), else on `pool`.
+fn for_each_env(
+    pool: &rayon::ThreadPool,
+    slots: &mut [Slot],
+    obs: &mut [f32],
+    outs: &mut [Out],
+    obs_size: usize,
+    actions: &[usize],
+    f: impl Fn(&mut Slot, &mut [f32], &mut Out, usize) -> Result<(), EpisodeError> + Sync,
+) -> Result<(), EpisodeError> {
+    let one = |(((slot, obs), out), &a): (((&mut Slot, &mut [f32]), &mut Out), &usize)| {
+        f(slot, obs, out, a)
+    };
+    if slots.len() <= MIN_PER_TASK {
+        slots
+            .iter_mut()
+            .zip(obs.chunks_mut(obs_size))
+            .zip(outs.iter_mut())
+            .zip(actions.iter())
+            .try_for_each(one)
+    } else {
+        pool.install(|| {
+            slots
+                .par_iter_mut()
+                .zip(obs.par_chunks_mut(obs_size))
+                .zip(outs.par_iter_mut())
+                .zip(actions.par_iter())
+                .with_min_len(MIN_PER_TASK)
+                .try_for_each(one)
+        })
+    }
+}
+
 /// Many RoNAP environments stepped together.
 #[pyclass(module = "ronap._ronap")]
 pub struct VecEnv {
@@ -145,27 +179,11 @@ impl VecEnv {
             self.obs_size,
         );
         let pool = &self.pool;
+        let actions = vec![0; slots.len()];
         py.allow_threads(|| {
-            let start = |((slot, obs), out): ((&mut Slot, &mut [f32]), &mut Out)| {
+            for_each_env(pool, slots, obs, outs, d, &actions, |slot, obs, out, _| {
                 Self::start(evaluator, slot, n, obs, out)
-            };
-            if slots.len() <= MIN_PER_TASK {
-                // Too little work to wake another thread for.
-                slots
-                    .iter_mut()
-                    .zip(obs.chunks_mut(d))
-                    .zip(outs.iter_mut())
-                    .try_for_each(start)
-            } else {
-                pool.install(|| {
-                    slots
-                        .par_iter_mut()
-                        .zip(obs.par_chunks_mut(d))
-                        .zip(outs.par_iter_mut())
-                        .with_min_len(MIN_PER_TASK)
-                        .try_for_each(start)
-                })
-            }
+            })
         })
         .map_err(errors::scene)?;
         self.arrays(py)
@@ -212,7 +230,7 @@ impl VecEnv {
         );
         let pool = &self.pool;
         let n64 = n as u64;
-        let step_one = |(((slot, obs), out), &a): (((&mut Slot, &mut [f32]), &mut Out), &usize)| {
+        let step_one = |slot: &mut Slot, obs: &mut [f32], out: &mut Out, a: usize| {
             if slot.needs_reset || slot.episode.is_none() {
                 return Self::start(evaluator, slot, n64, obs, out);
             }
@@ -234,28 +252,8 @@ impl VecEnv {
             slot.needs_reset = r.status.is_done();
             Ok(())
         };
-        py.allow_threads(|| {
-            if slots.len() <= MIN_PER_TASK {
-                // Too little work to wake another thread for.
-                slots
-                    .iter_mut()
-                    .zip(obs.chunks_mut(d))
-                    .zip(outs.iter_mut())
-                    .zip(actions.iter())
-                    .try_for_each(step_one)
-            } else {
-                pool.install(|| {
-                    slots
-                        .par_iter_mut()
-                        .zip(obs.par_chunks_mut(d))
-                        .zip(outs.par_iter_mut())
-                        .zip(actions.par_iter())
-                        .with_min_len(MIN_PER_TASK)
-                        .try_for_each(step_one)
-                })
-            }
-        })
-        .map_err(errors::scene)?;
+        py.allow_threads(|| for_each_env(pool, slots, obs, outs, d, &actions, step_one))
+            .map_err(errors::scene)?;
         let rewards = PyArray1::from_iter(py, self.outs.iter().map(|o| o.reward));
         let terminated = PyArray1::from_iter(py, self.outs.iter().map(|o| o.terminated));
         let truncated = PyArray1::from_iter(py, self.outs.iter().map(|o| o.truncated));

@@ -117,3 +117,11 @@ def test_evaluate_input_errors():
         ronap.evaluate("apf", [])
     with pytest.raises(ronap.SceneError, match="nowhere.png"):
         ronap.evaluate("apf", range(2), map="nowhere.png")
+
+
+def test_continuous_python_policy_uses_normalised_actions():
+    straight = ronap.evaluate(lambda obs: (1.0, 0.0), [1], threads=1, continuous=True, episode_max_steps=10)
+    # Full speed ahead for 10 steps: 50 px, unless a wall stops it.
+    row = straight["episodes"][0]
+    assert row["path_length_px"] <= 50.0 + 1e-9
+    assert row["path_length_px"] == pytest.approx(50.0) or row["collisions"] > 0

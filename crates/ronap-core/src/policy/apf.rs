@@ -11,7 +11,7 @@
 //! detected at once, the path is kept up to there, and the robot follows it into the trap and then
 //! gives up, so the run ends as a failure promptly instead of timing out.
 
-use super::follow::{FollowStep, Follower};
+use super::follow::Follower;
 use super::{Decision, Policy, PolicyError};
 use crate::config::ApfConfig;
 use crate::episode::Episode;
@@ -156,16 +156,12 @@ impl Policy for Apf {
         let Some(follower) = &mut self.follower else {
             return Err(PolicyError::Failed("apf: act() before reset()".into()));
         };
-        Ok(match follower.next(episode) {
-            FollowStep::Act(a) => Decision::Act(a.into()),
-            FollowStep::Arrived if self.reached => {
-                Decision::GiveUp("reached the end of the path short of the goal".into())
-            }
-            FollowStep::Arrived => {
-                Decision::GiveUp("trapped in a local minimum of the potential".into())
-            }
-            FollowStep::Stuck => Decision::GiveUp("stuck following the path".into()),
-        })
+        let end_reason = if self.reached {
+            "reached the end of the path short of the goal"
+        } else {
+            "trapped in a local minimum of the potential"
+        };
+        Ok(follower.next(episode).decision(end_reason))
     }
 }
 

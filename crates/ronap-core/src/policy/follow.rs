@@ -26,6 +26,18 @@ pub enum FollowStep {
     Stuck,
 }
 
+impl FollowStep {
+    /// The policy's decision: act, or give up, with `end_reason` saying why reaching the end of
+    /// the path (short of the goal, or the episode would have ended) is a failure.
+    pub fn decision(self, end_reason: &str) -> super::Decision {
+        match self {
+            FollowStep::Act(a) => super::Decision::Act(a.into()),
+            FollowStep::Arrived => super::Decision::GiveUp(end_reason.into()),
+            FollowStep::Stuck => super::Decision::GiveUp("stuck following the path".into()),
+        }
+    }
+}
+
 /// A path and where along it the robot is.
 #[derive(Clone, Debug)]
 pub struct Follower {

@@ -4,7 +4,7 @@
 //! Planning charges steps next to walls extra and smooths with a margin, so the path keeps a few
 //! px off corners the discrete robot could clip.
 
-use super::follow::{FollowStep, Follower};
+use super::follow::Follower;
 use super::{Decision, Policy, PolicyError};
 use crate::episode::Episode;
 use crate::planning::{smooth, DistanceField};
@@ -47,12 +47,8 @@ impl Policy for Geodesic {
         let Some(follower) = &mut self.follower else {
             return Ok(Decision::GiveUp("no path to the goal".into()));
         };
-        Ok(match follower.next(episode) {
-            FollowStep::Act(a) => Decision::Act(a.into()),
-            FollowStep::Arrived => {
-                Decision::GiveUp("reached the end of the path short of the goal".into())
-            }
-            FollowStep::Stuck => Decision::GiveUp("stuck following the path".into()),
-        })
+        Ok(follower
+            .next(episode)
+            .decision("reached the end of the path short of the goal"))
     }
 }

@@ -27,7 +27,7 @@ def evaluate(
 
     ``policy`` is a built-in name (``"apf"``, ``"geodesic"``, ``"random"``) or a callable taking
     the observation (``float32`` array) and returning an action: 0 LEFT, 1 AHEAD, 2 RIGHT (or
-    ``(v, w)`` with ``continuous=True``). Calls to a Python policy hold the GIL; the simulation runs
+    ``(v / v_max, w / w_max)`` in [-1, 1] with ``continuous=True``, as ``NavEnv``'s action space). Calls to a Python policy hold the GIL; the simulation runs
     on ``threads`` threads (0: all cores) beside them. With ``out``, writes ``episodes.csv``,
     ``timing.csv``, ``summary.json`` and, as asked, ``png/`` pictures (``png``: a count, ``"failures"``
     or ``"all"``) and ``steps/`` logs, as ``ronap run`` does.
