@@ -4,41 +4,15 @@ use crate::sim_args::{count, fraction, seed, SimArgs};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use ronap_core::evaluate::{EpisodeRecord, Evaluator, Outcome, Recording, Scenes};
+use ronap_core::evaluate::{EpisodeRecord, Evaluator, Recording, Scenes};
 use ronap_core::policy::{Builtin, PolicyFactory};
-use ronap_core::report;
+use ronap_core::report::{self, Pictures};
 use ronap_core::summary::Summary;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::str::FromStr;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-
-/// Which trajectory pictures to draw.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PngChoice {
-    /// The first N seeds of the range.
-    First(u64),
-    /// Every episode that did not succeed.
-    Failures,
-    /// Every episode.
-    All,
-}
-
-impl FromStr for PngChoice {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "failures" => Ok(Self::Failures),
-            "all" => Ok(Self::All),
-            n => n
-                .parse()
-                .map(Self::First)
-                .map_err(|_| format!("{n:?}: expected a number, `failures` or `all`")),
-        }
-    }
-}
 
 /// Arguments of `ronap run`.
 #[derive(Args, Debug)]
@@ -77,7 +51,7 @@ pub struct RunArgs {
     log_steps: bool,
     /// Trajectory pictures in png/: the first N seeds, `failures` or `all` [default: none].
     #[arg(long, allow_negative_numbers = true, value_name = "N|failures|all")]
-    png: Option<PngChoice>,
+    png: Option<Pictures>,
     /// Exit with code 1 when the success rate is below this fraction (a gate for CI).
     #[arg(long, allow_negative_numbers = true, value_name = "F", value_parser = fraction)]
     min_success: Option<f64>,
@@ -232,12 +206,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     bar.set_prefix(format!("ronap run {}", args.policy));
 
     let png = args.png;
-    let wants_png = |r: &EpisodeRecord| match png {
-        None => false,
-        Some(PngChoice::All) => true,
-        Some(PngChoice::Failures) => r.outcome != Outcome::Success,
-        Some(PngChoice::First(n)) => r.seed - first < n,
-    };
+    let wants_png = |r: &EpisodeRecord| png.is_some_and(|p| p.wants(r, first));
     let recording = Recording {
         trajectory: png.is_some(),
         steps: args.log_steps,

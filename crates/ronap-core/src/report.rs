@@ -8,6 +8,42 @@ use crate::evaluate::{action_name, EpisodeRecord};
 use crate::render::{Canvas, GOAL, PATH, START};
 use std::io::Write;
 
+/// Which episodes get a trajectory picture.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pictures {
+    /// The first N seeds of the range.
+    First(u64),
+    /// Every episode that did not succeed.
+    Failures,
+    /// Every episode.
+    All,
+}
+
+impl std::str::FromStr for Pictures {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "failures" => Ok(Self::Failures),
+            "all" => Ok(Self::All),
+            n => n
+                .parse()
+                .map(Self::First)
+                .map_err(|_| format!("{n:?}: expected a number, `failures` or `all`")),
+        }
+    }
+}
+
+impl Pictures {
+    /// Whether `record` gets a picture, in a run whose seeds start at `first_seed`.
+    pub fn wants(self, record: &EpisodeRecord, first_seed: u64) -> bool {
+        match self {
+            Pictures::All => true,
+            Pictures::Failures => record.outcome != crate::evaluate::Outcome::Success,
+            Pictures::First(n) => record.seed.wrapping_sub(first_seed) < n,
+        }
+    }
+}
+
 /// Columns of `episodes.csv`.
 pub const EPISODE_COLUMNS: [&str; 14] = [
     "seed",

@@ -97,7 +97,7 @@ impl Summary {
     /// The summary as an aligned two-column table for a terminal.
     pub fn table(&self) -> String {
         let pct = |x: f64| format!("{:.1}%", 100.0 * x);
-        let rows: Vec<(&str, String)> = vec![
+        let mut rows: Vec<(&str, String)> = vec![
             ("episodes", self.episodes.to_string()),
             (
                 "success rate",
@@ -126,7 +126,6 @@ impl Summary {
             ("wall time", format!("{:.2} s", self.wall_time_s)),
             ("steps per second", format!("{:.0}", self.steps_per_second)),
         ];
-        let mut rows = rows;
         if self.collision_ends > 0 {
             rows.insert(4, ("ended by collision", self.collision_ends.to_string()));
         }

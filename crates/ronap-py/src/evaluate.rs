@@ -5,8 +5,9 @@ use crate::errors;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use ronap_core::evaluate::{Evaluator, Outcome, Recording};
+use ronap_core::evaluate::{Evaluator, Recording};
 use ronap_core::policy::{Builtin, Decision, Policy, PolicyError, PolicyFactory};
+use ronap_core::report::Pictures;
 use ronap_core::summary::Summary;
 use ronap_core::{Action, DiscreteAction, Episode, World};
 use std::sync::atomic::AtomicBool;
@@ -178,16 +179,11 @@ pub fn evaluate<'py>(
             "policy {policy}: expected a built-in policy name or a callable (observation -> action)"
         )));
     };
-    let png_choice = match png.as_deref() {
-        None => None,
-        Some("all") => Some(u64::MAX),
-        Some("failures") => Some(0),
-        Some(n) => Some(n.parse::<u64>().map_err(|_| {
-            errors::ConfigError::new_err(format!(
-                "png = {n:?}: expected a number, \"failures\" or \"all\""
-            ))
-        })?),
-    };
+    let png_choice: Option<Pictures> = png
+        .as_deref()
+        .map(str::parse)
+        .transpose()
+        .map_err(|e| errors::ConfigError::new_err(format!("png = {e}")))?;
     if let Some(dir) = &out {
         for sub in [
             Some(""),
@@ -218,11 +214,7 @@ pub fn evaluate<'py>(
         .allow_threads(|| {
             let on_record = |r: &ronap_core::evaluate::EpisodeRecord| {
                 let Some(dir) = &out else { return };
-                let picture = match png_choice {
-                    None => false,
-                    Some(0) => r.outcome != Outcome::Success,
-                    Some(n) => r.seed.wrapping_sub(first) < n,
-                };
+                let picture = png_choice.is_some_and(|p| p.wants(r, first));
                 if let Err(e) = ronap_core::report::write_episode_files(dir, r, picture, log_steps)
                 {
                     if let Ok(mut all) = write_errors.lock() {

@@ -35,40 +35,6 @@ struct Out {
     pose: [f64; 3],
 }
 
-/// Runs `f` on every environment with its observation row, output and action: on the calling
-/// thread for a small batch (too little work to wake another thread for), else on `pool`.
-fn for_each_env(
-    pool: &rayon::ThreadPool,
-    slots: &mut [Slot],
-    obs: &mut [f32],
-    outs: &mut [Out],
-    obs_size: usize,
-    actions: &[usize],
-    f: impl Fn(&mut Slot, &mut [f32], &mut Out, usize) -> Result<(), EpisodeError> + Sync,
-) -> Result<(), EpisodeError> {
-    let one = |(((slot, obs), out), &a): (((&mut Slot, &mut [f32]), &mut Out), &usize)| {
-        f(slot, obs, out, a)
-    };
-    if slots.len() <= MIN_PER_TASK {
-        slots
-            .iter_mut()
-            .zip(obs.chunks_mut(obs_size))
-            .zip(outs.iter_mut())
-            .zip(actions.iter())
-            .try_for_each(one)
-    } else {
-        pool.install(|| {
-            slots
-                .par_iter_mut()
-                .zip(obs.par_chunks_mut(obs_size))
-                .zip(outs.par_iter_mut())
-                .zip(actions.par_iter())
-                .with_min_len(MIN_PER_TASK)
-                .try_for_each(one)
-        })
-    }
-}
-
 /// Many RoNAP environments stepped together.
 #[pyclass(module = "ronap._ronap")]
 pub struct VecEnv {
@@ -81,6 +47,38 @@ pub struct VecEnv {
 }
 
 impl VecEnv {
+    /// Runs `f` on every environment with its observation row, output and action: on the calling
+    /// thread for a small batch (too little work to wake another thread for), else on the pool.
+    fn for_each_env(
+        &mut self,
+        actions: &[usize],
+        f: impl Fn(&Evaluator, &mut Slot, &mut [f32], &mut Out, usize) -> Result<(), EpisodeError>
+            + Sync,
+    ) -> Result<(), EpisodeError> {
+        let (evaluator, d) = (&self.evaluator, self.obs_size);
+        let one = |(((slot, obs), out), &a): (((&mut Slot, &mut [f32]), &mut Out), &usize)| {
+            f(evaluator, slot, obs, out, a)
+        };
+        if self.slots.len() <= MIN_PER_TASK {
+            self.slots
+                .iter_mut()
+                .zip(self.obs.chunks_mut(d))
+                .zip(self.outs.iter_mut())
+                .zip(actions.iter())
+                .try_for_each(one)
+        } else {
+            self.pool.install(|| {
+                self.slots
+                    .par_iter_mut()
+                    .zip(self.obs.par_chunks_mut(d))
+                    .zip(self.outs.par_iter_mut())
+                    .zip(actions.par_iter())
+                    .with_min_len(MIN_PER_TASK)
+                    .try_for_each(one)
+            })
+        }
+    }
+
     fn start(
         evaluator: &Evaluator,
         slot: &mut Slot,
@@ -171,17 +169,9 @@ impl VecEnv {
         for (i, slot) in self.slots.iter_mut().enumerate() {
             slot.next_seed = seed.wrapping_add(i as u64);
         }
-        let (evaluator, slots, obs, outs, d) = (
-            &self.evaluator,
-            &mut self.slots,
-            &mut self.obs,
-            &mut self.outs,
-            self.obs_size,
-        );
-        let pool = &self.pool;
-        let actions = vec![0; slots.len()];
+        let actions = vec![0; self.slots.len()];
         py.allow_threads(|| {
-            for_each_env(pool, slots, obs, outs, d, &actions, |slot, obs, out, _| {
+            self.for_each_env(&actions, |evaluator, slot, obs, out, _| {
                 Self::start(evaluator, slot, n, obs, out)
             })
         })
@@ -221,38 +211,31 @@ impl VecEnv {
             )));
         }
         let actions: Vec<usize> = actions.iter().map(|&a| a as usize).collect();
-        let (evaluator, slots, obs, outs, d) = (
-            &self.evaluator,
-            &mut self.slots,
-            &mut self.obs,
-            &mut self.outs,
-            self.obs_size,
-        );
-        let pool = &self.pool;
         let n64 = n as u64;
-        let step_one = |slot: &mut Slot, obs: &mut [f32], out: &mut Out, a: usize| {
-            if slot.needs_reset || slot.episode.is_none() {
-                return Self::start(evaluator, slot, n64, obs, out);
-            }
-            let Some(episode) = slot.episode.as_mut() else {
-                return Ok(());
+        let step_one =
+            |evaluator: &Evaluator, slot: &mut Slot, obs: &mut [f32], out: &mut Out, a: usize| {
+                if slot.needs_reset || slot.episode.is_none() {
+                    return Self::start(evaluator, slot, n64, obs, out);
+                }
+                let Some(episode) = slot.episode.as_mut() else {
+                    return Ok(());
+                };
+                let r = episode.step(DiscreteAction::ALL[a]);
+                let (terminated, truncated) = ends(r.status);
+                *out = Out {
+                    reward: r.reward,
+                    terminated,
+                    truncated,
+                    collided: r.collided,
+                    success: r.status == Status::Success,
+                    distance: r.distance_px,
+                    pose: [r.pose.x, r.pose.y, r.pose.z_deg],
+                };
+                obs.copy_from_slice(r.observation);
+                slot.needs_reset = r.status.is_done();
+                Ok(())
             };
-            let r = episode.step(DiscreteAction::ALL[a]);
-            let (terminated, truncated) = ends(r.status);
-            *out = Out {
-                reward: r.reward,
-                terminated,
-                truncated,
-                collided: r.collided,
-                success: r.status == Status::Success,
-                distance: r.distance_px,
-                pose: [r.pose.x, r.pose.y, r.pose.z_deg],
-            };
-            obs.copy_from_slice(r.observation);
-            slot.needs_reset = r.status.is_done();
-            Ok(())
-        };
-        py.allow_threads(|| for_each_env(pool, slots, obs, outs, d, &actions, step_one))
+        py.allow_threads(|| self.for_each_env(&actions, step_one))
             .map_err(errors::scene)?;
         let rewards = PyArray1::from_iter(py, self.outs.iter().map(|o| o.reward));
         let terminated = PyArray1::from_iter(py, self.outs.iter().map(|o| o.terminated));

@@ -125,3 +125,15 @@ def test_continuous_python_policy_uses_normalised_actions():
     row = straight["episodes"][0]
     assert row["path_length_px"] <= 50.0 + 1e-9
     assert row["path_length_px"] == pytest.approx(50.0) or row["collisions"] > 0
+
+
+def test_png_choice_matches_the_cli(tmp_path):
+    # png=0 means no pictures (it once meant "failures"); "failures" draws only failures.
+    ronap.evaluate("apf", range(10), out=str(tmp_path / "none"), png=0)
+    assert list((tmp_path / "none" / "png").iterdir()) == []
+    result = ronap.evaluate("apf", range(10), out=str(tmp_path / "fail"), png="failures")
+    failed = {r["seed"] for r in result["episodes"] if r["outcome"] != "success"}
+    drawn = {int(p.name.split("-")[1]) for p in (tmp_path / "fail" / "png").iterdir()}
+    assert drawn == failed and failed
+    with pytest.raises(ronap.ConfigError, match="png"):
+        ronap.evaluate("apf", range(2), out=str(tmp_path / "bad"), png="some")

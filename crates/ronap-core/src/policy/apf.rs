@@ -42,7 +42,8 @@ pub fn potential(scene: &Scene, config: &ApfConfig, radius: f64, goal: Point, q:
         }
         None => {}
     }
-    if scene.occupied(q) {
+    // Inside an obstacle the clearance above is 0; what is left is leaving the scene.
+    if !scene.bounds().contains(q) {
         return f64::INFINITY;
     }
     u
@@ -91,15 +92,21 @@ pub fn plan(
                 reached: false,
             };
         }
+        // Two positions with clear discs less than a diameter apart cannot have a wall between
+        // them; a coarser lattice must check each move, or it would hop thin walls.
+        let hops = h * std::f64::consts::SQRT_2 >= 2.0 * radius;
         let best = offsets
             .iter()
             .map(|&(di, dj)| {
+                let next = at(i + di, j + dj);
                 (
                     (i + di, j + dj),
-                    potential(scene, config, radius, goal, at(i + di, j + dj)),
+                    next,
+                    potential(scene, config, radius, goal, next),
                 )
             })
-            .filter(|(_, u)| u.is_finite())
+            .filter(|&(_, next, u)| u.is_finite() && (!hops || scene.sweep_clear(q, next, radius)))
+            .map(|(ij, _, u)| (ij, u))
             .min_by(|a, b| a.1.total_cmp(&b.1));
         match best {
             Some(((ni, nj), _)) => (i, j) = (ni, nj),
@@ -192,6 +199,31 @@ mod tests {
         );
         assert!(p.reached);
         assert!((p.path.last().unwrap() - Point::new(260.0, 170.0)).norm() <= 10.0);
+    }
+
+    #[test]
+    fn a_coarse_lattice_does_not_hop_a_thin_wall() {
+        // A 2 px wall across the room between start and goal, and a 20 px lattice.
+        let wall = vec![Aabb::from_corners(
+            Point::new(149.0, 0.0),
+            Point::new(151.0, 200.0),
+        )];
+        let scene = room(wall);
+        let config = ApfConfig {
+            lattice_px: 20.0,
+            ..ApfConfig::default()
+        };
+        let p = plan(
+            &scene,
+            &config,
+            5.0,
+            Point::new(100.0, 100.0),
+            Point::new(200.0, 100.0),
+            10.0,
+            10_000,
+        );
+        assert!(!p.reached);
+        assert!(p.path.iter().all(|q| q.x < 149.0), "{:?}", p.path);
     }
 
     #[test]
