@@ -2,8 +2,10 @@
 //! the model itself lives in the core.
 
 mod bench;
+mod collect;
 mod maze;
 mod output;
+mod policies;
 mod py_policy;
 mod run;
 mod sim_args;
@@ -36,6 +38,8 @@ enum Command {
     Maze(maze::MazeArgs),
     /// Evaluate a policy over many seeded episodes: summary table, CSV logs, PNG trajectories.
     Run(run::RunArgs),
+    /// Record (observation, expert action) rows for behaviour cloning, in the data-log format.
+    Collect(collect::CollectArgs),
     /// Measure how fast this machine steps the default scene.
     Bench(bench::BenchArgs),
     /// Print the whole configuration as TOML, a comment on every field: a file to copy and edit
@@ -90,6 +94,7 @@ fn main() -> ExitCode {
         Command::Maze(args) => maze::run(args),
         Command::Run(args) => run::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Collect(args) => collect::run(args),
         Command::Config(args) => print_config(args),
     };
     match result {

@@ -1,18 +1,16 @@
 //! `ronap run`: evaluate a policy over many seeded episodes and write what happened.
 
-use crate::sim_args::{count, fraction, seed, SimArgs};
+use crate::policies::policy_factory;
+use crate::sim_args::{cancel_on_ctrl_c, count, fraction, seed, threads, SceneArgs, SimArgs};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use ronap_core::evaluate::{EpisodeRecord, Evaluator, Recording, Scenes};
-use ronap_core::policy::{Builtin, PolicyFactory};
+use ronap_core::evaluate::{EpisodeRecord, Evaluator, Recording};
 use ronap_core::report::{self, Pictures};
 use ronap_core::summary::Summary;
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 
 /// Arguments of `ronap run`.
 #[derive(Args, Debug)]
@@ -31,13 +29,8 @@ pub struct RunArgs {
     /// Worker threads [default: all cores].
     #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
     threads: Option<u32>,
-    /// Use the maze of this seed for every episode [default: each seed its own maze].
-    #[arg(long, allow_negative_numbers = true, value_name = "SEED", conflicts_with = "map", value_parser = seed)]
-    maze_seed: Option<u64>,
-    /// Run on an image scene (PNG/PGM: dark pixels are obstacles) or a ROS map_server YAML file;
-    /// start and goal are drawn per seed.
-    #[arg(long, value_name = "FILE")]
-    map: Option<PathBuf>,
+    #[command(flatten)]
+    scenes: SceneArgs,
     #[command(flatten)]
     sim: SimArgs,
     /// Steps before a time-out [default: 2000].
@@ -83,42 +76,16 @@ pub fn utc_now() -> (i64, u32, u32, u32, u32, u32) {
     )
 }
 
-fn policy_factory(name: &str) -> Result<Box<dyn PolicyFactory>> {
-    if let Some(spec) = name.strip_prefix("py:") {
-        return Ok(Box::new(
-            crate::py_policy::PyPolicyFactory::new(spec).map_err(anyhow::Error::msg)?,
-        ));
-    }
-    match Builtin::from_name(name) {
-        Some(b) => Ok(Box::new(b)),
-        None => {
-            let known: Vec<&str> = Builtin::ALL.iter().map(|(_, n, _)| *n).collect();
-            bail!(
-                "--policy {name:?}: unknown policy (expected one of: {})",
-                known.join(", ")
-            )
-        }
-    }
-}
-
 /// Runs `ronap run`.
 pub fn run(args: RunArgs) -> Result<ExitCode> {
     // Everything that can be wrong with the input is checked before anything is written.
-    let factory = policy_factory(&args.policy)?;
     let config = args.sim.config_with(|sim| {
         if let Some(n) = args.max_steps {
             sim.episode.max_steps = n;
         }
     })?;
-    let (scenes, map_source) = match (&args.map, args.maze_seed) {
-        (Some(path), _) => {
-            let reach = ronap_core::episode::reach_px(&config);
-            let (scene, source) = ronap_core::map::load(path, &config.map, reach)?;
-            (Scenes::Fixed(Arc::new(scene)), Some(source))
-        }
-        (None, Some(seed)) => (Scenes::Maze(seed), None),
-        (None, None) => (Scenes::MazePerSeed, None),
-    };
+    let factory = policy_factory(&args.policy, &config)?;
+    let (scenes, map_source) = args.scenes.scenes(&config)?;
     let evaluator = Evaluator::new(config.clone(), scenes);
     let first = args.seed_start;
     let end = first.checked_add(args.seeds).with_context(|| {
@@ -132,10 +99,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         .world(first)
         .episode(first)
         .with_context(|| format!("cannot start episodes in this scene (seed {first})"))?;
-    let threads = args.threads.map_or_else(
-        || std::thread::available_parallelism().map_or(1, |n| n.get()),
-        |n| n as usize,
-    );
+    let threads = threads(args.threads);
     let out_dir = match &args.out {
         Some(d) => d.clone(),
         None => {
@@ -181,17 +145,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
             .with_context(|| format!("cannot create {}/steps", out_dir.display()))?;
     }
 
-    let cancel = Arc::new(AtomicBool::new(false));
-    {
-        let cancel = cancel.clone();
-        // A second Ctrl-C stops at once; the first lets running episodes finish and keeps them.
-        let _ = ctrlc::set_handler(move || {
-            if cancel.swap(true, Ordering::SeqCst) {
-                std::process::exit(130);
-            }
-            eprintln!("\nronap: interrupted; finishing running episodes and writing what is done (Ctrl-C again to quit now)");
-        });
-    }
+    let cancel = cancel_on_ctrl_c("finishing running episodes and writing what is done");
     let bar = if std::io::stderr().is_terminal() {
         ProgressBar::with_draw_target(Some(args.seeds), ProgressDrawTarget::stderr())
     } else {
@@ -232,11 +186,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     bar.finish_and_clear();
 
     let summary = Summary::new(&result.records, result.wall_time_s);
-    let scenes = match (&args.map, args.maze_seed) {
-        (Some(p), _) => format!("map {}", p.display()),
-        (None, Some(s)) => format!("maze of seed {s}"),
-        (None, None) => "a maze per seed".to_string(),
-    };
+    let scenes = args.scenes.describe();
     let meta = serde_json::json!({
         "policy": args.policy,
         "seed_start": first,

@@ -3,8 +3,11 @@
 
 use anyhow::{Context, Result};
 use clap::Args;
+use ronap_core::evaluate::Scenes;
 use ronap_core::{SimConfig, ValidConfig};
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// Parses a positive, finite number of px.
 pub fn positive(s: &str) -> Result<f64, String> {
@@ -94,4 +97,65 @@ impl SimArgs {
         sim.validate()
             .with_context(|| format!("invalid configuration from {source}"))
     }
+}
+
+/// Where episodes take place.
+#[derive(Args, Debug, Clone, Default)]
+pub struct SceneArgs {
+    /// Use the maze of this seed for every episode [default: each seed its own maze].
+    #[arg(long, allow_negative_numbers = true, value_name = "SEED", conflicts_with = "map", value_parser = seed)]
+    pub maze_seed: Option<u64>,
+    /// Run on an image scene (PNG/PGM: dark pixels are obstacles) or a ROS map_server YAML file;
+    /// start and goal are drawn per seed.
+    #[arg(long, value_name = "FILE")]
+    pub map: Option<PathBuf>,
+}
+
+impl SceneArgs {
+    /// The scenes, and the map's source description when there is a map.
+    pub fn scenes(
+        &self,
+        config: &ValidConfig,
+    ) -> Result<(Scenes, Option<ronap_core::map::MapSource>)> {
+        Ok(match (&self.map, self.maze_seed) {
+            (Some(path), _) => {
+                let reach = ronap_core::episode::reach_px(config);
+                let (scene, source) = ronap_core::map::load(path, &config.map, reach)?;
+                (Scenes::Fixed(Arc::new(scene)), Some(source))
+            }
+            (None, Some(seed)) => (Scenes::Maze(seed), None),
+            (None, None) => (Scenes::MazePerSeed, None),
+        })
+    }
+
+    /// The scenes in words.
+    pub fn describe(&self) -> String {
+        match (&self.map, self.maze_seed) {
+            (Some(p), _) => format!("map {}", p.display()),
+            (None, Some(s)) => format!("maze of seed {s}"),
+            (None, None) => "a maze per seed".to_string(),
+        }
+    }
+}
+
+/// Worker threads: `flag`, or all cores.
+pub fn threads(flag: Option<u32>) -> usize {
+    flag.map_or_else(
+        || std::thread::available_parallelism().map_or(1, |n| n.get()),
+        |n| n as usize,
+    )
+}
+
+/// A flag the first Ctrl-C sets (after saying `what` happens now); a second Ctrl-C exits at once
+/// with code 130.
+pub fn cancel_on_ctrl_c(what: &'static str) -> Arc<AtomicBool> {
+    let cancel = Arc::new(AtomicBool::new(false));
+    let flag = cancel.clone();
+    let _ = ctrlc::set_handler(move || {
+        if flag.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+        eprintln!("\nronap: interrupted; {what} (Ctrl-C again to quit now)");
+    });
+    cancel
 }

@@ -354,6 +354,37 @@ impl Episode {
         self.observation[last] = (self.direction_deg() / 360.0) as f32;
     }
 
+    /// The paper's re-posing in data collection (SPEC.md): the robot jumps to a random free pose,
+    /// `x, y` uniform over the scene where the robot fits (and, given `grid`, in the goal's free
+    /// region, so the goal stays reachable), heading `theta + 360 lambda3` with
+    /// `lambda3 ~ N(0, 0.03^2)`: roughly towards the goal. The goal, step and collision counts stay.
+    /// `None` when no such pose turned up in many tries (the robot then stays where it was).
+    pub fn repose(&mut self, grid: Option<&FreeGrid>, rng: &mut Rng) -> Option<Pose> {
+        let radius = self.config.robot.radius_px;
+        let (w, h) = (self.scene.width(), self.scene.height());
+        let region = grid.and_then(|g| g.region_at(self.goal));
+        for _ in 0..PLACEMENT_TRIES * PLACEMENT_TRIES {
+            let p = Point::new(
+                rng.random_range(radius..(w - radius).max(radius + 1e-9)),
+                rng.random_range(radius..(h - radius).max(radius + 1e-9)),
+            );
+            let reachable = match (grid, region) {
+                (Some(g), Some(r)) => g.region_at(p) == Some(r),
+                _ => true,
+            };
+            if !reachable || !self.scene.disc_clear(p, radius) {
+                continue;
+            }
+            let lambda3 =
+                0.03 * rand_distr::Distribution::<f64>::sample(&rand_distr::StandardNormal, rng);
+            let z = wrap_deg(bearing_deg(p, self.goal) + 360.0 * lambda3);
+            self.pose = Pose::new(p.x, p.y, z);
+            self.sense();
+            return Some(self.pose);
+        }
+        None
+    }
+
     /// Takes one step. On a finished episode nothing moves and the reward is 0.
     pub fn step(&mut self, action: impl Into<Action>) -> StepResult<'_> {
         if self.status.is_done() {

@@ -5,7 +5,9 @@
 //! degrees, with x right and y up. Nothing here parses arguments, prints or exits: the `ronap`
 //! binary and the Python module wrap it.
 
+pub mod collect;
 pub mod config;
+pub mod datalog;
 pub mod episode;
 pub mod evaluate;
 pub mod freespace;

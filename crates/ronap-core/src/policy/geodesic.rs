@@ -4,10 +4,12 @@
 //! Planning charges steps next to walls extra and smooths with a margin, so the path keeps a few
 //! px off corners the discrete robot could clip.
 
-use super::follow::Follower;
+use super::follow::{FollowStep, Follower};
 use super::{Decision, Policy, PolicyError};
 use crate::episode::Episode;
+use crate::geometry::Point;
 use crate::planning::{smooth, DistanceField};
+use crate::robot::DiscreteAction;
 use crate::world::World;
 
 /// Cost factor of grid steps within a radius of touching a wall.
@@ -28,18 +30,33 @@ impl Geodesic {
     }
 }
 
+/// Grid points of the path an [`Expert`] smooths: about the next 400 px, plenty for its label
+/// (smoothing the whole path for every sample costs 3x the time and changes 0.5% of labels).
+const EXPERT_PATH_POINTS: usize = 80;
+
+/// Plans `field`'s path from `from` and a follower of it; with `prefix`, of only the first
+/// `prefix` grid points of the path.
+fn plan(
+    world: &World,
+    field: &DistanceField,
+    from: Point,
+    prefix: Option<usize>,
+) -> Option<Follower> {
+    let radius = world.config().robot.radius_px;
+    let (scene, grid) = (world.scene(), world.grid());
+    field.path(scene, grid, from, radius).map(|mut path| {
+        if let Some(n) = prefix {
+            path.truncate(n.max(2));
+        }
+        let path = smooth(scene, &path, radius + MARGIN_PX);
+        Follower::new(path, world.config().robot.move_speed_px * 2.0)
+    })
+}
+
 impl Policy for Geodesic {
     fn reset(&mut self, world: &World, episode: &Episode) -> Result<(), PolicyError> {
-        let radius = world.config().robot.radius_px;
-        let scene = world.scene();
-        let grid = world.grid();
-        let field = DistanceField::new(scene, grid, episode.goal(), radius, CLOSE_COST);
-        self.follower = field
-            .path(scene, grid, episode.pose().position(), radius)
-            .map(|path| {
-                let path = smooth(scene, &path, radius + MARGIN_PX);
-                Follower::new(path, world.config().robot.move_speed_px * 2.0)
-            });
+        let field = Expert::field(world, episode.goal());
+        self.follower = plan(world, &field, episode.pose().position(), None);
         Ok(())
     }
 
@@ -50,5 +67,42 @@ impl Policy for Geodesic {
         Ok(follower
             .next(episode)
             .decision("reached the end of the path short of the goal"))
+    }
+}
+
+/// The geodesic policy as a teacher: the action it would take from any pose towards one goal,
+/// planned afresh from that pose, for labelling data (re-posed samples, or states another policy
+/// drove to).
+#[derive(Debug)]
+pub struct Expert {
+    field: DistanceField,
+}
+
+impl Expert {
+    fn field(world: &World, goal: Point) -> DistanceField {
+        DistanceField::new(
+            world.scene(),
+            world.grid(),
+            goal,
+            world.config().robot.radius_px,
+            CLOSE_COST,
+        )
+    }
+
+    /// A teacher for `goal` in `world`.
+    pub fn new(world: &World, goal: Point) -> Self {
+        Self {
+            field: Self::field(world, goal),
+        }
+    }
+
+    /// The action from `episode`'s pose; `None` when the goal is unreachable from there or the
+    /// robot is already at the end of the path.
+    pub fn action(&self, world: &World, episode: &Episode) -> Option<DiscreteAction> {
+        let from = episode.pose().position();
+        match plan(world, &self.field, from, Some(EXPERT_PATH_POINTS))?.next(episode) {
+            FollowStep::Act(a) => Some(a),
+            FollowStep::Arrived | FollowStep::Stuck => None,
+        }
     }
 }

@@ -4,6 +4,7 @@
 pub mod apf;
 pub mod follow;
 pub mod geodesic;
+pub mod mlp;
 pub mod random;
 
 use crate::episode::Episode;
