@@ -9,6 +9,7 @@ mod policies;
 mod py_policy;
 mod run;
 mod sim_args;
+mod train;
 
 use clap::{Parser, Subcommand};
 use std::io::Write;
@@ -42,6 +43,8 @@ enum Command {
     Collect(collect::CollectArgs),
     /// Measure how fast this machine steps the default scene.
     Bench(bench::BenchArgs),
+    /// Train a policy network (behaviour cloning or DQN) and write its weights file.
+    Train(train::TrainArgs),
     /// Print the whole configuration as TOML, a comment on every field: a file to copy and edit
     /// for --config.
     Config(ConfigArgs),
@@ -95,6 +98,7 @@ fn main() -> ExitCode {
         Command::Run(args) => run::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Collect(args) => collect::run(args),
+        Command::Train(args) => train::run(args),
         Command::Config(args) => print_config(args),
     };
     match result {

@@ -1,16 +1,29 @@
 //! Policies by name, as the command line gives them.
 
-use anyhow::{bail, Result};
-use ronap_core::policy::mlp::MlpFactory;
+use anyhow::{bail, Context, Result};
+use ronap_core::policy::mlp::{DecisionRule, MlpFactory};
 use ronap_core::policy::{Builtin, PolicyFactory};
 use ronap_core::ValidConfig;
 use std::path::Path;
 
 /// The policy `name` names: a built-in, `mlp:FILE` or `py:FILE:FUNCTION`.
 pub fn policy_factory(name: &str, config: &ValidConfig) -> Result<Box<dyn PolicyFactory>> {
-    if let Some(path) = name.strip_prefix("mlp:") {
+    if let Some(spec) = name.strip_prefix("mlp:") {
         let size = config.laser.beams as usize + 1;
-        return Ok(Box::new(MlpFactory::load(Path::new(path), size)?));
+        let (path, rule) = match spec.rsplit_once('@') {
+            Some((path, rule)) => {
+                let rule = DecisionRule::parse(rule).with_context(|| {
+                    format!("--policy {name:?}: {rule:?} is not a decision rule (argmax or sample:TEMPERATURE)")
+                })?;
+                (path, Some(rule))
+            }
+            None => (spec, None),
+        };
+        let factory = MlpFactory::load(Path::new(path), size)?;
+        return Ok(Box::new(match rule {
+            Some(r) => factory.with_rule(r),
+            None => factory,
+        }));
     }
     if let Some(spec) = name.strip_prefix("py:") {
         return Ok(Box::new(

@@ -191,6 +191,14 @@ impl Mlp {
         })
     }
 
+    /// The `decision` metadata's rule, argmax when absent.
+    pub fn decision_rule(&self) -> DecisionRule {
+        self.metadata
+            .get("decision")
+            .and_then(|d| DecisionRule::parse(d))
+            .unwrap_or(DecisionRule::Argmax)
+    }
+
     /// Number of inputs.
     pub fn inputs(&self) -> usize {
         self.layers[0].weight.ncols()
@@ -299,6 +307,13 @@ impl Mlp {
                 "unexpected tensor {extra} (layers are numbered from 0 without gaps)"
             ));
         }
+        if let Some(d) = metadata.get("decision") {
+            if DecisionRule::parse(d).is_none() {
+                return Err(format!(
+                    "metadata decision = {d:?} (expected argmax or sample:TEMPERATURE)"
+                ));
+            }
+        }
         let mlp = Self::new(layers, activation, metadata.clone())?;
         if let Some(size) = metadata.get("observation_size") {
             if size.parse::<usize>().ok() != Some(mlp.inputs()) {
@@ -350,16 +365,57 @@ fn floats(t: &TensorView<'_>, name: &str) -> Result<Vec<f32>, String> {
         .collect())
 }
 
-/// The MLP as a policy: the action with the largest output at each step.
+/// How a policy turns the network's outputs into an action.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DecisionRule {
+    /// The action with the largest output.
+    Argmax,
+    /// An action drawn from softmax(outputs / temperature), from the episode's policy stream:
+    /// a classifier's probabilities, taken at their word.
+    Sample {
+        /// Softmax temperature, > 0.
+        temperature: f32,
+    },
+}
+
+impl DecisionRule {
+    /// Parses the `decision` metadata value: `argmax` or `sample:TEMPERATURE`.
+    pub fn parse(s: &str) -> Option<Self> {
+        if s == "argmax" {
+            return Some(Self::Argmax);
+        }
+        s.strip_prefix("sample:")
+            .and_then(|t| t.parse::<f32>().ok())
+            .filter(|t| t.is_finite() && *t > 0.0)
+            .map(|temperature| Self::Sample { temperature })
+    }
+
+    /// The metadata value.
+    pub fn name(self) -> String {
+        match self {
+            Self::Argmax => "argmax".into(),
+            Self::Sample { temperature } => format!("sample:{temperature}"),
+        }
+    }
+}
+
+/// The MLP as a policy.
 #[derive(Clone, Debug)]
 pub struct MlpPolicy {
     mlp: Arc<Mlp>,
+    rule: DecisionRule,
+    rng: crate::rng::Rng,
 }
 
 impl MlpPolicy {
-    /// A policy running `mlp`.
+    /// A policy running `mlp` with its file's decision rule.
     pub fn new(mlp: Arc<Mlp>) -> Self {
-        Self { mlp }
+        let rule = mlp.decision_rule();
+        Self {
+            mlp,
+            rule,
+            rng: crate::rng::stream(0, crate::rng::Stream::Policy),
+        }
     }
 }
 
@@ -374,11 +430,34 @@ impl Policy for MlpPolicy {
                 size - 1
             )));
         }
+        self.rng = crate::rng::stream(episode.seed(), crate::rng::Stream::Policy);
         Ok(())
     }
 
     fn act(&mut self, episode: &Episode) -> Result<Decision, PolicyError> {
-        Ok(Decision::Act(self.mlp.action(episode.observation()).into()))
+        let observation = episode.observation();
+        let action = match self.rule {
+            DecisionRule::Argmax => self.mlp.action(observation),
+            DecisionRule::Sample { temperature } => {
+                let out = self.mlp.forward(observation);
+                let top = out.max();
+                let weights: Vec<f32> = out
+                    .iter()
+                    .map(|v| ((v - top) / temperature).exp())
+                    .collect();
+                let mut u = rand::Rng::random::<f32>(&mut self.rng) * weights.iter().sum::<f32>();
+                let mut pick = weights.len() - 1;
+                for (i, w) in weights.iter().enumerate() {
+                    if u < *w {
+                        pick = i;
+                        break;
+                    }
+                    u -= w;
+                }
+                DiscreteAction::ALL[pick]
+            }
+        };
+        Ok(Decision::Act(action.into()))
     }
 }
 
@@ -410,6 +489,15 @@ impl MlpFactory {
             mlp: Arc::new(mlp),
             name: format!("mlp:{}", path.display()),
         })
+    }
+
+    /// The same network with `rule` instead of the file's decision rule.
+    pub fn with_rule(mut self, rule: DecisionRule) -> Self {
+        let mut mlp = (*self.mlp).clone();
+        mlp.metadata.insert("decision".into(), rule.name());
+        self.mlp = Arc::new(mlp);
+        self.name = format!("{}@{}", self.name, rule.name());
+        self
     }
 
     /// The network.

@@ -1,0 +1,218 @@
+//! The trainable network: the same multilayer perceptron as the core's [`Mlp`], as candle
+//! variables, with conversions both ways.
+
+use crate::LearnError;
+use candle_core::{DType, Device, Tensor, Var};
+use nalgebra::{DMatrix, DVector};
+use rand::Rng as _;
+use rand_chacha::ChaCha8Rng;
+use ronap_core::policy::mlp::{Activation, Layer, Mlp};
+use std::collections::HashMap;
+
+/// Bounds of RReLU's random negative slope in training (PyTorch's defaults).
+const RRELU_BOUNDS: (f32, f32) = (1.0 / 8.0, 1.0 / 3.0);
+
+/// How a hidden activation behaves in training.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TrainActivation {
+    /// max(0, x).
+    Relu,
+    /// tanh(x).
+    Tanh,
+    /// Leaky ReLU with a fixed slope.
+    LeakyRelu(f32),
+    /// The paper's randomised leaky ReLU: a slope drawn per value from U(1/8, 1/3) in training,
+    /// their mean at inference.
+    Rrelu,
+}
+
+impl TrainActivation {
+    /// Parses `relu`, `tanh`, `rrelu` or `leaky_relu:SLOPE`.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "relu" => Some(Self::Relu),
+            "tanh" => Some(Self::Tanh),
+            "rrelu" => Some(Self::Rrelu),
+            _ => match Activation::parse(s)? {
+                Activation::LeakyRelu(a) => Some(Self::LeakyRelu(a)),
+                _ => None,
+            },
+        }
+    }
+
+    /// The activation the saved network uses.
+    pub fn inference(self) -> Activation {
+        match self {
+            Self::Relu => Activation::Relu,
+            Self::Tanh => Activation::Tanh,
+            Self::LeakyRelu(a) => Activation::LeakyRelu(a),
+            Self::Rrelu => Activation::LeakyRelu(ronap_core::policy::mlp::RRELU_SLOPE),
+        }
+    }
+}
+
+/// A multilayer perceptron of candle variables.
+#[derive(Debug)]
+pub struct Net {
+    weights: Vec<Var>,
+    biases: Vec<Var>,
+    activation: TrainActivation,
+}
+
+impl Net {
+    /// A network of layer `sizes` (inputs first, outputs last) initialised as PyTorch's
+    /// `nn.Linear` does, U(-1/sqrt(in), 1/sqrt(in)), from `rng`.
+    pub fn new(
+        sizes: &[usize],
+        activation: TrainActivation,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Self, LearnError> {
+        let mut layers = Vec::new();
+        for pair in sizes.windows(2) {
+            let (n_in, n_out) = (pair[0], pair[1]);
+            let k = 1.0 / (n_in as f32).sqrt();
+            let weight = DMatrix::from_fn(n_out, n_in, |_, _| rng.random_range(-k..k));
+            let bias = DVector::from_fn(n_out, |_, _| rng.random_range(-k..k));
+            layers.push(Layer { weight, bias });
+        }
+        Self::from_layers(&layers, activation)
+    }
+
+    /// The trainable copy of `mlp`'s layers.
+    pub fn from_layers(layers: &[Layer], activation: TrainActivation) -> Result<Self, LearnError> {
+        let mut weights = Vec::new();
+        let mut biases = Vec::new();
+        for l in layers {
+            let rows: Vec<f32> = l.weight.transpose().iter().copied().collect();
+            let w = Tensor::from_vec(rows, (l.weight.nrows(), l.weight.ncols()), &Device::Cpu)?;
+            let b = Tensor::from_vec(l.bias.iter().copied().collect(), l.bias.len(), &Device::Cpu)?;
+            weights.push(Var::from_tensor(&w)?);
+            biases.push(Var::from_tensor(&b)?);
+        }
+        Ok(Self {
+            weights,
+            biases,
+            activation,
+        })
+    }
+
+    /// Every trainable variable.
+    pub fn vars(&self) -> Vec<Var> {
+        self.weights
+            .iter()
+            .zip(&self.biases)
+            .flat_map(|(w, b)| [w.clone(), b.clone()])
+            .collect()
+    }
+
+    /// Outputs for a batch `x` (`rows x inputs`). With `noise` (training), RReLU draws its slopes
+    /// from it; without, every activation is its inference form.
+    pub fn forward(
+        &self,
+        x: &Tensor,
+        noise: Option<&mut ChaCha8Rng>,
+    ) -> Result<Tensor, LearnError> {
+        let mut x = x.clone();
+        let last = self.weights.len() - 1;
+        let mut noise = noise;
+        for (i, (w, b)) in self.weights.iter().zip(&self.biases).enumerate() {
+            x = x
+                .matmul(&w.as_tensor().t()?)?
+                .broadcast_add(b.as_tensor())?;
+            if i == last {
+                break;
+            }
+            x = match (self.activation, noise.as_deref_mut()) {
+                (TrainActivation::Relu, _) => x.relu()?,
+                (TrainActivation::Tanh, _) => x.tanh()?,
+                (TrainActivation::Rrelu, Some(rng)) => {
+                    let n = x.elem_count();
+                    let slopes: Vec<f32> = (0..n)
+                        .map(|_| rng.random_range(RRELU_BOUNDS.0..RRELU_BOUNDS.1))
+                        .collect();
+                    let slopes = Tensor::from_vec(slopes, x.shape(), &Device::Cpu)?;
+                    (x.relu()? + x.minimum(0f32)?.mul(&slopes)?)?
+                }
+                (act, _) => {
+                    let slope = match act.inference() {
+                        Activation::LeakyRelu(s) => s,
+                        _ => 0.0,
+                    };
+                    (x.relu()? + x.minimum(0f32)?.affine(f64::from(slope), 0.0)?)?
+                }
+            };
+        }
+        Ok(x)
+    }
+
+    /// Copies `other`'s weights into this network (a target network refresh).
+    pub fn copy_from(&self, other: &Net) -> Result<(), LearnError> {
+        for (a, b) in self.vars().iter().zip(other.vars()) {
+            a.set(&b.as_tensor().copy()?)?;
+        }
+        Ok(())
+    }
+
+    /// The layers as the core's nalgebra layers.
+    pub fn layers(&self) -> Result<Vec<Layer>, LearnError> {
+        let mut out = Vec::new();
+        for (w, b) in self.weights.iter().zip(&self.biases) {
+            let (rows, cols) = w.as_tensor().dims2()?;
+            let values: Vec<f32> = w.as_tensor().flatten_all()?.to_vec1()?;
+            let bias: Vec<f32> = b.as_tensor().to_vec1()?;
+            out.push(Layer {
+                weight: DMatrix::from_row_slice(rows, cols, &values),
+                bias: DVector::from_vec(bias),
+            });
+        }
+        Ok(out)
+    }
+
+    /// The network for inference, with `metadata` for its file.
+    pub fn to_mlp(&self, metadata: HashMap<String, String>) -> Result<Mlp, LearnError> {
+        Mlp::new(self.layers()?, self.activation.inference(), metadata).map_err(LearnError::Network)
+    }
+}
+
+/// A `rows x width` batch tensor from row-major values.
+pub fn batch(values: Vec<f32>, width: usize) -> Result<Tensor, LearnError> {
+    let rows = values.len() / width.max(1);
+    Ok(Tensor::from_vec(values, (rows, width), &Device::Cpu)?)
+}
+
+/// Index of the largest value of each row of `outputs`.
+pub fn argmax_rows(outputs: &Tensor) -> Result<Vec<u32>, LearnError> {
+    Ok(outputs.argmax(1)?.to_dtype(DType::U32)?.to_vec1()?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+
+    #[test]
+    fn candle_and_nalgebra_agree() {
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        for act in [
+            TrainActivation::Relu,
+            TrainActivation::Tanh,
+            TrainActivation::Rrelu,
+            TrainActivation::LeakyRelu(0.05),
+        ] {
+            let net = Net::new(&[18, 16, 8, 3], act, &mut rng).unwrap();
+            let mlp = net.to_mlp(HashMap::new()).unwrap();
+            let x: Vec<f32> = (0..36).map(|i| (i as f32 * 0.7).sin()).collect();
+            let out: Vec<Vec<f32>> = net
+                .forward(&batch(x.clone(), 18).unwrap(), None)
+                .unwrap()
+                .to_vec2()
+                .unwrap();
+            for (row, o) in out.iter().enumerate() {
+                let expect = mlp.forward(&x[row * 18..(row + 1) * 18]);
+                for (a, b) in o.iter().zip(expect.iter()) {
+                    assert!((a - b).abs() < 1e-5, "{act:?}: {a} vs {b}");
+                }
+            }
+        }
+    }
+}
