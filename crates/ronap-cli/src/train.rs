@@ -7,7 +7,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use ronap_core::datalog;
 use ronap_core::evaluate::Evaluator;
 use ronap_core::output::write_atomic;
-use ronap_core::policy::mlp::Mlp;
+use ronap_core::policy::mlp::{DecisionRule, Mlp};
 use ronap_learn::bc::{self, BcOptions};
 use ronap_learn::dqn::{self, DqnOptions};
 use ronap_learn::net::TrainActivation;
@@ -51,6 +51,11 @@ struct NetArgs {
     /// Seed of the initial weights and of every random choice in training.
     #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 0, value_parser = seed)]
     seed: u64,
+    /// How `ronap run` turns the outputs into an action, saved in the file: argmax, or
+    /// sample:TEMPERATURE (draw from softmax(outputs / TEMPERATURE); a reactive policy that
+    /// samples does not loop forever where argmax would).
+    #[arg(long, value_name = "RULE", default_value = "argmax", value_parser = decision)]
+    decision: DecisionRule,
     /// Weights file to write (safetensors).
     #[arg(long, value_name = "FILE")]
     out: PathBuf,
@@ -146,6 +151,10 @@ fn widths(s: &str) -> Result<Widths, String> {
         .map(Widths)
 }
 
+fn decision(s: &str) -> Result<DecisionRule, String> {
+    DecisionRule::parse(s).ok_or_else(|| format!("{s:?}: expected argmax or sample:TEMPERATURE"))
+}
+
 fn activation(s: &str) -> Result<TrainActivation, String> {
     TrainActivation::parse(s)
         .ok_or_else(|| format!("{s:?}: expected relu, tanh, rrelu or leaky_relu:SLOPE"))
@@ -170,6 +179,16 @@ fn bar(len: u64, template: &str, prefix: &str) -> ProgressBar {
     );
     bar.set_prefix(prefix.to_string());
     bar
+}
+
+/// Prints a progress line above the bar, or straight to stdout (flushed, for logs and pipes)
+/// when there is no bar.
+fn show(progress: &ProgressBar, stdout: &mut impl Write, line: &str) {
+    if progress.is_hidden() {
+        let _ = writeln!(stdout, "{line}").and_then(|()| stdout.flush());
+    } else {
+        progress.println(line);
+    }
 }
 
 /// The command line, for the weights file's metadata.
@@ -275,12 +294,12 @@ fn train_bc(args: BcArgs) -> Result<ExitCode> {
         crate::sim_args::cancel_on_ctrl_c("stopping after this batch and saving the network");
     let mut metadata = HashMap::new();
     metadata.insert("output".into(), "logits".into());
+    metadata.insert("decision".into(), args.net.decision.name());
     metadata.insert("command".into(), command_line());
     metadata.insert(
         "trained".into(),
         format!("behaviour cloning on {}", described.join(", ")),
     );
-    let mut lines = Vec::new();
     let (mlp, reports) = bc::train(
         &data,
         &options,
@@ -297,17 +316,11 @@ fn train_bc(args: BcArgs) -> Result<ExitCode> {
                 100.0 * r.train_accuracy,
                 100.0 * r.test_accuracy
             );
-            progress.println(&line);
-            if progress.is_hidden() {
-                lines.push(line);
-            }
+            show(&progress, &mut stdout, &line);
             true
         },
     )?;
     progress.finish_and_clear();
-    for l in lines {
-        writeln!(stdout, "{l}")?;
-    }
     save(&mlp, &args.net.out)?;
     if let Some(last) = reports.last() {
         writeln!(
@@ -390,6 +403,7 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
     let cancel = crate::sim_args::cancel_on_ctrl_c("stopping and saving the network");
     let mut metadata = HashMap::new();
     metadata.insert("output".into(), "q_values".into());
+    metadata.insert("decision".into(), args.net.decision.name());
     metadata.insert("command".into(), command_line());
     metadata.insert(
         "trained".into(),
@@ -398,7 +412,6 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
             args.steps, args.seed_start
         ),
     );
-    let mut lines = Vec::new();
     let mut last_steps = 0;
     let mlp = dqn::train(
         &evaluator,
@@ -419,18 +432,12 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
                 r.loss
             );
             if !r.loss.is_nan() || r.steps >= options.steps {
-                progress.println(&line);
-                if progress.is_hidden() {
-                    lines.push(line);
-                }
+                show(&progress, &mut stdout, &line);
             }
             !cancel.load(Ordering::Relaxed)
         },
     )?;
     progress.finish_and_clear();
-    for l in lines {
-        writeln!(stdout, "{l}")?;
-    }
     save(&mlp, &args.net.out)?;
     writeln!(stdout, "wrote {}", args.net.out.display())?;
     if cancel.load(Ordering::Relaxed) {

@@ -63,6 +63,11 @@ impl Sample {
     pub fn direction_deg(&self) -> f64 {
         wrap_deg(self.bearing_deg - self.pose.z_deg)
     }
+
+    /// The observation (SPEC.md) for a laser of `range_px`.
+    pub fn observation(&self, range_px: f64) -> Vec<f32> {
+        observation(&self.readings, self.direction_deg(), range_px)
+    }
 }
 
 /// The header of a data log for `beams` laser beams.

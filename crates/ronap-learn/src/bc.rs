@@ -179,7 +179,7 @@ mod tests {
             let mut o: Vec<f32> = (0..17).map(|_| rng.random_range(0.0..1.0)).collect();
             let direction: f32 = rng.random_range(0.0..1.0);
             o.push(direction);
-            let action = if direction < 0.05 || direction > 0.95 {
+            let action = if !(0.05..=0.95).contains(&direction) {
                 DiscreteAction::Ahead
             } else if direction < 0.5 {
                 DiscreteAction::Left
@@ -214,5 +214,61 @@ mod tests {
             .filter(|&i| mlp.action(fresh.observation(i)) as u8 == fresh.actions[i])
             .count();
         assert!(right > 450, "{right} of 500");
+    }
+}
+
+#[cfg(test)]
+mod expert_data {
+    use super::*;
+    use ronap_core::collect::{collect, Posing};
+    use ronap_core::evaluate::{Evaluator, Scenes};
+    use ronap_core::SimConfig;
+    use std::sync::atomic::AtomicBool;
+
+    #[test]
+    fn beats_the_majority_class_on_held_out_expert_rows() {
+        // Re-posed rows (the paper's mode): no class dominates, unlike rows along expert paths,
+        // which are two-thirds AHEAD.
+        let evaluator = Evaluator::new(
+            SimConfig::default().validate().unwrap(),
+            Scenes::MazePerSeed,
+        );
+        let mut data = DataSet::new(18);
+        collect(
+            &evaluator,
+            1_000_000..,
+            500,
+            6000,
+            Posing::Repose,
+            None,
+            0,
+            &AtomicBool::new(false),
+            &mut |_, samples| {
+                for s in samples {
+                    data.push(&s.observation(50.0), s.action);
+                }
+                true
+            },
+        )
+        .unwrap();
+        assert_eq!(data.len(), 6000);
+        let majority = *data.action_counts().iter().max().unwrap() as f64 / data.len() as f64;
+        let options = BcOptions {
+            hidden: vec![64, 64],
+            activation: TrainActivation::Relu,
+            learning_rate: 0.003,
+            batch: 64,
+            epochs: 30,
+            ..BcOptions::default()
+        };
+        let (_, reports) = train(&data, &options, HashMap::new(), &mut |_| true, &mut |_| {
+            true
+        })
+        .unwrap();
+        let test = reports.last().unwrap().test_accuracy;
+        assert!(
+            test > majority + 0.05,
+            "test accuracy {test:.3} vs majority class {majority:.3}"
+        );
     }
 }

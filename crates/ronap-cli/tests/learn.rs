@@ -1,0 +1,315 @@
+//! The learning loop from the command line: collect, train, run; weights-file errors; the shipped
+//! policies against their reported figures.
+
+// Test helpers may panic on setup failures: that is a failed test, as intended.
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn ronap(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ronap"))
+        .args(args)
+        .output()
+        .expect("ronap runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+fn ok(o: &Output) -> String {
+    assert!(
+        o.status.success(),
+        "exit {:?}\nstdout: {}\nstderr: {}",
+        o.status.code(),
+        text(&o.stdout),
+        text(&o.stderr)
+    );
+    text(&o.stdout)
+}
+
+fn summary(dir: &Path) -> serde_json::Value {
+    let s = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
+    serde_json::from_str::<serde_json::Value>(&s).expect("json")["summary"].clone()
+}
+
+fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+#[test]
+fn collect_train_run_loop() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("expert.csv");
+    let data_s = data.to_str().unwrap();
+    let out = ok(&ronap(&[
+        "collect",
+        "--expert",
+        "geodesic",
+        "--mode",
+        "drive",
+        "--samples",
+        "1500",
+        "--per-episode",
+        "300",
+        "--out",
+        data_s,
+    ]));
+    assert!(out.contains("1500 rows from 5 episodes"), "{out}");
+    let log = std::fs::read_to_string(&data).unwrap();
+    assert_eq!(log.lines().count(), 1501);
+    assert!(log.starts_with("laser_0,"));
+
+    // Re-posed rows (the paper's mode) face the goal: direction near 0 or 360.
+    let reposed = dir.path().join("reposed.csv");
+    ok(&ronap(&[
+        "collect",
+        "--expert",
+        "geodesic",
+        "--samples",
+        "200",
+        "--out",
+        reposed.to_str().unwrap(),
+    ]));
+    let text = std::fs::read_to_string(&reposed).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "direction").unwrap();
+    let facing = text
+        .lines()
+        .skip(1)
+        .filter(|l| {
+            let d: f64 = l.split(',').nth(col).unwrap().parse().unwrap();
+            d.min(360.0 - d) < 33.0
+        })
+        .count();
+    assert!(facing >= 197, "{facing} of 200 re-posed rows face the goal");
+
+    let weights = dir.path().join("bc.safetensors");
+    let weights_s = weights.to_str().unwrap();
+    let out = ok(&ronap(&[
+        "train",
+        "bc",
+        "--data",
+        data_s,
+        "--epochs",
+        "3",
+        "--batch",
+        "64",
+        "--hidden",
+        "32,32",
+        "--activation",
+        "relu",
+        "--lr",
+        "0.003",
+        "--out",
+        weights_s,
+    ]));
+    assert!(
+        out.contains("train acc") && out.contains("final: train accuracy"),
+        "{out}"
+    );
+    let bytes = std::fs::read(&weights).unwrap();
+    let mlp = ronap_core::policy::mlp::Mlp::from_bytes(&bytes).unwrap();
+    assert_eq!(mlp.inputs(), 18);
+    assert!(mlp.metadata["command"].contains("train bc"));
+
+    let run_dir = dir.path().join("run");
+    let policy = format!("mlp:{weights_s}@sample:2");
+    ok(&ronap(&[
+        "run",
+        "--policy",
+        &policy,
+        "--seeds",
+        "10",
+        "--out",
+        run_dir.to_str().unwrap(),
+    ]));
+    assert_eq!(summary(&run_dir)["episodes"], 10);
+}
+
+#[test]
+fn dqn_trains_and_writes_weights() {
+    let dir = tempfile::tempdir().unwrap();
+    let weights = dir.path().join("dqn.safetensors");
+    let out = ok(&ronap(&[
+        "train",
+        "dqn",
+        "--steps",
+        "3000",
+        "--envs",
+        "8",
+        "--batch",
+        "32",
+        "--hidden",
+        "16",
+        "--max-steps",
+        "200",
+        "--report-every",
+        "1000",
+        "--out",
+        weights.to_str().unwrap(),
+    ]));
+    assert!(
+        out.contains("mean return") && out.contains("success"),
+        "{out}"
+    );
+    let mlp = ronap_core::policy::mlp::Mlp::load(&weights).unwrap();
+    assert_eq!(mlp.metadata["output"], "q_values");
+}
+
+#[test]
+fn trains_on_the_original_platforms_rows() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("original.csv");
+    let mut rows = String::new();
+    for i in 0..200 {
+        let side = if i % 2 == 0 { 100 } else { 498 };
+        let (direction, action) = match i % 4 {
+            0 => ("10.0", "LEFT"),
+            1 => ("350.0", "RIGHT"),
+            2 => ("0.5", "AHEAD"),
+            _ => ("0.0", "WARNING"),
+        };
+        rows.push_str(&format!(
+            "\"[{side}, 498, 498, 498, 498, 498, 498, 498, 498, 498, 498, 498, 498, 498, 401, 357, 330]\",343.72,{direction},{action}\n"
+        ));
+    }
+    std::fs::write(&data, rows).unwrap();
+    let out = ok(&ronap(&[
+        "train",
+        "bc",
+        "--data",
+        data.to_str().unwrap(),
+        "--epochs",
+        "30",
+        "--batch",
+        "16",
+        "--hidden",
+        "16",
+        "--activation",
+        "relu",
+        "--lr",
+        "0.01",
+        "--out",
+        dir.path().join("o.safetensors").to_str().unwrap(),
+    ]));
+    assert!(
+        out.contains("150 rows") && out.contains("50 skipped"),
+        "{out}"
+    );
+    assert!(out.contains("Original format"), "{out}");
+}
+
+#[test]
+fn bad_weights_and_data_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let junk = dir.path().join("junk.safetensors");
+    std::fs::write(&junk, b"not weights").unwrap();
+    let policy = format!("mlp:{}", junk.display());
+    let o = ronap(&[
+        "run",
+        "--policy",
+        &policy,
+        "--seeds",
+        "1",
+        "--out",
+        dir.path().join("r").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = text(&o.stderr);
+    assert!(
+        e.contains("junk.safetensors") && e.contains("not a safetensors file"),
+        "{e}"
+    );
+    assert!(!dir.path().join("r").exists());
+
+    // A network for another observation size.
+    let wide = dir.path().join("wide.safetensors");
+    let layer = |o, i| ronap_core::policy::mlp::Layer {
+        weight: nalgebra::DMatrix::zeros(o, i),
+        bias: nalgebra::DVector::zeros(o),
+    };
+    let mlp = ronap_core::policy::mlp::Mlp::new(
+        vec![layer(4, 25), layer(3, 4)],
+        ronap_core::policy::mlp::Activation::Relu,
+        Default::default(),
+    )
+    .unwrap();
+    std::fs::write(&wide, mlp.to_bytes().unwrap()).unwrap();
+    let o = ronap(&[
+        "run",
+        "--policy",
+        &format!("mlp:{}", wide.display()),
+        "--seeds",
+        "1",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = text(&o.stderr);
+    assert!(
+        e.contains("takes 25 inputs") && e.contains("observation has 18"),
+        "{e}"
+    );
+
+    let o = ronap(&[
+        "run",
+        "--policy",
+        &format!("mlp:{}@hottest", wide.display()),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("\"hottest\" is not a decision rule"));
+
+    let bad = dir.path().join("bad.csv");
+    std::fs::write(
+        &bad,
+        "laser_0,heading,bearing,action\n1,2,3,AHEAD\n4,5,x,LEFT\n",
+    )
+    .unwrap();
+    let o = ronap(&[
+        "train",
+        "bc",
+        "--data",
+        bad.to_str().unwrap(),
+        "--out",
+        dir.path().join("b.safetensors").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let e = text(&o.stderr);
+    assert!(
+        e.contains("bad.csv:3") && e.contains("bearing = \"x\""),
+        "{e}"
+    );
+    assert!(!dir.path().join("b.safetensors").exists());
+}
+
+/// The shipped policies reach, on the first 100 of their 1000 held-out evaluation seeds, the
+/// success rate their evaluation reports, within 12 points: about three standard deviations of a
+/// 100-episode estimate at the rates reported.
+#[test]
+fn shipped_policies_reach_their_reported_success() {
+    for name in ["bc", "dqn"] {
+        let root = repo_root().join("policies");
+        let report: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(root.join(format!("{name}.json"))).unwrap(),
+        )
+        .unwrap();
+        let reported = report["evaluation"]["success_rate"].as_f64().unwrap();
+        let policy = report["policy"]
+            .as_str()
+            .unwrap()
+            .replace("policies/", &format!("{}/", root.display()));
+        let dir = tempfile::tempdir().unwrap();
+        ok(&ronap(&[
+            "run",
+            "--policy",
+            &policy,
+            "--seeds",
+            "100",
+            "--out",
+            dir.path().to_str().unwrap(),
+        ]));
+        let got = summary(dir.path())["success_rate"].as_f64().unwrap();
+        assert!(
+            (got - reported).abs() <= 0.12,
+            "{name}: {got:.2} on seeds 0..99 vs {reported:.3} reported on 0..999"
+        );
+    }
+}
