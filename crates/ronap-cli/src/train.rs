@@ -265,6 +265,9 @@ fn train_bc(args: BcArgs) -> Result<ExitCode> {
     };
     let counts = data.action_counts();
     let mut stdout = std::io::stdout().lock();
+    for d in &described {
+        writeln!(stdout, "data: {d}")?;
+    }
     writeln!(
         stdout,
         "ronap train bc: {} rows (LEFT {}, AHEAD {}, RIGHT {}; {} skipped), {:.0}% to train, network {}-{}-3 {:?}",

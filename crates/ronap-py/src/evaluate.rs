@@ -6,7 +6,7 @@ use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use ronap_core::evaluate::{Evaluator, Recording};
-use ronap_core::policy::{Builtin, Decision, Policy, PolicyError, PolicyFactory};
+use ronap_core::policy::{Decision, Policy, PolicyError, PolicyFactory};
 use ronap_core::report::Pictures;
 use ronap_core::summary::Summary;
 use ronap_core::{Action, DiscreteAction, Episode, World};
@@ -156,14 +156,9 @@ pub fn evaluate<'py>(
         ));
     }
     let factory: Box<dyn PolicyFactory> = if let Ok(name) = policy.extract::<String>() {
-        let builtin = Builtin::from_name(&name).ok_or_else(|| {
-            let known: Vec<&str> = Builtin::ALL.iter().map(|(_, n, _)| *n).collect();
-            errors::ConfigError::new_err(format!(
-                "policy {name:?}: unknown (built-in policies: {})",
-                known.join(", ")
-            ))
-        })?;
-        Box::new(builtin)
+        let observation_size = config.laser.beams as usize + 1;
+        ronap_core::policy::factory(&name, observation_size)
+            .map_err(|e| errors::ConfigError::new_err(e.to_string()))?
     } else if policy.is_callable() {
         let name = policy
             .getattr("__name__")

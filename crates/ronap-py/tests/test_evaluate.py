@@ -137,3 +137,13 @@ def test_png_choice_matches_the_cli(tmp_path):
     assert drawn == failed and failed
     with pytest.raises(ronap.ConfigError, match="png"):
         ronap.evaluate("apf", range(2), out=str(tmp_path / "bad"), png="some")
+
+
+def test_evaluate_runs_a_shipped_network():
+    root = pathlib.Path(__file__).resolve().parents[3]
+    weights = root / "policies" / "bc.safetensors"
+    result = ronap.evaluate(f"mlp:{weights}", range(20))
+    assert result["summary"]["episodes"] == 20
+    assert result["summary"]["success_rate"] > 0.5
+    with pytest.raises(ronap.ConfigError, match="not a decision rule"):
+        ronap.evaluate(f"mlp:{weights}@hottest", range(2))

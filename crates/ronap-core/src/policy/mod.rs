@@ -108,3 +108,55 @@ impl PolicyFactory for Builtin {
         Builtin::name(*self).to_string()
     }
 }
+
+/// A policy name that names no policy, or a network file that cannot be used.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum PolicyNameError {
+    /// Neither a built-in nor a known `kind:` prefix.
+    #[error("policy {name:?}: unknown (expected one of: {}, mlp:FILE[@RULE])", Builtin::ALL.map(|b| b.1).join(", "))]
+    Unknown {
+        /// The name given.
+        name: String,
+    },
+    /// The `@RULE` of `mlp:FILE@RULE` is not a decision rule.
+    #[error("policy {name:?}: {rule:?} is not a decision rule (argmax or sample:TEMPERATURE)")]
+    Rule {
+        /// The name given.
+        name: String,
+        /// The rule.
+        rule: String,
+    },
+    /// The weights file cannot be used.
+    #[error(transparent)]
+    Network(#[from] mlp::MlpError),
+}
+
+/// The policy `name` names: a built-in (`apf`, `geodesic`, `random`) or `mlp:FILE[@RULE]` (a
+/// weights file, with an optional decision rule overriding the file's), for observations of
+/// `observation_size` values.
+pub fn factory(
+    name: &str,
+    observation_size: usize,
+) -> Result<Box<dyn PolicyFactory>, PolicyNameError> {
+    if let Some(spec) = name.strip_prefix("mlp:") {
+        let (path, rule) = match spec.rsplit_once('@') {
+            Some((path, rule)) => {
+                let parsed =
+                    mlp::DecisionRule::parse(rule).ok_or_else(|| PolicyNameError::Rule {
+                        name: name.into(),
+                        rule: rule.into(),
+                    })?;
+                (path, Some(parsed))
+            }
+            None => (spec, None),
+        };
+        let loaded = mlp::MlpFactory::load(std::path::Path::new(path), observation_size)?;
+        return Ok(Box::new(match rule {
+            Some(r) => loaded.with_rule(r),
+            None => loaded,
+        }));
+    }
+    Builtin::from_name(name)
+        .map(|b| Box::new(b) as Box<dyn PolicyFactory>)
+        .ok_or_else(|| PolicyNameError::Unknown { name: name.into() })
+}

@@ -25,7 +25,8 @@ def evaluate(
     """Runs ``policy`` over the episodes of ``seeds`` in parallel and returns
     ``{"summary": {...}, "episodes": [{...}, ...]}``, the figures and rows ``ronap run`` reports.
 
-    ``policy`` is a built-in name (``"apf"``, ``"geodesic"``, ``"random"``) or a callable taking
+    ``policy`` is a built-in name (``"apf"``, ``"geodesic"``, ``"random"``), a trained network
+    (``"mlp:policies/bc.safetensors"``, see ``policies/README.md``) or a callable taking
     the observation (``float32`` array) and returning an action: 0 LEFT, 1 AHEAD, 2 RIGHT (or
     ``(v / v_max, w / w_max)`` in [-1, 1] with ``continuous=True``, as ``NavEnv``'s action space). Calls to a Python policy hold the GIL; the simulation runs
     on ``threads`` threads (0: all cores) beside them. With ``out``, writes ``episodes.csv``,
