@@ -5,12 +5,11 @@ use crate::policies::policy_factory;
 use crate::sim_args::{cancel_on_ctrl_c, count, seed, threads, SceneArgs, SimArgs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use ronap_core::collect::{collect, Posing};
 use ronap_core::datalog::DataLogWriter;
 use ronap_core::evaluate::Evaluator;
 use ronap_core::output::write_atomic;
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
@@ -102,16 +101,11 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
     };
     let threads = threads(args.threads);
     let cancel = cancel_on_ctrl_c("writing the rows recorded so far");
-    let bar = if std::io::stderr().is_terminal() {
-        ProgressBar::with_draw_target(Some(args.samples), ProgressDrawTarget::stderr())
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template("{prefix} {wide_bar} {pos}/{len} rows, {per_sec}, eta {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    let bar = crate::output::progress_bar(
+        args.samples,
+        "{prefix} {wide_bar} {pos}/{len} rows, {per_sec}, eta {eta}",
+        "ronap collect".into(),
     );
-    bar.set_prefix("ronap collect");
     let beams = config.laser.beams as usize;
     let mut rows = 0usize;
     let mut episodes = 0usize;

@@ -4,11 +4,9 @@ use crate::policies::policy_factory;
 use crate::sim_args::{cancel_on_ctrl_c, count, fraction, seed, threads, SceneArgs, SimArgs};
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use ronap_core::evaluate::{EpisodeRecord, Evaluator, Recording};
 use ronap_core::report::{self, Pictures};
 use ronap_core::summary::Summary;
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -146,18 +144,11 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     }
 
     let cancel = cancel_on_ctrl_c("finishing running episodes and writing what is done");
-    let bar = if std::io::stderr().is_terminal() {
-        ProgressBar::with_draw_target(Some(args.seeds), ProgressDrawTarget::stderr())
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{prefix} {wide_bar} {pos}/{len} episodes, {per_sec}, eta {eta}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    let bar = crate::output::progress_bar(
+        args.seeds,
+        "{prefix} {wide_bar} {pos}/{len} episodes, {per_sec}, eta {eta}",
+        format!("ronap run {}", args.policy),
     );
-    bar.set_prefix(format!("ronap run {}", args.policy));
 
     let png = args.png;
     let wants_png = |r: &EpisodeRecord| png.is_some_and(|p| p.wants(r, first));

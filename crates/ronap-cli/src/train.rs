@@ -3,7 +3,7 @@
 use crate::sim_args::{count, fraction, seed, threads, SceneArgs, SimArgs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::ProgressBar;
 use ronap_core::datalog;
 use ronap_core::evaluate::Evaluator;
 use ronap_core::output::write_atomic;
@@ -12,7 +12,7 @@ use ronap_learn::bc::{self, BcOptions};
 use ronap_learn::dqn::{self, DqnOptions};
 use ronap_learn::net::TrainActivation;
 use std::collections::HashMap;
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::atomic::Ordering;
@@ -168,19 +168,6 @@ pub fn run(args: TrainArgs) -> Result<ExitCode> {
     }
 }
 
-fn bar(len: u64, template: &str, prefix: &str) -> ProgressBar {
-    let bar = if std::io::stderr().is_terminal() {
-        ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr())
-    } else {
-        ProgressBar::hidden()
-    };
-    bar.set_style(
-        ProgressStyle::with_template(template).unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    bar.set_prefix(prefix.to_string());
-    bar
-}
-
 /// Prints a progress line above the bar, or straight to stdout (flushed, for logs and pipes)
 /// when there is no bar.
 fn show(progress: &ProgressBar, stdout: &mut impl Write, line: &str) {
@@ -288,10 +275,10 @@ fn train_bc(args: BcArgs) -> Result<ExitCode> {
     )?;
     let per_epoch =
         (data.len() as f64 * options.train_fraction).ceil() as u64 / args.batch.max(1) + 1;
-    let progress = bar(
+    let progress = crate::output::progress_bar(
         per_epoch * args.epochs,
         "{prefix} {wide_bar} {pos}/{len} batches, eta {eta}",
-        "ronap train bc",
+        "ronap train bc".into(),
     );
     let cancel =
         crate::sim_args::cancel_on_ctrl_c("stopping after this batch and saving the network");
@@ -398,10 +385,10 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
         "{:>10} {:>9} {:>12} {:>9} {:>8} {:>10}",
         "steps", "episodes", "mean return", "success", "epsilon", "loss"
     )?;
-    let progress = bar(
+    let progress = crate::output::progress_bar(
         args.steps,
         "{prefix} {wide_bar} {pos}/{len} steps, {per_sec}, eta {eta}",
-        "ronap train dqn",
+        "ronap train dqn".into(),
     );
     let cancel = crate::sim_args::cancel_on_ctrl_c("stopping and saving the network");
     let mut metadata = HashMap::new();
