@@ -14,8 +14,10 @@ use std::process::ExitCode;
 #[derive(Args, Debug)]
 pub struct RunArgs {
     /// Policy to evaluate: apf (the paper's potential field, Algorithm 3), geodesic (shortest-path
-    /// follower, no local minima), random, or py:FILE.py:FUNCTION (a Python function: observation
-    /// in, action 0/1/2 out; run with $RONAP_PYTHON or python3).
+    /// follower, no local minima), random, mlp:FILE.safetensors (a trained network, e.g.
+    /// mlp:policies/bc.safetensors; append @argmax or @sample:T to override its decision rule), or
+    /// py:FILE.py:FUNCTION (a Python function: observation in, action 0/1/2 out; run with
+    /// $RONAP_PYTHON or python3).
     #[arg(long, value_name = "NAME")]
     policy: String,
     /// Number of episodes; episode i has seed seed-start + i.

@@ -79,8 +79,10 @@ struct BcArgs {
     /// Fraction of rows to train on; the rest are the test split.
     #[arg(long, allow_negative_numbers = true, value_name = "F", default_value_t = 0.8, value_parser = fraction)]
     train_fraction: f64,
-    #[command(flatten)]
-    sim: SimArgs,
+    /// Laser range, px: ronap's rows hold readings in px, the network sees them over this range
+    /// (SPEC.md's d_max).
+    #[arg(long, allow_negative_numbers = true, value_name = "PX", default_value_t = 50.0, value_parser = crate::sim_args::positive)]
+    laser_range: f64,
 }
 
 /// Arguments of `ronap train dqn`.
@@ -207,8 +209,7 @@ fn save(mlp: &Mlp, path: &Path) -> Result<()> {
 
 fn train_bc(args: BcArgs) -> Result<ExitCode> {
     check_out(&args.net.out)?;
-    let config = args.sim.config()?;
-    let range = config.laser.range_px;
+    let range = args.laser_range;
     let mut data: Option<datalog::DataSet> = None;
     let mut described = Vec::new();
     for path in &args.data {

@@ -262,4 +262,13 @@ fn help_explains_every_flag_with_its_default() {
     let o = ronap(&["run", "--help"]);
     assert!(o.status.success());
     insta::assert_snapshot!("run_help", stdout(&o));
+    for (args, name) in [
+        (&["collect", "--help"][..], "collect_help"),
+        (&["train", "bc", "--help"][..], "train_bc_help"),
+        (&["train", "dqn", "--help"][..], "train_dqn_help"),
+    ] {
+        let o = ronap(args);
+        assert!(o.status.success());
+        insta::assert_snapshot!(name, stdout(&o));
+    }
 }
