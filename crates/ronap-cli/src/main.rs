@@ -10,6 +10,8 @@ mod py_policy;
 mod run;
 mod sim_args;
 mod train;
+mod tui;
+mod view;
 
 use clap::{Parser, Subcommand};
 use std::io::Write;
@@ -41,6 +43,9 @@ enum Command {
     Run(run::RunArgs),
     /// Record (observation, expert action) rows for behaviour cloning, in the data-log format.
     Collect(collect::CollectArgs),
+    /// Watch a policy drive one episode live in the terminal: the paper's first-person view, the
+    /// whole scene with M, pause, speed and restart keys.
+    View(view::ViewArgs),
     /// Measure how fast this machine steps the default scene.
     Bench(bench::BenchArgs),
     /// Train a policy network (behaviour cloning or DQN) and write its weights file.
@@ -96,6 +101,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Maze(args) => maze::run(args),
         Command::Run(args) => run::run(args),
+        Command::View(args) => view::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Collect(args) => collect::run(args),
         Command::Train(args) => train::run(args),

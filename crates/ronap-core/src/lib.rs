@@ -5,6 +5,7 @@
 //! degrees, with x right and y up. Nothing here parses arguments, prints or exits: the `ronap`
 //! binary and the Python module wrap it.
 
+pub mod animation;
 pub mod collect;
 pub mod config;
 pub mod datalog;

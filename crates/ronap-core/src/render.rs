@@ -23,9 +23,9 @@ pub const PATH: Rgb<u8> = Rgb([40, 80, 230]);
 /// Colour of a laser ray of class `class`.
 pub fn ray_colour(class: RayClass) -> Rgb<u8> {
     match class {
-        RayClass::Green => Rgb([40, 190, 60]),
-        RayClass::Yellow => Rgb([235, 190, 20]),
-        RayClass::Red => Rgb([225, 40, 40]),
+        RayClass::Green => PALETTE[5],
+        RayClass::Yellow => PALETTE[6],
+        RayClass::Red => PALETTE[7],
     }
 }
 
@@ -177,35 +177,93 @@ pub fn top_down(episode: &crate::episode::Episode, path: &[Point], scale: f64) -
     canvas.into_image()
 }
 
+/// Colour of the circle of laser range in the first-person view.
+pub const RANGE_CIRCLE: Rgb<u8> = Rgb([150, 150, 150]);
+
+/// Every colour the pictures of this module use: floor, walls, markers, path, rays and the range
+/// circle. An animation encodes with exactly these ([`crate::animation`]).
+pub const PALETTE: [Rgb<u8>; 9] = [
+    FLOOR,
+    WALL,
+    START,
+    GOAL,
+    PATH,
+    Rgb([40, 190, 60]),
+    Rgb([235, 190, 20]),
+    Rgb([225, 40, 40]),
+    RANGE_CIRCLE,
+];
+
+/// Half the side of the square the first-person view shows, as a multiple of the laser range:
+/// the circle of range with a margin around it.
+pub const FIRST_PERSON_HALF_SPAN: f64 = 1.2;
+
+/// The first-person frame (SPEC.md, "Display only"): the scene turned by `theta_s = 90 - z` about
+/// the robot, so the heading points up. View coordinates are px from the robot, `u` to the right
+/// and `v` up (straight ahead); they keep scene lengths.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeadingUp {
+    origin: Point,
+    /// The scene direction of the view's `+u` axis: the heading turned 90 degrees clockwise.
+    right: crate::geometry::Vector,
+    heading_deg: f64,
+}
+
+impl HeadingUp {
+    /// The frame of a robot at `pose`.
+    pub fn new(pose: Pose) -> Self {
+        Self {
+            origin: pose.position(),
+            right: crate::geometry::unit(pose.z_deg - 90.0),
+            heading_deg: pose.z_deg,
+        }
+    }
+
+    /// The view coordinates `(u, v)` of scene point `p`.
+    pub fn to_view(&self, p: Point) -> (f64, f64) {
+        let d = p - self.origin;
+        let r = self.right;
+        (d.x * r.x + d.y * r.y, -d.x * r.y + d.y * r.x)
+    }
+
+    /// The scene point at view coordinates `(u, v)`.
+    pub fn to_scene(&self, u: f64, v: f64) -> Point {
+        let r = self.right;
+        Point::new(
+            self.origin.x + u * r.x - v * r.y,
+            self.origin.y + u * r.y + v * r.x,
+        )
+    }
+
+    /// The view direction of the scene direction `deg`, degrees counter-clockwise from `+u`.
+    /// For the goal bearing theta this is the paper's arrow angle `theta_a = 90 + (theta - z)`.
+    pub fn angle_deg(&self, deg: f64) -> f64 {
+        crate::geometry::wrap_deg(90.0 + deg - self.heading_deg)
+    }
+}
+
 /// The paper's first-person view: the scene around the robot rotated so the heading points up,
 /// the circle of laser range, the rays in their colour classes and an arrow towards the goal.
-/// `size` is the picture's side in pixels; it shows a square of `2.4 * range` px.
+/// `size` is the picture's side in pixels; it shows a square of `2 * FIRST_PERSON_HALF_SPAN *
+/// range` px.
 pub fn first_person(episode: &crate::episode::Episode, size: u32) -> RgbImage {
     let size = size.max(16);
     let laser = episode.laser();
     let range = laser.range_px();
     let pose = episode.pose();
     let scene = episode.scene();
-    let px_per = size as f64 / (2.4 * range);
+    let px_per = size as f64 / (2.0 * FIRST_PERSON_HALF_SPAN * range);
     let centre = size as f64 / 2.0;
-    // Screen up is the heading: screen (u right, v up) maps to the scene by a rotation of z - 90.
-    let rot = crate::geometry::unit(pose.z_deg - 90.0);
-    let to_scene = |u: f64, v: f64| {
-        Point::new(
-            pose.x + (u * rot.x - v * rot.y) / px_per,
-            pose.y + (u * rot.y + v * rot.x) / px_per,
-        )
-    };
+    let frame = HeadingUp::new(pose);
     let to_screen = |p: Point| {
-        let d = p - pose.position();
-        let (u, v) = (d.x * rot.x + d.y * rot.y, -d.x * rot.y + d.y * rot.x);
+        let (u, v) = frame.to_view(p);
         (centre + u * px_per, centre - v * px_per)
     };
     let mut img = RgbImage::from_pixel(size, size, FLOOR);
     for row in 0..size {
         for col in 0..size {
             let (u, v) = (col as f64 + 0.5 - centre, centre - (row as f64 + 0.5));
-            if scene.occupied(to_scene(u, v)) {
+            if scene.occupied(frame.to_scene(u / px_per, v / px_per)) {
                 img.put_pixel(col, row, WALL);
             }
         }
@@ -221,7 +279,7 @@ pub fn first_person(episode: &crate::episode::Episode, size: u32) -> RgbImage {
         put(
             centre + a.cos() * range * px_per,
             centre + a.sin() * range * px_per,
-            Rgb([150, 150, 150]),
+            RANGE_CIRCLE,
         );
     }
     let line =
@@ -278,5 +336,37 @@ mod tests {
         assert_eq!(*img.get_pixel(3, 8), WALL);
         assert_eq!(*img.get_pixel(3, 7), FLOOR);
         assert_eq!(*img.get_pixel(3, 0), FLOOR);
+    }
+
+    #[test]
+    fn heading_up_puts_the_heading_up_and_the_left_left() {
+        for z in [0.0, 37.0, 90.0, 200.0, 359.0] {
+            let pose = Pose::new(100.0, 50.0, z);
+            let frame = HeadingUp::new(pose);
+            let ahead = pose.position() + crate::geometry::unit(z) * 10.0;
+            let left = pose.position() + crate::geometry::unit(z + 90.0) * 10.0;
+            let (u, v) = frame.to_view(ahead);
+            assert!(
+                u.abs() < 1e-9 && (v - 10.0).abs() < 1e-9,
+                "z {z}: ({u}, {v})"
+            );
+            let (u, v) = frame.to_view(left);
+            assert!(
+                (u + 10.0).abs() < 1e-9 && v.abs() < 1e-9,
+                "z {z}: ({u}, {v})"
+            );
+            let back = frame.to_scene(3.0, -4.0);
+            let (u, v) = frame.to_view(back);
+            assert!((u - 3.0).abs() < 1e-9 && (v + 4.0).abs() < 1e-9);
+            // The paper's arrow angle: theta_a = 90 + (theta - z).
+            let theta = 10.0;
+            let expected = crate::geometry::wrap_deg(90.0 + theta - z);
+            let got = frame.angle_deg(theta);
+            let diff = crate::geometry::wrap_deg(got - expected);
+            assert!(
+                diff < 1e-9 || diff > 360.0 - 1e-9,
+                "z {z}: {got} vs {expected}"
+            );
+        }
     }
 }

@@ -1,0 +1,153 @@
+//! Owning the terminal: raw mode, the alternate screen and a hidden cursor while a session lives,
+//! and the terminal as it was afterwards, whichever way the session ends: return, error, panic
+//! (a panic hook restores it before the message prints), Ctrl-C (a key event in raw mode, left to
+//! the caller) or SIGINT/SIGTERM/SIGHUP (a flag the caller polls; a second signal ends the
+//! process at once, for a loop that has stopped polling).
+
+use anyhow::{bail, Context, Result};
+use ratatui::backend::CrosstermBackend;
+use ratatui::crossterm::event::{self, Event, KeyCode, KeyEvent, KeyEventKind, KeyModifiers};
+use ratatui::crossterm::{cursor, execute, terminal};
+use ratatui::Terminal;
+use std::io::{IsTerminal, Stdout};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Once};
+use std::time::Duration;
+
+/// The terminal while a command draws on it.
+pub struct Session {
+    terminal: Terminal<CrosstermBackend<Stdout>>,
+    signal: Arc<AtomicUsize>,
+    #[cfg(unix)]
+    handlers: Vec<signal_hook::SigId>,
+}
+
+/// Checks that stdout is a terminal: an interactive command cannot draw into a pipe or a file.
+pub fn require_terminal(command: &str) -> Result<()> {
+    if !std::io::stdout().is_terminal() {
+        bail!(
+            "ronap {command} draws in a terminal, and stdout is not one (run it in a terminal; \
+             `ronap replay` and `ronap run --gif` write episodes as GIF files instead)"
+        );
+    }
+    Ok(())
+}
+
+/// Gives the terminal back: raw mode off, main screen, cursor shown. Safe to call more than once.
+pub fn restore() {
+    let _ = terminal::disable_raw_mode();
+    let _ = execute!(
+        std::io::stdout(),
+        terminal::LeaveAlternateScreen,
+        cursor::Show
+    );
+}
+
+/// Makes every panic restore the terminal before its message is printed, so the message is
+/// readable and the shell usable.
+fn install_panic_hook() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            restore();
+            previous(info);
+        }));
+    });
+}
+
+impl Session {
+    /// Takes the terminal for `command` (`view`, `collect`). Fails, with the terminal untouched,
+    /// when stdout is not a terminal.
+    pub fn start(command: &str) -> Result<Self> {
+        require_terminal(command)?;
+        install_panic_hook();
+        let signal = Arc::new(AtomicUsize::new(0));
+        #[cfg(unix)]
+        let handlers = {
+            use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+            let mut ids = Vec::new();
+            let armed = Arc::new(std::sync::atomic::AtomicBool::new(false));
+            let context = "cannot install signal handlers";
+            for sig in [SIGINT, SIGTERM, SIGHUP] {
+                // Handlers run in the order registered: the first signal finds `armed` unset and
+                // only sets the flags; a later one exits at once with the shell's 128 + signal.
+                ids.push(
+                    signal_hook::flag::register_conditional_shutdown(sig, 128 + sig, armed.clone())
+                        .context(context)?,
+                );
+                ids.push(signal_hook::flag::register(sig, armed.clone()).context(context)?);
+                ids.push(
+                    signal_hook::flag::register_usize(sig, signal.clone(), sig as usize)
+                        .context(context)?,
+                );
+            }
+            ids
+        };
+        terminal::enable_raw_mode().context("cannot switch the terminal to raw mode")?;
+        // From here on the session exists, so every early return restores the terminal.
+        let backend = CrosstermBackend::new(std::io::stdout());
+        let mut session = Self {
+            terminal: Terminal::new(backend).context("cannot use the terminal")?,
+            signal,
+            #[cfg(unix)]
+            handlers,
+        };
+        execute!(
+            std::io::stdout(),
+            terminal::EnterAlternateScreen,
+            cursor::Hide
+        )
+        .context("cannot switch to the alternate screen")?;
+        session
+            .terminal
+            .clear()
+            .context("cannot clear the terminal")?;
+        Ok(session)
+    }
+
+    /// The terminal to draw on.
+    pub fn terminal(&mut self) -> &mut Terminal<CrosstermBackend<Stdout>> {
+        &mut self.terminal
+    }
+
+    /// The signal (SIGINT, SIGTERM, SIGHUP) that asked the session to end, if one did.
+    pub fn signal(&self) -> Option<i32> {
+        match self.signal.load(Ordering::SeqCst) {
+            0 => None,
+            s => i32::try_from(s).ok(),
+        }
+    }
+
+    /// The next terminal event, waiting at most `timeout`.
+    pub fn next_event(&mut self, timeout: Duration) -> Result<Option<Event>> {
+        if event::poll(timeout).context("cannot read the terminal")? {
+            Ok(Some(event::read().context("cannot read the terminal")?))
+        } else {
+            Ok(None)
+        }
+    }
+}
+
+impl Drop for Session {
+    fn drop(&mut self) {
+        restore();
+        #[cfg(unix)]
+        for id in self.handlers.drain(..) {
+            signal_hook::low_level::unregister(id);
+        }
+    }
+}
+
+/// A key the commands act on; key releases and repeats of unhandled keys are `None`.
+pub fn key(event: &Event) -> Option<KeyEvent> {
+    match event {
+        Event::Key(k) if k.kind != KeyEventKind::Release => Some(*k),
+        _ => None,
+    }
+}
+
+/// Whether `key` is Ctrl-C, which raw mode delivers as a key instead of a signal.
+pub fn is_ctrl_c(key: &KeyEvent) -> bool {
+    key.modifiers.contains(KeyModifiers::CONTROL) && matches!(key.code, KeyCode::Char('c'))
+}
