@@ -7,6 +7,7 @@ mod maze;
 mod output;
 mod policies;
 mod py_policy;
+mod replay;
 mod run;
 mod sim_args;
 mod train;
@@ -46,6 +47,9 @@ enum Command {
     /// Watch a policy drive one episode live in the terminal: the paper's first-person view, the
     /// whole scene with M, pause, speed and restart keys.
     View(view::ViewArgs),
+    /// Render a logged episode (`ronap run --log-steps`) as an animated GIF, from above or
+    /// first-person.
+    Replay(replay::ReplayArgs),
     /// Measure how fast this machine steps the default scene.
     Bench(bench::BenchArgs),
     /// Train a policy network (behaviour cloning or DQN) and write its weights file.
@@ -102,6 +106,7 @@ fn main() -> ExitCode {
         Command::Maze(args) => maze::run(args),
         Command::Run(args) => run::run(args),
         Command::View(args) => view::run(args),
+        Command::Replay(args) => replay::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Collect(args) => collect::run(args),
         Command::Train(args) => train::run(args),

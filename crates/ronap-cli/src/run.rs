@@ -7,6 +7,7 @@ use clap::Args;
 use ronap_core::evaluate::{EpisodeRecord, Evaluator, Recording};
 use ronap_core::report::{self, Pictures};
 use ronap_core::summary::Summary;
+use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -45,6 +46,11 @@ pub struct RunArgs {
     /// Trajectory pictures in png/: the first N seeds, `failures` or `all` [default: none].
     #[arg(long, allow_negative_numbers = true, value_name = "N|failures|all")]
     png: Option<Pictures>,
+    /// Also write an animated GIF of this seed's episode (top view, every step) to
+    /// gif/seed-<seed>-<outcome>.gif; repeat for more seeds, each within the run's seeds (other
+    /// views and strides: `--log-steps` and `ronap replay`) [default: none].
+    #[arg(long, allow_negative_numbers = true, value_name = "SEED", value_parser = seed)]
+    gif: Vec<u64>,
     /// Exit with code 1 when the success rate is below this fraction (a gate for CI).
     #[arg(long, allow_negative_numbers = true, value_name = "F", value_parser = fraction)]
     min_success: Option<f64>,
@@ -94,6 +100,12 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
             args.seeds
         )
     })?;
+    if let Some(s) = args.gif.iter().find(|&&s| s < first || s >= end) {
+        bail!(
+            "--gif {s}: not one of this run's seeds ({first}..={})",
+            end - 1
+        );
+    }
     // A scene with no room for a start and goal fails the same way for every seed: say so now.
     evaluator
         .world(first)
@@ -140,6 +152,10 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         std::fs::create_dir_all(out_dir.join("png"))
             .with_context(|| format!("cannot create {}/png", out_dir.display()))?;
     }
+    if !args.gif.is_empty() {
+        std::fs::create_dir_all(out_dir.join("gif"))
+            .with_context(|| format!("cannot create {}/gif", out_dir.display()))?;
+    }
     if args.log_steps {
         std::fs::create_dir_all(out_dir.join("steps"))
             .with_context(|| format!("cannot create {}/steps", out_dir.display()))?;
@@ -185,14 +201,21 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         "seed_start": first,
         "seeds_requested": args.seeds,
         "scenes": scenes,
+        "maze_seed": args.scenes.maze_seed,
+        "map_file": args.scenes.map,
         "map": map_source,
         "threads": threads,
     });
     let meta = meta.as_object().cloned().unwrap_or_default();
     report::write_run(&out_dir, meta, &config, &result, &summary)?;
+    let mut gif_notes = Vec::new();
+    for &seed in &args.gif {
+        if let Some(record) = result.records.iter().find(|r| r.seed == seed) {
+            gif_notes.extend(write_gif(&evaluator, factory.as_ref(), record, &out_dir)?);
+        }
+    }
 
     let mut stdout = std::io::stdout().lock();
-    use std::io::Write;
     writeln!(
         stdout,
         "ronap run: policy {}, seeds {first}..{}, {threads} threads",
@@ -201,6 +224,9 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     )?;
     write!(stdout, "{}", summary.table())?;
     writeln!(stdout, "outputs in {}", out_dir.display())?;
+    for note in gif_notes {
+        eprintln!("ronap run: {note}");
+    }
     let write_errors = write_errors.into_inner().unwrap_or_default();
     if let Some(e) = write_errors.first() {
         bail!(
@@ -236,10 +262,51 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
+/// Runs the episode of `record` again with a fresh policy, recording its steps, and writes its
+/// animation to `gif/`. Returns a note when the re-run differs from `record` (a policy that is not
+/// deterministic), since the GIF then shows the re-run.
+fn write_gif(
+    evaluator: &Evaluator,
+    factory: &dyn ronap_core::policy::PolicyFactory,
+    record: &EpisodeRecord,
+    out_dir: &std::path::Path,
+) -> Result<Option<String>> {
+    let seed = record.seed;
+    let mut policy = factory.make()?;
+    let recording = Recording {
+        trajectory: false,
+        steps: true,
+    };
+    let rerun = evaluator
+        .run_episode(policy.as_mut(), seed, recording)
+        .with_context(|| format!("--gif {seed}: cannot run the episode again"))?;
+    let episode = evaluator.world(seed).episode(seed)?;
+    let actions: Vec<_> = rerun.step_log.iter().map(|s| s.action).collect();
+    let options = ronap_core::animation::GifOptions::default();
+    let animation = ronap_core::animation::animate(episode, &actions, None, &options)
+        .with_context(|| format!("--gif {seed}"))?;
+    let path = out_dir
+        .join("gif")
+        .join(format!("seed-{seed:06}-{}.gif", rerun.outcome.name()));
+    ronap_core::output::write_atomic(&path, |w| w.write_all(&animation.bytes))?;
+    Ok(
+        (rerun.steps != record.steps || rerun.outcome != record.outcome).then(|| {
+            format!(
+                "--gif {seed}: the policy is not deterministic; the GIF shows a re-run ({} steps, \
+                 {}), episodes.csv the run ({} steps, {})",
+                rerun.steps,
+                rerun.outcome.name(),
+                record.steps,
+                record.outcome.name()
+            )
+        }),
+    )
+}
+
 /// Removes the per-episode files an earlier run left in `dir` (`png/seed-*.png`,
-/// `steps/seed-*.csv`), so a reused output directory shows only this run. Nothing else is touched.
+/// `steps/seed-*.csv`, `gif/seed-*.gif`), so a reused output directory shows only this run. Nothing else is touched.
 fn remove_stale_files(dir: &std::path::Path) -> Result<()> {
-    for (sub, ext) in [("png", ".png"), ("steps", ".csv")] {
+    for (sub, ext) in [("png", ".png"), ("steps", ".csv"), ("gif", ".gif")] {
         let Ok(entries) = std::fs::read_dir(dir.join(sub)) else {
             continue;
         };

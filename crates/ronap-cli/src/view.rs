@@ -26,6 +26,10 @@ use std::time::{Duration, Instant};
 
 /// Arguments of `ronap view`.
 #[derive(Args, Debug)]
+#[command(
+    after_help = "Keys: space pause/resume, + and - faster/slower, m whole scene/first \
+    person, s one step when paused, r restart, n next seed, q or Esc quit (Ctrl-C too)."
+)]
 pub struct ViewArgs {
     /// Policy to watch, as for `ronap run`: apf (the paper's potential field, Algorithm 3),
     /// geodesic (shortest-path follower), random, mlp:FILE.safetensors (a trained network), or

@@ -266,9 +266,34 @@ fn help_explains_every_flag_with_its_default() {
         (&["collect", "--help"][..], "collect_help"),
         (&["train", "bc", "--help"][..], "train_bc_help"),
         (&["train", "dqn", "--help"][..], "train_dqn_help"),
+        (&["view", "--help"][..], "view_help"),
+        (&["replay", "--help"][..], "replay_help"),
     ] {
         let o = ronap(args);
         assert!(o.status.success());
         insta::assert_snapshot!(name, stdout(&o));
     }
+}
+
+#[test]
+fn view_needs_a_terminal_and_says_so() {
+    // Output captured: stdout is a pipe. The command must fail at once, not wait for keys.
+    let start = std::time::Instant::now();
+    assert_rejected(
+        &["view", "--policy", "apf", "--seed", "7"],
+        &["ronap view", "stdout is not one"],
+        None,
+    );
+    assert!(start.elapsed() < std::time::Duration::from_secs(20));
+    assert_rejected(&["view", "--policy", "nope"], &["--policy", "nope"], None);
+    assert_rejected(
+        &["view", "--policy", "apf", "--speed", "0"],
+        &["--speed", "0"],
+        None,
+    );
+    assert_rejected(
+        &["view", "--policy", "apf", "--map", "/no/map.png"],
+        &["/no/map.png"],
+        None,
+    );
 }

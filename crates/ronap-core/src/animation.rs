@@ -258,7 +258,20 @@ impl<W: Write> GifWriter<W> {
                 ),
             )));
         }
-        let indices: Vec<u8> = image.pixels().map(|p| palette_index(p.0)).collect();
+        // Pictures come in long runs of one colour: look each new colour up once.
+        let mut last = (
+            image::Rgb([255, 255, 255]).0,
+            palette_index([255, 255, 255]),
+        );
+        let indices: Vec<u8> = image
+            .pixels()
+            .map(|p| {
+                if p.0 != last.0 {
+                    last = (p.0, palette_index(p.0));
+                }
+                last.1
+            })
+            .collect();
         // The rectangle that changed; a frame identical to the last still takes its time, as one
         // unchanged pixel.
         let (x0, y0, x1, y1) = match &self.previous {

@@ -62,12 +62,23 @@ impl Canvas {
         (lo <= hi).then_some((lo as u32, hi as u32))
     }
 
-    /// Fills the pixels whose centres lie in `b`.
+    /// The pixel range of [`Canvas::pixel_span`], or, for a span thinner than a pixel, the pixel
+    /// holding its middle: at small scales a thin wall still shows.
+    fn thin_span(&self, a: f64, b: f64, n: u32) -> Option<(u32, u32)> {
+        self.pixel_span(a, b, n).or_else(|| {
+            // The middle of the part inside the image, so a wall on the border shows too.
+            let (a, b) = (a.max(0.0), b.min(n as f64 / self.scale));
+            let mid = ((a + b) / 2.0 * self.scale).floor().min(n as f64 - 1.0);
+            (a <= b && mid >= 0.0).then_some((mid as u32, mid as u32))
+        })
+    }
+
+    /// Fills the pixels whose centres lie in `b` (at least one pixel across, however thin `b`).
     pub fn fill_box(&mut self, b: &Aabb, colour: Rgb<u8>) {
         let (w, h) = self.image.dimensions();
         let (Some((c0, c1)), Some((r0, r1))) = (
-            self.pixel_span(b.min.x, b.max.x, w),
-            self.pixel_span(b.min.y, b.max.y, h),
+            self.thin_span(b.min.x, b.max.x, w),
+            self.thin_span(b.min.y, b.max.y, h),
         ) else {
             return;
         };
@@ -336,6 +347,18 @@ mod tests {
         assert_eq!(*img.get_pixel(3, 8), WALL);
         assert_eq!(*img.get_pixel(3, 7), FLOOR);
         assert_eq!(*img.get_pixel(3, 0), FLOOR);
+        // At a tenth of the scale the 2 px wall is a fifth of a pixel, and still one pixel high.
+        let small = Canvas::new(&scene, 0.1).into_image();
+        assert_eq!(small.dimensions(), (1, 1));
+        assert_eq!(*small.get_pixel(0, 0), WALL);
+        let inner = Aabb::from_corners(Point::new(49.0, 0.0), Point::new(51.0, 100.0));
+        let border = Aabb::from_corners(Point::new(99.0, 0.0), Point::new(101.0, 100.0));
+        let scene = Scene::from_boxes(100.0, 100.0, vec![inner, border], 5.0);
+        let img = Canvas::new(&scene, 0.4).into_image();
+        for col in [19, 20, 39] {
+            let walls = (0..40).filter(|&r| *img.get_pixel(col, r) == WALL).count();
+            assert_eq!(walls, if col == 19 { 0 } else { 40 }, "column {col}");
+        }
     }
 
     #[test]
@@ -363,10 +386,7 @@ mod tests {
             let expected = crate::geometry::wrap_deg(90.0 + theta - z);
             let got = frame.angle_deg(theta);
             let diff = crate::geometry::wrap_deg(got - expected);
-            assert!(
-                diff < 1e-9 || diff > 360.0 - 1e-9,
-                "z {z}: {got} vs {expected}"
-            );
+            assert!(diff.min(360.0 - diff) < 1e-9, "z {z}: {got} vs {expected}");
         }
     }
 }

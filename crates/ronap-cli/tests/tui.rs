@@ -1,0 +1,213 @@
+//! The terminal commands driven as a person would: `ronap` runs in an 80x24 tmux pane, keys are
+//! sent with `send-keys`, and the screen is read with `capture-pane`. Each test has its own tmux
+//! server. Without tmux the tests print a notice and pass; CI installs it (.ci/run).
+
+// Test helpers may panic on setup failures: that is a failed test, as intended.
+#![allow(clippy::unwrap_used)]
+
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+/// A tmux server with one 80x24 pane running a plain shell.
+struct Tmux {
+    socket: String,
+}
+
+impl Tmux {
+    /// A new server, or `None` (with a notice) when tmux is not installed.
+    fn start(name: &str) -> Option<Self> {
+        if Command::new("tmux").arg("-V").output().is_err() {
+            eprintln!("tmux is not installed: skipping the terminal test {name}");
+            return None;
+        }
+        let tmux = Self {
+            socket: format!("ronap-test-{name}-{}", std::process::id()),
+        };
+        tmux.run(&[
+            "new-session",
+            "-d",
+            "-x",
+            "80",
+            "-y",
+            "24",
+            "env",
+            "-i",
+            &format!("PATH={}", std::env::var("PATH").unwrap_or_default()),
+            "TERM=xterm-256color",
+            "HOME=/tmp",
+            "PS1=$ ",
+            "bash",
+            "--norc",
+            "--noprofile",
+        ]);
+        tmux.run(&["set-option", "-g", "remain-on-exit", "on"]);
+        Some(tmux)
+    }
+
+    fn run(&self, args: &[&str]) -> String {
+        let o = Command::new("tmux")
+            .args(["-L", &self.socket])
+            .args(args)
+            .output()
+            .unwrap();
+        assert!(
+            o.status.success(),
+            "tmux {args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        String::from_utf8_lossy(&o.stdout).into_owned()
+    }
+
+    /// Types `keys` (tmux key names: `Enter`, `Left`, `C-c`, or literal text).
+    fn keys(&self, keys: &[&str]) {
+        let mut args = vec!["send-keys", "-t", "0"];
+        args.extend(keys);
+        self.run(&args);
+    }
+
+    /// Types a shell command line and Enter.
+    fn line(&self, command: &str) {
+        self.run(&["send-keys", "-t", "0", "-l", command]);
+        self.keys(&["Enter"]);
+    }
+
+    /// The visible screen.
+    fn screen(&self) -> String {
+        self.run(&["capture-pane", "-p", "-t", "0"])
+    }
+
+    /// A tmux format value of the pane, such as `#{alternate_on}`.
+    fn format(&self, format: &str) -> String {
+        self.run(&["display-message", "-p", "-t", "0", format])
+            .trim()
+            .to_string()
+    }
+
+    /// Waits until the screen satisfies `ready`; fails with the screen after `seconds`.
+    fn wait(&self, what: &str, seconds: u64, ready: impl Fn(&str) -> bool) -> String {
+        let deadline = Instant::now() + Duration::from_secs(seconds);
+        loop {
+            let screen = self.screen();
+            if ready(&screen) {
+                return screen;
+            }
+            assert!(
+                Instant::now() < deadline,
+                "waited {seconds} s for {what}; the screen:\n{screen}"
+            );
+            std::thread::sleep(Duration::from_millis(100));
+        }
+    }
+}
+
+impl Drop for Tmux {
+    fn drop(&mut self) {
+        let _ = Command::new("tmux")
+            .args(["-L", &self.socket, "kill-server"])
+            .output();
+    }
+}
+
+fn ronap() -> &'static str {
+    env!("CARGO_BIN_EXE_ronap")
+}
+
+/// Checks that the terminal is back to the shell: main screen, cursor shown, and cooked mode
+/// (the line discipline's settings equal to those saved before).
+fn assert_restored(tmux: &Tmux, marker: &str) {
+    let screen = tmux.wait(marker, 15, |s| s.contains(marker));
+    assert_eq!(tmux.format("#{alternate_on}"), "0", "{screen}");
+    assert_eq!(tmux.format("#{cursor_flag}"), "1", "{screen}");
+    assert!(!screen.contains("ronap view ─"), "{screen}");
+    tmux.line("stty -g > after.stty; cmp before.stty after.stty && echo same-tty-settings");
+    tmux.wait("the same tty settings", 10, |s| {
+        s.lines().any(|l| l.trim() == "same-tty-settings")
+    });
+}
+
+#[test]
+fn view_shows_the_episode_toggles_the_map_and_restores_the_terminal_on_quit() {
+    let Some(tmux) = Tmux::start("view") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    tmux.line(&format!(
+        "cd {}; stty -g > before.stty",
+        dir.path().display()
+    ));
+    tmux.line(&format!(
+        "{} view --policy apf --seed 7 --speed 5; echo after-view rc=$?",
+        ronap()
+    ));
+    let screen = tmux.wait("the first-person view", 30, |s| {
+        s.contains("first person · seed 7") && s.contains("step 1 ")
+    });
+    assert_eq!(tmux.format("#{alternate_on}"), "1");
+    let lines: Vec<&str> = screen.lines().collect();
+    assert!(lines[0].contains("ronap view"), "{screen}");
+    // The distance in the upper right of the scene, the status line at the bottom.
+    assert!(
+        lines[1]
+            .split('│')
+            .nth(1)
+            .unwrap()
+            .trim_end()
+            .ends_with(" px"),
+        "{screen}"
+    );
+    assert!(lines[23].contains("running · step"), "{screen}");
+    assert!(lines[23].contains("collisions 0"), "{screen}");
+    assert!(screen.contains("policy     apf"), "{screen}");
+    // Rays and the range circle are Braille dots.
+    let braille = screen
+        .chars()
+        .filter(|c| ('\u{2801}'..='\u{28ff}').contains(c))
+        .count();
+    assert!(braille > 100, "{screen}");
+
+    tmux.keys(&["M"]);
+    let screen = tmux.wait("the whole scene", 10, |s| {
+        s.contains("whole scene · seed 7")
+    });
+    assert!(
+        !screen.lines().next().unwrap().contains("first person"),
+        "{screen}"
+    );
+    tmux.keys(&["space"]);
+    tmux.wait("pause", 10, |s| s.contains("❚❚ paused"));
+
+    tmux.keys(&["q"]);
+    assert_restored(&tmux, "after-view rc=0");
+}
+
+#[test]
+fn view_restores_the_terminal_on_ctrl_c_and_sigterm() {
+    let Some(tmux) = Tmux::start("view-signals") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    tmux.line(&format!(
+        "cd {}; stty -g > before.stty",
+        dir.path().display()
+    ));
+    let view = format!("{} view --policy random --seed 3 --speed 50", ronap());
+    tmux.line(&format!("{view}; echo after-ctrl-c rc=$?"));
+    tmux.wait("the view", 30, |s| s.contains("first person · seed 3"));
+    tmux.keys(&["C-c"]);
+    assert_restored(&tmux, "after-ctrl-c rc=130");
+
+    tmux.line("clear");
+    // The view writes nothing we could read its process id from: a shell that records its own
+    // and becomes ronap does.
+    tmux.line(&format!(
+        "bash -c 'echo $$ > view.pid; exec {view}'; echo after-term rc=$?"
+    ));
+    tmux.wait("the view", 30, |s| s.contains("first person · seed 3"));
+    let pid = std::fs::read_to_string(dir.path().join("view.pid")).unwrap();
+    let killed = Command::new("kill")
+        .args(["-TERM", pid.trim()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    assert_restored(&tmux, "after-term rc=143");
+}
