@@ -1,5 +1,6 @@
 //! `ronap collect`: record (observation, action) rows for behaviour cloning, labelled by an expert
-//! planner, in the data-log format.
+//! planner or by a person at the keys (`--human`, the paper's Collect Data screen), in the
+//! data-log format.
 
 use crate::policies::policy_factory;
 use crate::sim_args::{cancel_on_ctrl_c, count, seed, threads, SceneArgs, SimArgs};
@@ -26,10 +27,16 @@ enum Mode {
 
 /// Arguments of `ronap collect`.
 #[derive(Args, Debug)]
+#[command(group(clap::ArgGroup::new("labeller").required(true).args(["expert", "human"])))]
 pub struct CollectArgs {
     /// The expert that labels each state with its action: geodesic (the shortest-path planner).
     #[arg(long, value_name = "PLANNER")]
-    expert: String,
+    expert: Option<String>,
+    /// A person labels each state in the terminal (the paper's Collect Data screen): left / up /
+    /// right arrows for LEFT / AHEAD / RIGHT, the down arrow to re-arm them after each action, m
+    /// for the whole scene, q to quit. Rows are written as they are taken.
+    #[arg(long, conflicts_with_all = ["driver", "threads"])]
+    human: bool,
     /// Number of rows to record.
     #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 10_000, value_parser = count)]
     samples: u64,
@@ -56,7 +63,8 @@ pub struct CollectArgs {
     /// Output CSV [default: <user>_<YYYYmmddHHMMSS>.csv].
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
-    /// User name for the default file name [default: expert-<PLANNER>].
+    /// User name for the default file name [default: $USER or `user` with --human,
+    /// expert-<PLANNER> otherwise].
     #[arg(long, value_name = "NAME")]
     user: Option<String>,
 }
@@ -69,11 +77,12 @@ pub fn default_log_name(user: &str) -> PathBuf {
 
 /// Runs `ronap collect`.
 pub fn run(args: CollectArgs) -> Result<ExitCode> {
-    if args.expert != "geodesic" {
-        bail!(
-            "--expert {:?}: unknown expert (expected geodesic)",
-            args.expert
-        );
+    if args.human {
+        return run_human(args);
+    }
+    let expert = args.expert.clone().unwrap_or_default();
+    if expert != "geodesic" {
+        bail!("--expert {expert:?}: unknown expert (expected geodesic)");
     }
     let config = args.sim.config()?;
     let (scenes, _) = args.scenes.scenes(&config)?;
@@ -89,11 +98,7 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
         .episode(first)
         .with_context(|| format!("cannot start episodes in this scene (seed {first})"))?;
     let out = args.out.clone().unwrap_or_else(|| {
-        default_log_name(
-            args.user
-                .as_deref()
-                .unwrap_or(&format!("expert-{}", args.expert)),
-        )
+        default_log_name(args.user.as_deref().unwrap_or(&format!("expert-{expert}")))
     });
     let posing = match args.mode {
         Mode::Repose => Posing::Repose,
@@ -152,7 +157,7 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
         stdout,
         "ronap collect: {rows} rows from {episodes} episodes (seeds {first}..{}), expert {}, mode {:?}, {:.1} s",
         first + episodes.saturating_sub(1) as u64,
-        args.expert,
+        expert,
         args.mode,
         clock.elapsed().as_secs_f64()
     )?;
@@ -165,4 +170,22 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
         return Ok(ExitCode::from(130));
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Runs `ronap collect --human`.
+fn run_human(args: CollectArgs) -> Result<ExitCode> {
+    if args.mode == Mode::Drive {
+        bail!("--human records in the paper's re-posing mode: --mode drive is for --expert");
+    }
+    let config = args.sim.config()?;
+    let (scenes, _) = args.scenes.scenes(&config)?;
+    let user = args.user.clone().unwrap_or_else(crate::human::default_user);
+    crate::human::run(crate::human::Setting {
+        evaluator: Evaluator::new(config, scenes),
+        seed_start: args.seed_start,
+        per_episode: args.per_episode,
+        samples: args.samples,
+        out: args.out.clone().unwrap_or_else(|| default_log_name(&user)),
+        user,
+    })
 }

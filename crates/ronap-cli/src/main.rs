@@ -3,6 +3,7 @@
 
 mod bench;
 mod collect;
+mod human;
 mod maze;
 mod output;
 mod policies;
@@ -42,7 +43,8 @@ enum Command {
     Maze(maze::MazeArgs),
     /// Evaluate a policy over many seeded episodes: summary table, CSV logs, PNG trajectories.
     Run(run::RunArgs),
-    /// Record (observation, expert action) rows for behaviour cloning, in the data-log format.
+    /// Record (observation, action) rows for behaviour cloning, in the data-log format: labelled
+    /// by an expert planner, or by you at the keys (--human, the paper's Collect Data screen).
     Collect(collect::CollectArgs),
     /// Watch a policy drive one episode live in the terminal: the paper's first-person view, the
     /// whole scene with M, pause, speed and restart keys.

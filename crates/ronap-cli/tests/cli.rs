@@ -276,6 +276,33 @@ fn help_explains_every_flag_with_its_default() {
 }
 
 #[test]
+fn collect_human_needs_a_terminal_and_writes_nothing_without_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("rows.csv");
+    let o = out.to_str().unwrap();
+    assert_rejected(
+        &["collect", "--human", "--out", o],
+        &["ronap collect --human", "stdout is not one"],
+        Some(&out),
+    );
+    assert_rejected(
+        &["collect", "--human", "--expert", "geodesic", "--out", o],
+        &["--human", "--expert"],
+        Some(&out),
+    );
+    assert_rejected(
+        &["collect", "--out", o],
+        &["--expert", "--human"],
+        Some(&out),
+    );
+    assert_rejected(
+        &["collect", "--human", "--mode", "drive", "--out", o],
+        &["--human", "--mode drive"],
+        Some(&out),
+    );
+}
+
+#[test]
 fn view_needs_a_terminal_and_says_so() {
     // Output captured: stdout is a pipe. The command must fail at once, not wait for keys.
     let start = std::time::Instant::now();

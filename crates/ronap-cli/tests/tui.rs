@@ -204,10 +204,128 @@ fn view_restores_the_terminal_on_ctrl_c_and_sigterm() {
     ));
     tmux.wait("the view", 30, |s| s.contains("first person · seed 3"));
     let pid = std::fs::read_to_string(dir.path().join("view.pid")).unwrap();
-    let killed = Command::new("kill")
-        .args(["-TERM", pid.trim()])
+    // bash's own kill: no procps needed.
+    let killed = Command::new("bash")
+        .args(["-c", &format!("kill -TERM {}", pid.trim())])
         .status()
         .unwrap();
     assert!(killed.success());
     assert_restored(&tmux, "after-term rc=143");
+
+    // The terminal goes away (a closed SSH connection): SIGHUP, and a terminal that reads
+    // end-of-file forever. The process must end, not spin.
+    tmux.line(&format!(
+        "bash -c 'echo $$ > view.pid; exec {view}'; echo after-hangup rc=$?"
+    ));
+    tmux.wait("the view", 30, |s| s.contains("first person · seed 3"));
+    let pid = std::fs::read_to_string(dir.path().join("view.pid")).unwrap();
+    let stat = std::path::PathBuf::from(format!("/proc/{}/stat", pid.trim()));
+    // Running, as opposed to gone or a zombie waiting to be reaped.
+    let running = || {
+        std::fs::read_to_string(&stat).is_ok_and(|s| {
+            s.rsplit(')')
+                .next()
+                .and_then(|r| r.split_whitespace().next())
+                != Some("Z")
+        })
+    };
+    assert!(running());
+    tmux.run(&["kill-server"]);
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while running() {
+        assert!(
+            Instant::now() < deadline,
+            "ronap view ({}) still runs after its terminal hung up",
+            pid.trim()
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}
+
+/// The data rows of a data log, as maps from column to value.
+fn log_rows(path: &std::path::Path) -> Vec<std::collections::HashMap<String, String>> {
+    let mut r = csv::Reader::from_path(path).unwrap();
+    let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+    r.records()
+        .map(|rec| {
+            header
+                .iter()
+                .cloned()
+                .zip(rec.unwrap().iter().map(String::from))
+                .collect()
+        })
+        .collect()
+}
+
+#[test]
+fn collect_human_records_one_row_per_armed_arrow_as_it_is_taken() {
+    let Some(tmux) = Tmux::start("collect") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let log = dir.path().join("tester_rows.csv");
+    tmux.line(&format!(
+        "cd {}; stty -g > before.stty",
+        dir.path().display()
+    ));
+    tmux.line(&format!(
+        "{} collect --human --user tester --seed-start 5 --out tester_rows.csv; echo after-collect rc=$?",
+        ronap()
+    ));
+    let rows_shown = |n: u64| move |s: &str| s.contains(&format!("rows       {n} of 10000"));
+    tmux.wait("the collect screen", 30, |s| {
+        s.contains("first person · seed 5") && s.contains("● armed") && rows_shown(0)(s)
+    });
+    // Only the header so far.
+    assert_eq!(log_rows(&log).len(), 0);
+
+    tmux.keys(&["Up"]);
+    tmux.wait("the first row", 10, rows_shown(1));
+    // Written and flushed while the session is still running.
+    assert_eq!(log_rows(&log).len(), 1);
+    // Pressed twice without the down arrow: no second row.
+    tmux.keys(&["Up"]);
+    tmux.wait("the ignored key", 10, |s| s.contains("ignored: ↓ first"));
+    tmux.keys(&["Right"]);
+    std::thread::sleep(Duration::from_millis(300));
+    assert!(rows_shown(1)(&tmux.screen()));
+    assert_eq!(log_rows(&log).len(), 1);
+
+    tmux.keys(&["Down"]);
+    tmux.wait("re-armed", 10, |s| s.contains("● armed"));
+    tmux.keys(&["Left"]);
+    tmux.wait("the second row", 10, rows_shown(2));
+    tmux.keys(&["Down", "Right"]);
+    tmux.wait("the third row", 10, rows_shown(3));
+    tmux.keys(&["M"]);
+    tmux.wait("the whole scene", 10, |s| {
+        s.contains("whole scene · seed 5")
+    });
+
+    tmux.keys(&["q"]);
+    assert_restored(&tmux, "after-collect rc=0");
+    let screen = tmux.screen();
+    assert!(screen.contains("3 rows by tester"), "{screen}");
+    let rows = log_rows(&log);
+    let actions: Vec<&str> = rows.iter().map(|r| r["action"].as_str()).collect();
+    assert_eq!(actions, ["AHEAD", "LEFT", "RIGHT"]);
+    let steps: Vec<&str> = rows.iter().map(|r| r["step"].as_str()).collect();
+    assert_eq!(steps, ["0", "1", "2"]);
+    assert!(rows
+        .iter()
+        .all(|r| r["seed"] == "5" && r.contains_key("laser_16")));
+    // After each action the robot jumped to a new pose facing roughly towards the goal.
+    for pair in rows.windows(2) {
+        let at = |r: &std::collections::HashMap<String, String>, k: &str| -> f64 {
+            r[k].parse().unwrap()
+        };
+        let moved =
+            (at(&pair[0], "x") - at(&pair[1], "x")).hypot(at(&pair[0], "y") - at(&pair[1], "y"));
+        assert!(moved > 5.0, "not re-posed: {pair:?}");
+        let off = (at(&pair[1], "direction") + 180.0).rem_euclid(360.0) - 180.0;
+        assert!(
+            off.abs() < 45.0,
+            "re-posed facing {off} degrees off the goal"
+        );
+    }
 }

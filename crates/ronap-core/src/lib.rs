@@ -13,6 +13,7 @@ pub mod episode;
 pub mod evaluate;
 pub mod freespace;
 pub mod geometry;
+pub mod human;
 pub mod index;
 pub mod lidar;
 pub mod map;

@@ -1,8 +1,13 @@
 //! Owning the terminal: raw mode, the alternate screen and a hidden cursor while a session lives,
 //! and the terminal as it was afterwards, whichever way the session ends: return, error, panic
 //! (a panic hook restores it before the message prints), Ctrl-C (a key event in raw mode, left to
-//! the caller) or SIGINT/SIGTERM/SIGHUP (a flag the caller polls; a second signal ends the
-//! process at once, for a loop that has stopped polling).
+//! the caller) or SIGINT/SIGTERM/SIGHUP (a flag the caller polls).
+//!
+//! A loop that stops polling cannot see the flag: a Python policy that blocks, or crossterm
+//! itself, whose reader spins on a terminal that hung up (a closed SSH connection or tmux pane
+//! reads end-of-file forever). So a watchdog thread gives the caller [`GRACE`] to end after a
+//! signal, then restores the terminal and exits with 128 + the signal; a second signal exits at
+//! once.
 
 use anyhow::{bail, Context, Result};
 use ratatui::backend::CrosstermBackend;
@@ -10,14 +15,18 @@ use ratatui::crossterm::event::{self, Event, KeyCode, KeyEvent, KeyEventKind, Ke
 use ratatui::crossterm::{cursor, execute, terminal};
 use ratatui::Terminal;
 use std::io::{IsTerminal, Stdout};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Once};
-use std::time::Duration;
+use std::time::{Duration, Instant};
+
+/// How long the loop has to end by itself after a signal before the watchdog ends the process.
+pub const GRACE: Duration = Duration::from_secs(1);
 
 /// The terminal while a command draws on it.
 pub struct Session {
     terminal: Terminal<CrosstermBackend<Stdout>>,
     signal: Arc<AtomicUsize>,
+    ended: Arc<AtomicBool>,
     #[cfg(unix)]
     handlers: Vec<signal_hook::SigId>,
 }
@@ -84,12 +93,15 @@ impl Session {
             }
             ids
         };
+        let ended = Arc::new(AtomicBool::new(false));
+        watchdog(signal.clone(), ended.clone());
         terminal::enable_raw_mode().context("cannot switch the terminal to raw mode")?;
         // From here on the session exists, so every early return restores the terminal.
         let backend = CrosstermBackend::new(std::io::stdout());
         let mut session = Self {
             terminal: Terminal::new(backend).context("cannot use the terminal")?,
             signal,
+            ended,
             #[cfg(unix)]
             handlers,
         };
@@ -129,8 +141,27 @@ impl Session {
     }
 }
 
+/// Ends the process [`GRACE`] after a signal unless `ended` is set by then (see the module doc).
+fn watchdog(signal: Arc<AtomicUsize>, ended: Arc<AtomicBool>) {
+    std::thread::spawn(move || {
+        let mut since: Option<Instant> = None;
+        while !ended.load(Ordering::SeqCst) {
+            let sig = signal.load(Ordering::SeqCst);
+            if sig != 0 {
+                let at = *since.get_or_insert_with(Instant::now);
+                if at.elapsed() >= GRACE {
+                    restore();
+                    std::process::exit(128 + i32::try_from(sig).unwrap_or(0));
+                }
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+    });
+}
+
 impl Drop for Session {
     fn drop(&mut self) {
+        self.ended.store(true, Ordering::SeqCst);
         restore();
         #[cfg(unix)]
         for id in self.handlers.drain(..) {
