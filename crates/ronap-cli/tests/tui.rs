@@ -176,6 +176,38 @@ fn view_shows_the_episode_toggles_the_map_and_restores_the_terminal_on_quit() {
     tmux.keys(&["space"]);
     tmux.wait("pause", 10, |s| s.contains("❚❚ paused"));
 
+    // Resized, the screen is laid out again for the new size, and again on the way back.
+    for (w, h) in [(100usize, 30usize), (80, 24)] {
+        tmux.run(&[
+            "resize-window",
+            "-t",
+            "0",
+            "-x",
+            &w.to_string(),
+            "-y",
+            &h.to_string(),
+        ]);
+        let screen = tmux.wait("the resized screen", 10, |s| {
+            let lines: Vec<&str> = s.lines().collect();
+            lines.len() == h
+                && lines[h - 1].contains("paused · step")
+                && lines[h - 2].starts_with('└')
+                && lines[h - 2].ends_with('┘')
+        });
+        for line in screen.lines() {
+            assert!(line.chars().count() <= w, "{w}x{h}:\n{screen}");
+        }
+        assert!(screen
+            .lines()
+            .next()
+            .unwrap()
+            .starts_with("┌ whole scene · seed 7"));
+        assert_eq!(
+            tmux.format("#{pane_width}x#{pane_height}"),
+            format!("{w}x{h}")
+        );
+    }
+
     tmux.keys(&["q"]);
     assert_restored(&tmux, "after-view rc=0");
 }
