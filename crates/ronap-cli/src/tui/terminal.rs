@@ -95,9 +95,8 @@ impl Session {
         };
         let ended = Arc::new(AtomicBool::new(false));
         watchdog(signal.clone(), ended.clone());
-        terminal::enable_raw_mode().context("cannot switch the terminal to raw mode")?;
-        // From here on the session exists, so every early return restores the terminal.
         let backend = CrosstermBackend::new(std::io::stdout());
+        // The session exists before the terminal changes, so every early return restores it.
         let mut session = Self {
             terminal: Terminal::new(backend).context("cannot use the terminal")?,
             signal,
@@ -105,6 +104,7 @@ impl Session {
             #[cfg(unix)]
             handlers,
         };
+        terminal::enable_raw_mode().context("cannot switch the terminal to raw mode")?;
         execute!(
             std::io::stdout(),
             terminal::EnterAlternateScreen,
