@@ -11,6 +11,7 @@ use std::time::{Duration, Instant};
 /// A tmux server with one 80x24 pane running a plain shell.
 struct Tmux {
     socket: String,
+    socket_path: String,
 }
 
 impl Tmux {
@@ -20,8 +21,9 @@ impl Tmux {
             eprintln!("tmux is not installed: skipping the terminal test {name}");
             return None;
         }
-        let tmux = Self {
+        let mut tmux = Self {
             socket: format!("ronap-test-{name}-{}", std::process::id()),
+            socket_path: String::new(),
         };
         tmux.run(&[
             "new-session",
@@ -41,6 +43,10 @@ impl Tmux {
             "--noprofile",
         ]);
         tmux.run(&["set-option", "-g", "remain-on-exit", "on"]);
+        tmux.socket_path = tmux
+            .run(&["display-message", "-p", "#{socket_path}"])
+            .trim()
+            .to_string();
         Some(tmux)
     }
 
@@ -105,6 +111,10 @@ impl Drop for Tmux {
         let _ = Command::new("tmux")
             .args(["-L", &self.socket, "kill-server"])
             .output();
+        // tmux leaves its socket file behind.
+        if !self.socket_path.is_empty() {
+            let _ = std::fs::remove_file(&self.socket_path);
+        }
     }
 }
 
