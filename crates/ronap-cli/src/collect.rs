@@ -155,10 +155,13 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
     let mut stdout = std::io::stdout().lock();
     writeln!(
         stdout,
-        "ronap collect: {rows} rows from {episodes} episodes (seeds {first}..{}), expert {}, mode {:?}, {:.1} s",
+        "ronap collect: {rows} rows from {episodes} episodes (seeds {first}..{}), expert {}, mode {}, {:.1} s",
         first + episodes.saturating_sub(1) as u64,
         expert,
-        args.mode,
+        match args.mode {
+            Mode::Repose => "repose",
+            Mode::Drive => "drive",
+        },
         clock.elapsed().as_secs_f64()
     )?;
     writeln!(stdout, "wrote {}", out.display())?;

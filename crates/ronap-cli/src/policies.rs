@@ -1,7 +1,7 @@
 //! Policies by name, as the command line gives them.
 
 use anyhow::Result;
-use ronap_core::policy::{PolicyFactory, PolicyNameError};
+use ronap_core::policy::{Builtin, PolicyFactory, PolicyNameError};
 use ronap_core::ValidConfig;
 
 /// The policy `name` names: a built-in, `mlp:FILE[@RULE]` or `py:FILE:FUNCTION`.
@@ -13,7 +13,14 @@ pub fn policy_factory(name: &str, config: &ValidConfig) -> Result<Box<dyn Policy
     }
     let observation_size = config.laser.beams as usize + 1;
     ronap_core::policy::factory(name, observation_size).map_err(|e| match e {
-        PolicyNameError::Unknown { .. } => anyhow::anyhow!("--{e}, or py:FILE:FUNCTION"),
+        PolicyNameError::Unknown { .. } => {
+            let known: Vec<&str> = Builtin::ALL.iter().map(|(_, n, _)| *n).collect();
+            anyhow::anyhow!(
+                "--policy {name:?}: unknown policy (expected one of: {}, mlp:FILE[@RULE], \
+                 py:FILE:FUNCTION)",
+                known.join(", ")
+            )
+        }
         PolicyNameError::Rule { .. } => anyhow::anyhow!("--{e}"),
         PolicyNameError::Network(e) => anyhow::Error::from(e).context(format!("--policy {name:?}")),
     })

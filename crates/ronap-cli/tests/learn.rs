@@ -196,7 +196,7 @@ fn trains_on_the_original_platforms_rows() {
         out.contains("150 rows") && out.contains("50 skipped"),
         "{out}"
     );
-    assert!(out.contains("Original format"), "{out}");
+    assert!(out.contains("original RoNAP format"), "{out}");
 }
 
 #[test]
@@ -278,6 +278,20 @@ fn bad_weights_and_data_are_named() {
         "{e}"
     );
     assert!(!dir.path().join("b.safetensors").exists());
+}
+
+#[test]
+fn an_output_directory_is_refused_before_training() {
+    let dir = tempfile::tempdir().unwrap();
+    for out in [
+        dir.path().to_str().unwrap().to_string(),
+        format!("{}/missing/", dir.path().display()),
+    ] {
+        let o = ronap(&["train", "dqn", "--steps", "1000000", "--out", &out]);
+        assert_eq!(o.status.code(), Some(2));
+        let e = text(&o.stderr);
+        assert!(e.contains("--out") && e.lines().count() == 1, "{e}");
+    }
 }
 
 /// The shipped policies reach, on the first 100 of their 1000 held-out evaluation seeds, the

@@ -93,7 +93,7 @@ pub struct DqnReport {
     pub steps: u64,
     /// Finished episodes so far.
     pub episodes: u64,
-    /// Mean return of the last (up to) 100 finished episodes.
+    /// Mean return of the last (up to) 100 finished episodes (0 before any has finished).
     pub mean_return: f64,
     /// Success rate of the last (up to) 100 finished episodes.
     pub success_rate: f64,
@@ -365,7 +365,15 @@ pub fn train(
             }
         }
     }
-    on_report(&report(steps, episodes, &recent, f64::NAN));
+    // The last stretch, unless a report just covered it.
+    if next_report - report_every.max(1) < steps {
+        let loss = if loss_count > 0 {
+            loss_sum / loss_count as f64
+        } else {
+            f64::NAN
+        };
+        on_report(&report(steps, episodes, &recent, loss));
+    }
     online.to_mlp(metadata)
 }
 
