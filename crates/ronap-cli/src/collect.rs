@@ -3,7 +3,7 @@
 //! data-log format.
 
 use crate::policies::policy_factory;
-use crate::sim_args::{cancel_on_ctrl_c, count, seed, threads, SceneArgs, SimArgs};
+use crate::sim_args::{cancel_on_ctrl_c, count, seed, SceneArgs, SimArgs, ThreadArgs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
 use ronap_core::collect::{collect, Posing};
@@ -53,9 +53,8 @@ pub struct CollectArgs {
     /// First seed; episode i has seed seed-start + i.
     #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 1_000_000, value_parser = seed)]
     seed_start: u64,
-    /// Worker threads [default: all cores].
-    #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
-    threads: Option<u32>,
+    #[command(flatten)]
+    threads: ThreadArgs,
     #[command(flatten)]
     scenes: SceneArgs,
     #[command(flatten)]
@@ -104,7 +103,7 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
         Mode::Repose => Posing::Repose,
         Mode::Drive => Posing::Drive,
     };
-    let threads = threads(args.threads);
+    let threads = args.threads.count();
     let cancel = cancel_on_ctrl_c("writing the rows recorded so far");
     let bar = crate::output::progress_bar(
         args.samples,

@@ -1,7 +1,7 @@
 //! `ronap run`: evaluate a policy over many seeded episodes and write what happened.
 
 use crate::policies::policy_factory;
-use crate::sim_args::{cancel_on_ctrl_c, count, fraction, seed, threads, SceneArgs, SimArgs};
+use crate::sim_args::{cancel_on_ctrl_c, count, fraction, seed, SceneArgs, SimArgs, ThreadArgs};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use ronap_core::evaluate::{EpisodeRecord, Evaluator, Recording};
@@ -27,9 +27,8 @@ pub struct RunArgs {
     /// First seed.
     #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 0, value_parser = seed)]
     seed_start: u64,
-    /// Worker threads [default: all cores].
-    #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
-    threads: Option<u32>,
+    #[command(flatten)]
+    threads: ThreadArgs,
     #[command(flatten)]
     scenes: SceneArgs,
     #[command(flatten)]
@@ -111,7 +110,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         .world(first)
         .episode(first)
         .with_context(|| format!("cannot start episodes in this scene (seed {first})"))?;
-    let threads = threads(args.threads);
+    let threads = args.threads.count();
     let out_dir = match &args.out {
         Some(d) => d.clone(),
         None => {

@@ -138,12 +138,22 @@ impl SceneArgs {
     }
 }
 
-/// Worker threads: `flag`, or all cores.
-pub fn threads(flag: Option<u32>) -> usize {
-    flag.map_or_else(
-        || std::thread::available_parallelism().map_or(1, |n| n.get()),
-        |n| n as usize,
-    )
+/// The worker-thread flag.
+#[derive(Args, Debug, Clone, Copy, Default)]
+pub struct ThreadArgs {
+    /// Worker threads [default: all cores].
+    #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+}
+
+impl ThreadArgs {
+    /// The number of worker threads: the flag's, or all cores.
+    pub fn count(self) -> usize {
+        self.threads.map_or_else(
+            || std::thread::available_parallelism().map_or(1, |n| n.get()),
+            |n| n as usize,
+        )
+    }
 }
 
 /// A flag the first Ctrl-C sets (after saying `what` happens now); a second Ctrl-C exits at once

@@ -1,6 +1,6 @@
 //! `ronap train bc|dqn`: train a policy network and write it as a safetensors weights file.
 
-use crate::sim_args::{count, fraction, seed, threads, SceneArgs, SimArgs};
+use crate::sim_args::{count, fraction, seed, SceneArgs, SimArgs, ThreadArgs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use indicatif::ProgressBar;
@@ -128,9 +128,8 @@ struct DqnArgs {
     /// Print a progress line every N environment steps.
     #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 50_000, value_parser = count)]
     report_every: u64,
-    /// Environment worker threads [default: all cores].
-    #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
-    threads: Option<u32>,
+    #[command(flatten)]
+    threads: ThreadArgs,
     #[command(flatten)]
     scenes: SceneArgs,
     #[command(flatten)]
@@ -181,9 +180,18 @@ fn show(progress: &ProgressBar, stdout: &mut impl Write, line: &str) {
     }
 }
 
-/// The command line, for the weights file's metadata.
-fn command_line() -> String {
-    std::env::args().collect::<Vec<_>>().join(" ")
+/// The weights file's metadata beyond the network itself: what the outputs are, the decision
+/// rule, the command line that trained it and a description of the training.
+fn metadata(output: &str, decision: DecisionRule, trained: String) -> HashMap<String, String> {
+    HashMap::from([
+        ("output".to_string(), output.to_string()),
+        ("decision".to_string(), decision.name()),
+        (
+            "command".to_string(),
+            std::env::args().collect::<Vec<_>>().join(" "),
+        ),
+        ("trained".to_string(), trained),
+    ])
 }
 
 /// Checks the output can be written before any training time is spent.
@@ -296,12 +304,9 @@ fn train_bc(args: BcArgs) -> Result<ExitCode> {
     );
     let cancel =
         crate::sim_args::cancel_on_ctrl_c("stopping after this batch and saving the network");
-    let mut metadata = HashMap::new();
-    metadata.insert("output".into(), "logits".into());
-    metadata.insert("decision".into(), args.net.decision.name());
-    metadata.insert("command".into(), command_line());
-    metadata.insert(
-        "trained".into(),
+    let metadata = metadata(
+        "logits",
+        args.net.decision,
         format!("behaviour cloning on {}", described.join(", ")),
     );
     let (mlp, reports) = bc::train(
@@ -379,7 +384,7 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
         seed: args.net.seed,
         seed_start: args.seed_start,
     };
-    let threads = threads(args.threads);
+    let threads = args.threads.count();
     let mut stdout = std::io::stdout().lock();
     writeln!(
         stdout,
@@ -405,12 +410,9 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
         "ronap train dqn".into(),
     );
     let cancel = crate::sim_args::cancel_on_ctrl_c("stopping and saving the network");
-    let mut metadata = HashMap::new();
-    metadata.insert("output".into(), "q_values".into());
-    metadata.insert("decision".into(), args.net.decision.name());
-    metadata.insert("command".into(), command_line());
-    metadata.insert(
-        "trained".into(),
+    let metadata = metadata(
+        "q_values",
+        args.net.decision,
         format!(
             "DQN, {} environment steps, episode seeds from {}",
             args.steps, args.seed_start

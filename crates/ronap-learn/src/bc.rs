@@ -4,7 +4,7 @@
 use crate::net::{argmax_rows, batch, Net, TrainActivation};
 use crate::LearnError;
 use candle_core::{Device, Tensor};
-use candle_nn::optim::{AdamW, Optimizer, ParamsAdamW};
+use candle_nn::optim::Optimizer;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -115,18 +115,8 @@ pub fn train(
     let (train_rows, test_rows) = rows.split_at(n_train);
     let mut train_rows = train_rows.to_vec();
 
-    let mut sizes = vec![data.width];
-    sizes.extend(&options.hidden);
-    sizes.push(3);
-    let net = Net::new(&sizes, options.activation, &mut rng)?;
-    let mut optimiser = AdamW::new(
-        net.vars(),
-        ParamsAdamW {
-            lr: options.learning_rate,
-            weight_decay: 0.0,
-            ..ParamsAdamW::default()
-        },
-    )?;
+    let net = Net::policy(data.width, &options.hidden, options.activation, &mut rng)?;
+    let mut optimiser = net.adam(options.learning_rate)?;
     let mut reports = Vec::new();
     let mut batches = 0usize;
     'epochs: for epoch in 1..=options.epochs {

@@ -13,7 +13,7 @@
 use crate::net::{batch, Net, TrainActivation};
 use crate::LearnError;
 use candle_core::{Device, Tensor, D};
-use candle_nn::optim::{AdamW, Optimizer, ParamsAdamW};
+use candle_nn::optim::Optimizer;
 use rand::{Rng as _, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -237,6 +237,15 @@ impl Slot {
     }
 }
 
+/// The mean of `count` losses summing to `sum`; NaN for none.
+fn mean_loss(sum: f64, count: usize) -> f64 {
+    if count > 0 {
+        sum / count as f64
+    } else {
+        f64::NAN
+    }
+}
+
 /// Trains a Q-network on episodes from `evaluator`. `on_report` hears every `report_every`
 /// environment steps and at the end; returning `false` stops training. `threads` is the number
 /// of environment workers (0: all cores). Returns the network with `metadata` added to its file's.
@@ -254,20 +263,10 @@ pub fn train(
         .map_err(|e| LearnError::Threads(e.to_string()))?;
     let width = evaluator.config().laser.beams as usize + 1;
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
-    let mut sizes = vec![width];
-    sizes.extend(&options.hidden);
-    sizes.push(3);
-    let online = Net::new(&sizes, options.activation, &mut rng)?;
-    let target = Net::new(&sizes, options.activation, &mut rng)?;
+    let online = Net::policy(width, &options.hidden, options.activation, &mut rng)?;
+    let target = Net::policy(width, &options.hidden, options.activation, &mut rng)?;
     target.copy_from(&online)?;
-    let mut optimiser = AdamW::new(
-        online.vars(),
-        ParamsAdamW {
-            lr: options.learning_rate,
-            weight_decay: 0.0,
-            ..ParamsAdamW::default()
-        },
-    )?;
+    let mut optimiser = online.adam(options.learning_rate)?;
     let mut acting = online.to_mlp(HashMap::new())?;
     let mut replay = Replay::new(width, options.replay_capacity.max(options.batch));
     let mut next_seed = options.seed_start;
@@ -354,11 +353,7 @@ pub fn train(
         }
         if steps >= next_report {
             next_report += report_every.max(1);
-            let loss = if loss_count > 0 {
-                loss_sum / loss_count as f64
-            } else {
-                f64::NAN
-            };
+            let loss = mean_loss(loss_sum, loss_count);
             (loss_sum, loss_count) = (0.0, 0);
             if !on_report(&report(steps, episodes, &recent, loss)) {
                 break;
@@ -367,11 +362,7 @@ pub fn train(
     }
     // The last stretch, unless a report just covered it.
     if next_report - report_every.max(1) < steps {
-        let loss = if loss_count > 0 {
-            loss_sum / loss_count as f64
-        } else {
-            f64::NAN
-        };
+        let loss = mean_loss(loss_sum, loss_count);
         on_report(&report(steps, episodes, &recent, loss));
     }
     online.to_mlp(metadata)

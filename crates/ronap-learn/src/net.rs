@@ -3,6 +3,7 @@
 
 use crate::LearnError;
 use candle_core::{DType, Device, Tensor, Var};
+use candle_nn::optim::{AdamW, Optimizer, ParamsAdamW};
 use nalgebra::{DMatrix, DVector};
 use rand::Rng as _;
 use rand_chacha::ChaCha8Rng;
@@ -76,6 +77,32 @@ impl Net {
             layers.push(Layer { weight, bias });
         }
         Self::from_layers(&layers, activation)
+    }
+
+    /// A policy network for observations `width` wide: `hidden` layers, then one output per
+    /// action (LEFT, AHEAD, RIGHT).
+    pub fn policy(
+        width: usize,
+        hidden: &[usize],
+        activation: TrainActivation,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Self, LearnError> {
+        let mut sizes = vec![width];
+        sizes.extend(hidden);
+        sizes.push(3);
+        Self::new(&sizes, activation, rng)
+    }
+
+    /// Adam (no weight decay) over every variable, at `learning_rate`.
+    pub fn adam(&self, learning_rate: f64) -> Result<AdamW, LearnError> {
+        Ok(AdamW::new(
+            self.vars(),
+            ParamsAdamW {
+                lr: learning_rate,
+                weight_decay: 0.0,
+                ..ParamsAdamW::default()
+            },
+        )?)
     }
 
     /// The trainable copy of `mlp`'s layers.
