@@ -1,21 +1,14 @@
 //! `ronap`: the command-line front of ronap-core. Parses arguments, writes files, reports errors;
 //! the model itself lives in the core.
 
-mod bench;
-mod collect;
-mod human;
-mod maze;
+mod args;
+mod commands;
 mod output;
-mod policies;
 mod py_policy;
-mod replay;
-mod run;
-mod sim_args;
-mod train;
 mod tui;
-mod view;
 
 use clap::{Parser, Subcommand};
+use commands::{bench, collect, config, maze, replay, run, train, view};
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -58,22 +51,7 @@ enum Command {
     Train(train::TrainArgs),
     /// Print the whole configuration as TOML, a comment on every field: a file to copy and edit
     /// for --config.
-    Config(ConfigArgs),
-}
-
-/// Arguments of `ronap config`.
-#[derive(clap::Args, Debug)]
-struct ConfigArgs {
-    #[command(flatten)]
-    sim: sim_args::SimArgs,
-}
-
-/// Runs `ronap config`.
-fn print_config(args: ConfigArgs) -> anyhow::Result<ExitCode> {
-    let config = args.sim.config()?;
-    let mut stdout = std::io::stdout().lock();
-    stdout.write_all(config.to_documented_toml().as_bytes())?;
-    Ok(ExitCode::SUCCESS)
+    Config(config::ConfigArgs),
 }
 
 fn main() -> ExitCode {
@@ -112,7 +90,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench::run(args),
         Command::Collect(args) => collect::run(args),
         Command::Train(args) => train::run(args),
-        Command::Config(args) => print_config(args),
+        Command::Config(args) => config::run(args),
     };
     match result {
         Ok(code) => code,

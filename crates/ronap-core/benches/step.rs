@@ -4,10 +4,10 @@
 //! core); `scan/parry2d` is the same scan through parry2d's general ray cast, for comparison.
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
-use ronap_core::episode::maze_scene;
-use ronap_core::freespace::FreeGrid;
+use ronap_core::geometry::reference::ParryScene;
 use ronap_core::geometry::unit;
-use ronap_core::reference::ParryScene;
+use ronap_core::scene::freespace::FreeGrid;
+use ronap_core::sim::world::maze_scene;
 use ronap_core::{Episode, Laser, ValidConfig};
 use std::hint::black_box;
 use std::sync::Arc;
@@ -60,7 +60,7 @@ fn scan(c: &mut Criterion) {
             )
         })
     });
-    let parry = ParryScene::new(&scene).expect("walls");
+    let parry = ParryScene::new(scene.boxes()).expect("walls");
     group.bench_function("parry2d", |b| {
         b.iter(|| {
             for (i, o) in out.iter_mut().enumerate() {
@@ -92,14 +92,14 @@ fn setup(c: &mut Criterion) {
     let (start, goal) = (episode.start().position(), episode.goal());
     let grid = world.grid();
     group.bench_function("distance_field", |b| {
-        b.iter(|| ronap_core::planning::DistanceField::new(world.scene(), grid, goal, 5.0, 4.0))
+        b.iter(|| ronap_core::plan::DistanceField::new(world.scene(), grid, goal, 5.0, 4.0))
     });
-    let field = ronap_core::planning::DistanceField::new(world.scene(), grid, goal, 5.0, 1.0);
+    let field = ronap_core::plan::DistanceField::new(world.scene(), grid, goal, 5.0, 1.0);
     let path = field
         .path(world.scene(), grid, start, 5.0)
         .expect("connected");
     group.bench_function("smooth", |b| {
-        b.iter(|| ronap_core::planning::smooth(world.scene(), &path, 5.0))
+        b.iter(|| ronap_core::plan::smooth(world.scene(), &path, 5.0))
     });
     group.finish();
 }

@@ -271,6 +271,19 @@ impl ValidConfig {
     pub fn as_sim_config(&self) -> &SimConfig {
         &self.0
     }
+
+    /// Length of the observation a policy sees: one value per laser beam, then the goal
+    /// direction (SPEC "Observation and reward").
+    pub fn observation_size(&self) -> usize {
+        self.laser.beams as usize + 1
+    }
+
+    /// The query distance scenes are indexed for: the laser range or a step plus the robot
+    /// radius, whichever is longer, px.
+    pub fn reach_px(&self) -> f64 {
+        let step = self.robot.move_speed_px.max(self.robot.max_linear_speed_px);
+        self.laser.range_px.max(step + self.robot.radius_px)
+    }
 }
 
 fn check(

@@ -4,37 +4,42 @@
 //! or continuous actions and a goal; an [`Episode`] steps it and scores it. Units are scene px and
 //! degrees, with x right and y up. Nothing here parses arguments, prints or exits: the `ronap`
 //! binary and the Python module wrap it.
+//!
+//! The crate is in layers, each a folder whose `mod.rs` says what it is for. A layer uses only
+//! the layers listed before it (`tests/layers.rs` holds the code to that):
+//!
+//! | layer | holds |
+//! | --- | --- |
+//! | [`config`] | every model field with its default, and their validation (uses nothing) |
+//! | [`geometry`] | points, boxes, the bin index, parry2d as the reference geometry |
+//! | [`scene`] | the scene's obstacles, mazes, image and ROS maps, the free-space grid |
+//! | [`sim`] | robot and actions, laser, random streams, placement, the episode, worlds and scenes |
+//! | [`plan`] | geodesic distance fields and shortest paths |
+//! | [`policy`] | the `Policy` trait and one file per policy |
+//! | [`run`] | one episode driven by one policy (a rollout), N episodes stepped side by side (a batch) |
+//! | [`eval`] | the batch evaluator, its records and summary |
+//! | [`render`] | pictures: canvas, first-person view, trajectories, GIFs |
+//! | [`io`] | files: atomic writes, run directories and their manifest, data logs, step logs |
+//! | [`collect`] | labelled data: expert and human collection |
 
-pub mod animation;
 pub mod collect;
 pub mod config;
-pub mod datalog;
-pub mod episode;
-pub mod evaluate;
-pub mod freespace;
+pub mod eval;
 pub mod geometry;
-pub mod human;
-pub mod index;
-pub mod lidar;
-pub mod map;
-pub mod maze;
-pub mod output;
-pub mod planning;
+pub mod io;
+pub mod plan;
 pub mod policy;
-pub mod reference;
 pub mod render;
-pub mod report;
-pub mod rng;
-pub mod robot;
+pub mod run;
 pub mod scene;
-pub mod summary;
-pub mod world;
+pub mod sim;
 
 pub use config::{ConfigError, SimConfig, ValidConfig};
-pub use episode::{Episode, EpisodeError, Placement, Status, StepResult};
 pub use geometry::{Aabb, Point, Vector};
-pub use lidar::Laser;
-pub use maze::Maze;
-pub use robot::{Action, DiscreteAction, Pose, Robot};
+pub use scene::maze::Maze;
 pub use scene::{Scene, SceneError};
-pub use world::World;
+pub use sim::episode::{Episode, Status, StepResult};
+pub use sim::lidar::Laser;
+pub use sim::placement::{EpisodeError, Placement};
+pub use sim::robot::{Action, DiscreteAction, Pose, Robot};
+pub use sim::world::{Scenes, World};

@@ -6,10 +6,10 @@
 
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
-use ronap_core::episode::maze_scene;
+use ronap_core::geometry::reference::ParryScene;
 use ronap_core::geometry::unit;
-use ronap_core::reference::ParryScene;
 use ronap_core::render::Canvas;
+use ronap_core::sim::world::maze_scene;
 use ronap_core::{DiscreteAction, Episode, Laser, Point, Scene, SimConfig, ValidConfig};
 use std::sync::Arc;
 
@@ -39,7 +39,7 @@ fn laser_matches_parry2d_to_1e_4_px() {
     let mut compared = 0;
     for seed in 0..20 {
         let scene = maze_scene(&config, seed);
-        let parry = ParryScene::new(&scene).expect("a maze has walls");
+        let parry = ParryScene::new(scene.boxes()).expect("a maze has walls");
         for _ in 0..200 {
             let p = free_point(&scene, 0.5, &mut rng);
             let z = rng.random_range(0.0..360.0);
@@ -63,7 +63,7 @@ fn long_rays_and_sweeps_match_parry2d() {
     // Queries longer than the index reach take the all-boxes path; they must agree too.
     let config = config();
     let scene = maze_scene(&config, 3);
-    let parry = ParryScene::new(&scene).expect("walls");
+    let parry = ParryScene::new(scene.boxes()).expect("walls");
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
     for _ in 0..2000 {
         let a = free_point(&scene, 5.0, &mut rng);
@@ -104,7 +104,7 @@ proptest! {
         sim.robot.max_linear_speed_px = speed;
         let config = sim.validate().unwrap();
         let scene = Arc::new(maze_scene(&config, seed));
-        let parry = ParryScene::new(&scene).unwrap();
+        let parry = ParryScene::new(scene.boxes()).unwrap();
         let mut episode = Episode::new(&config, scene.clone(), seed).unwrap();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         for _ in 0..300 {

@@ -8,7 +8,7 @@ use candle_nn::optim::Optimizer;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use ronap_core::datalog::DataSet;
+use ronap_core::io::datalog::DataSet;
 use ronap_core::policy::mlp::Mlp;
 use std::collections::HashMap;
 
@@ -158,7 +158,7 @@ pub fn train(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ronap_core::robot::DiscreteAction;
+    use ronap_core::sim::robot::DiscreteAction;
 
     /// A rule an MLP can learn: turn towards the goal unless it is ahead.
     fn rule_data(n: usize, seed: u64) -> DataSet {
@@ -210,9 +210,9 @@ mod tests {
 #[cfg(test)]
 mod expert_data {
     use super::*;
-    use ronap_core::collect::{collect, Posing};
-    use ronap_core::evaluate::{Evaluator, Scenes};
-    use ronap_core::SimConfig;
+    use ronap_core::collect::expert::{collect, Posing};
+    use ronap_core::eval::Evaluator;
+    use ronap_core::{Scenes, SimConfig};
     use std::sync::atomic::AtomicBool;
 
     #[test]

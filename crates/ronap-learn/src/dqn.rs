@@ -6,9 +6,10 @@
 //! episode's exploration draws from its own seed's policy stream and the replay memory fills in
 //! environment order, so a run is the same on any number of threads.
 //!
-//! Success (and a collision under `on_collision = terminate`) ends an episode with target `y = r`.
-//! A time-out or the `reward_min` cut-off also ends the episode but is not a property of the state,
-//! so its target still bootstraps (`y = r + gamma max Q_target`), as time limits should be.
+//! An episode that [`Status::is_terminated`] (success, a collision under `on_collision =
+//! terminate`, the summed reward reaching `reward_min`) gets target `y = r`, as Algorithm 1 has
+//! it. A time-out also ends the episode but is not a property of the state, so its target still
+//! bootstraps (`y = r + gamma max Q_target`), as time limits should.
 
 use crate::net::{batch, Net, TrainActivation};
 use crate::LearnError;
@@ -16,11 +17,10 @@ use candle_core::{Device, Tensor, D};
 use candle_nn::optim::Optimizer;
 use rand::{Rng as _, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rayon::prelude::*;
-use ronap_core::evaluate::{Evaluator, RunError};
+use ronap_core::eval::Evaluator;
 use ronap_core::policy::mlp::Mlp;
-use ronap_core::rng::{stream, Rng, Stream};
-use ronap_core::{DiscreteAction, Episode, Status};
+use ronap_core::run::batch::{Autoreset, Batch, BatchOptions, SeedOrder};
+use ronap_core::{Action, DiscreteAction, Status};
 use std::collections::{HashMap, VecDeque};
 
 /// Training settings.
@@ -190,53 +190,6 @@ struct Transition {
     terminal: bool,
 }
 
-/// One of the side-by-side episodes.
-struct Slot {
-    episode: Episode,
-    rng: Rng,
-    total: f64,
-}
-
-impl Slot {
-    fn start(evaluator: &Evaluator, seed: u64) -> Result<Self, LearnError> {
-        let world = evaluator.world(seed);
-        let episode = world
-            .episode(seed)
-            .map_err(|source| RunError::Episode { seed, source })?;
-        Ok(Self {
-            episode,
-            rng: stream(seed, Stream::Policy),
-            total: 0.0,
-        })
-    }
-
-    /// One epsilon-greedy step: the transition and, when the episode ended, its return and
-    /// whether it succeeded.
-    fn step(&mut self, q: &Mlp, epsilon: f64) -> (Transition, Option<(f64, bool)>) {
-        let observation = self.episode.observation().to_vec();
-        let action = if self.rng.random::<f64>() < epsilon {
-            DiscreteAction::ALL[self.rng.random_range(0..3)]
-        } else {
-            q.action(&observation)
-        };
-        let result = self.episode.step(action);
-        let terminal = matches!(result.status, Status::Success | Status::Collision);
-        let t = Transition {
-            observation,
-            action: action as u32,
-            reward: result.reward as f32,
-            next_observation: result.observation.to_vec(),
-            terminal,
-        };
-        self.total += result.reward;
-        let done = result
-            .status
-            .is_done()
-            .then_some((self.total, result.status == Status::Success));
-        (t, done)
-    }
-}
-
 /// The mean of `count` losses summing to `sum`; NaN for none.
 fn mean_loss(sum: f64, count: usize) -> f64 {
     if count > 0 {
@@ -257,11 +210,17 @@ pub fn train(
     report_every: u64,
     on_report: &mut dyn FnMut(&DqnReport) -> bool,
 ) -> Result<Mlp, LearnError> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .map_err(|e| LearnError::Threads(e.to_string()))?;
-    let width = evaluator.config().laser.beams as usize + 1;
+    let mut batch = Batch::new(
+        evaluator.worlds().clone(),
+        BatchOptions {
+            envs: options.envs.max(1),
+            threads,
+            autoreset: Autoreset::SameStep,
+            seed_order: SeedOrder::InOrder,
+        },
+    )?;
+    batch.reset(options.seed_start)?;
+    let width = batch.observation_size();
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     let online = Net::policy(width, &options.hidden, options.activation, &mut rng)?;
     let target = Net::policy(width, &options.hidden, options.activation, &mut rng)?;
@@ -269,12 +228,6 @@ pub fn train(
     let mut optimiser = online.adam(options.learning_rate)?;
     let mut acting = online.to_mlp(HashMap::new())?;
     let mut replay = Replay::new(width, options.replay_capacity.max(options.batch));
-    let mut next_seed = options.seed_start;
-    let mut slots = Vec::with_capacity(options.envs);
-    for _ in 0..options.envs.max(1) {
-        slots.push(Slot::start(evaluator, next_seed)?);
-        next_seed += 1;
-    }
     let mut recent: VecDeque<(f64, bool)> = VecDeque::with_capacity(100);
     let (mut steps, mut episodes, mut updates) = (0u64, 0u64, 0usize);
     let (mut loss_sum, mut loss_count) = (0.0, 0usize);
@@ -297,23 +250,38 @@ pub fn train(
     };
     while steps < options.steps {
         let epsilon = epsilon_at(steps);
-        let outcomes: Vec<(Transition, Option<(f64, bool)>)> = pool.install(|| {
-            slots
-                .par_iter_mut()
-                .map(|slot| slot.step(&acting, epsilon))
-                .collect()
-        });
-        for (i, (t, done)) in outcomes.into_iter().enumerate() {
-            replay.push(&t);
+        let before = batch.observations().to_vec();
+        // Epsilon-greedy, exploring from the episode seed's policy stream.
+        batch.step(&|_, episode, rng| {
+            let action = if rng.random::<f64>() < epsilon {
+                DiscreteAction::ALL[rng.random_range(0..3)]
+            } else {
+                acting.action(episode.observation())
+            };
+            Action::from(action)
+        })?;
+        for (i, s) in batch.steps().iter().enumerate() {
+            let done = s.status.is_done();
+            let next = if done {
+                batch.final_observations()
+            } else {
+                batch.observations()
+            };
+            let row = i * width..(i + 1) * width;
+            replay.push(&Transition {
+                observation: before[row.clone()].to_vec(),
+                action: s.action.and_then(Action::discrete).map_or(0, |a| a as u32),
+                reward: s.reward as f32,
+                next_observation: next[row].to_vec(),
+                terminal: s.status.is_terminated(),
+            });
             steps += 1;
-            if let Some(result) = done {
+            if done {
                 episodes += 1;
                 if recent.len() == 100 {
                     recent.pop_front();
                 }
-                recent.push_back(result);
-                slots[i] = Slot::start(evaluator, next_seed)?;
-                next_seed += 1;
+                recent.push_back((s.total_reward, s.status == Status::Success));
             }
         }
         if replay.len() >= options.warmup.max(options.batch) {
@@ -371,7 +339,7 @@ pub fn train(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ronap_core::evaluate::Scenes;
+    use ronap_core::sim::world::Scenes;
     use ronap_core::SimConfig;
 
     /// A small open room where the goal is always in reach: DQN must learn to head for it.

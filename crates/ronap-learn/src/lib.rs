@@ -26,7 +26,7 @@ pub enum LearnError {
     Diverged(String),
     /// An episode could not start.
     #[error(transparent)]
-    Run(#[from] ronap_core::evaluate::RunError),
+    Run(#[from] ronap_core::run::RunError),
     /// Worker threads could not start.
     #[error("cannot start worker threads: {0}")]
     Threads(String),

@@ -1,39 +1,41 @@
-//! The exception tree: everything ronap raises is a `ronap.RonapError`.
+//! The exception tree: everything ronap raises is a `ronap.RonapError`, mapped here from the
+//! core's errors. The classes live in the public module `ronap` (their `__module__`), so their
+//! instances pickle and unpickle by name.
 
 use pyo3::prelude::*;
 
 pyo3::create_exception!(
-    _ronap,
+    ronap,
     RonapError,
     pyo3::exceptions::PyException,
     "Base of every error ronap raises."
 );
 pyo3::create_exception!(
-    _ronap,
+    ronap,
     ConfigError,
     RonapError,
     "A configuration value is out of range or unknown; the message names the field and value."
 );
 pyo3::create_exception!(
-    _ronap,
+    ronap,
     SceneError,
     RonapError,
     "A scene or episode cannot be built: unreadable map, no room for start and goal."
 );
 pyo3::create_exception!(
-    _ronap,
+    ronap,
     PolicyError,
     RonapError,
     "A policy failed: it raised, or returned an invalid action; the message names seed and step."
 );
 pyo3::create_exception!(
-    _ronap,
+    ronap,
     ActionError,
     RonapError,
     "An action passed to step() is not one the environment takes."
 );
 pyo3::create_exception!(
-    _ronap,
+    ronap,
     OutputError,
     RonapError,
     "An output file could not be written."
@@ -54,4 +56,17 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 /// A scene or episode error as a `SceneError`.
 pub fn scene(e: impl std::fmt::Display) -> PyErr {
     SceneError::new_err(e.to_string())
+}
+
+/// A run's error: an episode that cannot start is a `SceneError`, the rest `PolicyError`.
+pub fn run(e: &ronap_core::run::RunError) -> PyErr {
+    match e {
+        ronap_core::run::RunError::Episode { .. } => scene(e),
+        _ => PolicyError::new_err(e.to_string()),
+    }
+}
+
+/// An output error as an `OutputError`.
+pub fn output(e: impl std::fmt::Display) -> PyErr {
+    OutputError::new_err(e.to_string())
 }

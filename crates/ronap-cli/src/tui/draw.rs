@@ -16,8 +16,8 @@ use ratatui::widgets::canvas::{Canvas, Painter, Shape};
 use ratatui::widgets::{Block, Paragraph};
 use ratatui::Frame;
 use ronap_core::geometry::{unit, Point};
-use ronap_core::lidar::RayClass;
 use ronap_core::render::{HeadingUp, FIRST_PERSON_HALF_SPAN};
+use ronap_core::sim::lidar::RayClass;
 use ronap_core::Episode;
 
 /// Walls within the laser's range (first-person) and everywhere (whole scene).

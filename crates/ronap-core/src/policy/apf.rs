@@ -14,10 +14,10 @@
 use super::follow::Follower;
 use super::{Decision, Policy, PolicyError};
 use crate::config::ApfConfig;
-use crate::episode::Episode;
 use crate::geometry::{Point, Vector};
 use crate::scene::Scene;
-use crate::world::World;
+use crate::sim::episode::Episode;
+use crate::sim::world::World;
 use std::collections::HashSet;
 
 /// The result of the descent.

@@ -5,9 +5,9 @@
 //! a while (pushing into a wall, turning back and forth) it reports itself stuck, so no episode
 //! waits for its time-out to fail.
 
-use crate::episode::Episode;
 use crate::geometry::{wrap_deg, Point};
-use crate::robot::DiscreteAction;
+use crate::sim::episode::Episode;
+use crate::sim::robot::DiscreteAction;
 
 /// Steps without the remaining length shrinking by [`PROGRESS_PX`] before the follower gives up:
 /// two full turns and then some.

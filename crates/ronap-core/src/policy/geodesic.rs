@@ -6,11 +6,11 @@
 
 use super::follow::{FollowStep, Follower};
 use super::{Decision, Policy, PolicyError};
-use crate::episode::Episode;
 use crate::geometry::Point;
-use crate::planning::{smooth, DistanceField};
-use crate::robot::DiscreteAction;
-use crate::world::World;
+use crate::plan::{smooth, DistanceField};
+use crate::sim::episode::Episode;
+use crate::sim::robot::DiscreteAction;
+use crate::sim::world::World;
 
 /// Cost factor of grid steps within a radius of touching a wall.
 const CLOSE_COST: f64 = 4.0;

@@ -1,15 +1,19 @@
-//! Policies: what decides each step's action. Every policy implements [`Policy`], so the episode
-//! loop and the evaluator never know which one they run.
+//! Policies, above `plan`: what decides each step's action, one file per policy. Every policy
+//! implements [`Policy`], so the episode loop and the evaluator never know which one they run.
+//! Uses `config`, `geometry`, `scene`, `sim` and `plan`.
 
 pub mod apf;
 pub mod follow;
 pub mod geodesic;
 pub mod mlp;
+pub mod name;
 pub mod random;
 
-use crate::episode::Episode;
-use crate::robot::Action;
-use crate::world::World;
+pub use name::{factory, Builtin, PolicyNameError};
+
+use crate::sim::episode::Episode;
+use crate::sim::robot::Action;
+use crate::sim::world::World;
 
 /// A policy that could not decide.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
@@ -45,118 +49,4 @@ pub trait PolicyFactory: Sync {
 
     /// The policy's name, for reports.
     fn name(&self) -> String;
-}
-
-/// The built-in policies.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Builtin {
-    /// The paper's artificial potential field (Algorithm 3), local minima and all.
-    Apf,
-    /// Descent on the geodesic distance to the goal: a navigation function with no local minima.
-    Geodesic,
-    /// Uniformly random discrete actions: the floor.
-    Random,
-}
-
-impl Builtin {
-    /// Every built-in policy with its name and a one-line description.
-    pub const ALL: [(Builtin, &'static str, &'static str); 3] = [
-        (
-            Builtin::Apf,
-            "apf",
-            "the paper's artificial potential field (Algorithm 3); trapped by local minima",
-        ),
-        (
-            Builtin::Geodesic,
-            "geodesic",
-            "follows the shortest path (descent on geodesic distance: no local minima)",
-        ),
-        (
-            Builtin::Random,
-            "random",
-            "uniformly random LEFT/AHEAD/RIGHT",
-        ),
-    ];
-
-    /// The policy named `name`.
-    pub fn from_name(name: &str) -> Option<Self> {
-        Self::ALL
-            .iter()
-            .find(|(_, n, _)| *n == name)
-            .map(|(b, _, _)| *b)
-    }
-
-    /// The policy's name.
-    pub fn name(self) -> &'static str {
-        Self::ALL
-            .iter()
-            .find(|(b, _, _)| *b == self)
-            .map_or("unknown", |(_, n, _)| n)
-    }
-}
-
-impl PolicyFactory for Builtin {
-    fn make(&self) -> Result<Box<dyn Policy>, PolicyError> {
-        Ok(match self {
-            Builtin::Apf => Box::new(apf::Apf::default()),
-            Builtin::Geodesic => Box::new(geodesic::Geodesic::default()),
-            Builtin::Random => Box::new(random::RandomPolicy::default()),
-        })
-    }
-
-    fn name(&self) -> String {
-        Builtin::name(*self).to_string()
-    }
-}
-
-/// A policy name that names no policy, or a network file that cannot be used.
-#[derive(Debug, thiserror::Error, Clone, PartialEq)]
-pub enum PolicyNameError {
-    /// Neither a built-in nor a known `kind:` prefix.
-    #[error("policy {name:?}: unknown (expected one of: {}, mlp:FILE[@RULE])", Builtin::ALL.map(|b| b.1).join(", "))]
-    Unknown {
-        /// The name given.
-        name: String,
-    },
-    /// The `@RULE` of `mlp:FILE@RULE` is not a decision rule.
-    #[error("policy {name:?}: {rule:?} is not a decision rule (argmax or sample:TEMPERATURE)")]
-    Rule {
-        /// The name given.
-        name: String,
-        /// The rule.
-        rule: String,
-    },
-    /// The weights file cannot be used.
-    #[error(transparent)]
-    Network(#[from] mlp::MlpError),
-}
-
-/// The policy `name` names: a built-in (`apf`, `geodesic`, `random`) or `mlp:FILE[@RULE]` (a
-/// weights file, with an optional decision rule overriding the file's), for observations of
-/// `observation_size` values.
-pub fn factory(
-    name: &str,
-    observation_size: usize,
-) -> Result<Box<dyn PolicyFactory>, PolicyNameError> {
-    if let Some(spec) = name.strip_prefix("mlp:") {
-        let (path, rule) = match spec.rsplit_once('@') {
-            Some((path, rule)) => {
-                let parsed =
-                    mlp::DecisionRule::parse(rule).ok_or_else(|| PolicyNameError::Rule {
-                        name: name.into(),
-                        rule: rule.into(),
-                    })?;
-                (path, Some(parsed))
-            }
-            None => (spec, None),
-        };
-        let loaded = mlp::MlpFactory::load(std::path::Path::new(path), observation_size)?;
-        return Ok(Box::new(match rule {
-            Some(r) => loaded.with_rule(r),
-            None => loaded,
-        }));
-    }
-    Builtin::from_name(name)
-        .map(|b| Box::new(b) as Box<dyn PolicyFactory>)
-        .ok_or_else(|| PolicyNameError::Unknown { name: name.into() })
 }

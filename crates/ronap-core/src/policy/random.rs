@@ -1,10 +1,10 @@
 //! The random policy: LEFT, AHEAD or RIGHT with equal probability, from the episode's policy stream.
 
 use super::{Decision, Policy, PolicyError};
-use crate::episode::Episode;
-use crate::rng::{stream, Rng, Stream};
-use crate::robot::DiscreteAction;
-use crate::world::World;
+use crate::sim::episode::Episode;
+use crate::sim::rng::{stream, Rng, Stream};
+use crate::sim::robot::DiscreteAction;
+use crate::sim::world::World;
 use rand::Rng as _;
 
 /// Uniformly random discrete actions.

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import copy
 import json
 from typing import Any, Mapping
 
@@ -21,6 +20,11 @@ def _merge(into: dict, section: str, field: str, value: Any) -> None:
     into[section][field] = value
 
 
+def checked_config(config: Mapping[str, Any] | None, fields: Mapping[str, Any]) -> _ronap.Config:
+    """The configuration as the extension takes it: merged here, then checked once in Rust."""
+    return _ronap.Config(json.dumps(_merged(config, fields)))
+
+
 def make_config(config: Mapping[str, Any] | None = None, **fields: Any) -> dict[str, dict[str, Any]]:
     """A complete, checked configuration.
 
@@ -28,6 +32,10 @@ def make_config(config: Mapping[str, Any] | None = None, **fields: Any) -> dict[
     (``{"maze.cols": 5}``); keyword arguments name ``section_field`` (``maze_cols=5``) and win.
     Raises ``ConfigError`` naming the field and value for anything unknown or out of range.
     """
+    return json.loads(checked_config(config, fields).json)
+
+
+def _merged(config: Mapping[str, Any] | None, fields: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
     merged = default_config()
     for key, value in (config or {}).items():
         if "." in key:
@@ -45,9 +53,4 @@ def make_config(config: Mapping[str, Any] | None = None, **fields: Any) -> dict[
         if not field:
             raise ConfigError(f"keyword {name!r}: expected section_field, e.g. maze_cols")
         _merge(merged, section, field, value)
-    return json.loads(_ronap.validate_config_json(json.dumps(copy.deepcopy(merged))))
-
-
-def config_json(config: Mapping[str, Any] | None, fields: Mapping[str, Any]) -> str:
-    """The checked configuration as the JSON text the extension takes."""
-    return json.dumps(make_config(config, **fields))
+    return merged

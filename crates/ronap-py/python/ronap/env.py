@@ -12,7 +12,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from . import _ronap
-from .config import config_json
+from .config import checked_config
 
 _SEED_LIMIT = 2**63
 
@@ -49,8 +49,9 @@ class NavEnv(gym.Env):
             raise _ronap.ConfigError(f"render_mode {render_mode!r}: expected None or 'rgb_array'")
         if render_view not in ("top", "first_person"):
             raise _ronap.ConfigError(f"render_view {render_view!r}: expected 'top' or 'first_person'")
-        self._env = _ronap.Env(config_json(config, fields), maze_seed, None if map is None else str(map), continuous)
-        self.config = json.loads(self._env.config_json)
+        checked = checked_config(config, fields)
+        self._env = _ronap.Env(checked, maze_seed, None if map is None else str(map), continuous)
+        self.config = json.loads(checked.json)
         self.render_mode = render_mode
         self.render_view = render_view
         self.render_scale = render_scale
@@ -107,7 +108,7 @@ class VecNavEnv(VectorEnv):
         threads: int = 0,
         **fields: Any,
     ) -> None:
-        self._vec = _ronap.VecEnv(num_envs, config_json(config, fields), maze_seed, None if map is None else str(map), threads)
+        self._vec = _ronap.VecEnv(num_envs, checked_config(config, fields), maze_seed, None if map is None else str(map), threads)
         self.num_envs = num_envs
         n = self._vec.observation_size
         self.single_observation_space = spaces.Box(0.0, 1.0, (n,), np.float32)

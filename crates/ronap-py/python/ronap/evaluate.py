@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any, Callable, Iterable, Mapping
 
 from . import _ronap
-from .config import config_json
+from .config import checked_config
 
 
 def evaluate(
@@ -40,7 +40,7 @@ def evaluate(
     return _ronap.evaluate(
         policy,
         seeds,
-        config_json(config, fields),
+        checked_config(config, fields),
         maze_seed,
         None if map is None else str(map),
         threads,

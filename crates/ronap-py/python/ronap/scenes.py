@@ -7,18 +7,18 @@ from typing import Any, Mapping
 import numpy as np
 
 from . import _ronap
-from .config import config_json
+from .config import checked_config
 
 
 def maze_occupancy(seed: int, scale: float = 1.0, config: Mapping[str, Any] | None = None, **fields: Any) -> np.ndarray:
     """The maze of ``seed`` as a boolean array, True on walls; rows from the top like the
     picture, ``scale`` entries per px."""
-    return _ronap.maze_occupancy(seed, config_json(config, fields), scale)
+    return _ronap.maze_occupancy(seed, checked_config(config, fields), scale)
 
 
 def maze_image(seed: int, scale: float = 1.0, config: Mapping[str, Any] | None = None, **fields: Any) -> np.ndarray:
     """The maze of ``seed`` as an RGB picture (height, width, 3), white floor and black walls."""
-    return _ronap.maze_image(seed, config_json(config, fields), scale)
+    return _ronap.maze_image(seed, checked_config(config, fields), scale)
 
 
 def policies() -> dict[str, str]:

@@ -1,0 +1,65 @@
+//! The flags the commands share, and the one place where they become validated values: the value
+//! parsers below check each flag as clap reads it, [`sim`] turns the model flags and a config file
+//! into one `ValidConfig` (flags win over the file, the file over defaults) and the scene flags
+//! into the core's `SceneSpec`, and [`policy`] turns a policy name into a policy factory. The
+//! commands (`crate::commands`) see only the results.
+
+pub mod policy;
+pub mod sim;
+
+pub use policy::policy_factory;
+pub use sim::{SceneArgs, SimArgs};
+
+use clap::Args;
+
+/// Parses a positive, finite number of px.
+pub fn positive(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err("must be a positive number".into())
+    }
+}
+
+/// Parses a whole number of at least 1.
+pub fn count(s: &str) -> Result<u64, String> {
+    match s.parse::<u64>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err("must be a whole number of at least 1".into()),
+    }
+}
+
+/// Parses a seed: a whole number from 0 to 2^64 - 1.
+pub fn seed(s: &str) -> Result<u64, String> {
+    s.parse::<u64>()
+        .map_err(|_| "a seed must be a whole number from 0 to 18446744073709551615".into())
+}
+
+/// Parses a fraction in [0, 1].
+pub fn fraction(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
+    if (0.0..=1.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err("must be between 0 and 1".into())
+    }
+}
+
+/// The worker-thread flag.
+#[derive(Args, Debug, Clone, Copy, Default)]
+pub struct ThreadArgs {
+    /// Worker threads [default: all cores].
+    #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+}
+
+impl ThreadArgs {
+    /// The number of worker threads: the flag's, or all cores.
+    pub fn count(self) -> usize {
+        self.threads.map_or_else(
+            || std::thread::available_parallelism().map_or(1, |n| n.get()),
+            |n| n as usize,
+        )
+    }
+}

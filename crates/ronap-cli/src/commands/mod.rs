@@ -1,0 +1,11 @@
+//! One file per subcommand: its flags (clap) and the few lines that hand the validated values to
+//! the core and report what came back.
+
+pub mod bench;
+pub mod collect;
+pub mod config;
+pub mod maze;
+pub mod replay;
+pub mod run;
+pub mod train;
+pub mod view;

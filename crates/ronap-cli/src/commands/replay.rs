@@ -1,0 +1,132 @@
+//! `ronap replay`: a logged episode as an animated GIF, from above or first-person.
+//!
+//! The log gives the actions; the run's `summary.json` gives the configuration and the scenes;
+//! the model steps the actions again from the episode's start and every logged pose is checked
+//! against it ([`ronap_core::render::gif`] says why this beats drawing the logged numbers or
+//! re-running the policy).
+
+use crate::args::{count, positive};
+use anyhow::{bail, Context, Result};
+use clap::Args;
+use ronap_core::eval::Evaluator;
+use ronap_core::io::manifest::RunManifest;
+use ronap_core::io::steplog::read_steps;
+use ronap_core::render::gif::{animate, GifOptions, View};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+/// Arguments of `ronap replay`.
+#[derive(Args, Debug)]
+pub struct ReplayArgs {
+    /// A step log that `ronap run --log-steps` wrote: RUN_DIR/steps/seed-<seed>.csv.
+    #[arg(value_name = "STEPS_CSV")]
+    steps: PathBuf,
+    /// The run's summary.json, which holds its configuration and scenes [default: summary.json in
+    /// the directory above steps/].
+    #[arg(long, value_name = "FILE")]
+    summary: Option<PathBuf>,
+    /// What each frame shows: `top` (the whole scene with the path so far) or `first` (the
+    /// paper's first-person view).
+    #[arg(long, value_name = "top|first", default_value = "top", value_parser = view)]
+    view: View,
+    /// A frame every N steps (the first and last states always get one).
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 1, value_parser = count)]
+    stride: u64,
+    /// Top view: picture pixels per scene px, at most 4.
+    #[arg(long, allow_negative_numbers = true, value_name = "F", default_value_t = 0.4, value_parser = scale)]
+    scale: f64,
+    /// First-person view: side of the square picture, pixels.
+    #[arg(long, allow_negative_numbers = true, value_name = "PX", default_value_t = 240, value_parser = clap::value_parser!(u32).range(16..=2048))]
+    size: u32,
+    /// Frames per second, 1 to 50 (the last frame stays 1.5 s before the animation loops).
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=50))]
+    fps: u32,
+    /// The GIF to write [default: beside the log, named after it: seed-<seed>-top.gif or
+    /// seed-<seed>-first.gif].
+    #[arg(long, value_name = "FILE")]
+    out: Option<PathBuf>,
+}
+
+fn view(s: &str) -> Result<View, String> {
+    s.parse()
+}
+
+/// Parses a picture scale: a positive number of pixels per px, at most 4.
+fn scale(s: &str) -> Result<f64, String> {
+    let v = positive(s)?;
+    if v <= 4.0 {
+        Ok(v)
+    } else {
+        Err("must be at most 4 (pixels per scene px)".into())
+    }
+}
+
+/// The animation options of the flags.
+pub fn options(view: View, stride: u64, scale: f64, size: u32, fps: u32) -> GifOptions {
+    GifOptions {
+        view,
+        stride: u32::try_from(stride).unwrap_or(u32::MAX),
+        scale,
+        size_px: size,
+        frame_delay_cs: (100.0 / f64::from(fps.max(1))).round().max(2.0) as u16,
+        ..GifOptions::default()
+    }
+}
+
+/// Runs `ronap replay`.
+pub fn run(args: ReplayArgs) -> Result<ExitCode> {
+    let steps = read_steps(&args.steps)?;
+    let summary = match &args.summary {
+        Some(p) => p.clone(),
+        None => {
+            let dir = args.steps.parent().unwrap_or(Path::new("."));
+            let run_dir = match dir.file_name() {
+                Some(name) if name == "steps" => dir.parent().unwrap_or(Path::new(".")),
+                _ => dir,
+            };
+            run_dir.join("summary.json")
+        }
+    };
+    let (config, scenes) = RunManifest::read(&summary)
+        .and_then(|m| m.setting(&summary))
+        .context("replay needs the run's configuration (pass --summary FILE)")?;
+    let out = args.out.clone().unwrap_or_else(|| {
+        let stem = args.steps.with_extension("");
+        PathBuf::from(format!("{}-{}.gif", stem.display(), args.view.name()))
+    });
+    if out.extension().and_then(|e| e.to_str()) != Some("gif") {
+        bail!("--out {}: the file name must end in .gif", out.display());
+    }
+    let Some(seed) = steps.first().map(|s| s.seed) else {
+        bail!(
+            "{}: the log has no steps: nothing to replay",
+            args.steps.display()
+        );
+    };
+    let evaluator = Evaluator::new(config, scenes);
+    let episode = evaluator
+        .worlds()
+        .episode(seed)
+        .with_context(|| format!("cannot start the episode of seed {seed}"))?;
+    let actions: Vec<_> = steps.iter().map(|s| s.action).collect();
+    let poses: Vec<_> = steps.iter().map(|s| s.pose).collect();
+    let options = options(args.view, args.stride, args.scale, args.size, args.fps);
+    let animation = animate(episode, &actions, Some(&poses), &options)
+        .with_context(|| format!("cannot replay {}", args.steps.display()))?;
+    ronap_core::io::atomic::write_atomic(&out, |w| w.write_all(&animation.bytes))?;
+    let mut stdout = std::io::stdout().lock();
+    writeln!(
+        stdout,
+        "{}: seed {seed}, {} steps, {} frames of {} x {} ({} view, stride {}), {:.0} KB",
+        out.display(),
+        animation.steps,
+        animation.frames,
+        animation.size.0,
+        animation.size.1,
+        args.view.name(),
+        args.stride,
+        animation.bytes.len() as f64 / 1024.0
+    )?;
+    Ok(ExitCode::SUCCESS)
+}

@@ -1,0 +1,460 @@
+//! `ronap train bc|dqn`: train a policy network and write it as a safetensors weights file.
+
+use crate::args::{count, fraction, seed, SceneArgs, SimArgs, ThreadArgs};
+use anyhow::{bail, Context, Result};
+use clap::{Args, Subcommand};
+use indicatif::ProgressBar;
+use ronap_core::eval::Evaluator;
+use ronap_core::io::atomic::write_atomic;
+use ronap_core::io::datalog;
+use ronap_core::policy::mlp::{DecisionRule, Mlp};
+use ronap_learn::bc::{self, BcOptions};
+use ronap_learn::dqn::{self, DqnOptions};
+use ronap_learn::net::TrainActivation;
+use std::collections::HashMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::atomic::Ordering;
+
+/// Arguments of `ronap train`.
+#[derive(Args, Debug)]
+pub struct TrainArgs {
+    #[command(subcommand)]
+    algorithm: Algorithm,
+}
+
+#[derive(Subcommand, Debug)]
+enum Algorithm {
+    /// Behaviour cloning (the paper's Algorithm 2): fit a classifier to logged (observation,
+    /// action) rows; prints training and test accuracy per epoch.
+    Bc(BcArgs),
+    /// Deep Q-learning (the paper's Algorithm 1) on the SPEC reward, episodes on every core;
+    /// prints returns and success rate as it trains.
+    Dqn(DqnArgs),
+}
+
+/// Flags both algorithms share.
+#[derive(Args, Debug)]
+struct NetArgs {
+    /// Hidden layer widths, comma-separated [default: bc 64,128,64,32,8 (the original's); dqn
+    /// 128,128].
+    #[arg(long, value_name = "N,N,...", value_parser = widths)]
+    hidden: Option<Widths>,
+    /// Hidden activation: relu, tanh, rrelu (the paper's) or leaky_relu:SLOPE [default: bc
+    /// rrelu, dqn relu].
+    #[arg(long, value_name = "NAME", value_parser = activation)]
+    activation: Option<TrainActivation>,
+    /// Adam's learning rate [default: bc 0.0008 (the original's), dqn 0.0005].
+    #[arg(long, allow_negative_numbers = true, value_name = "LR", value_parser = crate::args::positive)]
+    lr: Option<f64>,
+    /// Seed of the initial weights and of every random choice in training.
+    #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 0, value_parser = seed)]
+    seed: u64,
+    /// How `ronap run` turns the outputs into an action, saved in the file: argmax, or
+    /// sample:TEMPERATURE (draw from softmax(outputs / TEMPERATURE)). A reactive policy that
+    /// samples does not loop for ever where argmax would: the shipped networks reach 89% and 59%
+    /// with sample:2, 6% and 16% with argmax.
+    #[arg(long, value_name = "RULE", default_value = "sample:2", value_parser = decision)]
+    decision: DecisionRule,
+    /// Weights file to write (safetensors).
+    #[arg(long, value_name = "FILE")]
+    out: PathBuf,
+}
+
+/// Arguments of `ronap train bc`.
+#[derive(Args, Debug)]
+struct BcArgs {
+    /// Data log(s) to train on: ronap's (`ronap collect`) or the original RoNAP's CSV rows; give
+    /// --data more than once to join files.
+    #[arg(long, value_name = "FILE", required = true)]
+    data: Vec<PathBuf>,
+    #[command(flatten)]
+    net: NetArgs,
+    /// Passes over the training rows.
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 20, value_parser = count)]
+    epochs: u64,
+    /// Rows per mini-batch.
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 256, value_parser = count)]
+    batch: u64,
+    /// Fraction of rows to train on; the rest are the test split.
+    #[arg(long, allow_negative_numbers = true, value_name = "F", default_value_t = 0.8, value_parser = fraction)]
+    train_fraction: f64,
+    /// Laser range, px: ronap's rows hold readings in px, the network sees them over this range
+    /// (SPEC.md's d_max).
+    #[arg(long, allow_negative_numbers = true, value_name = "PX", default_value_t = 50.0, value_parser = crate::args::positive)]
+    laser_range: f64,
+}
+
+/// Arguments of `ronap train dqn`.
+#[derive(Args, Debug)]
+struct DqnArgs {
+    #[command(flatten)]
+    net: NetArgs,
+    /// Environment steps in all.
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 1_000_000, value_parser = count)]
+    steps: u64,
+    /// Episodes run side by side.
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 32, value_parser = count)]
+    envs: u64,
+    /// Transitions per update (B).
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 128, value_parser = count)]
+    batch: u64,
+    /// Replay memory size (D), transitions.
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 200_000, value_parser = count)]
+    replay: u64,
+    /// Updates between target-network refreshes (F).
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 1000, value_parser = count)]
+    target_update: u64,
+    /// Discount gamma.
+    #[arg(long, allow_negative_numbers = true, value_name = "G", default_value_t = 0.99, value_parser = fraction)]
+    gamma: f64,
+    /// Final exploration rate epsilon (it falls linearly from 1).
+    #[arg(long, allow_negative_numbers = true, value_name = "E", default_value_t = 0.05, value_parser = fraction)]
+    epsilon_end: f64,
+    /// Environment steps over which epsilon falls.
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 300_000, value_parser = count)]
+    epsilon_decay: u64,
+    /// Updates after each round of --envs steps.
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 1, value_parser = count)]
+    updates_per_round: u64,
+    /// First training episode seed (episodes use seed-start, seed-start + 1, ...); keep the range
+    /// apart from evaluation seeds.
+    #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 1_000_000, value_parser = seed)]
+    seed_start: u64,
+    /// Steps before a training episode times out [default: the configuration's, 2000].
+    #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    max_steps: Option<u32>,
+    /// Print a progress line every N environment steps.
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 50_000, value_parser = count)]
+    report_every: u64,
+    #[command(flatten)]
+    threads: ThreadArgs,
+    #[command(flatten)]
+    scenes: SceneArgs,
+    #[command(flatten)]
+    sim: SimArgs,
+}
+
+/// Layer widths from the command line.
+#[derive(Clone, Debug)]
+struct Widths(Vec<usize>);
+
+fn widths(s: &str) -> Result<Widths, String> {
+    s.split(',')
+        .map(|w| {
+            w.trim()
+                .parse::<usize>()
+                .ok()
+                .filter(|&n| (1..=4096).contains(&n))
+                .ok_or_else(|| format!("{w:?} is not a layer width from 1 to 4096"))
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(Widths)
+}
+
+fn decision(s: &str) -> Result<DecisionRule, String> {
+    DecisionRule::parse(s).ok_or_else(|| format!("{s:?}: expected argmax or sample:TEMPERATURE"))
+}
+
+fn activation(s: &str) -> Result<TrainActivation, String> {
+    TrainActivation::parse(s)
+        .ok_or_else(|| format!("{s:?}: expected relu, tanh, rrelu or leaky_relu:SLOPE"))
+}
+
+/// Runs `ronap train`.
+pub fn run(args: TrainArgs) -> Result<ExitCode> {
+    match args.algorithm {
+        Algorithm::Bc(a) => train_bc(a),
+        Algorithm::Dqn(a) => train_dqn(a),
+    }
+}
+
+/// Prints a progress line above the bar, or straight to stdout (flushed, for logs and pipes)
+/// when there is no bar.
+fn show(progress: &ProgressBar, stdout: &mut impl Write, line: &str) {
+    if progress.is_hidden() {
+        let _ = writeln!(stdout, "{line}").and_then(|()| stdout.flush());
+    } else {
+        progress.println(line);
+    }
+}
+
+/// The weights file's metadata beyond the network itself: what the outputs are, the decision
+/// rule, the command line that trained it and a description of the training.
+fn metadata(output: &str, decision: DecisionRule, trained: String) -> HashMap<String, String> {
+    HashMap::from([
+        ("output".to_string(), output.to_string()),
+        ("decision".to_string(), decision.name()),
+        (
+            "command".to_string(),
+            std::env::args().collect::<Vec<_>>().join(" "),
+        ),
+        ("trained".to_string(), trained),
+    ])
+}
+
+/// Checks the output can be written before any training time is spent.
+fn check_out(path: &Path) -> Result<()> {
+    if path.is_dir() || path.as_os_str().to_string_lossy().ends_with('/') {
+        bail!(
+            "--out {}: is a directory; give a file name such as {}",
+            path.display(),
+            path.join("policy.safetensors").display()
+        );
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        bail!(
+            "--out {}: directory {} does not exist",
+            path.display(),
+            dir.display()
+        );
+    }
+    Ok(())
+}
+
+fn save(mlp: &Mlp, path: &Path) -> Result<()> {
+    let bytes = mlp.to_bytes().map_err(anyhow::Error::msg)?;
+    write_atomic(path, |w| w.write_all(&bytes))?;
+    Ok(())
+}
+
+fn train_bc(args: BcArgs) -> Result<ExitCode> {
+    check_out(&args.net.out)?;
+    let range = args.laser_range;
+    let mut data: Option<datalog::DataSet> = None;
+    let mut described = Vec::new();
+    for path in &args.data {
+        let (d, format) =
+            datalog::read(path, range).with_context(|| format!("--data {}", path.display()))?;
+        described.push(format!(
+            "{} ({} rows, {} format, {} skipped)",
+            path.display(),
+            d.len(),
+            match format {
+                datalog::Format::Ronap => "ronap",
+                datalog::Format::Original => "original RoNAP",
+            },
+            d.skipped
+        ));
+        match &mut data {
+            None => data = Some(d),
+            Some(all) => {
+                if all.width != d.width {
+                    bail!(
+                        "{}: rows have {} laser readings but {} had {}",
+                        path.display(),
+                        d.width - 1,
+                        args.data[0].display(),
+                        all.width - 1
+                    );
+                }
+                all.observations.extend_from_slice(&d.observations);
+                all.actions.extend_from_slice(&d.actions);
+                all.skipped += d.skipped;
+            }
+        }
+    }
+    let Some(data) = data else {
+        bail!("--data: no file given");
+    };
+    let defaults = BcOptions::default();
+    let options = BcOptions {
+        hidden: args.net.hidden.map_or(defaults.hidden, |w| w.0),
+        activation: args.net.activation.unwrap_or(defaults.activation),
+        learning_rate: args.net.lr.unwrap_or(defaults.learning_rate),
+        batch: args.batch as usize,
+        epochs: args.epochs as usize,
+        train_fraction: args.train_fraction,
+        seed: args.net.seed,
+    };
+    let counts = data.action_counts();
+    let mut stdout = std::io::stdout().lock();
+    for d in &described {
+        writeln!(stdout, "data: {d}")?;
+    }
+    writeln!(
+        stdout,
+        "ronap train bc: {} rows (LEFT {}, AHEAD {}, RIGHT {}; {} skipped), {:.0}% to train, network {}-{}-3 {}",
+        data.len(),
+        counts[0],
+        counts[1],
+        counts[2],
+        data.skipped,
+        100.0 * options.train_fraction,
+        data.width,
+        options.hidden.iter().map(ToString::to_string).collect::<Vec<_>>().join("-"),
+        options.activation.inference().name(),
+    )?;
+    writeln!(
+        stdout,
+        "{:>6} {:>10} {:>10} {:>10}",
+        "epoch", "loss", "train acc", "test acc"
+    )?;
+    let per_epoch =
+        (data.len() as f64 * options.train_fraction).ceil() as u64 / args.batch.max(1) + 1;
+    let progress = crate::output::progress_bar(
+        per_epoch * args.epochs,
+        "{prefix} {wide_bar} {pos}/{len} batches, eta {eta}",
+        "ronap train bc".into(),
+    );
+    let cancel =
+        crate::output::cancel_on_ctrl_c("stopping after this batch and saving the network");
+    let metadata = metadata(
+        "logits",
+        args.net.decision,
+        format!("behaviour cloning on {}", described.join(", ")),
+    );
+    let (mlp, reports) = bc::train(
+        &data,
+        &options,
+        metadata,
+        &mut |_| {
+            progress.inc(1);
+            !cancel.load(Ordering::Relaxed)
+        },
+        &mut |r| {
+            let line = format!(
+                "{:>6} {:>10.4} {:>9.1}% {:>9.1}%",
+                r.epoch,
+                r.loss,
+                100.0 * r.train_accuracy,
+                100.0 * r.test_accuracy
+            );
+            show(&progress, &mut stdout, &line);
+            true
+        },
+    )?;
+    progress.finish_and_clear();
+    save(&mlp, &args.net.out)?;
+    if let Some(last) = reports.last() {
+        writeln!(
+            stdout,
+            "final: train accuracy {:.1}%, test accuracy {:.1}%",
+            100.0 * last.train_accuracy,
+            100.0 * last.test_accuracy
+        )?;
+    }
+    writeln!(stdout, "wrote {}", args.net.out.display())?;
+    if cancel.load(Ordering::Relaxed) {
+        return Ok(ExitCode::from(130));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
+    check_out(&args.net.out)?;
+    let config = args.sim.config_with(|sim| {
+        if let Some(n) = args.max_steps {
+            sim.episode.max_steps = n;
+        }
+    })?;
+    let (scenes, _) = args.scenes.scenes(&config)?;
+    let evaluator = Evaluator::new(config, scenes);
+    evaluator
+        .world(args.seed_start)
+        .episode(args.seed_start)
+        .with_context(|| {
+            format!(
+                "cannot start episodes in this scene (seed {})",
+                args.seed_start
+            )
+        })?;
+    let defaults = DqnOptions::default();
+    let options = DqnOptions {
+        hidden: args.net.hidden.map_or(defaults.hidden, |w| w.0),
+        activation: args.net.activation.unwrap_or(defaults.activation),
+        learning_rate: args.net.lr.unwrap_or(defaults.learning_rate),
+        gamma: args.gamma,
+        batch: args.batch as usize,
+        replay_capacity: args.replay as usize,
+        target_update: args.target_update as usize,
+        epsilon_start: 1.0,
+        epsilon_end: args.epsilon_end,
+        epsilon_decay_steps: args.epsilon_decay,
+        envs: args.envs as usize,
+        steps: args.steps,
+        updates_per_round: args.updates_per_round as usize,
+        warmup: defaults.warmup,
+        double: true,
+        seed: args.net.seed,
+        seed_start: args.seed_start,
+    };
+    let threads = args.threads.count();
+    let mut stdout = std::io::stdout().lock();
+    writeln!(
+        stdout,
+        "ronap train dqn: {} steps, {} episodes side by side on {threads} threads, network {}-{}-3",
+        options.steps,
+        options.envs,
+        args.sim.config()?.laser.beams + 1,
+        options
+            .hidden
+            .iter()
+            .map(ToString::to_string)
+            .collect::<Vec<_>>()
+            .join("-"),
+    )?;
+    writeln!(
+        stdout,
+        "{:>10} {:>9} {:>12} {:>9} {:>8} {:>10}",
+        "steps", "episodes", "mean return", "success", "epsilon", "loss"
+    )?;
+    let progress = crate::output::progress_bar(
+        args.steps,
+        "{prefix} {wide_bar} {pos}/{len} steps, {per_sec}, eta {eta}",
+        "ronap train dqn".into(),
+    );
+    let cancel = crate::output::cancel_on_ctrl_c("stopping and saving the network");
+    let metadata = metadata(
+        "q_values",
+        args.net.decision,
+        format!(
+            "DQN, {} environment steps, episode seeds from {}",
+            args.steps, args.seed_start
+        ),
+    );
+    let mut last_steps = 0;
+    let mlp = dqn::train(
+        &evaluator,
+        &options,
+        threads,
+        metadata,
+        args.report_every,
+        &mut |r| {
+            progress.inc(r.steps - last_steps);
+            last_steps = r.steps;
+            // Figures that do not exist yet (no finished episode, no update) show as "-".
+            let (mean_return, success) = if r.episodes == 0 {
+                ("-".to_string(), "-".to_string())
+            } else {
+                (
+                    format!("{:.2}", r.mean_return),
+                    format!("{:.1}%", 100.0 * r.success_rate),
+                )
+            };
+            let loss = if r.loss.is_nan() {
+                "-".to_string()
+            } else {
+                format!("{:.4}", r.loss)
+            };
+            let line = format!(
+                "{:>10} {:>9} {mean_return:>12} {success:>9} {:>8.3} {loss:>10}",
+                r.steps, r.episodes, r.epsilon,
+            );
+            show(&progress, &mut stdout, &line);
+            !cancel.load(Ordering::Relaxed)
+        },
+    )?;
+    progress.finish_and_clear();
+    save(&mlp, &args.net.out)?;
+    writeln!(stdout, "wrote {}", args.net.out.display())?;
+    if cancel.load(Ordering::Relaxed) {
+        return Ok(ExitCode::from(130));
+    }
+    Ok(ExitCode::SUCCESS)
+}

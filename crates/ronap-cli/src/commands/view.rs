@@ -1,0 +1,67 @@
+//! `ronap view`: watch a policy drive one episode live in the terminal ([`crate::tui::view`]).
+
+use crate::args::{policy_factory, seed, SceneArgs, SimArgs};
+use crate::tui::app;
+use crate::tui::terminal::{self, Session};
+use crate::tui::view::{start_episode, Ending, ViewApp, ViewState};
+use anyhow::{Context, Result};
+use clap::Args;
+use ronap_core::eval::Evaluator;
+use std::process::ExitCode;
+
+/// Arguments of `ronap view`.
+#[derive(Args, Debug)]
+#[command(
+    after_help = "Keys: space pause/resume, + and - faster/slower, m whole scene/first \
+    person, s one step when paused, r restart, n next seed, q or Esc quit (Ctrl-C too)."
+)]
+pub struct ViewArgs {
+    /// Policy to watch, as for `ronap run`: apf (the paper's potential field, Algorithm 3),
+    /// geodesic (shortest-path follower), random, mlp:FILE.safetensors[@argmax|@sample:T] (a
+    /// trained network, optionally with another decision rule), or
+    /// py:FILE.py:FUNCTION (a Python function: observation in, action 0/1/2 out).
+    #[arg(long, value_name = "NAME")]
+    policy: String,
+    /// Episode seed: the scene (unless --maze-seed or --map), start and goal, as `ronap run`'s
+    /// seed of the same number.
+    #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 0, value_parser = seed)]
+    seed: u64,
+    #[command(flatten)]
+    scenes: SceneArgs,
+    #[command(flatten)]
+    sim: SimArgs,
+    /// Steps before a time-out [default: 2000].
+    #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    max_steps: Option<u32>,
+    /// Steps per second to start with, 1 to 1000 (the + and - keys change it).
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    speed: u32,
+}
+
+/// Runs `ronap view`.
+pub fn run(args: ViewArgs) -> Result<ExitCode> {
+    let config = args.sim.config_with(|sim| {
+        if let Some(n) = args.max_steps {
+            sim.episode.max_steps = n;
+        }
+    })?;
+    let factory = policy_factory(&args.policy, &config)?;
+    let (scenes, _) = args.scenes.scenes(&config)?;
+    let evaluator = Evaluator::new(config, scenes);
+    // Before a policy process starts or the terminal changes: a pipe gets an error, not a hang.
+    terminal::require_terminal("view")?;
+    let mut policy = factory
+        .make()
+        .with_context(|| format!("cannot start policy {}", args.policy))?;
+    let rollout =
+        start_episode(&evaluator, policy.as_mut(), args.seed).map_err(anyhow::Error::msg)?;
+    let state = ViewState::new(rollout, &args.policy, args.speed);
+    let mut session = Session::start("view")?;
+    let mut view = ViewApp::new(state, &evaluator, policy.as_mut());
+    let code = app::run(&mut session, &mut view)?;
+    drop(session);
+    if let Some(Ending::Failed(why)) = &view.state.ending {
+        anyhow::bail!("seed {}: {why}", view.state.episode().seed());
+    }
+    Ok(code)
+}

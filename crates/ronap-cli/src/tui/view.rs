@@ -1,0 +1,669 @@
+//! `ronap view`: one episode run live in the terminal, as the paper's Start screen showed it: the
+//! first-person view (`M` for the whole scene with the path so far), a side panel of figures and
+//! keys, and a status line with the step, the collisions, and the paper's "TaskComplete" and
+//! "CollisionWarning" messages.
+//!
+//! [`ViewState`] is everything on screen and [`draw`] a pure function of it; [`ViewApp`] steps the
+//! policy at the chosen speed between keys, in the loop of [`crate::tui::app`].
+
+use crate::tui::app::App;
+use crate::tui::draw::{self, SceneMode};
+use crate::tui::terminal;
+use anyhow::Result;
+use ratatui::crossterm::event::{KeyCode, KeyEvent};
+use ratatui::style::{Color, Modifier, Style};
+use ratatui::text::{Line, Span};
+use ratatui::widgets::{Block, Paragraph};
+use ratatui::Frame;
+use ronap_core::eval::Evaluator;
+use ronap_core::geometry::Point;
+use ronap_core::policy::Policy;
+use ronap_core::run::rollout::Rollout;
+use ronap_core::run::RunError;
+use ronap_core::{Episode, Status};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+/// The speeds `+` and `-` step through, steps per second.
+const SPEEDS: [u32; 10] = [1, 2, 5, 10, 20, 50, 100, 200, 500, 1000];
+
+/// Longest wait for a key before the loop looks at signals and the clock again.
+const POLL: Duration = Duration::from_millis(50);
+
+/// How an episode stopped other than by its own status.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Ending {
+    /// The policy gave up (trapped, oscillating, no path), with its reason.
+    GaveUp(String),
+    /// The policy or the episode failed, with the error.
+    Failed(String),
+}
+
+/// Everything `ronap view` shows.
+pub struct ViewState {
+    /// The episode and the policy's say in it.
+    pub rollout: Rollout,
+    /// Positions so far, start first (the whole-scene view draws them).
+    pub path: Vec<Point>,
+    /// The policy's name as given.
+    pub policy: String,
+    /// First person or whole scene.
+    pub mode: SceneMode,
+    /// Whether stepping is paused.
+    pub paused: bool,
+    /// Steps per second.
+    pub speed: u32,
+    /// The step of the latest collision.
+    pub last_collision: Option<u32>,
+    /// Why the episode stopped, when its status does not say.
+    pub ending: Option<Ending>,
+}
+
+impl ViewState {
+    /// The view of `rollout`, just started, under `policy`.
+    pub fn new(rollout: Rollout, policy: &str, speed: u32) -> Self {
+        Self {
+            path: vec![rollout.episode().pose().position()],
+            rollout,
+            policy: policy.to_string(),
+            mode: SceneMode::FirstPerson,
+            paused: false,
+            speed,
+            last_collision: None,
+            ending: None,
+        }
+    }
+
+    /// The episode.
+    pub fn episode(&self) -> &Episode {
+        self.rollout.episode()
+    }
+
+    /// Whether the episode is over.
+    pub fn finished(&self) -> bool {
+        self.rollout.finished() || self.ending.is_some()
+    }
+
+    /// Whether the loop should be stepping.
+    pub fn running(&self) -> bool {
+        !self.paused && !self.finished()
+    }
+
+    /// Asks `policy` for the next action and takes it, keeping the path and the collision record.
+    pub fn advance(&mut self, policy: &mut dyn Policy) {
+        match self.rollout.advance(policy) {
+            Ok(Some(s)) if s.collided => self.last_collision = Some(s.step),
+            Ok(Some(s)) => self.path.push(s.pose.position()),
+            Ok(None) => {
+                if let Some(why) = self.rollout.gave_up() {
+                    self.ending = Some(Ending::GaveUp(why.to_string()));
+                }
+            }
+            Err(RunError::InvalidAction { step, action, .. }) => {
+                self.ending = Some(Ending::Failed(format!(
+                    "step {step}: the policy returned an invalid action {action:?}"
+                )))
+            }
+            Err(RunError::Policy { step, source, .. }) => {
+                self.ending = Some(Ending::Failed(format!(
+                    "step {step}: policy failed: {source}"
+                )))
+            }
+            Err(e) => self.ending = Some(Ending::Failed(e.to_string())),
+        }
+    }
+
+    /// Whether to show "CollisionWarning": the latest step collided, or one within the last
+    /// half second at the current speed, so a warning stays long enough to read.
+    pub fn warning(&self) -> bool {
+        let linger = (self.speed / 2).max(1);
+        self.last_collision
+            .is_some_and(|k| self.episode().steps().saturating_sub(k) < linger)
+    }
+
+    /// The next speed up (`faster`) or down.
+    fn change_speed(&mut self, faster: bool) {
+        self.speed = if faster {
+            SPEEDS.into_iter().find(|&s| s > self.speed).unwrap_or(1000)
+        } else {
+            SPEEDS
+                .into_iter()
+                .rev()
+                .find(|&s| s < self.speed)
+                .unwrap_or(1)
+        };
+    }
+}
+
+/// What a key asks of the loop.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KeyAction {
+    /// Nothing beyond what the key changed in the state.
+    None,
+    /// Take one step (paused).
+    Step,
+    /// Start the episode again.
+    Restart,
+    /// Go on to the next seed.
+    Next,
+    /// Quit.
+    Quit,
+    /// Quit as interrupted (Ctrl-C).
+    Interrupt,
+}
+
+/// Applies `key` to `state`; what is left for the loop to do comes back.
+pub fn handle_key(state: &mut ViewState, key: &KeyEvent) -> KeyAction {
+    if terminal::is_ctrl_c(key) {
+        return KeyAction::Interrupt;
+    }
+    match key.code {
+        KeyCode::Char('q') | KeyCode::Char('Q') | KeyCode::Esc => KeyAction::Quit,
+        KeyCode::Char(' ') => {
+            state.paused = !state.paused;
+            KeyAction::None
+        }
+        KeyCode::Char('+') | KeyCode::Char('=') => {
+            state.change_speed(true);
+            KeyAction::None
+        }
+        KeyCode::Char('-') | KeyCode::Char('_') => {
+            state.change_speed(false);
+            KeyAction::None
+        }
+        KeyCode::Char('m') | KeyCode::Char('M') => {
+            state.mode = state.mode.toggled();
+            KeyAction::None
+        }
+        KeyCode::Char('s') | KeyCode::Char('.') if state.paused => KeyAction::Step,
+        KeyCode::Char('r') | KeyCode::Char('R') => KeyAction::Restart,
+        KeyCode::Char('n') | KeyCode::Char('N') => KeyAction::Next,
+        _ => KeyAction::None,
+    }
+}
+
+/// The status line: state, step, collisions, speed and the latest message.
+pub fn status_line(state: &ViewState) -> Line<'static> {
+    let e = state.episode();
+    let (mark, mark_style) = if state.finished() {
+        ("■ ended", Style::default().add_modifier(Modifier::BOLD))
+    } else if state.paused {
+        ("❚❚ paused", Style::default().fg(Color::Yellow))
+    } else {
+        ("▶ running", Style::default().fg(Color::Green))
+    };
+    let mut spans = vec![
+        Span::raw(" "),
+        Span::styled(mark, mark_style),
+        Span::raw(format!(
+            " · step {} · collisions {} · {} steps/s",
+            e.steps(),
+            e.collisions(),
+            state.speed
+        )),
+    ];
+    if let Some((text, colour)) = message(state) {
+        spans.push(Span::raw(" · "));
+        spans.push(Span::styled(
+            text,
+            Style::default().fg(colour).add_modifier(Modifier::BOLD),
+        ));
+    }
+    Line::from(spans)
+}
+
+/// The message of the moment, in its colour: the paper's "TaskComplete" and "CollisionWarning",
+/// or why the episode ended.
+fn message(state: &ViewState) -> Option<(String, Color)> {
+    let e = state.episode();
+    let ended = match e.status() {
+        Status::Success => Some(("TaskComplete".to_string(), Color::Green)),
+        Status::TimeOut => Some((format!("time-out after {} steps", e.steps()), Color::Yellow)),
+        Status::RewardMin => Some(("summed reward fell to R_min".to_string(), Color::Yellow)),
+        Status::Collision => Some(("CollisionWarning: episode over".to_string(), Color::Red)),
+        Status::Running => match &state.ending {
+            Some(Ending::GaveUp(why)) => Some((format!("stuck: {why}"), Color::Yellow)),
+            Some(Ending::Failed(why)) => Some((why.clone(), Color::Red)),
+            None => None,
+        },
+    };
+    ended.or_else(|| {
+        state
+            .warning()
+            .then(|| ("CollisionWarning".to_string(), Color::Red))
+    })
+}
+
+/// The side panel's lines.
+fn side_lines(state: &ViewState) -> Vec<Line<'static>> {
+    let e = state.episode();
+    let mut lines = vec![
+        draw::field("seed", e.seed().to_string()),
+        draw::field("policy", state.policy.clone()),
+        draw::field(
+            "step",
+            format!("{} / {}", e.steps(), e.config().episode.max_steps),
+        ),
+        draw::field("distance", format!("{:.1} px", e.distance_px())),
+        draw::field("goal", draw::direction_text(e.direction_deg())),
+        draw::field("heading", format!("{:.1}°", e.pose().z_deg)),
+        draw::field("collisions", e.collisions().to_string()),
+        draw::field("path", format!("{:.1} px", e.path_length_px())),
+        draw::field("speed", format!("{} steps/s", state.speed)),
+        Line::raw(""),
+    ];
+    lines.extend(draw::legend());
+    lines.push(Line::raw(""));
+    lines.extend([
+        draw::key_help("space", "pause / resume"),
+        draw::key_help("+ -", "faster / slower"),
+        draw::key_help("m", "whole scene / first person"),
+        draw::key_help("s", "one step, when paused"),
+        draw::key_help("r n", "restart / next seed"),
+        draw::key_help("q", "quit"),
+    ]);
+    lines
+}
+
+/// Draws the whole screen for `state`.
+pub fn draw(frame: &mut Frame, state: &ViewState) {
+    if draw::too_small(frame) {
+        return;
+    }
+    let areas = draw::layout(frame.area());
+    let title = format!("{} · seed {}", state.mode.title(), state.episode().seed());
+    draw::scene(
+        frame,
+        areas.scene,
+        state.episode(),
+        &state.path,
+        state.mode,
+        &title,
+    );
+    if let Some(side) = areas.side {
+        frame.render_widget(
+            Paragraph::new(side_lines(state)).block(Block::bordered().title(" ronap view ")),
+            side,
+        );
+    }
+    frame.render_widget(Paragraph::new(status_line(state)), areas.status);
+}
+
+/// The rollout of `seed` with `policy` reset for it.
+pub fn start_episode(
+    evaluator: &Evaluator,
+    policy: &mut dyn Policy,
+    seed: u64,
+) -> Result<Rollout, String> {
+    Rollout::start(evaluator.world(seed), seed, policy).map_err(|e| match e {
+        RunError::Episode { source, .. } => format!("cannot start seed {seed}: {source}"),
+        RunError::Policy { source, .. } => format!("seed {seed}: policy failed: {source}"),
+        other => other.to_string(),
+    })
+}
+
+/// `ronap view`'s screen as an [`App`]: the policy steps at the chosen speed between keys.
+pub struct ViewApp<'a> {
+    /// What is on screen.
+    pub state: ViewState,
+    evaluator: &'a Evaluator,
+    policy: &'a mut dyn Policy,
+    owed: f64,
+    last_tick: Instant,
+}
+
+impl<'a> ViewApp<'a> {
+    /// The app over `state`, stepping `policy` in episodes from `evaluator`.
+    pub fn new(state: ViewState, evaluator: &'a Evaluator, policy: &'a mut dyn Policy) -> Self {
+        Self {
+            state,
+            evaluator,
+            policy,
+            owed: 0.0,
+            last_tick: Instant::now(),
+        }
+    }
+}
+
+impl App for ViewApp<'_> {
+    fn draw(&self, frame: &mut Frame) {
+        draw(frame, &self.state)
+    }
+
+    fn wait(&self) -> Duration {
+        if self.state.running() {
+            let next =
+                ((1.0 - self.owed).max(0.0) / f64::from(self.state.speed)).min(POLL.as_secs_f64());
+            Duration::from_secs_f64(next)
+        } else {
+            POLL
+        }
+    }
+
+    fn key(&mut self, key: &KeyEvent) -> Result<Option<ExitCode>> {
+        let state = &mut self.state;
+        let next_seed = match handle_key(state, key) {
+            KeyAction::None => None,
+            KeyAction::Quit => return Ok(Some(ExitCode::SUCCESS)),
+            KeyAction::Interrupt => return Ok(Some(ExitCode::from(130))),
+            KeyAction::Step => {
+                if !state.finished() {
+                    state.advance(self.policy);
+                }
+                None
+            }
+            KeyAction::Restart => Some(state.episode().seed()),
+            KeyAction::Next => Some(state.episode().seed().wrapping_add(1)),
+        };
+        if let Some(seed) = next_seed {
+            let (mode, speed, paused) = (state.mode, state.speed, state.paused);
+            let name = state.policy.clone();
+            match start_episode(self.evaluator, self.policy, seed) {
+                Ok(rollout) => {
+                    *state = ViewState::new(rollout, &name, speed);
+                    state.mode = mode;
+                    state.paused = paused;
+                }
+                Err(why) => state.ending = Some(Ending::Failed(why)),
+            }
+            self.owed = 0.0;
+        }
+        Ok(None)
+    }
+
+    fn tick(&mut self) -> Result<bool> {
+        let now = Instant::now();
+        let mut changed = false;
+        if self.state.running() {
+            // Never more than a quarter second of catching up after a slow frame.
+            let speed = f64::from(self.state.speed);
+            self.owed =
+                (self.owed + (now - self.last_tick).as_secs_f64() * speed).min(speed / 4.0 + 1.0);
+            while self.owed >= 1.0 && self.state.running() {
+                self.state.advance(self.policy);
+                self.owed -= 1.0;
+                changed = true;
+            }
+        } else {
+            self.owed = 0.0;
+        }
+        self.last_tick = now;
+        Ok(changed)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ratatui::backend::TestBackend;
+    use ratatui::buffer::Buffer;
+    use ratatui::crossterm::event::KeyModifiers;
+    use ratatui::Terminal;
+    use ronap_core::policy::{Builtin, PolicyFactory};
+    use ronap_core::ValidConfig;
+
+    /// Seed 7 under `policy`, stepped until `stop` says so (or the episode ends).
+    fn state_of(policy: Builtin, stop: impl Fn(&ViewState) -> bool) -> ViewState {
+        let evaluator = Evaluator::new(
+            ValidConfig::default(),
+            ronap_core::sim::world::Scenes::MazePerSeed,
+        );
+        let mut p = policy.make().unwrap();
+        let rollout = start_episode(&evaluator, p.as_mut(), 7).unwrap();
+        let mut state = ViewState::new(rollout, policy.name(), 20);
+        while !state.finished() && !stop(&state) {
+            state.advance(p.as_mut());
+        }
+        state
+    }
+
+    fn render(state: &ViewState, w: u16, h: u16) -> Buffer {
+        let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
+        terminal.draw(|f| draw(f, state)).unwrap();
+        terminal.backend().buffer().clone()
+    }
+
+    fn row(buf: &Buffer, y: u16) -> String {
+        (0..buf.area.width)
+            .map(|x| buf[(x, y)].symbol())
+            .collect::<String>()
+    }
+
+    /// Cells inside `area` drawn in `colour` with a Braille dot.
+    fn dots(buf: &Buffer, area: ratatui::layout::Rect, colour: Color) -> Vec<(u16, u16)> {
+        let mut cells = vec![];
+        for y in area.top()..area.bottom() {
+            for x in area.left()..area.right() {
+                let c = &buf[(x, y)];
+                let braille = c
+                    .symbol()
+                    .chars()
+                    .next()
+                    .is_some_and(|ch| ('\u{2801}'..='\u{28ff}').contains(&ch));
+                if braille && c.fg == colour {
+                    cells.push((x, y));
+                }
+            }
+        }
+        cells
+    }
+
+    /// A map of the scene panel's colours, one letter a cell: what a snapshot of text misses.
+    fn colour_map(buf: &Buffer, area: ratatui::layout::Rect) -> String {
+        let mut out = String::new();
+        for y in area.top()..area.bottom() {
+            for x in area.left()..area.right() {
+                let c = &buf[(x, y)];
+                out.push(if c.symbol() == " " || c.symbol() == "\u{2800}" {
+                    '.'
+                } else {
+                    match c.fg {
+                        Color::Green => 'g',
+                        Color::Yellow => 'y',
+                        Color::Red => 'r',
+                        Color::Magenta => 'M',
+                        Color::Cyan => 'C',
+                        Color::LightBlue => 'b',
+                        Color::White => 'W',
+                        Color::DarkGray => 'd',
+                        Color::Gray => 'o',
+                        Color::LightGreen => 'D',
+                        _ => '#',
+                    }
+                });
+            }
+            out.push('\n');
+        }
+        out
+    }
+
+    fn inner(area: ratatui::layout::Rect) -> ratatui::layout::Rect {
+        Block::bordered().inner(area)
+    }
+
+    #[test]
+    fn first_person_frame_shows_rays_arrow_distance_and_status() {
+        // Seed 7 under APF, at the first state with a near (yellow) ray.
+        let near = |s: &ViewState| {
+            let range = s.episode().laser().range_px();
+            s.episode().readings().iter().any(|&d| d <= 0.6 * range)
+        };
+        let state = state_of(Builtin::Apf, near);
+        assert!(!state.finished(), "APF on seed 7 never came near a wall");
+        let buf = render(&state, 80, 24);
+        let areas = draw::layout(buf.area);
+        let scene = inner(areas.scene);
+        for colour in [Color::Green, Color::Yellow] {
+            assert!(
+                !dots(&buf, scene, colour).is_empty(),
+                "no {colour:?} rays:\n{}",
+                colour_map(&buf, scene)
+            );
+        }
+        // APF keeps 20 px from walls; the random walk does not: its first close (red) ray.
+        let close = state_of(Builtin::Random, |s| {
+            let range = s.episode().laser().range_px();
+            s.episode().readings().iter().any(|&d| d <= 0.3 * range)
+        });
+        assert!(!close.finished());
+        let close_buf = render(&close, 80, 24);
+        assert!(!dots(&close_buf, scene, Color::Red).is_empty());
+        // The arrow points at the goal: its cells lie on the side the paper's theta_a says.
+        let arrow = dots(&buf, scene, draw::ARROW);
+        assert!(arrow.len() >= 3, "{}", colour_map(&buf, scene));
+        let centre = (
+            f64::from(scene.x) + f64::from(scene.width) / 2.0,
+            f64::from(scene.y) + f64::from(scene.height) / 2.0,
+        );
+        let (mut dx, mut dy) = (0.0, 0.0);
+        for &(x, y) in &arrow {
+            dx += f64::from(x) + 0.5 - centre.0;
+            // Cells are twice as tall as wide; screen y grows downwards.
+            dy -= (f64::from(y) + 0.5 - centre.1) * 2.0;
+        }
+        let seen = dy.atan2(dx).to_degrees();
+        let theta_a = 90.0 + state.episode().direction_deg();
+        let off = ronap_core::geometry::wrap_deg(seen - theta_a);
+        assert!(
+            off.min(360.0 - off) < 30.0,
+            "arrow at {seen}, theta_a {theta_a}"
+        );
+        // The distance, green, in the upper right of the scene.
+        let distance = format!("{:.1} px", state.episode().distance_px());
+        let top: String = (scene.left()..scene.right())
+            .map(|x| buf[(x, scene.y)].symbol())
+            .collect();
+        assert!(top.ends_with(&distance), "{top}");
+        let x = scene.right() - 1;
+        assert_eq!(buf[(x, scene.y)].fg, draw::DISTANCE);
+        // The status line.
+        let status = row(&buf, 23);
+        assert!(
+            status.contains(&format!("step {}", state.episode().steps())),
+            "{status}"
+        );
+        assert!(status.contains("collisions 0"), "{status}");
+        insta::assert_snapshot!("view_first_person_seed_7", TestBackendView(&buf));
+        insta::assert_snapshot!("view_first_person_seed_7_colours", colour_map(&buf, scene));
+    }
+
+    /// The text of a buffer, as `TestBackend` prints it.
+    struct TestBackendView<'a>(&'a Buffer);
+
+    impl std::fmt::Display for TestBackendView<'_> {
+        fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            for y in 0..self.0.area.height {
+                writeln!(f, "{}", row(self.0, y))?;
+            }
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn m_shows_the_whole_scene_with_the_path_in_blue() {
+        let mut state = state_of(Builtin::Geodesic, |s| s.episode().steps() >= 60);
+        let m = KeyEvent::new(KeyCode::Char('m'), KeyModifiers::NONE);
+        assert_eq!(handle_key(&mut state, &m), KeyAction::None);
+        assert_eq!(state.mode, SceneMode::WholeScene);
+        let buf = render(&state, 80, 24);
+        let scene = inner(draw::layout(buf.area).scene);
+        assert!(row(&buf, 0).contains("whole scene · seed 7"));
+        assert!(dots(&buf, scene, draw::PATH).len() >= 5);
+        assert!(!dots(&buf, scene, draw::ROBOT).is_empty());
+        assert!(!dots(&buf, scene, draw::GOAL).is_empty());
+        assert!(dots(&buf, scene, draw::WALL).len() > 200);
+        insta::assert_snapshot!("view_whole_scene_seed_7", TestBackendView(&buf));
+        handle_key(&mut state, &m);
+        assert_eq!(state.mode, SceneMode::FirstPerson);
+    }
+
+    #[test]
+    fn collisions_and_success_get_the_papers_messages() {
+        /// Always straight on.
+        struct Ahead;
+        impl Policy for Ahead {
+            fn reset(
+                &mut self,
+                _: &ronap_core::World,
+                _: &Episode,
+            ) -> Result<(), ronap_core::policy::PolicyError> {
+                Ok(())
+            }
+            fn act(
+                &mut self,
+                _: &Episode,
+            ) -> Result<ronap_core::policy::Decision, ronap_core::policy::PolicyError> {
+                Ok(ronap_core::policy::Decision::Act(
+                    ronap_core::DiscreteAction::Ahead.into(),
+                ))
+            }
+        }
+        let mut state = state_of(Builtin::Geodesic, |_| true);
+        // Drive straight on until a wall stops the robot.
+        for _ in 0..400 {
+            state.advance(&mut Ahead);
+            if state.last_collision.is_some() {
+                break;
+            }
+        }
+        assert!(state.last_collision.is_some());
+        let status = row(&render(&state, 80, 24), 23);
+        assert!(status.contains("CollisionWarning"), "{status}");
+        let collisions = state.episode().collisions();
+        assert!(status.contains(&format!("collisions {collisions}")));
+
+        let done = state_of(Builtin::Geodesic, |_| false);
+        assert_eq!(done.episode().status(), Status::Success);
+        let status = row(&render(&done, 80, 24), 23);
+        assert!(status.contains("TaskComplete"), "{status}");
+        assert!(status.contains("■ ended"), "{status}");
+    }
+
+    #[test]
+    fn keys_pause_change_speed_and_quit() {
+        let mut state = state_of(Builtin::Random, |s| s.episode().steps() >= 1);
+        let key = |c| KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE);
+        handle_key(&mut state, &key(' '));
+        assert!(state.paused && !state.running());
+        assert!(row(&render(&state, 80, 24), 23).contains("paused"));
+        assert_eq!(handle_key(&mut state, &key('s')), KeyAction::Step);
+        handle_key(&mut state, &key(' '));
+        assert!(state.running());
+        assert_eq!(handle_key(&mut state, &key('s')), KeyAction::None);
+        handle_key(&mut state, &key('+'));
+        assert_eq!(state.speed, 50);
+        handle_key(&mut state, &key('-'));
+        handle_key(&mut state, &key('-'));
+        assert_eq!(state.speed, 10);
+        for _ in 0..20 {
+            handle_key(&mut state, &key('-'));
+        }
+        assert_eq!(state.speed, 1);
+        assert_eq!(handle_key(&mut state, &key('q')), KeyAction::Quit);
+        let ctrl_c = KeyEvent::new(KeyCode::Char('c'), KeyModifiers::CONTROL);
+        assert_eq!(handle_key(&mut state, &ctrl_c), KeyAction::Interrupt);
+        assert_eq!(handle_key(&mut state, &key('n')), KeyAction::Next);
+    }
+
+    #[test]
+    fn every_size_from_small_to_large_draws_without_panicking() {
+        let state = state_of(Builtin::Apf, |s| s.episode().steps() >= 3);
+        for (w, h) in [
+            (20, 5),
+            (40, 12),
+            (60, 20),
+            (80, 24),
+            (81, 25),
+            (120, 40),
+            (300, 90),
+        ] {
+            let buf = render(&state, w, h);
+            let text: String = (0..h).map(|y| row(&buf, y)).collect();
+            if w >= 40 && h >= 12 {
+                assert!(text.contains("step 3"), "{w}x{h}");
+            } else {
+                assert!(text.contains("needs at least 40x12"), "{w}x{h}");
+            }
+        }
+    }
+}

@@ -1,0 +1,131 @@
+//! What an evaluation keeps of each episode: how it ended, its figures, and on request its
+//! trajectory and steps.
+
+use crate::geometry::Point;
+use crate::sim::episode::Status;
+use crate::sim::robot::{Action, Pose};
+use crate::sim::world::World;
+use serde::Serialize;
+use std::sync::Arc;
+
+/// How an episode ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Outcome {
+    /// Reached the goal.
+    Success,
+    /// Ran out of steps.
+    Timeout,
+    /// The policy gave up (trapped, oscillating, no path).
+    Stuck,
+    /// Collided with `on_collision = terminate`.
+    Collision,
+    /// The summed reward fell to `reward_min`.
+    RewardMin,
+}
+
+impl Outcome {
+    /// How an episode with `status` ended; a running one ended because the policy gave up.
+    pub fn of(status: Status) -> Self {
+        match status {
+            Status::Success => Outcome::Success,
+            Status::TimeOut => Outcome::Timeout,
+            Status::Collision => Outcome::Collision,
+            Status::RewardMin => Outcome::RewardMin,
+            Status::Running => Outcome::Stuck,
+        }
+    }
+
+    /// The name in logs and tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            Outcome::Success => "success",
+            Outcome::Timeout => "timeout",
+            Outcome::Stuck => "stuck",
+            Outcome::Collision => "collision",
+            Outcome::RewardMin => "reward_min",
+        }
+    }
+}
+
+/// One logged step (SPEC "Data log").
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepLog {
+    /// Step number, from 1.
+    pub step: u32,
+    /// Pose before the action.
+    pub pose: Pose,
+    /// Laser readings before the action, px.
+    pub readings: Vec<f64>,
+    /// Bearing to the goal theta, degrees.
+    pub bearing_deg: f64,
+    /// Distance to the goal D, px.
+    pub distance_px: f64,
+    /// Goal direction relative to the heading, degrees.
+    pub direction_deg: f64,
+    /// The action taken.
+    pub action: Action,
+    /// Whether it collided.
+    pub collided: bool,
+    /// Its reward.
+    pub reward: f64,
+}
+
+/// What to keep of each episode beyond its figures.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Recording {
+    /// The poses (for trajectory pictures).
+    pub trajectory: bool,
+    /// Every step (for data logs).
+    pub steps: bool,
+}
+
+/// One finished episode.
+#[derive(Clone, Debug)]
+pub struct EpisodeRecord {
+    /// The seed.
+    pub seed: u64,
+    /// How it ended.
+    pub outcome: Outcome,
+    /// Why the policy gave up, for [`Outcome::Stuck`].
+    pub reason: Option<String>,
+    /// Steps taken.
+    pub steps: u32,
+    /// Steps that collided.
+    pub collisions: u32,
+    /// Distance driven, px.
+    pub path_length_px: f64,
+    /// Shortest collision-free path length from start to within epsilon of the goal, px (`None`
+    /// when the goal is unreachable).
+    pub shortest_px: Option<f64>,
+    /// Success weighted by path length: `shortest / max(shortest, driven)` on success, else 0.
+    pub spl: f64,
+    /// Summed reward.
+    pub total_reward: f64,
+    /// Wall time of the episode (setup, planning and stepping), seconds.
+    pub wall_time_s: f64,
+    /// Start pose.
+    pub start: Pose,
+    /// Goal.
+    pub goal: Point,
+    /// Final pose.
+    pub end: Pose,
+    /// Final laser readings, px.
+    pub last_readings: Vec<f64>,
+    /// Poses from start to end, when recorded.
+    pub trajectory: Vec<Pose>,
+    /// Steps, when recorded.
+    pub step_log: Vec<StepLog>,
+    /// The world the episode ran in; dropped by [`EpisodeRecord::strip`], since a per-seed world
+    /// holds its scene and grids.
+    pub world: Option<Arc<World>>,
+}
+
+impl EpisodeRecord {
+    /// Drops the recorded trajectory, steps and world (after they have been written out).
+    pub fn strip(&mut self) {
+        self.trajectory = Vec::new();
+        self.step_log = Vec::new();
+        self.world = None;
+    }
+}

@@ -1,0 +1,201 @@
+//! Geometry, the bottom layer: points, boxes and the exact queries on them, the bin index, and
+//! parry2d as the reference geometry. Uses nothing of the crate.
+//!
+//! Plane geometry on axis-aligned boxes, in scene px (x right, y up).
+//!
+//! Every obstacle in a ronap scene is an axis-aligned box: a maze wall is a thin box along a cell
+//! edge, an image scene is its occupied pixels merged into boxes. These are the exact queries the
+//! sensors and the collision check need, written for boxes so they cost a few nanoseconds each.
+
+pub mod index;
+pub mod reference;
+
+use nalgebra::{Point2, Vector2};
+
+/// A point in the scene, px.
+pub type Point = Point2<f64>;
+/// A displacement or direction in the scene, px.
+pub type Vector = Vector2<f64>;
+
+/// An axis-aligned box `[min.x, max.x] x [min.y, max.y]`, px.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// Lower-left corner.
+    pub min: Point,
+    /// Upper-right corner.
+    pub max: Point,
+}
+
+impl Aabb {
+    /// The box spanning two corners given in any order.
+    pub fn from_corners(a: Point, b: Point) -> Self {
+        Self {
+            min: Point::new(a.x.min(b.x), a.y.min(b.y)),
+            max: Point::new(a.x.max(b.x), a.y.max(b.y)),
+        }
+    }
+
+    /// Width and height, px.
+    pub fn extents(&self) -> Vector {
+        self.max - self.min
+    }
+
+    /// The box grown by `margin` on every side.
+    pub fn inflated(&self, margin: f64) -> Self {
+        let m = Vector::new(margin, margin);
+        Self {
+            min: self.min - m,
+            max: self.max + m,
+        }
+    }
+
+    /// Whether `p` lies in the closed box.
+    pub fn contains(&self, p: Point) -> bool {
+        p.x >= self.min.x && p.x <= self.max.x && p.y >= self.min.y && p.y <= self.max.y
+    }
+
+    /// Squared distance from `p` to the box (0 inside).
+    pub fn distance_squared(&self, p: Point) -> f64 {
+        let dx = (self.min.x - p.x).max(0.0).max(p.x - self.max.x);
+        let dy = (self.min.y - p.y).max(0.0).max(p.y - self.max.y);
+        dx * dx + dy * dy
+    }
+
+    /// Distance along the ray `origin + t * dir` to the box's boundary, for `t` in `[0, max_t]`,
+    /// given `inv_dir = 1 / dir` per component. `Some(0.0)` when the origin is inside.
+    #[inline]
+    pub fn ray_hit(&self, origin: Point, inv_dir: Vector, max_t: f64) -> Option<f64> {
+        // A ray parallel to an axis that starts exactly on a face gives 0 * inf = NaN for that
+        // face; the ray then runs along the face, which counts as touching: that slab spans the
+        // whole line, so NaN reads as -inf where the slab is entered and +inf where it is left.
+        let slab = |lo: f64, hi: f64, o: f64, inv: f64| {
+            let (t1, t2) = ((lo - o) * inv, (hi - o) * inv);
+            let enter = t1.min(t2);
+            let exit = t1.max(t2);
+            if t1.is_nan() || t2.is_nan() {
+                (f64::NEG_INFINITY, f64::INFINITY)
+            } else {
+                (enter, exit)
+            }
+        };
+        let (ex, xx) = slab(self.min.x, self.max.x, origin.x, inv_dir.x);
+        let (ey, xy) = slab(self.min.y, self.max.y, origin.y, inv_dir.y);
+        let enter = ex.max(ey).max(0.0);
+        let exit = xx.min(xy).min(max_t);
+        (enter <= exit).then_some(enter)
+    }
+
+    /// Squared distance between the segment `a`–`b` and the box (0 when they meet).
+    pub fn segment_distance_squared(&self, a: Point, b: Point) -> f64 {
+        let d = b - a;
+        let len = d.norm();
+        if len > 0.0 {
+            let inv = Vector::new(1.0 / (d.x / len), 1.0 / (d.y / len));
+            if self.ray_hit(a, inv, len).is_some() {
+                return 0.0;
+            }
+        } else if self.contains(a) {
+            return 0.0;
+        }
+        // Disjoint convex sets in the plane are closest at a vertex of one of them.
+        let corners = [
+            self.min,
+            Point::new(self.max.x, self.min.y),
+            self.max,
+            Point::new(self.min.x, self.max.y),
+        ];
+        corners
+            .iter()
+            .map(|&c| point_segment_distance_squared(c, a, b))
+            .fold(
+                self.distance_squared(a).min(self.distance_squared(b)),
+                f64::min,
+            )
+    }
+}
+
+/// Squared distance from `p` to the segment `a`–`b`.
+pub fn point_segment_distance_squared(p: Point, a: Point, b: Point) -> f64 {
+    let d = b - a;
+    let len2 = d.norm_squared();
+    let t = if len2 > 0.0 {
+        ((p - a).dot(&d) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + d * t - p).norm_squared()
+}
+
+/// The unit vector at `deg` degrees counter-clockwise from +x.
+pub fn unit(deg: f64) -> Vector {
+    let (s, c) = deg.to_radians().sin_cos();
+    Vector::new(c, s)
+}
+
+/// An angle in degrees brought into `[0, 360)`.
+pub fn wrap_deg(deg: f64) -> f64 {
+    let w = deg.rem_euclid(360.0);
+    // rem_euclid can round up to exactly 360.0 for tiny negative inputs.
+    if w >= 360.0 {
+        0.0
+    } else {
+        w
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn inv(d: Vector) -> Vector {
+        Vector::new(1.0 / d.x, 1.0 / d.y)
+    }
+
+    #[test]
+    fn ray_hits_box_ahead_and_misses_behind() {
+        let b = Aabb::from_corners(Point::new(10.0, -1.0), Point::new(12.0, 1.0));
+        let o = Point::new(0.0, 0.0);
+        assert_eq!(b.ray_hit(o, inv(Vector::new(1.0, 0.0)), 50.0), Some(10.0));
+        assert_eq!(b.ray_hit(o, inv(Vector::new(-1.0, 0.0)), 50.0), None);
+        assert_eq!(b.ray_hit(o, inv(Vector::new(1.0, 0.0)), 5.0), None);
+        assert_eq!(
+            b.ray_hit(Point::new(11.0, 0.0), inv(Vector::new(0.0, 1.0)), 5.0),
+            Some(0.0)
+        );
+    }
+
+    #[test]
+    fn ray_along_a_face_touches_it() {
+        let b = Aabb::from_corners(Point::new(10.0, 20.0), Point::new(12.0, 30.0));
+        let up = inv(Vector::new(0.0, 1.0));
+        assert_eq!(b.ray_hit(Point::new(10.0, 0.0), up, 50.0), Some(20.0));
+        assert_eq!(b.ray_hit(Point::new(12.0, 0.0), up, 50.0), Some(20.0));
+        assert_eq!(b.ray_hit(Point::new(12.5, 0.0), up, 50.0), None);
+        let right = inv(Vector::new(1.0, 0.0));
+        assert_eq!(b.ray_hit(Point::new(0.0, 30.0), right, 50.0), Some(10.0));
+    }
+
+    #[test]
+    fn segment_distance_matches_hand_values() {
+        let b = Aabb::from_corners(Point::new(0.0, 0.0), Point::new(2.0, 2.0));
+        // Passing above the box at height 5.
+        let d = b.segment_distance_squared(Point::new(-10.0, 5.0), Point::new(10.0, 5.0));
+        assert!((d - 9.0).abs() < 1e-12);
+        // Crossing it.
+        let d = b.segment_distance_squared(Point::new(-10.0, 1.0), Point::new(10.0, 1.0));
+        assert_eq!(d, 0.0);
+        // Diagonal approach to a corner.
+        let d = b.segment_distance_squared(Point::new(5.0, 5.0), Point::new(3.0, 3.0));
+        assert!((d - 2.0).abs() < 1e-12);
+        // A segment passing a corner diagonally: the corner is the closest point.
+        let d = b.segment_distance_squared(Point::new(5.0, 0.0), Point::new(0.0, 5.0));
+        assert!((d - 0.5).abs() < 1e-12, "{d}");
+    }
+
+    #[test]
+    fn wrap_stays_in_range() {
+        assert_eq!(wrap_deg(360.0), 0.0);
+        assert_eq!(wrap_deg(-15.0), 345.0);
+        assert!(wrap_deg(-1e-18) < 360.0);
+    }
+}

@@ -1,0 +1,116 @@
+//! Writing files atomically: a temporary file beside the target, renamed into place only once
+//! complete, so an error or an interrupt never leaves a half-written file.
+
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// A file that could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// The directory to write into does not exist.
+    #[error("cannot write {}: directory {} does not exist", path.display(), dir.display())]
+    NoDirectory {
+        /// The file.
+        path: PathBuf,
+        /// Its directory.
+        dir: PathBuf,
+    },
+    /// Writing failed.
+    #[error("cannot write {}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The error.
+        source: std::io::Error,
+    },
+    /// Some episodes' own files (pictures, step logs) could not be written.
+    #[error("{count} output file(s) could not be written; first: {first}")]
+    Episodes {
+        /// How many failed.
+        count: usize,
+        /// The first failure.
+        first: String,
+    },
+    /// The file name has an extension no writer knows.
+    #[error("cannot write {}: {message}", path.display())]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// Writes `path` through `write`, atomically; the file gets mode 0644 on Unix.
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<(), OutputError> {
+    let io = |source| OutputError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        return Err(OutputError::NoDirectory {
+            path: path.to_path_buf(),
+            dir: dir.to_path_buf(),
+        });
+    }
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".ronap-").suffix(".partial");
+    // Temporary files are private (0600); the finished output gets the usual 0644.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
+    // tempfile's own error names its temporary path; the target path says more to a user.
+    let mut temp = builder.tempfile_in(dir).map_err(|e| {
+        let message = e.to_string();
+        let message = message
+            .split(" at path ")
+            .next()
+            .unwrap_or(&message)
+            .to_string();
+        io(std::io::Error::new(e.kind(), message))
+    })?;
+    {
+        let mut out = BufWriter::new(temp.as_file_mut());
+        write(&mut out).map_err(io)?;
+        out.flush().map_err(io)?;
+    }
+    temp.persist(path).map_err(|e| io(e.error))?;
+    Ok(())
+}
+
+/// Saves an image as PNG (or PGM/PPM for a `.pgm`/`.ppm` path), atomically.
+pub fn save_image(path: &Path, image: &image::RgbImage) -> Result<(), OutputError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let format = match ext.as_deref() {
+        Some("png") => image::ImageFormat::Png,
+        Some("pgm") | Some("ppm") => image::ImageFormat::Pnm,
+        _ => {
+            return Err(OutputError::Format {
+                path: path.to_path_buf(),
+                message: "unknown picture type (use a .png, .pgm or .ppm file name)".into(),
+            })
+        }
+    };
+    let mut buffer = std::io::Cursor::new(Vec::new());
+    let encoded = if ext.as_deref() == Some("pgm") {
+        image::DynamicImage::ImageRgb8(image.clone())
+            .to_luma8()
+            .write_to(&mut buffer, format)
+    } else {
+        image.write_to(&mut buffer, format)
+    };
+    encoded.map_err(|e| OutputError::Format {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    write_atomic(path, |out| out.write_all(buffer.get_ref()))
+}

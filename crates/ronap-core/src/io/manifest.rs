@@ -1,0 +1,135 @@
+//! A run's manifest: `summary.json`, one versioned schema whoever wrote the run (`ronap run` or
+//! Python's `ronap.evaluate`), read back by `ronap replay` to rebuild the run's configuration
+//! and scenes.
+
+use crate::config::{SimConfig, ValidConfig};
+use crate::eval::Summary;
+use crate::scene::map::{MapError, MapSource};
+use crate::sim::world::{SceneSpec, Scenes};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The schema version this ronap writes; a manifest of another version is refused by name.
+pub const SCHEMA_VERSION: u32 = 1;
+
+/// What a run was and what it gave: the contents of `summary.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunManifest {
+    /// [`SCHEMA_VERSION`] of the writer.
+    pub schema_version: u32,
+    /// The ronap version that wrote the run.
+    pub ronap_version: String,
+    /// The policy, as named to the front end (`apf`, `mlp:FILE`, a Python function's name...).
+    pub policy: String,
+    /// The first seed.
+    pub seed_start: u64,
+    /// Episodes asked for.
+    pub seeds_requested: u64,
+    /// Worker threads (0: all cores).
+    pub threads: usize,
+    /// Where episodes took place.
+    pub scenes: SceneSpec,
+    /// What the map file was read as, for runs on a map.
+    pub map: Option<MapSource>,
+    /// Whether the run was interrupted before every seed ran.
+    pub interrupted: bool,
+    /// The error that stopped the run, if one did.
+    pub error: Option<String>,
+    /// The figures.
+    pub summary: Summary,
+    /// The whole configuration.
+    pub config: SimConfig,
+}
+
+/// A manifest that cannot be read.
+#[derive(Debug, thiserror::Error)]
+pub enum ManifestError {
+    /// The file cannot be read.
+    #[error("cannot read the run's summary {}: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The file is not a manifest of this schema.
+    #[error("{} is not a ronap run summary: {message}", path.display())]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The recorded configuration is invalid.
+    #[error("{}: invalid `config`: {source}", path.display())]
+    Config {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: crate::config::ConfigError,
+    },
+    /// The run's map cannot be read.
+    #[error("the run's map (from {}): {source}", path.display())]
+    Map {
+        /// The manifest.
+        path: PathBuf,
+        /// Why.
+        source: MapError,
+    },
+}
+
+impl RunManifest {
+    /// Reads `path`.
+    pub fn read(path: &Path) -> Result<Self, ManifestError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ManifestError::Read {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let format = |message: String| ManifestError::Format {
+            path: path.to_path_buf(),
+            message,
+        };
+        let value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| format(e.to_string()))?;
+        match value.get("schema_version").and_then(|v| v.as_u64()) {
+            Some(v) if v == u64::from(SCHEMA_VERSION) => {}
+            Some(v) => {
+                return Err(format(format!(
+                    "schema_version {v}; this ronap reads version {SCHEMA_VERSION}"
+                )))
+            }
+            None => return Err(format("no `schema_version`".into())),
+        }
+        serde_json::from_value(value).map_err(|e| format(e.to_string()))
+    }
+
+    /// Writes the manifest to `path`, atomically.
+    pub fn write(&self, path: &Path) -> Result<(), crate::io::atomic::OutputError> {
+        crate::io::atomic::write_atomic(path, |out| {
+            serde_json::to_writer_pretty(&mut *out, self)?;
+            std::io::Write::write_all(out, b"\n")
+        })
+    }
+
+    /// The run's configuration and scenes, as the run had them (`path` names the manifest in
+    /// errors).
+    pub fn setting(&self, path: &Path) -> Result<(ValidConfig, Scenes), ManifestError> {
+        let config = self
+            .config
+            .clone()
+            .validate()
+            .map_err(|source| ManifestError::Config {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        let (scenes, _) = self
+            .scenes
+            .load(&config)
+            .map_err(|source| ManifestError::Map {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        Ok((config, scenes))
+    }
+}

@@ -1,0 +1,8 @@
+//! Files, above `render`: atomic writes, run directories and their manifest, data logs and step
+//! logs. Uses every layer below it; the layers below never touch a file they were not handed.
+
+pub mod atomic;
+pub mod datalog;
+pub mod manifest;
+pub mod run_dir;
+pub mod steplog;

@@ -1,0 +1,250 @@
+//! Learned policies: a multilayer perceptron read from a safetensors file and run with nalgebra,
+//! no ML framework at inference.
+//!
+//! # The file
+//! Tensors, all `F32`, for layers `i = 0..n`:
+//! - `layers.{i}.weight`, shape `[out_i, in_i]` (PyTorch's `nn.Linear` layout, `y = W x + b`);
+//! - `layers.{i}.bias`, shape `[out_i]`.
+//!
+//! `in_0` is the observation size, `in_{i+1} = out_i`, and the last layer has 3 outputs, one per
+//! action in the order LEFT, AHEAD, RIGHT (Q-values or logits: the policy takes the largest).
+//! The hidden activation, applied after every layer but the last, and the rest are metadata
+//! (string to string, as safetensors allows):
+//! - `format`: `ronap-mlp/1`;
+//! - `activation`: `relu`, `tanh`, `leaky_relu:SLOPE`, or `rrelu` (the paper's RReLU; at inference
+//!   it is a leaky ReLU of slope `(1/8 + 1/3) / 2`, PyTorch's evaluation mode);
+//! - `observation`: the observation layout, [`OBSERVATION_LAYOUT`] for SPEC.md's 18 values;
+//! - `observation_size`: the number of inputs;
+//! - optional, for people: `output` (`q_values` or `logits`), `command` (what trained it),
+//!   `trained` (a description of the training data or run).
+
+pub mod file;
+pub mod network;
+
+pub use file::MlpError;
+pub use network::{
+    observation_layout, Activation, DecisionRule, Layer, Mlp, FORMAT, OBSERVATION_LAYOUT,
+    RRELU_SLOPE,
+};
+
+use crate::policy::{Decision, Policy, PolicyError, PolicyFactory};
+use crate::sim::episode::Episode;
+use crate::sim::robot::DiscreteAction;
+use crate::sim::world::World;
+use std::path::Path;
+use std::sync::Arc;
+
+/// The MLP as a policy.
+#[derive(Clone, Debug)]
+pub struct MlpPolicy {
+    mlp: Arc<Mlp>,
+    rule: DecisionRule,
+    rng: crate::sim::rng::Rng,
+}
+
+impl MlpPolicy {
+    /// A policy running `mlp` with its file's decision rule.
+    pub fn new(mlp: Arc<Mlp>) -> Self {
+        let rule = mlp.decision_rule();
+        Self {
+            mlp,
+            rule,
+            rng: crate::sim::rng::stream(0, crate::sim::rng::Stream::Policy),
+        }
+    }
+}
+
+impl Policy for MlpPolicy {
+    fn reset(&mut self, _world: &World, episode: &Episode) -> Result<(), PolicyError> {
+        let size = episode.observation().len();
+        if size != self.mlp.inputs() {
+            return Err(PolicyError::Failed(format!(
+                "the network takes {} inputs but the episode's observation has {size} \
+                 ({} laser beams + direction)",
+                self.mlp.inputs(),
+                size - 1
+            )));
+        }
+        self.rng = crate::sim::rng::stream(episode.seed(), crate::sim::rng::Stream::Policy);
+        Ok(())
+    }
+
+    fn act(&mut self, episode: &Episode) -> Result<Decision, PolicyError> {
+        let observation = episode.observation();
+        let action = match self.rule {
+            DecisionRule::Argmax => self.mlp.action(observation),
+            DecisionRule::Sample { temperature } => {
+                let out = self.mlp.forward(observation);
+                let top = out.max();
+                let weights: Vec<f32> = out
+                    .iter()
+                    .map(|v| ((v - top) / temperature).exp())
+                    .collect();
+                let mut u = rand::Rng::random::<f32>(&mut self.rng) * weights.iter().sum::<f32>();
+                let mut pick = weights.len() - 1;
+                for (i, w) in weights.iter().enumerate() {
+                    if u < *w {
+                        pick = i;
+                        break;
+                    }
+                    u -= w;
+                }
+                DiscreteAction::ALL[pick]
+            }
+        };
+        Ok(Decision::Act(action.into()))
+    }
+}
+
+/// Makes [`MlpPolicy`]s sharing one loaded network.
+#[derive(Clone, Debug)]
+pub struct MlpFactory {
+    mlp: Arc<Mlp>,
+    name: String,
+}
+
+impl MlpFactory {
+    /// Loads `path` and checks it fits observations of `observation_size` values.
+    pub fn load(path: &Path, observation_size: usize) -> Result<Self, MlpError> {
+        let mlp = Mlp::load(path)?;
+        if mlp.inputs() != observation_size {
+            return Err(MlpError::Invalid {
+                path: path.to_path_buf(),
+                message: format!(
+                    "the network takes {} inputs (metadata observation: {:?}) but this \
+                     configuration's observation has {observation_size} ({} laser beams + \
+                     direction)",
+                    mlp.inputs(),
+                    mlp.metadata.get("observation").map_or("", String::as_str),
+                    observation_size - 1
+                ),
+            });
+        }
+        Ok(Self {
+            mlp: Arc::new(mlp),
+            name: format!("mlp:{}", path.display()),
+        })
+    }
+
+    /// The same network with `rule` instead of the file's decision rule.
+    pub fn with_rule(mut self, rule: DecisionRule) -> Self {
+        let mut mlp = (*self.mlp).clone();
+        mlp.metadata.insert("decision".into(), rule.name());
+        self.mlp = Arc::new(mlp);
+        self.name = format!("{}@{}", self.name, rule.name());
+        self
+    }
+
+    /// The network.
+    pub fn mlp(&self) -> &Arc<Mlp> {
+        &self.mlp
+    }
+}
+
+impl PolicyFactory for MlpFactory {
+    fn make(&self) -> Result<Box<dyn Policy>, PolicyError> {
+        Ok(Box::new(MlpPolicy::new(self.mlp.clone())))
+    }
+
+    fn name(&self) -> String {
+        self.name.clone()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{DMatrix, DVector};
+    use safetensors::tensor::TensorView;
+    use safetensors::SafeTensors;
+    use std::collections::HashMap;
+
+    fn tiny() -> Mlp {
+        let l0 = Layer {
+            weight: DMatrix::from_fn(4, 18, |r, c| ((r * 18 + c) as f32 * 0.37).sin()),
+            bias: DVector::from_fn(4, |r, _| r as f32 * 0.1 - 0.2),
+        };
+        let l1 = Layer {
+            weight: DMatrix::from_fn(3, 4, |r, c| ((r * 4 + c) as f32 * 1.3).cos()),
+            bias: DVector::from_vec(vec![0.0, 0.5, -0.5]),
+        };
+        Mlp::new(
+            vec![l0, l1],
+            Activation::LeakyRelu(RRELU_SLOPE),
+            HashMap::new(),
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn round_trips_and_computes_by_hand() {
+        let m = tiny();
+        let back = Mlp::from_bytes(&m.to_bytes().unwrap()).unwrap();
+        assert_eq!(back, m);
+        assert_eq!(back.metadata["activation"], "rrelu");
+        assert_eq!(back.metadata["observation"], OBSERVATION_LAYOUT);
+        let x: Vec<f32> = (0..18).map(|i| i as f32 / 18.0).collect();
+        // By hand, row-major as in the file.
+        let mut h = [0f32; 4];
+        for (r, hr) in h.iter_mut().enumerate() {
+            let mut s = r as f32 * 0.1 - 0.2;
+            for (c, xc) in x.iter().enumerate() {
+                s += ((r * 18 + c) as f32 * 0.37).sin() * xc;
+            }
+            *hr = if s < 0.0 { s * RRELU_SLOPE } else { s };
+        }
+        let out = back.forward(&x);
+        for r in 0..3 {
+            let mut s = [0.0, 0.5, -0.5][r];
+            for (c, hc) in h.iter().enumerate() {
+                s += ((r * 4 + c) as f32 * 1.3).cos() * hc;
+            }
+            assert!((out[r] - s).abs() < 1e-5, "{} vs {s}", out[r]);
+        }
+    }
+
+    #[test]
+    fn bad_files_say_what_is_wrong() {
+        let m = tiny();
+        let mut nan = m.clone();
+        nan.layers[1].weight[(0, 0)] = f32::NAN;
+        let e = Mlp::from_bytes(&nan.to_bytes().unwrap()).unwrap_err();
+        assert!(e.contains("non-finite"), "{e}");
+
+        let mut wrong = m.clone();
+        wrong.layers[1].weight = DMatrix::zeros(3, 5);
+        assert!(Mlp::from_bytes(&wrong.to_bytes().unwrap())
+            .unwrap_err()
+            .contains("layers.1.weight takes 5 inputs but layers.0 gives 4"));
+
+        let mut missing = m.clone();
+        missing.layers.pop();
+        let e = Mlp::from_bytes(&missing.to_bytes().unwrap()).unwrap_err();
+        assert!(e.contains("4 outputs"), "{e}");
+
+        let e = Mlp::from_bytes(b"not a file").unwrap_err();
+        assert!(e.contains("not a safetensors file"), "{e}");
+
+        let mut meta = m.clone();
+        meta.metadata.insert("activation".into(), "swish".into());
+        let e = Mlp::from_bytes(&meta.to_bytes().unwrap()).unwrap_err();
+        assert!(e.contains("swish"), "{e}");
+    }
+
+    #[test]
+    fn a_missing_bias_is_named() {
+        let m = tiny();
+        let bytes = m.to_bytes().unwrap();
+        let t = SafeTensors::deserialize(&bytes).unwrap();
+        let views: Vec<(String, TensorView<'_>)> = t
+            .tensors()
+            .into_iter()
+            .filter(|(n, _)| n != "layers.1.bias")
+            .collect();
+        let cut = safetensors::serialize(views, Some(m.metadata.clone())).unwrap();
+        assert_eq!(
+            Mlp::from_bytes(&cut).unwrap_err(),
+            "missing tensor layers.1.bias"
+        );
+    }
+}

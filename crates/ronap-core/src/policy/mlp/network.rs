@@ -1,0 +1,222 @@
+//! The network: layers, activations and the forward pass, with nalgebra; and how its outputs
+//! become an action ([`DecisionRule`]).
+
+use crate::sim::robot::DiscreteAction;
+use nalgebra::{DMatrix, DVector};
+use std::collections::HashMap;
+
+/// The `format` metadata value this version reads and writes.
+pub const FORMAT: &str = "ronap-mlp/1";
+/// The `observation` metadata value for SPEC.md's observation.
+pub const OBSERVATION_LAYOUT: &str = "laser_0/range,...,laser_16/range,direction/360";
+/// Slope of RReLU at inference: the mean of its default bounds 1/8 and 1/3.
+pub const RRELU_SLOPE: f32 = (1.0 / 8.0 + 1.0 / 3.0) / 2.0;
+
+/// The observation layout for a laser of `beams` beams.
+pub fn observation_layout(beams: usize) -> String {
+    if beams == 17 {
+        OBSERVATION_LAYOUT.to_string()
+    } else {
+        format!(
+            "laser_0/range,...,laser_{}/range,direction/360",
+            beams.saturating_sub(1)
+        )
+    }
+}
+
+/// A hidden-layer activation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Activation {
+    /// max(0, x).
+    Relu,
+    /// tanh(x).
+    Tanh,
+    /// x for x >= 0, slope * x below.
+    LeakyRelu(f32),
+}
+
+impl Activation {
+    /// Parses the `activation` metadata value.
+    pub fn parse(s: &str) -> Option<Self> {
+        match s {
+            "relu" => Some(Self::Relu),
+            "tanh" => Some(Self::Tanh),
+            "rrelu" => Some(Self::LeakyRelu(RRELU_SLOPE)),
+            _ => s
+                .strip_prefix("leaky_relu:")
+                .and_then(|v| v.parse::<f32>().ok())
+                .filter(|v| v.is_finite())
+                .map(Self::LeakyRelu),
+        }
+    }
+
+    /// The metadata value.
+    pub fn name(self) -> String {
+        match self {
+            Self::Relu => "relu".into(),
+            Self::Tanh => "tanh".into(),
+            Self::LeakyRelu(s) if s == RRELU_SLOPE => "rrelu".into(),
+            Self::LeakyRelu(s) => format!("leaky_relu:{s}"),
+        }
+    }
+
+    fn apply(self, v: &mut DVector<f32>) {
+        match self {
+            Self::Relu => v.apply(|x| *x = x.max(0.0)),
+            Self::Tanh => v.apply(|x| *x = x.tanh()),
+            Self::LeakyRelu(s) => v.apply(|x| {
+                if *x < 0.0 {
+                    *x *= s;
+                }
+            }),
+        }
+    }
+}
+
+/// One layer, `y = W x + b`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Layer {
+    /// Weights, `out x in`.
+    pub weight: DMatrix<f32>,
+    /// Bias, `out`.
+    pub bias: DVector<f32>,
+}
+
+/// A multilayer perceptron: observation in, one value per action out.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mlp {
+    /// The layers, input first.
+    pub layers: Vec<Layer>,
+    /// Activation after every layer but the last.
+    pub activation: Activation,
+    /// Metadata carried in the file (`format`, `activation` and `observation_size` included).
+    pub metadata: HashMap<String, String>,
+}
+
+impl Mlp {
+    /// An MLP from its layers; checks that the shapes chain and the weights are finite.
+    pub fn new(
+        layers: Vec<Layer>,
+        activation: Activation,
+        mut metadata: HashMap<String, String>,
+    ) -> Result<Self, String> {
+        let first = layers.first().ok_or("the network has no layers")?;
+        let inputs = first.weight.ncols();
+        for (i, l) in layers.iter().enumerate() {
+            if l.bias.len() != l.weight.nrows() {
+                return Err(format!(
+                    "layers.{i}.bias has {} values for {} outputs",
+                    l.bias.len(),
+                    l.weight.nrows()
+                ));
+            }
+            if i > 0 && l.weight.ncols() != layers[i - 1].weight.nrows() {
+                return Err(format!(
+                    "layers.{i}.weight takes {} inputs but layers.{} gives {}",
+                    l.weight.ncols(),
+                    i - 1,
+                    layers[i - 1].weight.nrows()
+                ));
+            }
+            if let Some(bad) = l
+                .weight
+                .iter()
+                .chain(l.bias.iter())
+                .find(|v| !v.is_finite())
+            {
+                return Err(format!("layer {i} has a non-finite weight ({bad})"));
+            }
+        }
+        let outputs = layers[layers.len() - 1].weight.nrows();
+        if outputs != DiscreteAction::ALL.len() {
+            return Err(format!(
+                "the last layer has {outputs} outputs; a policy needs 3 (LEFT, AHEAD, RIGHT)"
+            ));
+        }
+        metadata.insert("format".into(), FORMAT.into());
+        metadata.insert("activation".into(), activation.name());
+        metadata.insert("observation_size".into(), inputs.to_string());
+        metadata
+            .entry("observation".into())
+            .or_insert_with(|| observation_layout(inputs.saturating_sub(1)));
+        Ok(Self {
+            layers,
+            activation,
+            metadata,
+        })
+    }
+
+    /// The `decision` metadata's rule, argmax when absent.
+    pub fn decision_rule(&self) -> DecisionRule {
+        self.metadata
+            .get("decision")
+            .and_then(|d| DecisionRule::parse(d))
+            .unwrap_or(DecisionRule::Argmax)
+    }
+
+    /// Number of inputs.
+    pub fn inputs(&self) -> usize {
+        self.layers[0].weight.ncols()
+    }
+
+    /// The network's outputs for `observation`.
+    pub fn forward(&self, observation: &[f32]) -> DVector<f32> {
+        let mut x = DVector::from_column_slice(observation);
+        let last = self.layers.len() - 1;
+        for (i, l) in self.layers.iter().enumerate() {
+            let mut y = l.bias.clone();
+            y.gemv(1.0, &l.weight, &x, 1.0);
+            if i < last {
+                self.activation.apply(&mut y);
+            }
+            x = y;
+        }
+        x
+    }
+
+    /// The action with the largest output (the first of equals).
+    pub fn action(&self, observation: &[f32]) -> DiscreteAction {
+        let out = self.forward(observation);
+        let mut best = 0;
+        for i in 1..out.len() {
+            if out[i] > out[best] {
+                best = i;
+            }
+        }
+        DiscreteAction::ALL[best]
+    }
+}
+
+/// How a policy turns the network's outputs into an action.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DecisionRule {
+    /// The action with the largest output.
+    Argmax,
+    /// An action drawn from softmax(outputs / temperature), from the episode's policy stream:
+    /// a classifier's probabilities, taken at their word.
+    Sample {
+        /// Softmax temperature, > 0.
+        temperature: f32,
+    },
+}
+
+impl DecisionRule {
+    /// Parses the `decision` metadata value: `argmax` or `sample:TEMPERATURE`.
+    pub fn parse(s: &str) -> Option<Self> {
+        if s == "argmax" {
+            return Some(Self::Argmax);
+        }
+        s.strip_prefix("sample:")
+            .and_then(|t| t.parse::<f32>().ok())
+            .filter(|t| t.is_finite() && *t > 0.0)
+            .map(|temperature| Self::Sample { temperature })
+    }
+
+    /// The metadata value.
+    pub fn name(self) -> String {
+        match self {
+            Self::Argmax => "argmax".into(),
+            Self::Sample { temperature } => format!("sample:{temperature}"),
+        }
+    }
+}

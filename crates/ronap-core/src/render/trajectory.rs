@@ -1,0 +1,27 @@
+//! Trajectory pictures like the paper's Figures 7-9: a finished episode over its whole scene.
+
+use crate::eval::EpisodeRecord;
+use crate::render::{Canvas, GOAL, PATH, START};
+use crate::sim::lidar::Laser;
+
+/// The picture of an episode: the whole scene, the path in blue, the start in red, the goal in
+/// green, and the last laser scan in its colour classes. Needs the record's trajectory and world
+/// (`None` once the record is stripped).
+pub fn trajectory_image(record: &EpisodeRecord, scale: f64) -> Option<image::RgbImage> {
+    let world = record.world.as_ref()?;
+    let config = world.config();
+    let mut canvas = Canvas::new(world.scene(), scale);
+    let least = 4.0 / scale;
+    canvas.fill_disc(
+        record.goal,
+        config.episode.goal_tolerance_px.max(least),
+        GOAL,
+    );
+    let points: Vec<_> = record.trajectory.iter().map(|p| p.position()).collect();
+    canvas.path(&points, 2.0, PATH);
+    let laser = Laser::new(&config.laser);
+    canvas.scan(&laser, record.end, &record.last_readings);
+    canvas.robot(record.start, config.robot.radius_px.max(least), START);
+    canvas.robot(record.end, config.robot.radius_px.max(least), PATH);
+    Some(canvas.into_image())
+}

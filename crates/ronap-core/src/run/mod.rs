@@ -1,0 +1,54 @@
+//! Running policies, above `policy`: one episode driven by one policy ([`rollout`]), and many
+//! episodes stepped side by side with automatic resets ([`batch`]), the engine of the vectorised
+//! Python environment and of DQN. Uses every layer up to `policy`.
+
+pub mod batch;
+pub mod rollout;
+
+use crate::policy::PolicyError;
+use crate::sim::placement::EpisodeError;
+use crate::sim::robot::Action;
+
+/// An episode that could not start, or a policy that failed while driving one.
+#[derive(Debug, thiserror::Error, Clone, PartialEq)]
+pub enum RunError {
+    /// An episode could not start.
+    #[error("seed {seed}: {source}")]
+    Episode {
+        /// The episode seed.
+        seed: u64,
+        /// What went wrong.
+        source: EpisodeError,
+    },
+    /// The policy failed.
+    #[error("seed {seed}, step {step}: policy failed: {source}")]
+    Policy {
+        /// The episode seed.
+        seed: u64,
+        /// The step at which it failed (0: while resetting).
+        step: u32,
+        /// What went wrong.
+        source: PolicyError,
+    },
+    /// The policy returned an action that is not finite.
+    #[error("seed {seed}, step {step}: policy returned an invalid action {action:?}")]
+    InvalidAction {
+        /// The episode seed.
+        seed: u64,
+        /// The step.
+        step: u32,
+        /// The action.
+        action: Action,
+    },
+    /// A batch was given another number of actions than it has environments.
+    #[error("{given} actions for {envs} environments")]
+    ActionCount {
+        /// Actions given.
+        given: usize,
+        /// Environments.
+        envs: usize,
+    },
+    /// The worker threads could not start.
+    #[error("cannot start worker threads: {0}")]
+    Threads(String),
+}

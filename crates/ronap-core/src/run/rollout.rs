@@ -1,0 +1,134 @@
+//! A rollout: one episode driven by one policy, a step at a time. The evaluator, `ronap view` and
+//! driven data collection all step episodes through it, so they agree on what a policy's answer
+//! means: an action is taken (a non-finite continuous one is an error), giving up ends the episode
+//! as a failure with the policy's reason.
+
+use crate::policy::{Decision, Policy};
+use crate::run::RunError;
+use crate::sim::episode::Episode;
+use crate::sim::robot::{Action, Pose};
+use crate::sim::world::World;
+use std::sync::Arc;
+
+/// What one step of a rollout did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stepped {
+    /// The step number, from 1.
+    pub step: u32,
+    /// The action taken.
+    pub action: Action,
+    /// Whether its motion would have touched an obstacle (and so did not happen).
+    pub collided: bool,
+    /// Its reward.
+    pub reward: f64,
+    /// The pose after it.
+    pub pose: Pose,
+}
+
+/// One episode in its world, driven by a policy.
+#[derive(Clone, Debug)]
+pub struct Rollout {
+    world: Arc<World>,
+    episode: Episode,
+    gave_up: Option<String>,
+}
+
+impl Rollout {
+    /// The episode of `seed` in `world`, with `policy` reset for it.
+    pub fn start(world: Arc<World>, seed: u64, policy: &mut dyn Policy) -> Result<Self, RunError> {
+        let rollout = Self::new(world, seed)?;
+        policy
+            .reset(&rollout.world, &rollout.episode)
+            .map_err(|source| RunError::Policy {
+                seed,
+                step: 0,
+                source,
+            })?;
+        Ok(rollout)
+    }
+
+    /// The episode of `seed` in `world`, for a caller that chooses every action itself.
+    pub fn new(world: Arc<World>, seed: u64) -> Result<Self, RunError> {
+        let episode = world
+            .episode(seed)
+            .map_err(|source| RunError::Episode { seed, source })?;
+        Ok(Self {
+            world,
+            episode,
+            gave_up: None,
+        })
+    }
+
+    /// Whether the episode is over: its status says so, or the policy gave up.
+    pub fn finished(&self) -> bool {
+        self.episode.status().is_done() || self.gave_up.is_some()
+    }
+
+    /// The policy's next action, checked; `None` once the episode is over (the policy giving up
+    /// ends it, and [`Rollout::gave_up`] then says why).
+    pub fn decide(&mut self, policy: &mut dyn Policy) -> Result<Option<Action>, RunError> {
+        if self.finished() {
+            return Ok(None);
+        }
+        let seed = self.episode.seed();
+        let step = self.episode.steps() + 1;
+        let action = match policy
+            .act(&self.episode)
+            .map_err(|source| RunError::Policy { seed, step, source })?
+        {
+            Decision::Act(action) => action,
+            Decision::GiveUp(why) => {
+                self.gave_up = Some(why);
+                return Ok(None);
+            }
+        };
+        if let Action::Continuous { v, w_deg } = action {
+            if !v.is_finite() || !w_deg.is_finite() {
+                return Err(RunError::InvalidAction { seed, step, action });
+            }
+        }
+        Ok(Some(action))
+    }
+
+    /// Takes `action`.
+    pub fn take(&mut self, action: Action) -> Stepped {
+        let r = self.episode.step(action);
+        Stepped {
+            step: r.step,
+            action,
+            collided: r.collided,
+            reward: r.reward,
+            pose: r.pose,
+        }
+    }
+
+    /// Asks `policy` for the next action and takes it; `None` once the episode is over.
+    pub fn advance(&mut self, policy: &mut dyn Policy) -> Result<Option<Stepped>, RunError> {
+        Ok(self.decide(policy)?.map(|action| self.take(action)))
+    }
+
+    /// The episode as it stands.
+    pub fn episode(&self) -> &Episode {
+        &self.episode
+    }
+
+    /// The episode, for callers that move the robot by other means (re-posing in data collection).
+    pub fn episode_mut(&mut self) -> &mut Episode {
+        &mut self.episode
+    }
+
+    /// The world the episode runs in.
+    pub fn world(&self) -> &Arc<World> {
+        &self.world
+    }
+
+    /// Why the policy gave up, when it did.
+    pub fn gave_up(&self) -> Option<&str> {
+        self.gave_up.as_deref()
+    }
+
+    /// The world, the episode and the reason the policy gave up.
+    pub fn into_parts(self) -> (Arc<World>, Episode, Option<String>) {
+        (self.world, self.episode, self.gave_up)
+    }
+}

@@ -1,0 +1,418 @@
+//! Scenes, above `geometry`: the obstacles of a scene, generated mazes, image and ROS maps, and the
+//! free-space grid of where a robot fits. Uses `config` and `geometry`.
+//!
+//! Scenes: the obstacles a robot moves among, as axis-aligned boxes, and the exact queries on them.
+//!
+//! A scene covers `[0, width] x [0, height]` px. It comes from a generated maze (walls on cell
+//! edges), an image (occupied pixels merged into boxes, everything outside the image an obstacle)
+//! or boxes given by hand. Queries run through a [`BinIndex`] so one costs a single bin lookup.
+
+pub mod freespace;
+pub mod map;
+pub mod maze;
+
+use crate::config::{MapConfig, MazeConfig};
+use crate::geometry::index::BinIndex;
+use crate::geometry::{Aabb, Point, Vector};
+use crate::scene::maze::Maze;
+use std::path::{Path, PathBuf};
+
+/// Bin side of the query index, px: small enough that a bin's list is close to the boxes really
+/// within reach, large enough that building it per episode stays well under a millisecond.
+const BIN_PX: f64 = 10.0;
+
+/// A scene that could not be built.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The image file could not be read or decoded.
+    #[error("cannot read map image {}: {message}", path.display())]
+    ImageRead {
+        /// The file.
+        path: PathBuf,
+        /// What the decoder said.
+        message: String,
+    },
+    /// The image has no pixels.
+    #[error("map image {} is empty ({width} x {height} pixels)", path.display())]
+    EmptyImage {
+        /// The file.
+        path: PathBuf,
+        /// Width in pixels.
+        width: u32,
+        /// Height in pixels.
+        height: u32,
+    },
+}
+
+/// Where a scene came from.
+#[derive(Clone, Debug)]
+pub enum SceneSource {
+    /// A generated maze with cells of `cell_px`.
+    Maze {
+        /// The maze.
+        maze: Maze,
+        /// Cell side, px.
+        cell_px: f64,
+        /// Wall thickness, px.
+        wall_thickness_px: f64,
+    },
+    /// An image, `resolution_px` scene px per pixel.
+    Image {
+        /// Image width and height, pixels.
+        size: (u32, u32),
+        /// Scene px per pixel.
+        resolution_px: f64,
+    },
+    /// Boxes given directly.
+    Boxes,
+}
+
+/// Reads and decodes an image file (PNG, PGM, or any format the decoder recognises), refusing
+/// an empty one.
+pub fn read_image(path: &Path) -> Result<image::DynamicImage, SceneError> {
+    let read_error = |message: String| SceneError::ImageRead {
+        path: path.to_path_buf(),
+        message,
+    };
+    let reader = image::ImageReader::open(path)
+        .map_err(|e| read_error(e.to_string()))?
+        .with_guessed_format()
+        .map_err(|e| read_error(e.to_string()))?;
+    let image = reader.decode().map_err(|e| read_error(e.to_string()))?;
+    if image.width() == 0 || image.height() == 0 {
+        return Err(SceneError::EmptyImage {
+            path: path.to_path_buf(),
+            width: image.width(),
+            height: image.height(),
+        });
+    }
+    Ok(image)
+}
+
+/// Obstacles and the queries the sensors and collision checks need.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    width: f64,
+    height: f64,
+    boxes: Vec<Aabb>,
+    index: BinIndex,
+    source: SceneSource,
+}
+
+impl Scene {
+    /// A scene of `width x height` px with the given obstacle boxes. `reach_px` is the longest
+    /// query distance to make fast (the laser range, or a step plus the robot radius); longer
+    /// queries stay exact but read every box.
+    pub fn from_boxes(width: f64, height: f64, boxes: Vec<Aabb>, reach_px: f64) -> Self {
+        Self::build(width, height, boxes, reach_px, SceneSource::Boxes)
+    }
+
+    fn build(
+        width: f64,
+        height: f64,
+        boxes: Vec<Aabb>,
+        reach_px: f64,
+        source: SceneSource,
+    ) -> Self {
+        let bounds = Aabb::from_corners(Point::origin(), Point::new(width, height));
+        let index = BinIndex::new(&boxes, bounds, reach_px, BIN_PX);
+        Self {
+            width,
+            height,
+            boxes,
+            index,
+            source,
+        }
+    }
+
+    /// The scene of a maze, with walls as `config` says.
+    pub fn from_maze(maze: Maze, config: &MazeConfig, reach_px: f64) -> Self {
+        let boxes = maze.wall_boxes(config.cell_px, config.wall_thickness_px);
+        let width = maze.cols() as f64 * config.cell_px;
+        let height = maze.rows() as f64 * config.cell_px;
+        let source = SceneSource::Maze {
+            maze,
+            cell_px: config.cell_px,
+            wall_thickness_px: config.wall_thickness_px,
+        };
+        Self::build(width, height, boxes, reach_px, source)
+    }
+
+    /// A scene from an occupancy raster, `occupied[row * width + col]` with row 0 at the **top**
+    /// (image order). Each pixel is a `resolution_px` square; everything outside is an obstacle.
+    pub fn from_occupancy(
+        width: u32,
+        height: u32,
+        occupied: &[bool],
+        resolution_px: f64,
+        reach_px: f64,
+    ) -> Self {
+        let (w, h) = (width as usize, height as usize);
+        assert_eq!(occupied.len(), w * h, "occupancy raster size");
+        let res = resolution_px;
+        let mut boxes = Vec::new();
+        // Runs of occupied pixels per row, merged downwards while the next row has the same run.
+        // `open` holds (x0, x1, top row) of runs still growing, sorted by x0.
+        let mut open: Vec<(usize, usize, usize)> = Vec::new();
+        let mut next: Vec<(usize, usize, usize)> = Vec::new();
+        let close = |(x0, x1, top): (usize, usize, usize), bottom: usize, boxes: &mut Vec<Aabb>| {
+            // Rows top..bottom (exclusive) in image order span y from (h - bottom) to (h - top).
+            boxes.push(Aabb::from_corners(
+                Point::new(x0 as f64 * res, (h - bottom) as f64 * res),
+                Point::new(x1 as f64 * res, (h - top) as f64 * res),
+            ));
+        };
+        for row in 0..=h {
+            next.clear();
+            let mut k = 0;
+            let mut col = 0;
+            while row < h && col < w {
+                if !occupied[row * w + col] {
+                    col += 1;
+                    continue;
+                }
+                let x0 = col;
+                while col < w && occupied[row * w + col] {
+                    col += 1;
+                }
+                let x1 = col;
+                while k < open.len() && open[k].0 < x0 {
+                    close(open[k], row, &mut boxes);
+                    k += 1;
+                }
+                if k < open.len() && open[k].0 == x0 && open[k].1 == x1 {
+                    next.push(open[k]);
+                    k += 1;
+                } else {
+                    next.push((x0, x1, row));
+                }
+            }
+            for &run in &open[k..] {
+                close(run, row, &mut boxes);
+            }
+            std::mem::swap(&mut open, &mut next);
+        }
+        let (sw, sh) = (w as f64 * res, h as f64 * res);
+        // Outside the image is an obstacle: a frame deep enough that no query sees past it.
+        let t = reach_px + res + 1.0;
+        boxes.push(Aabb::from_corners(
+            Point::new(-t, -t),
+            Point::new(0.0, sh + t),
+        ));
+        boxes.push(Aabb::from_corners(
+            Point::new(sw, -t),
+            Point::new(sw + t, sh + t),
+        ));
+        boxes.push(Aabb::from_corners(Point::new(0.0, -t), Point::new(sw, 0.0)));
+        boxes.push(Aabb::from_corners(
+            Point::new(0.0, sh),
+            Point::new(sw, sh + t),
+        ));
+        let source = SceneSource::Image {
+            size: (width, height),
+            resolution_px,
+        };
+        Self::build(sw, sh, boxes, reach_px, source)
+    }
+
+    /// A scene from a decoded image: grey value <= `threshold` is an obstacle.
+    pub fn from_image(image: &image::DynamicImage, config: &MapConfig, reach_px: f64) -> Self {
+        let grey = image.to_luma8();
+        let occupied: Vec<bool> = grey.pixels().map(|p| p.0[0] <= config.threshold).collect();
+        Self::from_occupancy(
+            grey.width(),
+            grey.height(),
+            &occupied,
+            config.resolution_px,
+            reach_px,
+        )
+    }
+
+    /// Reads a PNG or PGM file (any format the decoder knows) as a scene.
+    pub fn load_image(path: &Path, config: &MapConfig, reach_px: f64) -> Result<Self, SceneError> {
+        Ok(Self::from_image(&read_image(path)?, config, reach_px))
+    }
+
+    /// Width, px.
+    pub fn width(&self) -> f64 {
+        self.width
+    }
+
+    /// Height, px.
+    pub fn height(&self) -> f64 {
+        self.height
+    }
+
+    /// `[0, width] x [0, height]`.
+    pub fn bounds(&self) -> Aabb {
+        Aabb::from_corners(Point::origin(), Point::new(self.width, self.height))
+    }
+
+    /// The obstacle boxes.
+    pub fn boxes(&self) -> &[Aabb] {
+        &self.boxes
+    }
+
+    /// Where the scene came from.
+    pub fn source(&self) -> &SceneSource {
+        &self.source
+    }
+
+    /// The maze, for maze scenes.
+    pub fn maze(&self) -> Option<(&Maze, f64)> {
+        match &self.source {
+            SceneSource::Maze { maze, cell_px, .. } => Some((maze, *cell_px)),
+            _ => None,
+        }
+    }
+
+    /// Indices of the boxes within `radius` of `p` (and possibly a few further).
+    #[inline]
+    pub fn boxes_near(&self, p: Point, radius: f64) -> &[u32] {
+        self.index.near(p, radius)
+    }
+
+    /// Length of the pieces long queries are cut into, so that each piece (grown by `radius`) is
+    /// answered by one bin of the index; `None` when the index cannot serve `radius` at all.
+    fn piece_px(&self, radius: f64) -> Option<f64> {
+        let piece = self.index.reach_px() - radius;
+        (piece >= 1.0).then_some(piece)
+    }
+
+    /// Distance from `origin` along the unit direction `dir` to the first obstacle, if one lies
+    /// within `max_px`. `Some(0.0)` when `origin` is inside an obstacle.
+    pub fn cast_ray(&self, origin: Point, dir: Vector, max_px: f64) -> Option<f64> {
+        let inv = Vector::new(1.0 / dir.x, 1.0 / dir.y);
+        let first_hit = |from: Point, reach: f64, limit: f64| -> Option<f64> {
+            let mut best = limit;
+            let mut hit = false;
+            for &i in self.index.near(from, reach) {
+                if let Some(t) = self.boxes[i as usize].ray_hit(origin, inv, best) {
+                    best = t;
+                    hit = true;
+                }
+            }
+            hit.then_some(best)
+        };
+        let Some(piece) = self.piece_px(0.0).filter(|&p| max_px > p) else {
+            return first_hit(origin, max_px, max_px);
+        };
+        // A hit at distance t lies within `piece` of the start of the piece holding t, so the
+        // first piece with a hit inside it has the first hit.
+        let mut start = 0.0;
+        while start < max_px {
+            let end = (start + piece).min(max_px);
+            if let Some(t) = first_hit(origin + dir * start, end - start, end) {
+                return Some(t);
+            }
+            start = end;
+        }
+        None
+    }
+
+    /// Whether a disc of `radius` at `p` touches no obstacle (a tangent disc does not touch).
+    pub fn disc_clear(&self, p: Point, radius: f64) -> bool {
+        let r2 = radius * radius;
+        self.index
+            .near(p, radius)
+            .iter()
+            .all(|&i| self.boxes[i as usize].distance_squared(p) >= r2)
+    }
+
+    /// Whether a disc of `radius` can move in a straight line from `a` to `b` touching nothing:
+    /// the whole swept capsule is checked, so no step length passes through an obstacle.
+    pub fn sweep_clear(&self, a: Point, b: Point, radius: f64) -> bool {
+        let r2 = radius * radius;
+        let piece_clear = |a: Point, b: Point| {
+            let reach = (b - a).norm() + radius;
+            self.index
+                .near(a, reach)
+                .iter()
+                .all(|&i| self.boxes[i as usize].segment_distance_squared(a, b) >= r2)
+        };
+        let length = (b - a).norm();
+        let Some(piece) = self.piece_px(radius).filter(|&p| length > p) else {
+            return piece_clear(a, b);
+        };
+        let pieces = (length / piece).ceil() as usize;
+        (0..pieces).all(|k| {
+            let from = a + (b - a) * (k as f64 / pieces as f64);
+            let to = a + (b - a) * ((k + 1) as f64 / pieces as f64);
+            piece_clear(from, to)
+        })
+    }
+
+    /// Whether `p` lies inside an obstacle or outside the scene.
+    pub fn occupied(&self, p: Point) -> bool {
+        !self.bounds().contains(p)
+            || self
+                .index
+                .near(p, 0.0)
+                .iter()
+                .any(|&i| self.boxes[i as usize].contains(p))
+    }
+
+    /// Distance from `p` to the nearest obstacle, if one lies within `max_px`.
+    pub fn clearance(&self, p: Point, max_px: f64) -> Option<f64> {
+        let d2 = self
+            .index
+            .near(p, max_px)
+            .iter()
+            .map(|&i| self.boxes[i as usize].distance_squared(p))
+            .fold(f64::INFINITY, f64::min);
+        let d = d2.sqrt();
+        (d <= max_px).then_some(d)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::unit;
+
+    fn square_room() -> Scene {
+        let occupied = vec![false; 100 * 80];
+        Scene::from_occupancy(100, 80, &occupied, 1.0, 50.0)
+    }
+
+    #[test]
+    fn outside_an_image_is_an_obstacle() {
+        let room = square_room();
+        let p = Point::new(30.0, 40.0);
+        assert_eq!(room.cast_ray(p, unit(180.0), 50.0), Some(30.0));
+        assert_eq!(room.cast_ray(p, unit(0.0), 50.0), None);
+        assert!(room.occupied(Point::new(-0.5, 10.0)));
+        assert!(!room.occupied(p));
+    }
+
+    #[test]
+    fn occupancy_runs_merge_into_boxes() {
+        // A 4 x 3 image with a 2-wide column block at x 1..3 on rows 0..2 (top two rows).
+        #[rustfmt::skip]
+        let occupied = [
+            false, true, true, false,
+            false, true, true, false,
+            false, false, false, true,
+        ];
+        let scene = Scene::from_occupancy(4, 3, &occupied, 10.0, 5.0);
+        let inner: Vec<_> = scene.boxes()[..scene.boxes().len() - 4].to_vec();
+        assert_eq!(
+            inner,
+            vec![
+                Aabb::from_corners(Point::new(10.0, 10.0), Point::new(30.0, 30.0)),
+                Aabb::from_corners(Point::new(30.0, 0.0), Point::new(40.0, 10.0)),
+            ]
+        );
+    }
+
+    #[test]
+    fn sweep_catches_a_thin_wall_at_any_speed() {
+        let wall = Aabb::from_corners(Point::new(99.0, 0.0), Point::new(101.0, 200.0));
+        let scene = Scene::from_boxes(200.0, 200.0, vec![wall], 55.0);
+        let a = Point::new(50.0, 100.0);
+        assert!(!scene.sweep_clear(a, Point::new(150.0, 100.0), 5.0));
+        assert!(!scene.sweep_clear(a, Point::new(1050.0, 100.0), 5.0));
+        assert!(scene.sweep_clear(a, Point::new(93.0, 100.0), 5.0));
+        assert!(!scene.sweep_clear(a, Point::new(94.5, 100.0), 5.0));
+    }
+}

@@ -1,0 +1,518 @@
+//! Episodes: a robot, a goal and a scene, stepped until success, a time-out or an early end.
+//!
+//! Everything random in an episode (maze, start, goal, noise) comes from its seed through separate
+//! streams ([`crate::sim::rng`]), so the same seed gives the same run bit for bit.
+
+use crate::config::{OnCollision, ValidConfig};
+use crate::geometry::{wrap_deg, Point};
+use crate::scene::freespace::FreeGrid;
+use crate::scene::Scene;
+use crate::sim::lidar::Laser;
+use crate::sim::placement::{sample_placement, EpisodeError, Placement, PLACEMENT_TRIES};
+use crate::sim::rng::{stream, Rng, Stream};
+use crate::sim::robot::{Action, DiscreteAction, Pose, Robot};
+use rand::Rng as _;
+use std::sync::Arc;
+
+/// How an episode stands.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Status {
+    /// Still going.
+    #[default]
+    Running,
+    /// Reached the goal: D < epsilon ("TaskComplete").
+    Success,
+    /// Ran `max_steps` steps.
+    TimeOut,
+    /// The summed reward fell to `reward_min`.
+    RewardMin,
+    /// Collided with `on_collision = terminate`.
+    Collision,
+}
+
+impl Status {
+    /// Whether the episode is over: [`Status::is_terminated`] or [`Status::is_truncated`].
+    pub fn is_done(self) -> bool {
+        self != Status::Running
+    }
+
+    /// Gymnasium's `terminated`: the task itself ended, so no value follows this state. Success,
+    /// a collision under `on_collision = terminate`, and the summed reward reaching `reward_min`
+    /// (the paper's R_min, which ends Algorithm 1's episodes with target `y = r`).
+    pub fn is_terminated(self) -> bool {
+        matches!(
+            self,
+            Status::Success | Status::Collision | Status::RewardMin
+        )
+    }
+
+    /// Gymnasium's `truncated`: a limit outside the task (the `max_steps` time-out) cut the
+    /// episode short; the state still has a value.
+    pub fn is_truncated(self) -> bool {
+        self == Status::TimeOut
+    }
+
+    /// The name used in logs: `running`, `success`, `timeout`, `reward_min`, `collision`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Status::Running => "running",
+            Status::Success => "success",
+            Status::TimeOut => "timeout",
+            Status::RewardMin => "reward_min",
+            Status::Collision => "collision",
+        }
+    }
+}
+
+/// What one step did: everything a caller needs, borrowed from the episode.
+#[derive(Clone, Copy, Debug)]
+pub struct StepResult<'a> {
+    /// The observation after the step: `[d_1/d_max, ..., d_m/d_max, direction/360]`.
+    pub observation: &'a [f32],
+    /// The laser readings after the step, px.
+    pub readings: &'a [f64],
+    /// This step's reward `r_a + r_b + r_c + r_d`.
+    pub reward: f64,
+    /// Whether the step's motion would have touched an obstacle (and so did not happen).
+    pub collided: bool,
+    /// The episode's status after the step.
+    pub status: Status,
+    /// The pose after the step.
+    pub pose: Pose,
+    /// Distance to the goal D after the step, px.
+    pub distance_px: f64,
+    /// Number of steps taken so far, this one included.
+    pub step: u32,
+}
+
+/// Bearing from `from` to `to`, degrees in [0, 360); 0 when the points coincide.
+pub fn bearing_deg(from: Point, to: Point) -> f64 {
+    let d = to - from;
+    wrap_deg(d.y.atan2(d.x).to_degrees())
+}
+
+/// One episode in progress.
+#[derive(Clone, Debug)]
+pub struct Episode {
+    scene: Arc<Scene>,
+    config: ValidConfig,
+    robot: Robot,
+    laser: Laser,
+    seed: u64,
+    start: Pose,
+    pose: Pose,
+    goal: Point,
+    noise_rng: Rng,
+    readings: Vec<f64>,
+    observation: Vec<f32>,
+    distance_px: f64,
+    steps: u32,
+    collisions: u32,
+    total_reward: f64,
+    path_length_px: f64,
+    status: Status,
+}
+
+impl Episode {
+    /// An episode in `scene` for `seed`, with the start and goal the configuration fixes or, where
+    /// it does not, drawn from the seed.
+    pub fn new(config: &ValidConfig, scene: Arc<Scene>, seed: u64) -> Result<Self, EpisodeError> {
+        let placement = sample_placement(config, &scene, None, seed)?;
+        Self::with_placement(config, scene, seed, placement)
+    }
+
+    /// An episode with a given start and goal; both must leave the robot clear of obstacles.
+    pub fn with_placement(
+        config: &ValidConfig,
+        scene: Arc<Scene>,
+        seed: u64,
+        placement: Placement,
+    ) -> Result<Self, EpisodeError> {
+        let radius = config.robot.radius_px;
+        let inside = |p: Point| scene.bounds().contains(p) && scene.disc_clear(p, radius);
+        for (which, p) in [
+            ("start", placement.start.position()),
+            ("goal", placement.goal),
+        ] {
+            if !inside(p) {
+                return Err(EpisodeError::Blocked {
+                    which,
+                    x: p.x,
+                    y: p.y,
+                    radius_px: radius,
+                });
+            }
+        }
+        let laser = Laser::new(&config.laser);
+        let beams = laser.beams();
+        let mut episode = Self {
+            robot: Robot::new(&config.robot),
+            laser,
+            config: config.clone(),
+            seed,
+            start: placement.start,
+            pose: placement.start,
+            goal: placement.goal,
+            noise_rng: stream(seed, Stream::Noise),
+            readings: vec![0.0; beams],
+            observation: vec![0.0; beams + 1],
+            distance_px: 0.0,
+            steps: 0,
+            collisions: 0,
+            total_reward: 0.0,
+            path_length_px: 0.0,
+            status: Status::Running,
+            scene,
+        };
+        episode.sense();
+        if episode.distance_px < config.episode.goal_tolerance_px {
+            episode.status = Status::Success;
+        }
+        Ok(episode)
+    }
+
+    /// Reads the laser and goal sensors at the current pose and refreshes the observation.
+    fn sense(&mut self) {
+        let p = self.pose.position();
+        self.laser
+            .scan(&self.scene, p, self.pose.z_deg, &mut self.readings);
+        self.laser
+            .add_noise(&mut self.readings, &mut self.noise_rng);
+        self.distance_px = (self.goal - p).norm();
+        let range = self.laser.range_px();
+        for (o, r) in self.observation.iter_mut().zip(&self.readings) {
+            *o = (r / range) as f32;
+        }
+        let last = self.readings.len();
+        self.observation[last] = (self.direction_deg() / 360.0) as f32;
+    }
+
+    /// The paper's re-posing in data collection (SPEC.md): the robot jumps to a random free pose,
+    /// `x, y` uniform over the scene where the robot fits (and, given `grid`, in the goal's free
+    /// region, so the goal stays reachable), heading `theta + 360 lambda3` with
+    /// `lambda3 ~ N(0, 0.03^2)`: roughly towards the goal. The goal, step and collision counts stay.
+    /// `None` when no such pose turned up in many tries (the robot then stays where it was).
+    pub fn repose(&mut self, grid: Option<&FreeGrid>, rng: &mut Rng) -> Option<Pose> {
+        let radius = self.config.robot.radius_px;
+        let (w, h) = (self.scene.width(), self.scene.height());
+        let region = grid.and_then(|g| g.region_at(self.goal));
+        for _ in 0..PLACEMENT_TRIES * PLACEMENT_TRIES {
+            let p = Point::new(
+                rng.random_range(radius..(w - radius).max(radius + 1e-9)),
+                rng.random_range(radius..(h - radius).max(radius + 1e-9)),
+            );
+            let reachable = match (grid, region) {
+                (Some(g), Some(r)) => g.region_at(p) == Some(r),
+                _ => true,
+            };
+            if !reachable || !self.scene.disc_clear(p, radius) {
+                continue;
+            }
+            let lambda3 =
+                0.03 * rand_distr::Distribution::<f64>::sample(&rand_distr::StandardNormal, rng);
+            let z = wrap_deg(bearing_deg(p, self.goal) + 360.0 * lambda3);
+            self.pose = Pose::new(p.x, p.y, z);
+            self.sense();
+            return Some(self.pose);
+        }
+        None
+    }
+
+    /// Takes one step. On a finished episode nothing moves and the reward is 0.
+    pub fn step(&mut self, action: impl Into<Action>) -> StepResult<'_> {
+        if self.status.is_done() {
+            return self.result(0.0, false);
+        }
+        let action = action.into();
+        let before = self.distance_px;
+        let motion = self.robot.motion(self.pose, action);
+        let collided = !self.robot.motion_clear(&self.scene, self.pose, &motion);
+        if collided {
+            self.collisions += 1;
+        } else {
+            self.path_length_px += (motion.end.position() - self.pose.position()).norm();
+            self.pose = motion.end;
+        }
+        self.steps += 1;
+        self.sense();
+
+        let w = &self.config.reward;
+        let success = self.distance_px < self.config.episode.goal_tolerance_px;
+        let mut reward =
+            w.progress_per_px * (before - self.distance_px) + w.turn * motion.turn_fraction;
+        if collided {
+            reward += w.collision;
+        }
+        if success {
+            reward += w.success;
+        }
+        self.total_reward += reward;
+        self.status = if success {
+            Status::Success
+        } else if collided && self.config.robot.on_collision == OnCollision::Terminate {
+            Status::Collision
+        } else if self
+            .config
+            .episode
+            .reward_min
+            .is_some_and(|m| self.total_reward <= m)
+        {
+            Status::RewardMin
+        } else if self.steps >= self.config.episode.max_steps {
+            Status::TimeOut
+        } else {
+            Status::Running
+        };
+        self.result(reward, collided)
+    }
+
+    fn result(&self, reward: f64, collided: bool) -> StepResult<'_> {
+        StepResult {
+            observation: &self.observation,
+            readings: &self.readings,
+            reward,
+            collided,
+            status: self.status,
+            pose: self.pose,
+            distance_px: self.distance_px,
+            step: self.steps,
+        }
+    }
+
+    /// Takes a discrete action by index (0 LEFT, 1 AHEAD, 2 RIGHT); `None` for another index.
+    pub fn step_index(&mut self, index: usize) -> Option<StepResult<'_>> {
+        DiscreteAction::from_index(index).map(|a| self.step(a))
+    }
+
+    /// The scene.
+    pub fn scene(&self) -> &Arc<Scene> {
+        &self.scene
+    }
+
+    /// The validated configuration the episode runs with.
+    pub fn config(&self) -> &ValidConfig {
+        &self.config
+    }
+
+    /// The laser.
+    pub fn laser(&self) -> &Laser {
+        &self.laser
+    }
+
+    /// The episode seed.
+    pub fn seed(&self) -> u64 {
+        self.seed
+    }
+
+    /// Start pose.
+    pub fn start(&self) -> Pose {
+        self.start
+    }
+
+    /// Current pose.
+    pub fn pose(&self) -> Pose {
+        self.pose
+    }
+
+    /// Goal position.
+    pub fn goal(&self) -> Point {
+        self.goal
+    }
+
+    /// Current laser readings, px.
+    pub fn readings(&self) -> &[f64] {
+        &self.readings
+    }
+
+    /// Current observation `[d_1/d_max, ..., d_m/d_max, direction/360]`.
+    pub fn observation(&self) -> &[f32] {
+        &self.observation
+    }
+
+    /// Distance to the goal D, px.
+    pub fn distance_px(&self) -> f64 {
+        self.distance_px
+    }
+
+    /// Bearing to the goal theta, degrees in [0, 360).
+    pub fn bearing_deg(&self) -> f64 {
+        bearing_deg(self.pose.position(), self.goal)
+    }
+
+    /// Goal direction relative to the heading, `(theta - z) mod 360`: 0 straight ahead, 90 left.
+    pub fn direction_deg(&self) -> f64 {
+        wrap_deg(self.bearing_deg() - self.pose.z_deg)
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u32 {
+        self.steps
+    }
+
+    /// Steps that collided.
+    pub fn collisions(&self) -> u32 {
+        self.collisions
+    }
+
+    /// Summed reward.
+    pub fn total_reward(&self) -> f64 {
+        self.total_reward
+    }
+
+    /// Distance driven, px.
+    pub fn path_length_px(&self) -> f64 {
+        self.path_length_px
+    }
+
+    /// Current status.
+    pub fn status(&self) -> Status {
+        self.status
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::SimConfig;
+    use crate::sim::world::maze_scene;
+
+    fn default_episode(seed: u64) -> Episode {
+        let config = ValidConfig::default();
+        let scene = Arc::new(maze_scene(&config, seed));
+        Episode::new(&config, scene, seed).expect("default scene places")
+    }
+
+    #[test]
+    fn placement_respects_clearance_and_distance() {
+        for seed in 0..50 {
+            let e = default_episode(seed);
+            let r = e.config().robot.radius_px;
+            assert!(e.scene().disc_clear(e.start().position(), r));
+            assert!(e.scene().disc_clear(e.goal(), r));
+            assert!((e.goal() - e.start().position()).norm() >= 200.0);
+            assert!((0.0..360.0).contains(&e.start().z_deg));
+        }
+    }
+
+    #[test]
+    fn bearing_follows_the_papers_cases() {
+        let o = Point::new(10.0, 10.0);
+        assert_eq!(bearing_deg(o, Point::new(20.0, 10.0)), 0.0);
+        assert_eq!(bearing_deg(o, Point::new(10.0, 20.0)), 90.0);
+        assert_eq!(bearing_deg(o, Point::new(0.0, 10.0)), 180.0);
+        assert_eq!(bearing_deg(o, Point::new(10.0, 0.0)), 270.0);
+        assert!((bearing_deg(o, Point::new(20.0, 0.0)) - 315.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn reward_terms_add_up() {
+        let mut sim = SimConfig::default();
+        sim.episode.start = Some([150.0, 150.0, 0.0]);
+        sim.episode.goal = Some([450.0, 150.0]);
+        let config = sim.validate().unwrap();
+        let scene = Arc::new(Scene::from_boxes(1000.0, 1000.0, vec![], 50.0));
+        let mut e = Episode::new(&config, scene, 0).unwrap();
+        let r = e.step(DiscreteAction::Ahead);
+        assert!((r.reward - 0.5).abs() < 1e-9, "{}", r.reward);
+        assert_eq!(r.observation.len(), 18);
+        assert_eq!(r.observation[17], 0.0);
+        let r = e.step(DiscreteAction::Left);
+        assert!((r.reward - -0.05).abs() < 1e-9);
+        // Goal now 15 deg to the right of the heading: direction 345.
+        assert!((e.direction_deg() - 345.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn timeout_and_reward_min_end_episodes() {
+        let mut sim = SimConfig::default();
+        sim.episode.max_steps = 3;
+        let config = sim.clone().validate().unwrap();
+        let scene = Arc::new(maze_scene(&config, 1));
+        let mut e = Episode::new(&config, scene.clone(), 1).unwrap();
+        let statuses: Vec<_> = (0..4)
+            .map(|_| e.step(DiscreteAction::Left).status)
+            .collect();
+        assert_eq!(
+            statuses,
+            [
+                Status::Running,
+                Status::Running,
+                Status::TimeOut,
+                Status::TimeOut
+            ]
+        );
+        assert_eq!(e.steps(), 3);
+
+        sim.episode.max_steps = 100;
+        sim.episode.reward_min = Some(-0.12);
+        let config = sim.validate().unwrap();
+        let mut e = Episode::new(&config, scene, 1).unwrap();
+        let statuses: Vec<_> = (0..3)
+            .map(|_| e.step(DiscreteAction::Left).status)
+            .collect();
+        assert_eq!(
+            statuses,
+            [Status::Running, Status::Running, Status::RewardMin]
+        );
+    }
+
+    #[test]
+    fn reaching_the_goal_succeeds() {
+        let mut sim = SimConfig::default();
+        sim.episode.start = Some([100.0, 100.0, 0.0]);
+        sim.episode.goal = Some([118.0, 100.0]);
+        let config = sim.validate().unwrap();
+        let scene = Arc::new(Scene::from_boxes(1000.0, 1000.0, vec![], 50.0));
+        let mut e = Episode::new(&config, scene, 0).unwrap();
+        assert_eq!(e.step(DiscreteAction::Ahead).status, Status::Running);
+        let r = e.step(DiscreteAction::Ahead);
+        assert_eq!(r.status, Status::Success);
+        assert!((r.reward - (0.5 + 10.0)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_fixed_start_gets_a_goal_far_enough_in_its_region() {
+        let mut sim = SimConfig::default();
+        sim.episode.start = Some([150.0, 150.0, 0.0]);
+        let config = sim.validate().unwrap();
+        for seed in 0..200 {
+            let scene = Arc::new(maze_scene(&config, seed));
+            let e = Episode::new(&config, scene, seed).unwrap();
+            assert_eq!(e.start(), Pose::new(150.0, 150.0, 0.0));
+            assert!(
+                (e.goal() - e.start().position()).norm() >= 200.0,
+                "seed {seed}"
+            );
+        }
+        let mut sim = SimConfig::default();
+        sim.episode.goal = Some([850.0, 850.0]);
+        let config = sim.validate().unwrap();
+        for seed in 0..50 {
+            let e = Episode::new(&config, Arc::new(maze_scene(&config, seed)), seed).unwrap();
+            assert_eq!(e.goal(), Point::new(850.0, 850.0));
+            assert!((e.goal() - e.start().position()).norm() >= 200.0);
+        }
+    }
+
+    #[test]
+    fn blocked_fixed_start_is_named() {
+        let mut sim = SimConfig::default();
+        sim.episode.start = Some([100.0, 52.0, 0.0]);
+        sim.episode.goal = Some([450.0, 450.0]);
+        let config = sim.validate().unwrap();
+        let scene = Arc::new(Scene::from_boxes(
+            1000.0,
+            1000.0,
+            vec![crate::geometry::Aabb::from_corners(
+                Point::new(0.0, 49.0),
+                Point::new(1000.0, 51.0),
+            )],
+            50.0,
+        ));
+        let e = Episode::new(&config, scene, 0).unwrap_err();
+        assert!(
+            matches!(e, EpisodeError::Blocked { which: "start", .. }),
+            "{e}"
+        );
+    }
+}

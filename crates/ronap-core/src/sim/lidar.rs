@@ -1,0 +1,266 @@
+//! The laser range finder: `beams` rays spread evenly over `fov` degrees centred on the heading.
+//!
+//! Beam `i` points at `z - fov/2 + i * fov/(m-1)` degrees (beam 0 on the right). A reading is the
+//! distance in px from the robot centre to the first obstacle, `range_px` when none is in range.
+
+use crate::config::LaserConfig;
+use crate::geometry::{unit, Aabb, Point, Vector};
+use crate::scene::Scene;
+use rand_distr::{Distribution, Normal};
+
+/// Above this many candidate boxes a scan tests the bin's list as it is instead of copying the
+/// boxes in range to the stack.
+const MAX_LOCAL_BOXES: usize = 48;
+
+/// Colour class of a reading, for drawing rays (SPEC "Sensors").
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayClass {
+    /// d > 0.6 d_max.
+    Green,
+    /// 0.3 d_max < d <= 0.6 d_max.
+    Yellow,
+    /// d <= 0.3 d_max.
+    Red,
+}
+
+/// A configured laser: beam directions relative to the heading, precomputed.
+#[derive(Clone, Debug)]
+pub struct Laser {
+    range_px: f64,
+    /// Unit vector of each beam in the robot frame (heading along +x).
+    offsets: Vec<Vector>,
+    first_offset_deg: f64,
+    step_deg: f64,
+    noise: Option<Normal<f64>>,
+}
+
+impl Laser {
+    /// The laser `config` describes (a validated config: at least one beam, positive range).
+    pub fn new(config: &LaserConfig) -> Self {
+        let m = config.beams as usize;
+        let step_deg = if m > 1 {
+            config.fov_deg / (m - 1) as f64
+        } else {
+            0.0
+        };
+        let first_offset_deg = if m > 1 { -config.fov_deg / 2.0 } else { 0.0 };
+        let offsets = (0..m)
+            .map(|i| unit(first_offset_deg + i as f64 * step_deg))
+            .collect();
+        // A validated sigma is finite and >= 0, so `Normal::new` cannot fail.
+        let noise = (config.noise_sigma_px > 0.0)
+            .then(|| Normal::new(0.0, config.noise_sigma_px).ok())
+            .flatten();
+        Self {
+            range_px: config.range_px,
+            offsets,
+            first_offset_deg,
+            step_deg,
+            noise,
+        }
+    }
+
+    /// Number of beams.
+    pub fn beams(&self) -> usize {
+        self.offsets.len()
+    }
+
+    /// Largest reading, px.
+    pub fn range_px(&self) -> f64 {
+        self.range_px
+    }
+
+    /// Direction of beam `i` in the scene for heading `heading_deg`, degrees.
+    pub fn beam_angle_deg(&self, i: usize, heading_deg: f64) -> f64 {
+        heading_deg + self.first_offset_deg + i as f64 * self.step_deg
+    }
+
+    /// Colour class of reading `d`.
+    pub fn class(&self, d: f64) -> RayClass {
+        if d > 0.6 * self.range_px {
+            RayClass::Green
+        } else if d > 0.3 * self.range_px {
+            RayClass::Yellow
+        } else {
+            RayClass::Red
+        }
+    }
+
+    /// Noise-free readings from `position` at `heading_deg` into `out` (one per beam), px.
+    pub fn scan(&self, scene: &Scene, position: Point, heading_deg: f64, out: &mut [f64]) {
+        debug_assert_eq!(out.len(), self.offsets.len());
+        let range = self.range_px;
+        let heading = unit(heading_deg);
+        let near = scene.boxes_near(position, range);
+        let boxes = scene.boxes();
+        // Copy the boxes that are really in range next to each other: every beam reads them all.
+        let mut local = [Aabb::from_corners(Point::origin(), Point::origin()); MAX_LOCAL_BOXES];
+        let mut count = 0;
+        let r2 = range * range;
+        let mut overflow = false;
+        for &i in near {
+            let b = boxes[i as usize];
+            if b.distance_squared(position) <= r2 {
+                if count == MAX_LOCAL_BOXES {
+                    overflow = true;
+                    break;
+                }
+                local[count] = b;
+                count += 1;
+            }
+        }
+        for (reading, offset) in out.iter_mut().zip(&self.offsets) {
+            let dir = Vector::new(
+                heading.x * offset.x - heading.y * offset.y,
+                heading.x * offset.y + heading.y * offset.x,
+            );
+            let inv = Vector::new(1.0 / dir.x, 1.0 / dir.y);
+            let mut best = range;
+            if overflow {
+                for &i in near {
+                    if let Some(t) = boxes[i as usize].ray_hit(position, inv, best) {
+                        best = t;
+                    }
+                }
+            } else {
+                for b in &local[..count] {
+                    if let Some(t) = b.ray_hit(position, inv, best) {
+                        best = t;
+                    }
+                }
+            }
+            *reading = best;
+        }
+    }
+
+    /// Adds Gaussian noise (if configured) to readings, keeping each in `[0, range]`.
+    pub fn add_noise(&self, readings: &mut [f64], rng: &mut impl rand::Rng) {
+        if let Some(noise) = &self.noise {
+            for r in readings {
+                *r = (*r + noise.sample(rng)).clamp(0.0, self.range_px);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::LaserConfig;
+
+    fn laser() -> Laser {
+        Laser::new(&LaserConfig::default())
+    }
+
+    fn scene(boxes: Vec<Aabb>) -> Scene {
+        Scene::from_boxes(1000.0, 1000.0, boxes, 50.0)
+    }
+
+    fn read(scene: &Scene, p: Point, z: f64) -> Vec<f64> {
+        let l = laser();
+        let mut out = vec![0.0; l.beams()];
+        l.scan(scene, p, z, &mut out);
+        out
+    }
+
+    #[test]
+    fn wall_straight_ahead_at_thirty() {
+        // Heading +x; a wall whose near face is 30 px ahead.
+        let s = scene(vec![Aabb::from_corners(
+            Point::new(130.0, 0.0),
+            Point::new(132.0, 1000.0),
+        )]);
+        let r = read(&s, Point::new(100.0, 500.0), 0.0);
+        assert!((r[8] - 30.0).abs() < 1e-9, "{}", r[8]);
+        // Beam 7 is 11.25 deg to the right of the heading: 30 / cos(11.25 deg).
+        let expected = 30.0 / 11.25f64.to_radians().cos();
+        assert!((r[7] - expected).abs() < 1e-9);
+        // Beams at +-45 deg: 30 * sqrt 2 = 42.4 < 50, in range; beyond 53.13 deg it is out of range.
+        assert!((r[4] - 30.0 * 2f64.sqrt()).abs() < 1e-9);
+        assert_eq!(r[0], 50.0);
+        assert_eq!(r[16], 50.0);
+    }
+
+    #[test]
+    fn wall_at_an_angle() {
+        // Heading 90 (up); a wall 20 px to the right: the beam at 60 deg right of the heading
+        // meets it at 20 / cos(30 deg).
+        let s = scene(vec![Aabb::from_corners(
+            Point::new(120.0, 0.0),
+            Point::new(122.0, 1000.0),
+        )]);
+        let l = Laser::new(&LaserConfig {
+            beams: 7,
+            ..LaserConfig::default()
+        });
+        let mut out = vec![0.0; 7];
+        l.scan(&s, Point::new(100.0, 500.0), 90.0, &mut out);
+        // Beams every 30 deg from -90: beam 1 points at 90 - 60 = 30 deg from +x.
+        assert!(
+            (out[1] - 20.0 / 30f64.to_radians().cos()).abs() < 1e-9,
+            "{out:?}"
+        );
+        assert!((out[0] - 20.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn into_a_corner() {
+        // Walls at x = 120 and y = 120 meeting in a corner; robot at (100, 100) facing 45 deg.
+        let s = scene(vec![
+            Aabb::from_corners(Point::new(120.0, 0.0), Point::new(122.0, 122.0)),
+            Aabb::from_corners(Point::new(0.0, 120.0), Point::new(122.0, 122.0)),
+        ]);
+        let r = read(&s, Point::new(100.0, 100.0), 45.0);
+        assert!((r[8] - 20.0 * 2f64.sqrt()).abs() < 1e-9, "{}", r[8]);
+        // Beams along +x and +y meet the walls square on, 20 px away.
+        assert!((r[4] - 20.0).abs() < 1e-9);
+        assert!((r[12] - 20.0).abs() < 1e-9);
+        // The side beams (-45 and 135 deg) meet each wall at 45 degrees, 20 sqrt 2 away.
+        assert!((r[0] - 20.0 * 2f64.sqrt()).abs() < 1e-9);
+        assert!((r[16] - 20.0 * 2f64.sqrt()).abs() < 1e-9);
+    }
+
+    #[test]
+    fn beam_along_a_wall_face_reads_it() {
+        // Heading exactly 0: beam 8 runs along y = 50, the bottom face of the box.
+        let s = scene(vec![Aabb::from_corners(
+            Point::new(40.0, 50.0),
+            Point::new(42.0, 90.0),
+        )]);
+        let r = read(&s, Point::new(20.0, 50.0), 0.0);
+        assert_eq!(r[8], 20.0);
+    }
+
+    #[test]
+    fn nothing_in_range_reads_exactly_range() {
+        let s = scene(vec![Aabb::from_corners(
+            Point::new(900.0, 900.0),
+            Point::new(910.0, 910.0),
+        )]);
+        assert!(read(&s, Point::new(100.0, 100.0), 33.0)
+            .iter()
+            .all(|&d| d == 50.0));
+    }
+
+    #[test]
+    fn noise_keeps_readings_in_range() {
+        let l = Laser::new(&LaserConfig {
+            noise_sigma_px: 30.0,
+            ..LaserConfig::default()
+        });
+        let mut rng = crate::sim::rng::stream(1, crate::sim::rng::Stream::Noise);
+        let mut r = vec![25.0; 17];
+        for _ in 0..100 {
+            l.add_noise(&mut r, &mut rng);
+            assert!(r.iter().all(|&d| (0.0..=50.0).contains(&d)));
+        }
+    }
+
+    #[test]
+    fn classes_follow_the_spec_thresholds() {
+        let l = laser();
+        assert_eq!(l.class(31.0), RayClass::Green);
+        assert_eq!(l.class(30.0), RayClass::Yellow);
+        assert_eq!(l.class(15.0), RayClass::Red);
+    }
+}

@@ -1,0 +1,10 @@
+//! The simulation: the robot and its actions, the laser, the random streams, placement of start
+//! and goal, the episode that steps and scores them, and the worlds episodes run in. Uses
+//! `config`, `geometry` and `scene`.
+
+pub mod episode;
+pub mod lidar;
+pub mod placement;
+pub mod rng;
+pub mod robot;
+pub mod world;

@@ -1,0 +1,191 @@
+//! Worlds and scenes: a validated configuration and a scene, with the scene's free-space grid
+//! computed on first use and shared by placement, planners and path metrics; and [`Scenes`], which
+//! says where each seed's episode takes place.
+
+use crate::config::ValidConfig;
+use crate::scene::freespace::FreeGrid;
+use crate::scene::map::{self, MapError, MapSource};
+use crate::scene::maze::Maze;
+use crate::scene::Scene;
+use crate::sim::episode::Episode;
+use crate::sim::placement::{free_grid, needs_region_grid, sample_placement, EpisodeError};
+use crate::sim::rng::{stream, Stream};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, OnceLock};
+
+/// The scene for an episode seed: a maze drawn from the seed's scene stream.
+pub fn maze_scene(config: &ValidConfig, scene_seed: u64) -> Scene {
+    let maze = Maze::from_config(&config.maze, &mut stream(scene_seed, Stream::Scene));
+    Scene::from_maze(maze, &config.maze, config.reach_px())
+}
+
+/// A scene under a configuration.
+#[derive(Debug)]
+pub struct World {
+    config: ValidConfig,
+    scene: Arc<Scene>,
+    grid: OnceLock<FreeGrid>,
+}
+
+impl World {
+    /// The world of `scene` under `config`.
+    pub fn new(config: ValidConfig, scene: Arc<Scene>) -> Self {
+        Self {
+            config,
+            scene,
+            grid: OnceLock::new(),
+        }
+    }
+
+    /// The maze world of `scene_seed`.
+    pub fn maze(config: ValidConfig, scene_seed: u64) -> Self {
+        let scene = Arc::new(maze_scene(&config, scene_seed));
+        Self::new(config, scene)
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &ValidConfig {
+        &self.config
+    }
+
+    /// The scene.
+    pub fn scene(&self) -> &Arc<Scene> {
+        &self.scene
+    }
+
+    /// The free-space grid for the configured robot (computed once, on first use).
+    pub fn grid(&self) -> &FreeGrid {
+        self.grid
+            .get_or_init(|| free_grid(&self.config, &self.scene))
+    }
+
+    /// The episode of `seed`: start and goal as the configuration fixes them or drawn from the seed.
+    pub fn episode(&self, seed: u64) -> Result<Episode, EpisodeError> {
+        let both_fixed = self.config.episode.start.is_some() && self.config.episode.goal.is_some();
+        let grid =
+            (!both_fixed && needs_region_grid(&self.config, &self.scene)).then(|| self.grid());
+        let placement = sample_placement(&self.config, &self.scene, grid, seed)?;
+        Episode::with_placement(&self.config, self.scene.clone(), seed, placement)
+    }
+}
+
+/// Where episodes take place.
+#[derive(Clone, Debug)]
+pub enum Scenes {
+    /// Each seed gets its own maze, generated from the seed.
+    MazePerSeed,
+    /// One maze, from this seed, for every episode.
+    Maze(u64),
+    /// One given scene (an image or ROS map) for every episode.
+    Fixed(Arc<Scene>),
+}
+
+/// Where episodes take place, as a user says it and a run's manifest records it: the one
+/// description every front end turns into [`Scenes`].
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum SceneSpec {
+    /// Each seed its own maze.
+    MazePerSeed,
+    /// The maze of `seed` for every episode.
+    Maze {
+        /// The maze's seed.
+        seed: u64,
+    },
+    /// An image (PNG/PGM) or ROS `map_server` YAML file for every episode.
+    Map {
+        /// The map file, as given.
+        file: PathBuf,
+    },
+}
+
+impl SceneSpec {
+    /// The scenes of a map file when one is given, else of one maze when `maze_seed` is given,
+    /// else a maze per seed.
+    pub fn from_options(maze_seed: Option<u64>, map_file: Option<&Path>) -> Self {
+        match (map_file, maze_seed) {
+            (Some(file), _) => Self::Map {
+                file: file.to_path_buf(),
+            },
+            (None, Some(seed)) => Self::Maze { seed },
+            (None, None) => Self::MazePerSeed,
+        }
+    }
+
+    /// The scenes, reading the map file if there is one (and what it was read as).
+    pub fn load(&self, config: &ValidConfig) -> Result<(Scenes, Option<MapSource>), MapError> {
+        Ok(match self {
+            Self::Map { file } => {
+                let (scene, source) = map::load(file, &config.map, config.reach_px())?;
+                (Scenes::Fixed(Arc::new(scene)), Some(source))
+            }
+            Self::Maze { seed } => (Scenes::Maze(*seed), None),
+            Self::MazePerSeed => (Scenes::MazePerSeed, None),
+        })
+    }
+}
+
+impl std::fmt::Display for SceneSpec {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::MazePerSeed => f.write_str("a maze per seed"),
+            Self::Maze { seed } => write!(f, "maze of seed {seed}"),
+            Self::Map { file } => write!(f, "map {}", file.display()),
+        }
+    }
+}
+
+/// The worlds of a run's episodes: each seed's own maze world, or one world shared by every seed
+/// (so its free-space grid is built once).
+#[derive(Clone, Debug)]
+pub struct Worlds {
+    config: ValidConfig,
+    scenes: Scenes,
+    shared: Option<Arc<World>>,
+}
+
+impl Worlds {
+    /// The worlds of `scenes` under `config`.
+    pub fn new(config: ValidConfig, scenes: Scenes) -> Self {
+        let shared = match &scenes {
+            Scenes::MazePerSeed => None,
+            Scenes::Maze(seed) => Some(Arc::new(World::maze(config.clone(), *seed))),
+            Scenes::Fixed(scene) => Some(Arc::new(World::new(config.clone(), scene.clone()))),
+        };
+        Self {
+            config,
+            scenes,
+            shared,
+        }
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &ValidConfig {
+        &self.config
+    }
+
+    /// Where episodes take place.
+    pub fn scenes(&self) -> &Scenes {
+        &self.scenes
+    }
+
+    /// The world of episode `seed`.
+    pub fn world(&self, seed: u64) -> Arc<World> {
+        match &self.shared {
+            Some(w) => w.clone(),
+            None => Arc::new(World::maze(self.config.clone(), seed)),
+        }
+    }
+
+    /// The episode of `seed` in its world.
+    pub fn episode(&self, seed: u64) -> Result<Episode, EpisodeError> {
+        self.world(seed).episode(seed)
+    }
+
+    /// The start-up check every front end makes before it writes anything: a scene with no room
+    /// for a start and goal fails the same way for every seed, so the first seed tells.
+    pub fn check_start(&self, seed: u64) -> Result<(), EpisodeError> {
+        self.episode(seed).map(drop)
+    }
+}
