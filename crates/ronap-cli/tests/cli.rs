@@ -1,25 +1,6 @@
 //! End-to-end tests of the `ronap` binary: outputs read back and checked, bad input rejected.
 
-// Test helpers may panic on setup failures: that is a failed test, as intended.
-#![allow(clippy::unwrap_used)]
-
-use std::path::Path;
-use std::process::{Command, Output};
-
-fn ronap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ronap"))
-        .args(args)
-        .output()
-        .expect("ronap runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use crate::util::{assert_rejected_in_empty_dir, ronap, stderr, stdout};
 
 #[test]
 fn maze_prints_text_by_default() {
@@ -126,78 +107,58 @@ fn maze_flags_shape_the_picture() {
     assert_eq!(img.get_pixel(4, 295).0[0], 255);
 }
 
-fn assert_rejected(args: &[&str], names: &[&str], out: Option<&Path>) {
-    let o = ronap(args);
-    assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
-    let err = stderr(&o);
-    assert_eq!(
-        err.trim_end().lines().count(),
-        1,
-        "{args:?}: not one line: {err}"
-    );
-    for n in names {
-        assert!(err.contains(n), "{args:?}: {err:?} does not name {n:?}");
-    }
-    assert!(!err.contains("panicked"));
-    if let Some(out) = out {
-        assert!(!out.exists(), "{args:?} left {}", out.display());
-        let leftovers: Vec<_> = std::fs::read_dir(out.parent().unwrap()).unwrap().collect();
-        assert!(leftovers.is_empty(), "{args:?} left {leftovers:?}");
-    }
-}
-
 #[test]
 fn bad_input_is_named_with_exit_code_2_and_no_output() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("m.png");
     let o = out.to_str().unwrap();
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["maze", "--cols", "0", "--out", o],
         &["--cols", "0"],
         Some(&out),
     );
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["maze", "--rows", "-2", "--out", o],
         &["--rows", "-2"],
         Some(&out),
     );
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["maze", "--cell", "-5", "--out", o],
         &["--cell", "-5"],
         Some(&out),
     );
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["maze", "--wall-thickness", "0", "--out", o],
         &["--wall-thickness", "0"],
         Some(&out),
     );
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["maze", "--loops", "1.5", "--out", o],
         &["--loops", "1.5"],
         Some(&out),
     );
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["maze", "--loops", "-0.1", "--out", o],
         &["--loops", "-0.1"],
         Some(&out),
     );
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["maze", "--scale", "nan", "--out", o],
         &["--scale", "nan"],
         Some(&out),
     );
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["maze", "--out", "/nonexistent-dir/m.png"],
         &["/nonexistent-dir/m.png"],
         None,
     );
     let txt = dir.path().join("m.txt");
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["maze", "--out", txt.to_str().unwrap()],
         &["m.txt"],
         Some(&txt),
     );
-    assert_rejected(&["maze", "--bogus"], &["--bogus"], None);
+    assert_rejected_in_empty_dir(&["maze", "--bogus"], &["--bogus"], None);
 }
 
 #[test]
@@ -205,18 +166,18 @@ fn config_file_errors_name_the_file_and_field() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = dir.path().join("c.toml");
     std::fs::write(&cfg, "[maze]\ncolz = 3\n").unwrap();
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["maze", "--config", cfg.to_str().unwrap()],
         &["c.toml", "colz"],
         None,
     );
     std::fs::write(&cfg, "[maze]\nloops = 2.0\n").unwrap();
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["maze", "--config", cfg.to_str().unwrap()],
         &["c.toml", "maze.loops", "2"],
         None,
     );
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["maze", "--config", "/no/such.toml"],
         &["/no/such.toml"],
         None,
@@ -280,22 +241,22 @@ fn collect_human_needs_a_terminal_and_writes_nothing_without_one() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("rows.csv");
     let o = out.to_str().unwrap();
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["collect", "--human", "--out", o],
         &["ronap collect --human", "stdout is not one"],
         Some(&out),
     );
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["collect", "--human", "--expert", "geodesic", "--out", o],
         &["--human", "--expert"],
         Some(&out),
     );
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["collect", "--out", o],
         &["--expert", "--human"],
         Some(&out),
     );
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["collect", "--human", "--mode", "drive", "--out", o],
         &["--human", "--mode drive"],
         Some(&out),
@@ -306,19 +267,19 @@ fn collect_human_needs_a_terminal_and_writes_nothing_without_one() {
 fn view_needs_a_terminal_and_says_so() {
     // Output captured: stdout is a pipe. The command must fail at once, not wait for keys.
     let start = std::time::Instant::now();
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["view", "--policy", "apf", "--seed", "7"],
         &["ronap view", "stdout is not one"],
         None,
     );
     assert!(start.elapsed() < std::time::Duration::from_secs(20));
-    assert_rejected(&["view", "--policy", "nope"], &["--policy", "nope"], None);
-    assert_rejected(
+    assert_rejected_in_empty_dir(&["view", "--policy", "nope"], &["--policy", "nope"], None);
+    assert_rejected_in_empty_dir(
         &["view", "--policy", "apf", "--speed", "0"],
         &["--speed", "0"],
         None,
     );
-    assert_rejected(
+    assert_rejected_in_empty_dir(
         &["view", "--policy", "apf", "--map", "/no/map.png"],
         &["/no/map.png"],
         None,

@@ -1,40 +1,7 @@
 //! The learning loop from the command line: collect, train, run; weights-file errors; the shipped
 //! policies against their reported figures.
 
-// Test helpers may panic on setup failures: that is a failed test, as intended.
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn ronap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ronap"))
-        .args(args)
-        .output()
-        .expect("ronap runs")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-fn ok(o: &Output) -> String {
-    assert!(
-        o.status.success(),
-        "exit {:?}\nstdout: {}\nstderr: {}",
-        o.status.code(),
-        text(&o.stdout),
-        text(&o.stderr)
-    );
-    text(&o.stdout)
-}
-
-fn summary(dir: &Path) -> serde_json::Value {
-    let s = std::fs::read_to_string(dir.join("summary.json")).expect("summary.json");
-    serde_json::from_str::<serde_json::Value>(&s).expect("json")["summary"].clone()
-}
-
-fn repo_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
+use crate::util::{ok, repo_root, ronap, summary, text};
 
 #[test]
 fn collect_train_run_loop() {

@@ -1,23 +1,9 @@
 //! End-to-end tests of the GIF outputs: `ronap replay` of a step log and `ronap run --gif`, each
 //! decoded back and checked frame by frame; bad input refused with one line and no file.
 
-// Test helpers may panic on setup failures: that is a failed test, as intended.
-#![allow(clippy::unwrap_used)]
-
+use crate::util::{assert_rejected, ronap, text};
 use image::AnimationDecoder;
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn ronap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ronap"))
-        .args(args)
-        .output()
-        .expect("ronap runs")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
 
 /// The frames of a GIF, decoded by the image crate, as full pictures.
 fn frames(path: &Path) -> Vec<image::RgbaImage> {
@@ -123,7 +109,7 @@ fn replay_draws_one_frame_per_step_with_the_robot_moving() {
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", text(&o.stderr));
-    let frames = crate::frames(&out);
+    let frames = self::frames(&out);
     assert_eq!(frames.len(), 1 + steps.div_ceil(3));
     assert_eq!(frames[0].dimensions(), (120, 120));
     assert_ne!(frames[0], frames[frames.len() - 1]);
@@ -157,17 +143,6 @@ fn run_gif_writes_the_chosen_seeds_episode() {
     assert_ne!(frames[0], frames[frames.len() - 1]);
 }
 
-fn assert_refused(args: &[&str], names: &[&str]) {
-    let o = ronap(args);
-    assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o.stderr));
-    let err = text(&o.stderr);
-    assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
-    for n in names {
-        assert!(err.contains(n), "{args:?}: {err:?} does not name {n:?}");
-    }
-    assert!(!err.contains("panicked"));
-}
-
 #[test]
 fn bad_replays_are_named_and_write_nothing() {
     let dir = tempfile::tempdir().unwrap();
@@ -176,10 +151,10 @@ fn bad_replays_are_named_and_write_nothing() {
     let log = log.to_str().unwrap();
     let out = dir.path().join("x.gif");
     let o = out.to_str().unwrap();
-    assert_refused(&["replay", "/no/such.csv", "--out", o], &["/no/such.csv"]);
+    assert_rejected(&["replay", "/no/such.csv", "--out", o], &["/no/such.csv"]);
     let bad = dir.path().join("bad.csv");
     std::fs::write(&bad, "seed,step,x,y,z,action\n6,1,1,2,3,FLY\n").unwrap();
-    assert_refused(
+    assert_rejected(
         &[
             "replay",
             bad.to_str().unwrap(),
@@ -193,7 +168,7 @@ fn bad_replays_are_named_and_write_nothing() {
     // Outside its run directory a log has no summary.json beside it.
     let lonely = dir.path().join("lonely.csv");
     std::fs::copy(log, &lonely).unwrap();
-    assert_refused(
+    assert_rejected(
         &["replay", lonely.to_str().unwrap(), "--out", o],
         &["summary.json", "--summary"],
     );
@@ -212,7 +187,7 @@ fn bad_replays_are_named_and_write_nothing() {
         other.to_str().unwrap(),
     ]);
     assert!(r.status.success());
-    assert_refused(
+    assert_rejected(
         &[
             "replay",
             log,
@@ -227,10 +202,10 @@ fn bad_replays_are_named_and_write_nothing() {
             "seed-000006.csv",
         ],
     );
-    assert_refused(&["replay", log, "--out", "x.png"], &["x.png", ".gif"]);
-    assert_refused(&["replay", log, "--view", "side"], &["--view", "side"]);
-    assert_refused(&["replay", log, "--stride", "0"], &["--stride", "0"]);
-    assert_refused(&["replay", log, "--scale", "9"], &["--scale", "9"]);
+    assert_rejected(&["replay", log, "--out", "x.png"], &["x.png", ".gif"]);
+    assert_rejected(&["replay", log, "--view", "side"], &["--view", "side"]);
+    assert_rejected(&["replay", log, "--stride", "0"], &["--stride", "0"]);
+    assert_rejected(&["replay", log, "--scale", "9"], &["--scale", "9"]);
     assert!(!out.exists());
     let leftovers: Vec<_> = std::fs::read_dir(dir.path())
         .unwrap()
@@ -240,7 +215,7 @@ fn bad_replays_are_named_and_write_nothing() {
     assert!(leftovers.is_empty(), "{leftovers:?}");
 
     let none = dir.path().join("none");
-    assert_refused(
+    assert_rejected(
         &[
             "run",
             "--policy",

@@ -1,43 +1,9 @@
 //! End-to-end tests of `ronap run`: every output file read back, determinism across thread
 //! counts, the success gate, bad input, maps, APF's local minima, and Ctrl-C.
 
-// Test helpers may panic on setup failures: that is a failed test, as intended.
-#![allow(clippy::unwrap_used)]
-
+use crate::util::{assert_rejected_leaving_nothing, col, json, ronap, rows, text};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn ronap(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_ronap"))
-        .args(args)
-        .output()
-        .expect("ronap runs")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
-fn rows(path: &Path) -> Vec<Vec<String>> {
-    let mut r = csv::Reader::from_path(path).unwrap();
-    let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
-    let mut out = vec![header];
-    for rec in r.records() {
-        out.push(rec.unwrap().iter().map(String::from).collect());
-    }
-    out
-}
-
-fn col(table: &[Vec<String>], name: &str) -> usize {
-    table[0]
-        .iter()
-        .position(|h| h == name)
-        .unwrap_or_else(|| panic!("no column {name}"))
-}
-
-fn json(path: &Path) -> serde_json::Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
+use std::process::Command;
 
 #[test]
 fn run_writes_episodes_summary_pictures_and_step_logs() {
@@ -195,37 +161,22 @@ fn min_success_gates_the_exit_code() {
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
 }
 
-fn assert_rejected(args: &[&str], names: &[&str], out: &Path) {
-    let o = ronap(args);
-    assert_eq!(o.status.code(), Some(2), "{args:?}: {}", text(&o.stderr));
-    let err = text(&o.stderr);
-    assert_eq!(
-        err.trim_end().lines().count(),
-        1,
-        "{args:?}: not one line: {err}"
-    );
-    for n in names {
-        assert!(err.contains(n), "{args:?}: {err:?} does not name {n:?}");
-    }
-    assert!(!out.exists(), "{args:?} created {}", out.display());
-}
-
 #[test]
 fn bad_input_is_named_and_leaves_no_output() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("never");
     let o = out.to_str().unwrap();
-    assert_rejected(
+    assert_rejected_leaving_nothing(
         &["run", "--policy", "teleport", "--out", o],
         &["teleport", "apf"],
         &out,
     );
-    assert_rejected(
+    assert_rejected_leaving_nothing(
         &["run", "--policy", "apf", "--seeds", "0", "--out", o],
         &["--seeds", "0"],
         &out,
     );
-    assert_rejected(
+    assert_rejected_leaving_nothing(
         &[
             "run",
             "--policy",
@@ -240,7 +191,7 @@ fn bad_input_is_named_and_leaves_no_output() {
     );
     let corrupt = dir.path().join("corrupt.png");
     std::fs::write(&corrupt, b"\x89PNG not really").unwrap();
-    assert_rejected(
+    assert_rejected_leaving_nothing(
         &[
             "run",
             "--policy",
@@ -255,7 +206,7 @@ fn bad_input_is_named_and_leaves_no_output() {
     );
     let yaml = dir.path().join("bad.yaml");
     std::fs::write(&yaml, "image: x.pgm\nresolution: fast\n").unwrap();
-    assert_rejected(
+    assert_rejected_leaving_nothing(
         &[
             "run",
             "--policy",
@@ -270,7 +221,7 @@ fn bad_input_is_named_and_leaves_no_output() {
     );
     let cfg = dir.path().join("c.toml");
     std::fs::write(&cfg, "[robot]\nradius_px = -3\n").unwrap();
-    assert_rejected(
+    assert_rejected_leaving_nothing(
         &[
             "run",
             "--policy",
@@ -284,7 +235,7 @@ fn bad_input_is_named_and_leaves_no_output() {
         &out,
     );
     std::fs::write(&cfg, "[laser]\nbeams = 17\nbeam = 3\n").unwrap();
-    assert_rejected(
+    assert_rejected_leaving_nothing(
         &[
             "run",
             "--policy",
@@ -301,7 +252,7 @@ fn bad_input_is_named_and_leaves_no_output() {
     let file = dir.path().join("file");
     std::fs::write(&file, "x").unwrap();
     let under = file.join("out");
-    assert_rejected(
+    assert_rejected_leaving_nothing(
         &[
             "run",
             "--policy",

@@ -2,9 +2,7 @@
 //! sent with `send-keys`, and the screen is read with `capture-pane`. Each test has its own tmux
 //! server. Without tmux the tests print a notice and pass; CI installs it (.ci/run).
 
-// Test helpers may panic on setup failures: that is a failed test, as intended.
-#![allow(clippy::unwrap_used)]
-
+use crate::util::BIN;
 use std::process::Command;
 use std::time::{Duration, Instant};
 
@@ -118,10 +116,6 @@ impl Drop for Tmux {
     }
 }
 
-fn ronap() -> &'static str {
-    env!("CARGO_BIN_EXE_ronap")
-}
-
 /// Checks that the terminal is back to the shell: main screen, cursor shown, and cooked mode
 /// (the line discipline's settings equal to those saved before).
 fn assert_restored(tmux: &Tmux, marker: &str) {
@@ -147,7 +141,7 @@ fn view_shows_the_episode_toggles_the_map_and_restores_the_terminal_on_quit() {
     ));
     tmux.line(&format!(
         "{} view --policy apf --seed 7 --speed 5; echo after-view rc=$?",
-        ronap()
+        BIN
     ));
     let screen = tmux.wait("the first-person view", 30, |s| {
         s.contains("first person · seed 7") && s.contains("step 1 ")
@@ -232,7 +226,7 @@ fn view_restores_the_terminal_on_ctrl_c_and_sigterm() {
         "cd {}; stty -g > before.stty",
         dir.path().display()
     ));
-    let view = format!("{} view --policy random --seed 3 --speed 50", ronap());
+    let view = format!("{} view --policy random --seed 3 --speed 50", BIN);
     tmux.line(&format!("{view}; echo after-ctrl-c rc=$?"));
     tmux.wait("the view", 30, |s| s.contains("first person · seed 3"));
     tmux.keys(&["C-c"]);
@@ -312,7 +306,7 @@ fn collect_human_records_one_row_per_armed_arrow_as_it_is_taken() {
     ));
     tmux.line(&format!(
         "{} collect --human --user tester --seed-start 5 --out tester_rows.csv; echo after-collect rc=$?",
-        ronap()
+        BIN
     ));
     let rows_shown = |n: u64| move |s: &str| s.contains(&format!("rows       {n} of 10000"));
     tmux.wait("the collect screen", 30, |s| {

@@ -1,26 +1,11 @@
-"""The batch evaluator from Python, and Python policies from the CLI."""
+"""The batch evaluator from Python (the CLI side of the same runs is in the top-level tests/)."""
 
-import json
 import pathlib
-import subprocess
 
 import numpy as np
 import pytest
 
 import ronap
-
-POLICY_FILE = '''
-def act(obs):
-    d = float(obs[-1]) * 360.0
-    if 15 < d < 180:
-        return 0
-    if 180 <= d < 345:
-        return 2
-    return 1
-
-def boom(obs):
-    raise ValueError("no idea")
-'''
 
 
 def toward_goal(obs):
@@ -64,50 +49,6 @@ def test_python_policy_runs_and_is_deterministic():
 def test_bad_python_policies_raise_policy_error_naming_seed_and_step(policy, message):
     with pytest.raises(ronap.PolicyError, match=message):
         ronap.evaluate(policy, [3], threads=1)
-
-
-def test_cli_and_python_agree_bit_for_bit(tmp_path, ronap_bin):
-    policy = tmp_path / "policy.py"
-    policy.write_text(POLICY_FILE)
-    cli_out, py_out = tmp_path / "cli", tmp_path / "py"
-    subprocess.run(
-        [ronap_bin, "run", "--policy", f"py:{policy}:act", "--seeds", "6", "--out", str(cli_out), "--log-steps"],
-        check=True,
-        capture_output=True,
-    )
-    ronap.evaluate(toward_goal, range(6), out=str(py_out), log_steps=True)
-    assert (cli_out / "episodes.csv").read_bytes() == (py_out / "episodes.csv").read_bytes()
-    for seed in range(6):
-        name = f"steps/seed-{seed:06}.csv"
-        assert (cli_out / name).read_bytes() == (py_out / name).read_bytes(), name
-    summary = json.loads((py_out / "summary.json").read_text())
-    assert summary["summary"]["episodes"] == 6 and summary["policy"] == "toward_goal"
-
-
-def test_builtin_files_match_the_cli(tmp_path, ronap_bin):
-    subprocess.run([ronap_bin, "run", "--policy", "apf", "--seeds", "10", "--out", str(tmp_path / "cli")], check=True, capture_output=True)
-    ronap.evaluate("apf", range(10), out=str(tmp_path / "py"), png="failures")
-    assert (tmp_path / "cli" / "episodes.csv").read_bytes() == (tmp_path / "py" / "episodes.csv").read_bytes()
-    assert any((tmp_path / "py" / "png").iterdir())
-
-
-def test_cli_reports_a_failing_python_policy(tmp_path, ronap_bin):
-    policy = tmp_path / "policy.py"
-    policy.write_text(POLICY_FILE)
-    r = subprocess.run(
-        [ronap_bin, "run", "--policy", f"py:{policy}:boom", "--seeds", "3", "--out", str(tmp_path / "o")],
-        capture_output=True,
-        text=True,
-    )
-    assert r.returncode == 2
-    assert "seed 0, step 1" in r.stderr and "ValueError('no idea')" in r.stderr
-    r = subprocess.run(
-        [ronap_bin, "run", "--policy", f"py:{policy}:missing", "--seeds", "3", "--out", str(tmp_path / "m")],
-        capture_output=True,
-        text=True,
-    )
-    assert r.returncode == 2 and "missing" in r.stderr
-    assert not (tmp_path / "m").exists()
 
 
 def test_evaluate_input_errors():

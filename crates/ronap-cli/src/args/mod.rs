@@ -8,7 +8,7 @@ pub mod policy;
 pub mod sim;
 
 pub use policy::policy_factory;
-pub use sim::{SceneArgs, SimArgs};
+pub use sim::{EpisodeArgs, SceneArgs, SimArgs};
 
 use clap::Args;
 

@@ -11,8 +11,7 @@ pub fn policy_factory(name: &str, config: &ValidConfig) -> Result<Box<dyn Policy
             crate::py_policy::PyPolicyFactory::new(spec).map_err(anyhow::Error::msg)?,
         ));
     }
-    let observation_size = config.laser.beams as usize + 1;
-    ronap_core::policy::factory(name, observation_size).map_err(|e| match e {
+    ronap_core::policy::factory(name, config.observation_size()).map_err(|e| match e {
         PolicyNameError::Unknown { .. } => {
             let known: Vec<&str> = Builtin::ALL.iter().map(|(_, n, _)| *n).collect();
             anyhow::anyhow!(

@@ -88,3 +88,30 @@ impl SceneArgs {
         Ok(self.spec().load(config)?)
     }
 }
+
+/// The scene, model and time-out flags of the commands that run episodes as evaluated
+/// (`ronap run`, `ronap view`).
+#[derive(Args, Debug, Clone, Default)]
+pub struct EpisodeArgs {
+    #[command(flatten)]
+    pub scenes: SceneArgs,
+    #[command(flatten)]
+    pub sim: SimArgs,
+    /// Steps before a time-out [default: 2000].
+    #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    pub max_steps: Option<u32>,
+}
+
+impl EpisodeArgs {
+    /// The validated configuration (the file, then the flags) and the scenes, with what the map
+    /// file was read as.
+    pub fn resolve(&self) -> Result<(ValidConfig, Scenes, Option<MapSource>)> {
+        let config = self.sim.config_with(|sim| {
+            if let Some(n) = self.max_steps {
+                sim.episode.max_steps = n;
+            }
+        })?;
+        let (scenes, map) = self.scenes.scenes(&config)?;
+        Ok((config, scenes, map))
+    }
+}

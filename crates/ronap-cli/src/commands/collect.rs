@@ -94,8 +94,8 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
     let evaluator = Evaluator::new(config.clone(), scenes);
     let first = args.seed_start;
     evaluator
-        .world(first)
-        .episode(first)
+        .worlds()
+        .check_start(first)
         .with_context(|| format!("cannot start episodes in this scene (seed {first})"))?;
     let out = args.out.clone().unwrap_or_else(|| {
         default_log_name(args.user.as_deref().unwrap_or(&format!("expert-{expert}")))

@@ -1,6 +1,6 @@
 //! `ronap run`: evaluate a policy over many seeded episodes and write what happened.
 
-use crate::args::{count, fraction, policy_factory, seed, SceneArgs, SimArgs, ThreadArgs};
+use crate::args::{count, fraction, policy_factory, seed, EpisodeArgs, ThreadArgs};
 use crate::output::cancel_on_ctrl_c;
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -29,12 +29,7 @@ pub struct RunArgs {
     #[command(flatten)]
     threads: ThreadArgs,
     #[command(flatten)]
-    scenes: SceneArgs,
-    #[command(flatten)]
-    sim: SimArgs,
-    /// Steps before a time-out [default: 2000].
-    #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
-    max_steps: Option<u32>,
+    episodes: EpisodeArgs,
     /// Output directory [default: runs/<policy>-<UTC time>].
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -57,13 +52,8 @@ pub struct RunArgs {
 /// Runs `ronap run`.
 pub fn run(args: RunArgs) -> Result<ExitCode> {
     // Everything that can be wrong with the input is checked before anything is written.
-    let config = args.sim.config_with(|sim| {
-        if let Some(n) = args.max_steps {
-            sim.episode.max_steps = n;
-        }
-    })?;
+    let (config, scenes, map_source) = args.episodes.resolve()?;
     let factory = policy_factory(&args.policy, &config)?;
-    let (scenes, map_source) = args.scenes.scenes(&config)?;
     let evaluator = Evaluator::new(config.clone(), scenes);
     let first = args.seed_start;
     let end = first.checked_add(args.seeds).with_context(|| {
@@ -109,7 +99,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     };
     let info = RunInfo {
         policy: args.policy.clone(),
-        scenes: args.scenes.spec(),
+        scenes: args.episodes.scenes.spec(),
         map: map_source,
     };
     let evaluation = evaluate_into(

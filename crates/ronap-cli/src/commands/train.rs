@@ -391,7 +391,7 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
         "ronap train dqn: {} steps, {} episodes side by side on {threads} threads, network {}-{}-3",
         options.steps,
         options.envs,
-        args.sim.config()?.laser.beams + 1,
+        args.sim.config()?.observation_size(),
         options
             .hidden
             .iter()

@@ -1,6 +1,6 @@
 //! `ronap view`: watch a policy drive one episode live in the terminal ([`crate::tui::view`]).
 
-use crate::args::{policy_factory, seed, SceneArgs, SimArgs};
+use crate::args::{policy_factory, seed, EpisodeArgs};
 use crate::tui::app;
 use crate::tui::terminal::{self, Session};
 use crate::tui::view::{start_episode, Ending, ViewApp, ViewState};
@@ -27,12 +27,7 @@ pub struct ViewArgs {
     #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 0, value_parser = seed)]
     seed: u64,
     #[command(flatten)]
-    scenes: SceneArgs,
-    #[command(flatten)]
-    sim: SimArgs,
-    /// Steps before a time-out [default: 2000].
-    #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
-    max_steps: Option<u32>,
+    episodes: EpisodeArgs,
     /// Steps per second to start with, 1 to 1000 (the + and - keys change it).
     #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=1000))]
     speed: u32,
@@ -40,13 +35,8 @@ pub struct ViewArgs {
 
 /// Runs `ronap view`.
 pub fn run(args: ViewArgs) -> Result<ExitCode> {
-    let config = args.sim.config_with(|sim| {
-        if let Some(n) = args.max_steps {
-            sim.episode.max_steps = n;
-        }
-    })?;
+    let (config, scenes, _) = args.episodes.resolve()?;
     let factory = policy_factory(&args.policy, &config)?;
-    let (scenes, _) = args.scenes.scenes(&config)?;
     let evaluator = Evaluator::new(config, scenes);
     // Before a policy process starts or the terminal changes: a pipe gets an error, not a hang.
     terminal::require_terminal("view")?;

@@ -13,7 +13,6 @@ use anyhow::{Context, Result};
 use ratatui::crossterm::event::{KeyCode, KeyEvent};
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::{Line, Span};
-use ratatui::widgets::{Block, Paragraph};
 use ratatui::Frame;
 use ronap_core::collect::human::HumanCollector;
 use ronap_core::eval::Evaluator;
@@ -179,7 +178,7 @@ fn shorten(text: &str, max: usize) -> String {
 fn side_lines(view: &HumanView) -> Vec<Line<'static>> {
     let c = &view.collector;
     let e = c.episode();
-    let mut lines = vec![
+    let lines = vec![
         draw::field("user", view.user.clone()),
         draw::field("file", shorten(&view.file, 22)),
         draw::field("rows", format!("{} of {}", c.rows(), view.samples)),
@@ -190,37 +189,32 @@ fn side_lines(view: &HumanView) -> Vec<Line<'static>> {
         draw::field("seed", e.seed().to_string()),
         draw::field("distance", format!("{:.1} px", e.distance_px())),
         draw::field("goal", draw::direction_text(e.direction_deg())),
-        Line::raw(""),
     ];
-    lines.extend(draw::legend());
-    lines.push(Line::raw(""));
-    lines.extend([
-        draw::key_help("← ↑ →", "LEFT / AHEAD / RIGHT"),
-        draw::key_help("↓", "re-arm after each action"),
-        draw::key_help("m", "whole scene / first person"),
-        draw::key_help("q", "quit (every row is saved)"),
-    ]);
-    lines
+    draw::side_panel(
+        lines,
+        &[
+            ("← ↑ →", "LEFT / AHEAD / RIGHT"),
+            ("↓", "re-arm after each action"),
+            ("m", "whole scene / first person"),
+            ("q", "quit (every row is saved)"),
+        ],
+    )
 }
 
 /// Draws the whole Collect Data screen for `view`.
 pub fn draw(frame: &mut Frame, view: &HumanView) {
-    if draw::too_small(frame) {
-        return;
-    }
-    let areas = draw::layout(frame.area());
     let episode = view.collector.episode();
-    let title = format!("{} · seed {}", view.mode.title(), episode.seed());
     // Re-posing makes a path meaningless: the whole scene shows the robot and the goal.
     let here = [episode.pose().position()];
-    draw::scene(frame, areas.scene, episode, &here, view.mode, &title);
-    if let Some(side) = areas.side {
-        frame.render_widget(
-            Paragraph::new(side_lines(view)).block(Block::bordered().title(" ronap collect ")),
-            side,
-        );
-    }
-    frame.render_widget(Paragraph::new(status_line(view)), areas.status);
+    draw::screen(
+        frame,
+        episode,
+        &here,
+        view.mode,
+        "ronap collect",
+        side_lines(view),
+        status_line(view),
+    );
 }
 
 /// Runs a human collection session.

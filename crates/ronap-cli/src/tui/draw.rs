@@ -436,6 +436,41 @@ pub fn key_help(keys: &str, what: &str) -> Line<'static> {
     ])
 }
 
+/// A side panel: `fields`, the colour legend, then each key with what it does.
+pub fn side_panel(mut fields: Vec<Line<'static>>, keys: &[(&str, &str)]) -> Vec<Line<'static>> {
+    fields.push(Line::raw(""));
+    fields.extend(legend());
+    fields.push(Line::raw(""));
+    fields.extend(keys.iter().map(|(k, what)| key_help(k, what)));
+    fields
+}
+
+/// A whole screen: the scene of `episode` (with `path`, titled with the mode and seed), the side
+/// panel titled `name` when there is room, and the status line.
+pub fn screen(
+    frame: &mut Frame,
+    episode: &Episode,
+    path: &[Point],
+    mode: SceneMode,
+    name: &str,
+    side: Vec<Line<'static>>,
+    status: Line<'static>,
+) {
+    if too_small(frame) {
+        return;
+    }
+    let areas = layout(frame.area());
+    let title = format!("{} · seed {}", mode.title(), episode.seed());
+    scene(frame, areas.scene, episode, path, mode, &title);
+    if let Some(area) = areas.side {
+        frame.render_widget(
+            Paragraph::new(side).block(Block::bordered().title(format!(" {name} "))),
+            area,
+        );
+    }
+    frame.render_widget(Paragraph::new(status), areas.status);
+}
+
 /// The message shown when the terminal is too small for anything useful.
 pub fn too_small(frame: &mut Frame) -> bool {
     let area = frame.area();

@@ -13,7 +13,6 @@ use anyhow::Result;
 use ratatui::crossterm::event::{KeyCode, KeyEvent};
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::{Line, Span};
-use ratatui::widgets::{Block, Paragraph};
 use ratatui::Frame;
 use ronap_core::eval::Evaluator;
 use ronap_core::geometry::Point;
@@ -237,7 +236,7 @@ fn message(state: &ViewState) -> Option<(String, Color)> {
 /// The side panel's lines.
 fn side_lines(state: &ViewState) -> Vec<Line<'static>> {
     let e = state.episode();
-    let mut lines = vec![
+    let lines = vec![
         draw::field("seed", e.seed().to_string()),
         draw::field("policy", state.policy.clone()),
         draw::field(
@@ -250,43 +249,31 @@ fn side_lines(state: &ViewState) -> Vec<Line<'static>> {
         draw::field("collisions", e.collisions().to_string()),
         draw::field("path", format!("{:.1} px", e.path_length_px())),
         draw::field("speed", format!("{} steps/s", state.speed)),
-        Line::raw(""),
     ];
-    lines.extend(draw::legend());
-    lines.push(Line::raw(""));
-    lines.extend([
-        draw::key_help("space", "pause / resume"),
-        draw::key_help("+ -", "faster / slower"),
-        draw::key_help("m", "whole scene / first person"),
-        draw::key_help("s", "one step, when paused"),
-        draw::key_help("r n", "restart / next seed"),
-        draw::key_help("q", "quit"),
-    ]);
-    lines
+    draw::side_panel(
+        lines,
+        &[
+            ("space", "pause / resume"),
+            ("+ -", "faster / slower"),
+            ("m", "whole scene / first person"),
+            ("s", "one step, when paused"),
+            ("r n", "restart / next seed"),
+            ("q", "quit"),
+        ],
+    )
 }
 
 /// Draws the whole screen for `state`.
 pub fn draw(frame: &mut Frame, state: &ViewState) {
-    if draw::too_small(frame) {
-        return;
-    }
-    let areas = draw::layout(frame.area());
-    let title = format!("{} · seed {}", state.mode.title(), state.episode().seed());
-    draw::scene(
+    draw::screen(
         frame,
-        areas.scene,
         state.episode(),
         &state.path,
         state.mode,
-        &title,
+        "ronap view",
+        side_lines(state),
+        status_line(state),
     );
-    if let Some(side) = areas.side {
-        frame.render_widget(
-            Paragraph::new(side_lines(state)).block(Block::bordered().title(" ronap view ")),
-            side,
-        );
-    }
-    frame.render_widget(Paragraph::new(status_line(state)), areas.status);
 }
 
 /// The rollout of `seed` with `policy` reset for it.
@@ -478,7 +465,7 @@ mod tests {
     }
 
     fn inner(area: ratatui::layout::Rect) -> ratatui::layout::Rect {
-        Block::bordered().inner(area)
+        ratatui::widgets::Block::bordered().inner(area)
     }
 
     #[test]

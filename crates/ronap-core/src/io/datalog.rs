@@ -328,10 +328,9 @@ fn number(field: &str, name: &str) -> Result<f64, String> {
 }
 
 fn action(field: &str) -> Result<DiscreteAction, String> {
-    DiscreteAction::ALL
-        .into_iter()
-        .find(|a| a.name() == field)
-        .ok_or_else(|| format!("action = {field:?} is not AHEAD, LEFT or RIGHT"))
+    field
+        .parse()
+        .map_err(|_| format!("action = {field:?} is not AHEAD, LEFT or RIGHT"))
 }
 
 fn observation(readings_px: &[f64], direction_deg: f64, range_px: f64) -> Vec<f32> {
