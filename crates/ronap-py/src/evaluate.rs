@@ -11,11 +11,56 @@ use ronap_core::io::run_dir::{evaluate_into, Pictures, RunFiles, RunInfo, RunWri
 use ronap_core::policy::{Decision, Policy, PolicyError, PolicyFactory};
 use ronap_core::{Action, Episode, World};
 use std::sync::atomic::AtomicBool;
+use std::sync::{Arc, Condvar, Mutex};
+
+/// One call at a time into a policy that is not known to be thread-safe.
+///
+/// A Python policy can release the GIL inside a call (torch does, in every forward pass), so the
+/// GIL alone does not keep two workers out of it; a policy with state (SB3's `predict`) then gives
+/// wrong actions. Waiting for the turn happens with the GIL released, so the holder can finish.
+#[derive(Default)]
+struct Turn {
+    busy: Mutex<bool>,
+    free: Condvar,
+}
+
+impl Turn {
+    fn take(&self, py: Python<'_>) {
+        py.allow_threads(|| {
+            let mut busy = self.busy.lock().unwrap_or_else(|e| e.into_inner());
+            while *busy {
+                busy = self.free.wait(busy).unwrap_or_else(|e| e.into_inner());
+            }
+            *busy = true;
+        });
+    }
+
+    fn give_back(&self) {
+        *self.busy.lock().unwrap_or_else(|e| e.into_inner()) = false;
+        self.free.notify_one();
+    }
+}
 
 /// A Python callable as a policy: observation (a float32 array) in, action out.
 struct PyPolicy {
     callable: Py<PyAny>,
     continuous: bool,
+    /// Shared by every worker's copy of the policy; `None` for a thread-safe policy.
+    turn: Option<Arc<Turn>>,
+}
+
+impl PyPolicy {
+    /// Calls the policy on `episode`'s observation, in its turn.
+    fn call(&self, py: Python<'_>, episode: &Episode) -> PyResult<PyObject> {
+        let obs = PyArray1::from_slice(py, episode.observation());
+        let Some(turn) = &self.turn else {
+            return self.callable.call1(py, (obs,));
+        };
+        turn.take(py);
+        let value = self.callable.call1(py, (obs,));
+        turn.give_back();
+        value
+    }
 }
 
 impl Policy for PyPolicy {
@@ -25,8 +70,7 @@ impl Policy for PyPolicy {
 
     fn act(&mut self, episode: &Episode) -> Result<Decision, PolicyError> {
         Python::with_gil(|py| {
-            let obs = PyArray1::from_slice(py, episode.observation());
-            let value = self.callable.call1(py, (obs,)).map_err(|e| {
+            let value = self.call(py, episode).map_err(|e| {
                 PolicyError::Failed(format!(
                     "raised {}",
                     e.value(py)
@@ -54,6 +98,7 @@ struct PyPolicyFactory {
     callable: Py<PyAny>,
     continuous: bool,
     name: String,
+    turn: Option<Arc<Turn>>,
 }
 
 impl PolicyFactory for PyPolicyFactory {
@@ -62,6 +107,7 @@ impl PolicyFactory for PyPolicyFactory {
         Ok(Box::new(PyPolicy {
             callable,
             continuous: self.continuous,
+            turn: self.turn.clone(),
         }))
     }
 
@@ -74,7 +120,7 @@ impl PolicyFactory for PyPolicyFactory {
 /// "episodes": [...]} with the figures and rows `ronap run` reports, and writes its files (the
 /// same files, `summary.json` in the same schema) into `out` when given.
 #[pyfunction]
-#[pyo3(signature = (policy, seeds, config, maze_seed = None, map_path = None, threads = 0, continuous = false, out = None, png = None, log_steps = false))]
+#[pyo3(signature = (policy, seeds, config, maze_seed = None, map_path = None, threads = 0, continuous = false, out = None, png = None, log_steps = false, thread_safe = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate<'py>(
     py: Python<'py>,
@@ -88,6 +134,7 @@ pub fn evaluate<'py>(
     out: Option<std::path::PathBuf>,
     png: Option<String>,
     log_steps: bool,
+    thread_safe: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let config = config.valid();
     let Some(&first) = seeds.first() else {
@@ -109,6 +156,7 @@ pub fn evaluate<'py>(
                 callable: policy.clone().unbind(),
                 continuous,
                 name: name.clone(),
+                turn: (!thread_safe).then(|| Arc::new(Turn::default())),
             };
             (Box::new(factory), name)
         } else {

@@ -1,6 +1,8 @@
 """The batch evaluator from Python (the CLI side of the same runs is in the top-level tests/)."""
 
 import pathlib
+import threading
+import time
 
 import numpy as np
 import pytest
@@ -49,6 +51,37 @@ def test_python_policy_runs_and_is_deterministic():
 def test_bad_python_policies_raise_policy_error_naming_seed_and_step(policy, message):
     with pytest.raises(ronap.PolicyError, match=message):
         ronap.evaluate(policy, [3], threads=1)
+
+
+class _Overlaps:
+    """A policy that releases the GIL inside each call (as torch does) and counts the calls that
+    overlap."""
+
+    def __init__(self):
+        self.inside = 0
+        self.most = 0
+        self.lock = threading.Lock()
+
+    def __call__(self, obs):
+        with self.lock:
+            self.inside += 1
+            self.most = max(self.most, self.inside)
+        time.sleep(0.0005)
+        with self.lock:
+            self.inside -= 1
+        return 1
+
+
+def test_a_python_policy_is_never_called_concurrently_unless_thread_safe():
+    policy = _Overlaps()
+    one = ronap.evaluate(policy, range(8), threads=2, episode_max_steps=40)
+    assert policy.most == 1
+    # Declared thread-safe, two workers do call it at once; the episodes are the same.
+    free = _Overlaps()
+    two = ronap.evaluate(free, range(8), threads=2, episode_max_steps=40, thread_safe=True)
+    assert free.most == 2
+    strip = lambda res: [{k: v for k, v in r.items() if k != "wall_time_s"} for r in res["episodes"]]
+    assert strip(one) == strip(two)
 
 
 def test_evaluate_input_errors():

@@ -52,4 +52,5 @@ def evaluate(
     out: str | None = None,
     png: str | None = None,
     log_steps: bool = False,
+    thread_safe: bool = False,
 ) -> dict[str, Any]: ...

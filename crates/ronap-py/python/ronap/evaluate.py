@@ -20,6 +20,7 @@ def evaluate(
     out: str | None = None,
     png: int | str | None = None,
     log_steps: bool = False,
+    thread_safe: bool = False,
     **fields: Any,
 ) -> dict[str, Any]:
     """Runs ``policy`` over the episodes of ``seeds`` in parallel and returns
@@ -28,8 +29,10 @@ def evaluate(
     ``policy`` is a built-in name (``"apf"``, ``"geodesic"``, ``"random"``), a trained network
     (``"mlp:policies/bc.safetensors"``, see ``policies/README.md``) or a callable taking
     the observation (``float32`` array) and returning an action: 0 LEFT, 1 AHEAD, 2 RIGHT (or
-    ``(v / v_max, w / w_max)`` in [-1, 1] with ``continuous=True``, as ``NavEnv``'s action space). Calls to a Python policy hold the GIL; the simulation runs
-    on ``threads`` threads (0: all cores) beside them. With ``out``, writes ``episodes.csv``,
+    ``(v / v_max, w / w_max)`` in [-1, 1] with ``continuous=True``, as ``NavEnv``'s action space).
+    The simulation runs on ``threads`` threads (0: all cores); a Python policy is called by one of
+    them at a time, even when it releases the GIL inside (torch, SB3's ``predict``), unless it is
+    declared ``thread_safe=True`` (a pure function of the observation, say). With ``out``, writes ``episodes.csv``,
     ``timing.csv``, ``summary.json`` and, as asked, ``png/`` pictures (``png``: a count, ``"failures"``
     or ``"all"``) and ``steps/`` logs, as ``ronap run`` does.
 
@@ -48,4 +51,5 @@ def evaluate(
         None if out is None else str(out),
         None if png is None else str(png),
         log_steps,
+        thread_safe,
     )
