@@ -1,7 +1,9 @@
 //! Criterion benchmarks of the model's hot paths on the default scene (10 x 10 maze, 17 beams).
 //!
-//! `cargo bench -p ronap-core --bench step`. Target: one step under 1 us (1,000,000 steps/s on one
-//! core); `scan/parry2d` is the same scan through parry2d's general ray cast, for comparison.
+//! `cargo bench -p ronap-core --bench step`. Targets: one step under 1 us (1,000,000 steps/s on one
+//! core), with 100 `random_walk` discs too (`step/100_random_walk_discs`), and a scan among them
+//! (`scan/100_discs`) within twice the still-maze scan (`scan/default`); `scan/parry2d` is the
+//! same scan through parry2d's general ray cast, for comparison.
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use ronap_core::geometry::reference::ParryScene;
@@ -15,30 +17,46 @@ use std::sync::Arc;
 /// The action pattern `ronap bench` uses too: mostly ahead, some turns.
 const PATTERN: [usize; 8] = [1, 1, 1, 0, 1, 1, 2, 1];
 
+/// The default configuration with 100 `random_walk` discs (radius 8 px, 2 px a step).
+fn crowd_config() -> ronap_core::SimConfig {
+    ronap_core::SimConfig {
+        moving: vec![ronap_core::config::MovingConfig {
+            count: 100,
+            ..Default::default()
+        }],
+        ..Default::default()
+    }
+}
+
 fn step(c: &mut Criterion) {
-    // Long episodes, so the figure is the step and not the occasional new episode.
-    let mut sim = ronap_core::SimConfig::default();
-    sim.episode.max_steps = 1_000_000;
-    let config = sim.validate().expect("valid");
-    let scene = Arc::new(maze_scene(&config, 0));
-    let mut seed = 0;
-    let mut episode = Episode::new(&config, scene.clone(), seed).expect("default scene");
-    let mut k = 0;
     let mut group = c.benchmark_group("step");
     group.throughput(Throughput::Elements(1));
-    group.bench_function("default", |b| {
-        b.iter(|| {
-            k += 1;
-            let done = episode
-                .step_index(PATTERN[k % PATTERN.len()])
-                .map(|r| r.status.is_done())
-                .unwrap_or(true);
-            if done {
-                seed += 1;
-                episode = Episode::new(&config, scene.clone(), seed).expect("default scene");
-            }
-        })
-    });
+    for (name, sim) in [
+        ("default", ronap_core::SimConfig::default()),
+        ("100_random_walk_discs", crowd_config()),
+    ] {
+        // Long episodes, so the figure is the step and not the occasional new episode.
+        let mut sim = sim;
+        sim.episode.max_steps = 1_000_000;
+        let config = sim.validate().expect("valid");
+        let scene = Arc::new(maze_scene(&config, 0));
+        let mut seed = 0;
+        let mut episode = Episode::new(&config, scene.clone(), seed).expect("default scene");
+        let mut k = 0;
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                k += 1;
+                let done = episode
+                    .step_index(PATTERN[k % PATTERN.len()])
+                    .map(|r| r.status.is_done())
+                    .unwrap_or(true);
+                if done {
+                    seed += 1;
+                    episode = Episode::new(&config, scene.clone(), seed).expect("default scene");
+                }
+            })
+        });
+    }
     group.finish();
 }
 
@@ -49,7 +67,26 @@ fn scan(c: &mut Criterion) {
     let episode = Episode::new(&config, Arc::new(scene.clone()), 0).expect("default scene");
     let pose = episode.start();
     let mut out = vec![0.0; laser.beams()];
+    let crowd = crowd_config().validate().expect("valid");
+    let crowded = Episode::new(&crowd, Arc::new(maze_scene(&crowd, 0)), 0).expect("places");
+    let movers = crowded.movers().expect("a crowd").clone();
     let mut group = c.benchmark_group("scan");
+    group.bench_function("100_discs", |b| {
+        b.iter(|| {
+            laser.scan(
+                &scene,
+                black_box(pose.position()),
+                black_box(pose.z_deg),
+                &mut out,
+            );
+            movers.sense(
+                &laser,
+                black_box(pose.position()),
+                black_box(pose.z_deg),
+                &mut out,
+            )
+        })
+    });
     group.bench_function("default", |b| {
         b.iter(|| {
             laser.scan(
@@ -108,7 +145,36 @@ fn setup(c: &mut Criterion) {
 #[allow(missing_docs)]
 mod group {
     use super::*;
-    criterion_group!(benches, step, scan, setup);
+    criterion_group!(benches, step, scan, movers, setup);
 }
 use group::benches;
 criterion_main!(benches);
+
+/// The moving-obstacle step alone: 100 `random_walk` discs moved once, and a robot step swept
+/// against them.
+fn movers(c: &mut Criterion) {
+    let crowd = crowd_config().validate().expect("valid");
+    let scene = maze_scene(&crowd, 0);
+    let e = Episode::new(&crowd, Arc::new(scene.clone()), 0).expect("places");
+    let mut movers = e.movers().expect("a crowd").clone();
+    let robot = e.start().position();
+    let mut step = 0;
+    let mut group = c.benchmark_group("movers");
+    group.bench_function("advance_100", |b| {
+        b.iter(|| {
+            step += 1;
+            movers.advance(step, &scene, robot)
+        })
+    });
+    let m2 = movers.clone();
+    group.bench_function("sweep_clear_100", |b| {
+        b.iter(|| {
+            m2.sweep_clear(
+                black_box(robot),
+                black_box(robot + ronap_core::Vector::new(5.0, 0.0)),
+                5.0,
+            )
+        })
+    });
+    group.finish();
+}

@@ -13,8 +13,8 @@ pub enum ConfigError {
     /// A field holds a value outside its allowed range.
     #[error("{field} = {value}: {expected}")]
     OutOfRange {
-        /// Dotted field name, as in the TOML file (`maze.cols`).
-        field: &'static str,
+        /// Dotted field name, as in the TOML file (`maze.cols`, `moving[2].speed_px`).
+        field: String,
         /// The offending value, as written.
         value: String,
         /// What the field accepts.
@@ -23,6 +23,167 @@ pub enum ConfigError {
     /// The TOML text could not be read into a configuration (syntax, type or unknown key).
     #[error("{0}")]
     Toml(String),
+    /// A configuration or scenario file that cannot be used: the file, the line when known, and
+    /// what was wrong.
+    #[error("{}{}: {message}", path.display(), line.map_or(String::new(), |l| format!(":{l}")))]
+    File {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The line of the offending key, from 1.
+        line: Option<usize>,
+        /// What was wrong, naming the key and value.
+        message: String,
+    },
+}
+
+/// Which scene episodes take place in (SPEC "Scenario files").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SceneKind {
+    /// A maze generated as `[maze]` says (the paper's scene).
+    #[default]
+    Maze,
+    /// A warehouse generated as `[warehouse]` says.
+    Warehouse,
+    /// An image (PNG/PGM) or ROS `map_server` YAML file, read as `[map]` says.
+    Map,
+}
+
+/// Where episodes take place: the scene section of a scenario file.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SceneConfig {
+    /// `maze` (default), `warehouse` or `map`.
+    pub kind: SceneKind,
+    /// Generated scenes: the seed of the one scene every episode uses. Unset: each episode's
+    /// seed draws its own scene.
+    pub seed: Option<u64>,
+    /// Map scenes: the image or YAML file (relative to the scenario file).
+    pub file: Option<std::path::PathBuf>,
+}
+
+/// A static obstacle added to the scene (SPEC "Static obstacles beyond boxes").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "shape", rename_all = "lowercase", deny_unknown_fields)]
+pub enum ObstacleConfig {
+    /// An axis-aligned box between two corners, px.
+    Box {
+        /// Lower-left corner `[x, y]`.
+        min: [f64; 2],
+        /// Upper-right corner `[x, y]`.
+        max: [f64; 2],
+    },
+    /// A disc.
+    Disc {
+        /// Centre `[x, y]`, px.
+        center: [f64; 2],
+        /// Radius, px.
+        radius_px: f64,
+    },
+    /// A convex polygon, its corners in order (either way round).
+    Polygon {
+        /// Corners `[[x, y], ...]`, px; at least three, convex.
+        points: Vec<[f64; 2]>,
+    },
+}
+
+/// The shape of a moving obstacle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum MovingShape {
+    /// A disc of `radius_px`.
+    #[default]
+    Disc,
+    /// An axis-aligned box of `size_px`.
+    Box,
+}
+
+/// How a moving obstacle moves (SPEC "Moving obstacles").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MotionKind {
+    /// Does not move.
+    Still,
+    /// Constant velocity, reflecting off static obstacles and the scene border.
+    Linear,
+    /// Patrols `points`.
+    Waypoints,
+    /// Heading changes drawn from N(0, `turn_sigma_deg`^2) each step, reflecting off static
+    /// obstacles.
+    #[default]
+    RandomWalk,
+    /// Absent until a step drawn in `[from_step, to_step]`, then present and moving as `then`.
+    Appear,
+}
+
+/// How a `waypoints` obstacle goes round its points.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Patrol {
+    /// From the last point back to the first, and round again.
+    #[default]
+    Loop,
+    /// Back and forth along the points.
+    PingPong,
+}
+
+/// One `[[moving]]` entry: `count` obstacles alike (SPEC "Moving obstacles").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MovingConfig {
+    /// How many obstacles this entry makes. Default 1.
+    pub count: u32,
+    /// `disc` (default) or `box`.
+    pub shape: MovingShape,
+    /// Disc radius, px. Default 8.
+    pub radius_px: f64,
+    /// Box width and height, px. Default [24, 12].
+    pub size_px: [f64; 2],
+    /// Fixed start `[x, y]` (of the centre), px. Default: drawn from the seed in free space, at
+    /// least `min_robot_distance_px` from the robot's start and goal (waypoints: the first point).
+    pub start: Option<[f64; 2]>,
+    /// `still`, `linear`, `waypoints`, `random_walk` (default) or `appear`.
+    pub motion: MotionKind,
+    /// Distance moved per step, px. Default 2.
+    pub speed_px: f64,
+    /// `linear`: direction of travel, degrees. Default: drawn from the seed.
+    pub direction_deg: Option<f64>,
+    /// `random_walk`: standard deviation of the heading change per step, degrees. Default 15.
+    pub turn_sigma_deg: f64,
+    /// `waypoints`: the points patrolled `[[x, y], ...]`, px.
+    pub points: Vec<[f64; 2]>,
+    /// `waypoints`: `loop` (default) or `ping_pong`.
+    pub mode: Patrol,
+    /// `appear`: earliest step of appearance. Default 1.
+    pub from_step: u32,
+    /// `appear`: latest step of appearance. Default 200.
+    pub to_step: u32,
+    /// Least gap between the obstacle and the robot where it starts or appears, px. Default 30.
+    pub min_robot_distance_px: f64,
+    /// `appear`: how it moves once there: `still` (default), `linear` or `random_walk`.
+    pub then: MotionKind,
+}
+
+impl Default for MovingConfig {
+    fn default() -> Self {
+        Self {
+            count: 1,
+            shape: MovingShape::Disc,
+            radius_px: 8.0,
+            size_px: [24.0, 12.0],
+            start: None,
+            motion: MotionKind::RandomWalk,
+            speed_px: 2.0,
+            direction_deg: None,
+            turn_sigma_deg: 15.0,
+            points: Vec::new(),
+            mode: Patrol::Loop,
+            from_step: 1,
+            to_step: 200,
+            min_robot_distance_px: 30.0,
+            then: MotionKind::Still,
+        }
+    }
 }
 
 /// Maze generation (SPEC "Scene: maze").
@@ -69,6 +230,52 @@ impl Default for MapConfig {
         Self {
             threshold: 127,
             resolution_px: 1.0,
+        }
+    }
+}
+
+/// A generated logistics warehouse (SPEC "Warehouse scene"): rows of racks back to back in pairs,
+/// aisles between them, cross aisles, a free loading area along the bottom, and pallets of clutter
+/// in the aisles.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WarehouseConfig {
+    /// Pairs of rack rows (two racks back to back), bottom to top. Default 5.
+    pub rack_pairs: u32,
+    /// Racks along one row. Default 12.
+    pub racks_per_row: u32,
+    /// Length of one rack along its row, px. Default 50.
+    pub rack_length_px: f64,
+    /// Depth of one rack (a pair is twice as deep), px. Default 15.
+    pub rack_depth_px: f64,
+    /// Width of the aisles between rack pairs, of the cross aisles and of the border aisle, px.
+    /// Default 40.
+    pub aisle_px: f64,
+    /// A cross aisle after every this many racks along a row. Default 4.
+    pub cross_aisle_every: u32,
+    /// Depth of the free loading area along the bottom, px. Default 150.
+    pub loading_px: f64,
+    /// Fraction of aisle spots (one rack length each) holding a pallet, 0 to 1. Default 0.15.
+    pub clutter: f64,
+    /// Side of a square pallet, px. Default 12.
+    pub pallet_px: f64,
+    /// Thickness of the outer walls, px. Default 2.
+    pub wall_thickness_px: f64,
+}
+
+impl Default for WarehouseConfig {
+    fn default() -> Self {
+        Self {
+            rack_pairs: 5,
+            racks_per_row: 12,
+            rack_length_px: 50.0,
+            rack_depth_px: 15.0,
+            aisle_px: 40.0,
+            cross_aisle_every: 4,
+            loading_px: 150.0,
+            clutter: 0.15,
+            pallet_px: 12.0,
+            wall_thickness_px: 2.0,
         }
     }
 }
@@ -158,6 +365,9 @@ pub struct EpisodeConfig {
     /// Cell side of the free-space grid used to find connected regions (and by planners), px.
     /// Default 5.
     pub grid_px: f64,
+    /// A step counts as near a moving obstacle when the gap to one is below this, px.
+    /// Default: two robot radii.
+    pub safety_radius_px: Option<f64>,
 }
 
 impl Default for EpisodeConfig {
@@ -170,6 +380,7 @@ impl Default for EpisodeConfig {
             start: None,
             goal: None,
             grid_px: 5.0,
+            safety_radius_px: None,
         }
     }
 }
@@ -221,6 +432,9 @@ pub struct ApfConfig {
     /// Spacing of the positions the descent steps between (the paper's image pixels), px.
     /// Default 1.
     pub lattice_px: f64,
+    /// Add the moving obstacles the laser can reach to the repulsion, steering round them while
+    /// following the descent. Default false (the paper's APF knows only the still scene).
+    pub repel_moving: bool,
 }
 
 impl Default for ApfConfig {
@@ -230,6 +444,7 @@ impl Default for ApfConfig {
             repulsion_gain: 50_000.0,
             influence_px: 20.0,
             lattice_px: 1.0,
+            repel_moving: false,
         }
     }
 }
@@ -238,8 +453,12 @@ impl Default for ApfConfig {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SimConfig {
+    /// Where episodes take place.
+    pub scene: SceneConfig,
     /// Maze generation.
     pub maze: MazeConfig,
+    /// Warehouse generation.
+    pub warehouse: WarehouseConfig,
     /// Image scenes.
     pub map: MapConfig,
     /// The robot.
@@ -252,6 +471,10 @@ pub struct SimConfig {
     pub reward: RewardConfig,
     /// The artificial potential field policy.
     pub apf: ApfConfig,
+    /// Static obstacles added to the scene.
+    pub obstacles: Vec<ObstacleConfig>,
+    /// Moving obstacles.
+    pub moving: Vec<MovingConfig>,
 }
 
 /// A [`SimConfig`] whose every field has been checked. Dereferences to the `SimConfig`.
@@ -288,7 +511,7 @@ impl ValidConfig {
 
 fn check(
     ok: bool,
-    field: &'static str,
+    field: &str,
     value: impl ToString,
     expected: &'static str,
 ) -> Result<(), ConfigError> {
@@ -296,14 +519,14 @@ fn check(
         Ok(())
     } else {
         Err(ConfigError::OutOfRange {
-            field,
+            field: field.to_string(),
             value: value.to_string(),
             expected,
         })
     }
 }
 
-fn non_negative(field: &'static str, v: f64) -> Result<(), ConfigError> {
+fn non_negative(field: &str, v: f64) -> Result<(), ConfigError> {
     check(
         v.is_finite() && v >= 0.0,
         field,
@@ -312,7 +535,7 @@ fn non_negative(field: &'static str, v: f64) -> Result<(), ConfigError> {
     )
 }
 
-fn finite(field: &'static str, v: f64) -> Result<(), ConfigError> {
+fn finite(field: &str, v: f64) -> Result<(), ConfigError> {
     check(
         v.is_finite(),
         field,
@@ -326,7 +549,7 @@ pub const MAX_MAZE_CELLS_PER_SIDE: u32 = 1000;
 /// Largest length any field may give, px: scene sides, ranges, radii and speeds.
 pub const MAX_LENGTH_PX: f64 = 100_000.0;
 
-fn length(field: &'static str, v: f64, zero_ok: bool) -> Result<(), ConfigError> {
+fn length(field: &str, v: f64, zero_ok: bool) -> Result<(), ConfigError> {
     let low_ok = if zero_ok { v >= 0.0 } else { v > 0.0 };
     check(
         v.is_finite() && low_ok && v <= MAX_LENGTH_PX,
@@ -464,18 +687,239 @@ impl SimConfig {
         non_negative("apf.repulsion_gain", a.repulsion_gain)?;
         length("apf.influence_px", a.influence_px, false)?;
         length("apf.lattice_px", a.lattice_px, false)?;
+        if let Some(v) = e.safety_radius_px {
+            length("episode.safety_radius_px", v, true)?;
+        }
+        self.validate_scenario()?;
         Ok(ValidConfig(self))
     }
+}
+
+/// Most moving obstacles a configuration may ask for.
+pub const MAX_MOVING: u32 = 10_000;
+
+fn point(field: &str, p: [f64; 2]) -> Result<(), ConfigError> {
+    check(
+        p.iter().all(|v| v.is_finite() && v.abs() <= MAX_LENGTH_PX),
+        field,
+        format!("{p:?}"),
+        "must be two finite numbers [x, y] within 100000 px",
+    )
+}
+
+impl SimConfig {
+    /// Checks the scene, warehouse, obstacle and moving-obstacle sections.
+    fn validate_scenario(&self) -> Result<(), ConfigError> {
+        let s = &self.scene;
+        match (s.kind, &s.file) {
+            (SceneKind::Map, None) => check(
+                false,
+                "scene.file",
+                "(unset)",
+                "a map scene needs the image or YAML file",
+            )?,
+            (SceneKind::Maze | SceneKind::Warehouse, Some(f)) => check(
+                false,
+                "scene.file",
+                f.display(),
+                "only a map scene reads a file (set scene.kind = \"map\")",
+            )?,
+            _ => {}
+        }
+        let w = &self.warehouse;
+        let count = "must be between 1 and 1000";
+        check(
+            (1..=1000).contains(&w.rack_pairs),
+            "warehouse.rack_pairs",
+            w.rack_pairs,
+            count,
+        )?;
+        check(
+            (1..=1000).contains(&w.racks_per_row),
+            "warehouse.racks_per_row",
+            w.racks_per_row,
+            count,
+        )?;
+        check(
+            w.cross_aisle_every <= 1000,
+            "warehouse.cross_aisle_every",
+            w.cross_aisle_every,
+            "must be between 0 (no cross aisles) and 1000",
+        )?;
+        length("warehouse.rack_length_px", w.rack_length_px, false)?;
+        length("warehouse.rack_depth_px", w.rack_depth_px, false)?;
+        length("warehouse.aisle_px", w.aisle_px, false)?;
+        length("warehouse.loading_px", w.loading_px, true)?;
+        length("warehouse.pallet_px", w.pallet_px, false)?;
+        length("warehouse.wall_thickness_px", w.wall_thickness_px, false)?;
+        check(
+            (0.0..=1.0).contains(&w.clutter),
+            "warehouse.clutter",
+            format!("{:?}", w.clutter),
+            "must be between 0 and 1",
+        )?;
+        let wide = f64::from(w.racks_per_row) * w.rack_length_px
+            + f64::from(w.racks_per_row) * w.aisle_px
+            + 2.0 * w.wall_thickness_px;
+        let tall = w.loading_px
+            + f64::from(w.rack_pairs) * (2.0 * w.rack_depth_px + w.aisle_px)
+            + w.aisle_px
+            + 2.0 * w.wall_thickness_px;
+        check(
+            wide.max(tall) <= MAX_LENGTH_PX,
+            "warehouse.racks_per_row",
+            w.racks_per_row,
+            "the warehouse would be wider or taller than 100000 px",
+        )?;
+
+        for (i, o) in self.obstacles.iter().enumerate() {
+            match o {
+                ObstacleConfig::Box { min, max } => {
+                    point(&format!("obstacles[{i}].min"), *min)?;
+                    point(&format!("obstacles[{i}].max"), *max)?;
+                    check(
+                        min[0] < max[0] && min[1] < max[1],
+                        &format!("obstacles[{i}].max"),
+                        format!("{max:?}"),
+                        "must be above and to the right of min",
+                    )?;
+                }
+                ObstacleConfig::Disc { center, radius_px } => {
+                    point(&format!("obstacles[{i}].center"), *center)?;
+                    length(&format!("obstacles[{i}].radius_px"), *radius_px, false)?;
+                }
+                ObstacleConfig::Polygon { points } => {
+                    let field = format!("obstacles[{i}].points");
+                    for p in points {
+                        point(&field, *p)?;
+                    }
+                    check(
+                        is_convex_polygon(points),
+                        &field,
+                        format!("{points:?}"),
+                        "must be at least three corners of a convex polygon with an area, in order",
+                    )?;
+                }
+            }
+        }
+
+        let mut total = 0u64;
+        for (i, m) in self.moving.iter().enumerate() {
+            let f = |name: &str| format!("moving[{i}].{name}");
+            check(
+                (1..=MAX_MOVING).contains(&m.count),
+                &f("count"),
+                m.count,
+                "must be between 1 and 10000",
+            )?;
+            total += u64::from(m.count);
+            length(&f("radius_px"), m.radius_px, false)?;
+            length(&f("size_px"), m.size_px[0], false)?;
+            length(&f("size_px"), m.size_px[1], false)?;
+            if let Some(p) = m.start {
+                point(&f("start"), p)?;
+            }
+            length(&f("speed_px"), m.speed_px, true)?;
+            if let Some(d) = m.direction_deg {
+                finite(&f("direction_deg"), d)?;
+            }
+            check(
+                m.turn_sigma_deg.is_finite() && (0.0..=360.0).contains(&m.turn_sigma_deg),
+                &f("turn_sigma_deg"),
+                format!("{:?}", m.turn_sigma_deg),
+                "must be between 0 and 360",
+            )?;
+            length(&f("min_robot_distance_px"), m.min_robot_distance_px, true)?;
+            for p in &m.points {
+                point(&f("points"), *p)?;
+            }
+            let patrols = m.motion == MotionKind::Waypoints
+                || (m.motion == MotionKind::Appear && m.then == MotionKind::Waypoints);
+            check(
+                !patrols || m.points.len() >= 2,
+                &f("points"),
+                format!("{:?}", m.points),
+                "a waypoints obstacle needs at least two points",
+            )?;
+            check(
+                !(m.motion == MotionKind::Appear && m.then == MotionKind::Waypoints),
+                &f("then"),
+                "\"waypoints\"",
+                "an appearing obstacle moves as still, linear or random_walk",
+            )?;
+            check(
+                m.then != MotionKind::Appear,
+                &f("then"),
+                "\"appear\"",
+                "an appearing obstacle moves as still, linear or random_walk",
+            )?;
+            check(
+                m.from_step <= m.to_step,
+                &f("to_step"),
+                m.to_step,
+                "must be at least from_step",
+            )?;
+        }
+        check(
+            total <= u64::from(MAX_MOVING),
+            "moving",
+            total,
+            "at most 10000 moving obstacles in all",
+        )
+    }
+}
+
+/// Whether `points` are the corners, in order either way round, of a convex polygon with an area.
+pub fn is_convex_polygon(points: &[[f64; 2]]) -> bool {
+    let n = points.len();
+    if n < 3 {
+        return false;
+    }
+    let mut sign = 0.0f64;
+    for i in 0..n {
+        let [ax, ay] = points[i];
+        let [bx, by] = points[(i + 1) % n];
+        let [cx, cy] = points[(i + 2) % n];
+        let cross = (bx - ax) * (cy - by) - (by - ay) * (cx - bx);
+        if cross == 0.0 {
+            continue;
+        }
+        if sign * cross < 0.0 {
+            return false;
+        }
+        sign = cross.signum();
+    }
+    let area2: f64 = (0..n)
+        .map(|i| {
+            let [ax, ay] = points[i];
+            let [bx, by] = points[(i + 1) % n];
+            ax * by - bx * ay
+        })
+        .sum();
+    sign != 0.0 && area2.abs() > 1e-9
 }
 
 /// Every configuration field: section, name, and what it means with its unit. Fields that are
 /// unset by default carry an example value, written commented out.
 const FIELD_DOCS: &[(&str, &str, &str, Option<&str>)] = &[
+    ("scene", "kind", "Where episodes take place: \"maze\" (the paper's), \"warehouse\" or \"map\" (an image or ROS YAML file).", None),
+    ("scene", "seed", "Generated scenes: one scene, of this seed, for every episode. Unset: each episode's seed draws its own.", Some("7")),
+    ("scene", "file", "Map scenes: the PNG/PGM image or ROS map_server YAML file, relative to this file.", Some("\"map.png\"")),
     ("maze", "cols", "Number of cell columns.", None),
     ("maze", "rows", "Number of cell rows.", None),
     ("maze", "cell_px", "Side of a square cell, px.", None),
     ("maze", "loops", "Fraction of the perfect maze's interior walls removed afterwards, 0 to 1 (0: perfect maze).", None),
     ("maze", "wall_thickness_px", "Wall thickness, px.", None),
+    ("warehouse", "rack_pairs", "Pairs of rack rows (two racks back to back), bottom to top.", None),
+    ("warehouse", "racks_per_row", "Racks along one row.", None),
+    ("warehouse", "rack_length_px", "Length of a rack along its row, px.", None),
+    ("warehouse", "rack_depth_px", "Depth of one rack (a pair is twice as deep), px.", None),
+    ("warehouse", "aisle_px", "Width of the aisles, cross aisles and border aisle, px.", None),
+    ("warehouse", "cross_aisle_every", "A cross aisle after every this many racks (0: none).", None),
+    ("warehouse", "loading_px", "Depth of the free loading area along the bottom, px.", None),
+    ("warehouse", "clutter", "Fraction of aisle spots holding a pallet, 0 to 1 (kept passable for the robot).", None),
+    ("warehouse", "pallet_px", "Side of a square pallet, px.", None),
+    ("warehouse", "wall_thickness_px", "Thickness of the outer walls, px.", None),
     ("map", "threshold", "Image maps: grey value (0-255) at or below which a pixel is an obstacle.", None),
     ("map", "resolution_px", "Image maps: scene px per image pixel.", None),
     ("robot", "radius_px", "Robot disc radius, px.", None),
@@ -495,6 +939,7 @@ const FIELD_DOCS: &[(&str, &str, &str, Option<&str>)] = &[
     ("episode", "start", "Fixed start pose [x px, y px, heading deg]. Unset: drawn from the seed.", Some("[150.0, 150.0, 0.0]")),
     ("episode", "goal", "Fixed goal [x px, y px]. Unset: drawn from the seed.", Some("[850.0, 850.0]")),
     ("episode", "grid_px", "Cell side of the free-space grid for connected regions and planners, px.", None),
+    ("episode", "safety_radius_px", "A step is near a moving obstacle when the gap to one is below this, px. Unset: two robot radii.", Some("10.0")),
     ("reward", "collision", "r_a: added on a step that collided.", None),
     ("reward", "progress_per_px", "r_b: per px of progress towards the goal (negative when moving away).", None),
     ("reward", "turn", "r_c: added on LEFT and RIGHT (scaled by |w| / w_max for continuous actions).", None),
@@ -503,16 +948,66 @@ const FIELD_DOCS: &[(&str, &str, &str, Option<&str>)] = &[
     ("apf", "repulsion_gain", "APF policy: repulsion gain eta, px^2.", None),
     ("apf", "influence_px", "APF policy: distance d0 beyond which obstacles do not repel, px.", None),
     ("apf", "lattice_px", "APF policy: spacing of the positions the descent steps between, px.", None),
+    ("apf", "repel_moving", "APF policy: also steer away from the moving obstacles within laser range.", None),
 ];
+
+/// Every field of a `[[moving]]` entry and what it means.
+const MOVING_DOCS: &[(&str, &str)] = &[
+    ("count", "How many obstacles this entry makes."),
+    (
+        "shape",
+        "\"disc\" (radius_px) or \"box\" (size_px, axis-aligned).",
+    ),
+    ("radius_px", "Disc radius, px."),
+    ("size_px", "Box width and height, px."),
+    (
+        "start",
+        "Fixed start of the centre [x, y], px. Unset: drawn in free space from the seed.",
+    ),
+    (
+        "motion",
+        "\"still\", \"linear\", \"waypoints\", \"random_walk\" or \"appear\".",
+    ),
+    ("speed_px", "Distance moved per step, px."),
+    (
+        "direction_deg",
+        "linear: direction of travel, degrees. Unset: drawn from the seed.",
+    ),
+    (
+        "turn_sigma_deg",
+        "random_walk: standard deviation of the heading change per step, degrees.",
+    ),
+    (
+        "points",
+        "waypoints: the points patrolled [[x, y], ...], px.",
+    ),
+    ("mode", "waypoints: \"loop\" or \"ping_pong\"."),
+    ("from_step", "appear: earliest step of appearance."),
+    ("to_step", "appear: latest step of appearance."),
+    (
+        "min_robot_distance_px",
+        "Least gap to the robot where the obstacle starts or appears, px.",
+    ),
+    (
+        "then",
+        "appear: how it moves once there: \"still\", \"linear\" or \"random_walk\".",
+    ),
+];
+
+fn commented(block: &str) -> String {
+    block.lines().map(|l| format!("# {l}\n")).collect()
+}
 
 impl SimConfig {
     /// The configuration as TOML with a comment on every field (meaning and unit), ready to copy
-    /// and edit. Unset optional fields appear commented out with an example value.
+    /// and edit. Unset optional fields appear commented out with an example value; with no static
+    /// or moving obstacles, an example of each appears commented out.
     pub fn to_documented_toml(&self) -> String {
         let mut out = String::from(
-            "# ronap configuration. Every field of the model with its value; pass the file with\n\
-             # --config FILE.toml (flags override it). Units: px (scene pixels, x right, y up) and\n\
-             # degrees (counter-clockwise from +x).\n",
+            "# ronap scenario: everything about a task (scene, robot, laser, episode, reward, static\n\
+             # and moving obstacles). Pass it with --scenario FILE.toml (flags override it), or to\n\
+             # ronap.NavEnv(scenario=...). Units: px (scene pixels, x right, y up) and degrees\n\
+             # (counter-clockwise from +x).\n",
         );
         let value = toml::Value::try_from(self).unwrap_or(toml::Value::Table(Default::default()));
         let mut section = "";
@@ -527,8 +1022,232 @@ impl SimConfig {
                 None => out.push_str(&format!("# {field} = {}\n", example.unwrap_or("..."))),
             }
         }
+        out.push_str(
+            "\n# Static obstacles added to the scene, any number: shape = \"box\" (min, max corners),\n\
+             # \"disc\" (center, radius_px) or \"polygon\" (points: the corners of a convex polygon).\n",
+        );
+        let obstacles = value.get("obstacles").and_then(|v| v.as_array());
+        match obstacles.filter(|a| !a.is_empty()) {
+            Some(list) => {
+                for o in list {
+                    out.push_str("[[obstacles]]\n");
+                    out.push_str(&inline_fields(o));
+                }
+            }
+            None => out.push_str(&commented(
+                "[[obstacles]]\nshape = \"disc\"\ncenter = [500.0, 500.0]\nradius_px = 20.0\n",
+            )),
+        }
+        out.push_str(
+            "\n# Moving obstacles, any number of entries; each makes `count` obstacles alike. They\n\
+             # move first in each step, then the robot; contact either way is a dynamic collision.\n",
+        );
+        let moving = value.get("moving").and_then(|v| v.as_array());
+        match moving.filter(|a| !a.is_empty()) {
+            Some(list) => {
+                for m in list {
+                    out.push_str("[[moving]]\n");
+                    for &(field, doc) in MOVING_DOCS {
+                        out.push_str(&format!("# {doc}\n"));
+                        match m.get(field) {
+                            Some(v) => out.push_str(&format!("{field} = {v}\n")),
+                            None => out.push_str(&format!("# {field} = ...\n")),
+                        }
+                    }
+                }
+            }
+            None => out.push_str(&commented(
+                "[[moving]]\ncount = 5\nshape = \"disc\"\nradius_px = 8.0\nmotion = \"random_walk\"\nspeed_px = 2.0\n",
+            )),
+        }
         out
     }
+
+    /// A scenario that shows every kind of entry: the default maze with a pillar, a rotated
+    /// shelf, crossing walkers, a patrol, a linear mover and obstacles that appear mid-episode.
+    pub fn example_scenario() -> Self {
+        let obstacles = vec![
+            ObstacleConfig::Disc {
+                center: [450.0, 450.0],
+                radius_px: 12.0,
+            },
+            ObstacleConfig::Polygon {
+                points: vec![
+                    [620.0, 300.0],
+                    [660.0, 320.0],
+                    [650.0, 340.0],
+                    [610.0, 320.0],
+                ],
+            },
+        ];
+        let moving = vec![
+            MovingConfig {
+                count: 4,
+                ..MovingConfig::default()
+            },
+            MovingConfig {
+                shape: MovingShape::Box,
+                motion: MotionKind::Waypoints,
+                points: vec![[150.0, 850.0], [850.0, 850.0]],
+                mode: Patrol::PingPong,
+                speed_px: 3.0,
+                ..MovingConfig::default()
+            },
+            MovingConfig {
+                motion: MotionKind::Linear,
+                direction_deg: Some(45.0),
+                ..MovingConfig::default()
+            },
+            MovingConfig {
+                count: 2,
+                motion: MotionKind::Appear,
+                from_step: 20,
+                to_step: 100,
+                ..MovingConfig::default()
+            },
+        ];
+        Self {
+            obstacles,
+            moving,
+            ..Self::default()
+        }
+    }
+}
+
+/// The fields of one array-of-tables entry as `key = value` lines.
+fn inline_fields(entry: &toml::Value) -> String {
+    entry
+        .as_table()
+        .map(|t| t.iter().map(|(k, v)| format!("{k} = {v}\n")).collect())
+        .unwrap_or_default()
+}
+
+/// A configuration or scenario file as read: its path and text, for naming lines in errors.
+#[derive(Clone, Debug)]
+pub struct ConfigFile {
+    path: std::path::PathBuf,
+    text: String,
+}
+
+impl ConfigFile {
+    /// Reads `path` (not yet parsed).
+    pub fn read(path: &std::path::Path) -> Result<Self, ConfigError> {
+        let text = std::fs::read_to_string(path).map_err(|e| ConfigError::File {
+            path: path.to_path_buf(),
+            line: None,
+            message: format!("cannot read: {e}"),
+        })?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            text,
+        })
+    }
+
+    /// A file of `text` said to be at `path` (for text that did not come from disk).
+    pub fn from_text(path: &std::path::Path, text: String) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            text,
+        }
+    }
+
+    /// The file.
+    pub fn path(&self) -> &std::path::Path {
+        &self.path
+    }
+
+    /// The configuration the file sets (unset fields keep their defaults), with a map scene's
+    /// file made relative to the directory of this file. An unknown key or a wrong type is an
+    /// error naming the file, line, key and value.
+    pub fn parse(&self) -> Result<SimConfig, ConfigError> {
+        let mut config: SimConfig = toml::from_str(&self.text).map_err(|e| {
+            let message = e.message().trim().replace('\n', " ");
+            let line = e.span().map(|span| {
+                self.text[..span.start.min(self.text.len())]
+                    .matches('\n')
+                    .count()
+                    + 1
+            });
+            let quoted = line
+                .and_then(|l| self.text.lines().nth(l - 1))
+                .map(|t| format!("`{}`: ", t.trim()))
+                .unwrap_or_default();
+            ConfigError::File {
+                path: self.path.clone(),
+                line,
+                message: format!("{quoted}{message}"),
+            }
+        })?;
+        if let Some(file) = &mut config.scene.file {
+            if file.is_relative() {
+                if let Some(dir) = self.path.parent() {
+                    *file = dir.join(&*file);
+                }
+            }
+        }
+        Ok(config)
+    }
+
+    /// `error` from validating a configuration read from this file, with the file and the line
+    /// of the offending key when the file sets it (a value from a flag has no line here).
+    pub fn locate(&self, error: ConfigError) -> ConfigError {
+        let ConfigError::OutOfRange { field, .. } = &error else {
+            return error;
+        };
+        match key_line(&self.text, field) {
+            Some(line) => ConfigError::File {
+                path: self.path.clone(),
+                line: Some(line),
+                message: error.to_string(),
+            },
+            None => error,
+        }
+    }
+}
+
+/// The line (from 1) where `field` (`laser.beams`, `moving[2].speed_px`, `scene.file`) is set in
+/// TOML `text` written with `[section]` / `[[array]]` headers, if it is.
+pub fn key_line(text: &str, field: &str) -> Option<usize> {
+    let (table, key) = field.split_once('.').unwrap_or((field, ""));
+    let (name, index) = match table.split_once('[') {
+        Some((n, rest)) => (n, rest.trim_end_matches(']').parse::<usize>().ok()),
+        None => (table, None),
+    };
+    let mut current = String::new();
+    let mut counts: std::collections::HashMap<String, usize> = Default::default();
+    let mut current_index = None;
+    for (i, raw) in text.lines().enumerate() {
+        let line = raw.split('#').next().unwrap_or("").trim();
+        if let Some(h) = line.strip_prefix("[[").and_then(|l| l.strip_suffix("]]")) {
+            let h = h.trim().to_string();
+            let n = counts.entry(h.clone()).or_insert(0);
+            current_index = Some(*n);
+            *n += 1;
+            if key.is_empty() && h == name && (index.is_none() || index == current_index) {
+                return Some(i + 1);
+            }
+            current = h;
+            continue;
+        }
+        if let Some(h) = line.strip_prefix('[').and_then(|l| l.strip_suffix(']')) {
+            current = h.trim().to_string();
+            current_index = None;
+            continue;
+        }
+        let Some((k, _)) = line.split_once('=') else {
+            continue;
+        };
+        let k = k.trim();
+        let here = current == name && (index.is_none() || index == current_index);
+        if here && k == key {
+            return Some(i + 1);
+        }
+        // A dotted key at the top level: `laser.beams = 9`.
+        if current.is_empty() && index.is_none() && k == field {
+            return Some(i + 1);
+        }
+    }
+    None
 }
 
 #[cfg(test)]
@@ -546,10 +1265,16 @@ mod documented_tests {
         // Every serialised field (and every optional one) has a line of its own.
         c.episode.reward_min = Some(-1.0);
         c.episode.start = Some([0.0; 3]);
+        c.episode.safety_radius_px = Some(3.0);
+        c.scene.seed = Some(1);
+        c.scene.file = Some("m.png".into());
         let full = toml::Value::try_from(&c).unwrap();
         let mut count = 0;
         for (sec, table) in full.as_table().unwrap() {
-            for field in table.as_table().unwrap().keys() {
+            let Some(table) = table.as_table() else {
+                continue;
+            };
+            for field in table.keys() {
                 assert!(
                     FIELD_DOCS.iter().any(|(s, f, _, _)| s == sec && f == field),
                     "{sec}.{field} has no documentation"
@@ -607,5 +1332,73 @@ mod tests {
         let c = SimConfig::from_toml_str("[maze]\ncols = 3\n").unwrap();
         assert_eq!(c.maze.cols, 3);
         assert_eq!(c.maze.rows, 10);
+    }
+
+    #[test]
+    fn the_example_scenario_reads_back_and_validates() {
+        let c = SimConfig::example_scenario();
+        let text = c.to_documented_toml();
+        let back = SimConfig::from_toml_str(&text).unwrap();
+        assert_eq!(back, c);
+        assert!(back.validate().is_ok());
+        // With no obstacles, the examples are there but commented out.
+        let plain = SimConfig::default().to_documented_toml();
+        assert!(plain.contains("# [[moving]]"));
+        assert_eq!(
+            SimConfig::from_toml_str(&plain).unwrap(),
+            SimConfig::default()
+        );
+    }
+
+    #[test]
+    fn scenario_errors_name_file_line_key_and_value() {
+        let text =
+            "[scene]\nkind = \"maze\"\n\n[[moving]]\ncount = 2\n\n[[moving]]\nspeed_px = -3.0\n";
+        let file = ConfigFile::from_text(std::path::Path::new("s.toml"), text.to_string());
+        let e = file.parse().unwrap().validate().unwrap_err();
+        let e = file.locate(e).to_string();
+        assert_eq!(
+            e,
+            "s.toml:8: moving[1].speed_px = -3.0: must be between 0 and 100000 px"
+        );
+        let file = ConfigFile::from_text(
+            std::path::Path::new("s.toml"),
+            "[[moving]]\nmotion = \"teleport\"\n".to_string(),
+        );
+        let e = file.parse().unwrap_err().to_string();
+        assert!(
+            e.starts_with("s.toml:2: `motion = \"teleport\"`: unknown variant"),
+            "{e}"
+        );
+        let file = ConfigFile::from_text(
+            std::path::Path::new("s.toml"),
+            "[[obstacles]]\nshape = \"polygon\"\npoints = [[0.0, 0.0], [10.0, 0.0], [0.0, 10.0], [10.0, 10.0]]\n".to_string(),
+        );
+        let e = file
+            .locate(file.parse().unwrap().validate().unwrap_err())
+            .to_string();
+        assert!(e.starts_with("s.toml:3: obstacles[0].points = "), "{e}");
+        assert_eq!(key_line("laser.beams = 3\n", "laser.beams"), Some(1));
+        assert_eq!(key_line("[laser]\nrange_px = 3\n", "laser.beams"), None);
+    }
+
+    #[test]
+    fn a_map_scene_file_is_relative_to_the_scenario() {
+        let file = ConfigFile::from_text(
+            std::path::Path::new("dir/s.toml"),
+            "[scene]\nkind = \"map\"\nfile = \"room.png\"\n".to_string(),
+        );
+        let c = file.parse().unwrap();
+        assert_eq!(
+            c.scene.file.as_deref(),
+            Some(std::path::Path::new("dir/room.png"))
+        );
+        let mut c = SimConfig::default();
+        c.scene.kind = SceneKind::Map;
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("scene.file"));
     }
 }

@@ -2,19 +2,21 @@
 //! core's validated configuration, and where episodes take place.
 
 use crate::args::{fraction, positive, seed};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
+use ronap_core::config::ConfigFile;
 use ronap_core::scene::map::MapSource;
 use ronap_core::sim::world::{SceneSpec, Scenes};
-use ronap_core::{SimConfig, ValidConfig};
+use ronap_core::{ConfigError, SimConfig, ValidConfig};
 use std::path::PathBuf;
 
 /// Scene and model flags.
 #[derive(Args, Debug, Clone, Default)]
 pub struct SimArgs {
-    /// TOML file setting any model field (`ronap config` prints them all); flags override it.
-    #[arg(long, value_name = "FILE")]
-    pub config: Option<PathBuf>,
+    /// Scenario file (TOML): the scene, static and moving obstacles, robot, laser, episode and
+    /// reward (`ronap config --scenario` prints a complete example); flags override it.
+    #[arg(long, visible_alias = "config", value_name = "FILE", num_args = 0..=1, default_missing_value = "-")]
+    pub scenario: Option<PathBuf>,
     /// Maze columns [default: 10].
     #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub cols: Option<u32>,
@@ -34,6 +36,11 @@ pub struct SimArgs {
 }
 
 impl SimArgs {
+    /// Whether `--scenario` was given with no file (`ronap config --scenario`: print an example).
+    pub fn wants_example(&self) -> bool {
+        self.scenario.as_deref() == Some(std::path::Path::new("-"))
+    }
+
     /// The configuration: defaults, then the file, then the flags; checked.
     pub fn config(&self) -> Result<ValidConfig> {
         self.config_with(|_| {})
@@ -41,13 +48,12 @@ impl SimArgs {
 
     /// Like [`SimArgs::config`], with a command's own flags applied by `more` before the check.
     pub fn config_with(&self, more: impl FnOnce(&mut SimConfig)) -> Result<ValidConfig> {
-        let mut sim = match &self.config {
-            Some(path) => {
-                let text = std::fs::read_to_string(path)
-                    .with_context(|| format!("cannot read config file {}", path.display()))?;
-                SimConfig::from_toml_str(&text)
-                    .with_context(|| format!("invalid config file {}", path.display()))?
-            }
+        if self.wants_example() {
+            anyhow::bail!("--scenario needs a FILE (`ronap config --scenario` prints an example)");
+        }
+        let file = self.scenario.as_deref().map(ConfigFile::read).transpose()?;
+        let mut sim = match &file {
+            Some(file) => file.parse()?,
             None => SimConfig::default(),
         };
         let m = &mut sim.maze;
@@ -57,19 +63,25 @@ impl SimArgs {
         m.loops = self.loops.unwrap_or(m.loops);
         m.wall_thickness_px = self.wall_thickness.unwrap_or(m.wall_thickness_px);
         more(&mut sim);
-        let source = self.config.as_ref().map_or("flags".to_string(), |p| {
-            format!("config file {} and flags", p.display())
-        });
-        sim.validate()
-            .with_context(|| format!("invalid configuration from {source}"))
+        sim.validate().map_err(|e| match &file {
+            Some(file) => match file.locate(e) {
+                located @ ConfigError::File { .. } => anyhow::Error::new(located),
+                other => anyhow::Error::new(other).context(format!(
+                    "invalid configuration from scenario {} and flags",
+                    file.path().display()
+                )),
+            },
+            None => anyhow::Error::new(e).context("invalid configuration from flags"),
+        })
     }
 }
 
 /// Where episodes take place.
 #[derive(Args, Debug, Clone, Default)]
 pub struct SceneArgs {
-    /// Use the maze of this seed for every episode [default: each seed its own maze].
-    #[arg(long, allow_negative_numbers = true, value_name = "SEED", conflicts_with = "map", value_parser = seed)]
+    /// Use the maze (or the scenario's warehouse) of this seed for every episode [default: the
+    /// scenario's scene.seed, else each seed its own].
+    #[arg(long, visible_alias = "scene-seed", allow_negative_numbers = true, value_name = "SEED", conflicts_with = "map", value_parser = seed)]
     pub maze_seed: Option<u64>,
     /// Run on an image scene (PNG/PGM: dark pixels are obstacles) or a ROS map_server YAML file;
     /// start and goal are drawn per seed.
@@ -78,14 +90,15 @@ pub struct SceneArgs {
 }
 
 impl SceneArgs {
-    /// Where episodes take place, as the core describes it.
-    pub fn spec(&self) -> SceneSpec {
-        SceneSpec::from_options(self.maze_seed, self.map.as_deref())
+    /// Where episodes take place, as the core describes it: the flags, else the scenario's
+    /// `[scene]`.
+    pub fn spec(&self, config: &ValidConfig) -> SceneSpec {
+        SceneSpec::resolve(&config.scene, self.maze_seed, self.map.as_deref())
     }
 
     /// The scenes (reading the map, if any), with what the map file was read as.
     pub fn scenes(&self, config: &ValidConfig) -> Result<(Scenes, Option<MapSource>)> {
-        Ok(self.spec().load(config)?)
+        Ok(self.spec(config).load(config)?)
     }
 }
 

@@ -1,4 +1,5 @@
-//! `ronap config`: the whole configuration as TOML, a comment on every field.
+//! `ronap config`: the whole configuration as TOML, a comment on every field; with `--scenario`
+//! and no file, a complete example scenario (static and moving obstacles of every kind).
 
 use crate::args::SimArgs;
 use anyhow::Result;
@@ -15,7 +16,11 @@ pub struct ConfigArgs {
 
 /// Runs `ronap config`.
 pub fn run(args: ConfigArgs) -> Result<ExitCode> {
-    let config = args.sim.config()?;
+    let config = if args.sim.wants_example() {
+        ronap_core::SimConfig::example_scenario().validate()?
+    } else {
+        args.sim.config()?
+    };
     let mut stdout = std::io::stdout().lock();
     stdout.write_all(config.to_documented_toml().as_bytes())?;
     Ok(ExitCode::SUCCESS)

@@ -99,7 +99,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     };
     let info = RunInfo {
         policy: args.policy.clone(),
-        scenes: args.episodes.scenes.spec(),
+        scenes: args.episodes.scenes.spec(&config),
         map: map_source,
     };
     let evaluation = evaluate_into(

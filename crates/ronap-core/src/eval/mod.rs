@@ -90,8 +90,20 @@ impl Evaluator {
         let mut rollout = Rollout::start(self.world(seed), seed, policy)?;
         let mut trajectory = Vec::new();
         let mut step_log = Vec::new();
+        let mut tracks = Vec::new();
+        let record_tracks =
+            |e: &crate::sim::episode::Episode,
+             tracks: &mut Vec<Vec<Option<crate::geometry::Point>>>| {
+                if let Some(movers) = e.movers() {
+                    tracks.resize(movers.items().len(), Vec::new());
+                    for (t, m) in tracks.iter_mut().zip(movers.items()) {
+                        t.push(m.present().then(|| m.position()));
+                    }
+                }
+            };
         if recording.trajectory {
             trajectory.push(rollout.episode().pose());
+            record_tracks(rollout.episode(), &mut tracks);
         }
         while let Some(action) = rollout.decide(policy)? {
             let before = recording.steps.then(|| {
@@ -120,6 +132,7 @@ impl Evaluator {
             }
             if recording.trajectory {
                 trajectory.push(s.pose);
+                record_tracks(rollout.episode(), &mut tracks);
             }
         }
         let (world, episode, reason) = rollout.into_parts();
@@ -158,6 +171,8 @@ impl Evaluator {
             end: episode.pose(),
             last_readings: episode.readings().to_vec(),
             trajectory,
+            mover_tracks: tracks,
+            dynamic: episode.dynamic_metrics(),
             step_log,
             world: Some(world),
         })

@@ -2,7 +2,7 @@
 //! trajectory and steps.
 
 use crate::geometry::Point;
-use crate::sim::episode::Status;
+use crate::sim::episode::{DynamicMetrics, Status};
 use crate::sim::robot::{Action, Pose};
 use crate::sim::world::World;
 use serde::Serialize;
@@ -114,6 +114,11 @@ pub struct EpisodeRecord {
     pub last_readings: Vec<f64>,
     /// Poses from start to end, when recorded.
     pub trajectory: Vec<Pose>,
+    /// Each moving obstacle's centre at each pose of `trajectory` (`None` while absent), when
+    /// recorded.
+    pub mover_tracks: Vec<Vec<Option<Point>>>,
+    /// How the episode went among moving obstacles; `None` without any.
+    pub dynamic: Option<DynamicMetrics>,
     /// Steps, when recorded.
     pub step_log: Vec<StepLog>,
     /// The world the episode ran in; dropped by [`EpisodeRecord::strip`], since a per-seed world
@@ -125,6 +130,7 @@ impl EpisodeRecord {
     /// Drops the recorded trajectory, steps and world (after they have been written out).
     pub fn strip(&mut self) {
         self.trajectory = Vec::new();
+        self.mover_tracks = Vec::new();
         self.step_log = Vec::new();
         self.world = None;
     }

@@ -37,6 +37,23 @@ pub struct Summary {
     pub wall_time_s: f64,
     /// Steps simulated per second of wall time.
     pub steps_per_second: f64,
+    /// Figures among moving obstacles, when the episodes had some.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub moving: Option<MovingSummary>,
+}
+
+/// Summary figures of episodes among moving obstacles.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MovingSummary {
+    /// Mean steps with contact between the robot and a moving obstacle, per episode.
+    pub dynamic_collisions_per_episode: f64,
+    /// Episodes with at least one such contact.
+    pub episodes_with_dynamic_collision: usize,
+    /// Mean over episodes of the least gap to any obstacle, px (episodes that never came within
+    /// the laser range of one are left out).
+    pub mean_min_clearance_px: f64,
+    /// Mean fraction of steps spent within `safety_radius_px` of a moving obstacle.
+    pub near_moving_fraction: f64,
 }
 
 /// The 95% Wilson score interval for `k` successes in `n` trials.
@@ -66,6 +83,39 @@ impl Summary {
             }
         };
         let successes = count(Outcome::Success);
+        let dynamic: Vec<_> = records
+            .iter()
+            .filter_map(|r| r.dynamic.map(|d| (d, r.steps)))
+            .collect();
+        let moving = (!dynamic.is_empty()).then(|| {
+            let k = dynamic.len() as f64;
+            let clear: Vec<f64> = dynamic
+                .iter()
+                .map(|(d, _)| d.min_clearance_px)
+                .filter(|c| c.is_finite())
+                .collect();
+            MovingSummary {
+                dynamic_collisions_per_episode: dynamic
+                    .iter()
+                    .map(|(d, _)| d.collisions as f64)
+                    .sum::<f64>()
+                    / k,
+                episodes_with_dynamic_collision: dynamic
+                    .iter()
+                    .filter(|(d, _)| d.collisions > 0)
+                    .count(),
+                mean_min_clearance_px: if clear.is_empty() {
+                    0.0
+                } else {
+                    clear.iter().sum::<f64>() / clear.len() as f64
+                },
+                near_moving_fraction: dynamic
+                    .iter()
+                    .map(|(d, steps)| d.near_steps as f64 / (*steps).max(1) as f64)
+                    .sum::<f64>()
+                    / k,
+            }
+        });
         let steps: u64 = records.iter().map(|r| r.steps as u64).sum();
         Self {
             episodes: n,
@@ -91,6 +141,7 @@ impl Summary {
             } else {
                 0.0
             },
+            moving,
         }
     }
 
@@ -126,6 +177,29 @@ impl Summary {
             ("wall time", format!("{:.2} s", self.wall_time_s)),
             ("steps per second", format!("{:.0}", self.steps_per_second)),
         ];
+        if let Some(m) = &self.moving {
+            let at = rows
+                .iter()
+                .position(|(k, _)| *k == "mean steps")
+                .unwrap_or(rows.len());
+            rows.splice(
+                at..at,
+                [
+                    (
+                        "moving-obstacle collisions",
+                        format!(
+                            "{:.2} per episode ({} episodes with one)",
+                            m.dynamic_collisions_per_episode, m.episodes_with_dynamic_collision
+                        ),
+                    ),
+                    (
+                        "least clearance (mean)",
+                        format!("{:.1} px", m.mean_min_clearance_px),
+                    ),
+                    ("steps near a mover", pct(m.near_moving_fraction)),
+                ],
+            );
+        }
         if self.collision_ends > 0 {
             rows.insert(4, ("ended by collision", self.collision_ends.to_string()));
         }

@@ -9,6 +9,7 @@
 
 pub mod index;
 pub mod reference;
+pub mod shape;
 
 use nalgebra::{Point2, Vector2};
 

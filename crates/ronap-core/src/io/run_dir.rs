@@ -74,12 +74,36 @@ pub const EPISODE_COLUMNS: [&str; 14] = [
     "reason",
 ];
 
-/// Writes `episodes.csv`: one row per record.
+/// Columns `episodes.csv` gains when the episodes have moving obstacles.
+pub const DYNAMIC_COLUMNS: [&str; 3] = [
+    "dynamic_collisions",
+    "min_clearance_px",
+    "near_moving_fraction",
+];
+
+/// Writes `episodes.csv`: one row per record, with [`DYNAMIC_COLUMNS`] after the others when the
+/// episodes had moving obstacles.
 pub fn write_episodes(records: &[EpisodeRecord], out: &mut dyn Write) -> std::io::Result<()> {
     let mut w = csv::Writer::from_writer(out);
-    w.write_record(EPISODE_COLUMNS)?;
+    let dynamic = records.iter().any(|r| r.dynamic.is_some());
+    if dynamic {
+        w.write_record(EPISODE_COLUMNS.iter().chain(&DYNAMIC_COLUMNS))?;
+    } else {
+        w.write_record(EPISODE_COLUMNS)?;
+    }
     for r in records {
-        w.write_record([
+        let extra = r.dynamic.map(|d| {
+            [
+                d.collisions.to_string(),
+                if d.min_clearance_px.is_finite() {
+                    format!("{:.3}", d.min_clearance_px)
+                } else {
+                    String::new()
+                },
+                format!("{:.4}", d.near_steps as f64 / r.steps.max(1) as f64),
+            ]
+        });
+        let base = [
             r.seed.to_string(),
             r.outcome.name().to_string(),
             r.steps.to_string(),
@@ -94,7 +118,13 @@ pub fn write_episodes(records: &[EpisodeRecord], out: &mut dyn Write) -> std::io
             format!("{:.3}", r.goal.x),
             format!("{:.3}", r.goal.y),
             r.reason.clone().unwrap_or_default(),
-        ])?;
+        ];
+        if dynamic {
+            let extra = extra.unwrap_or_default();
+            w.write_record(base.iter().chain(&extra))?;
+        } else {
+            w.write_record(base)?;
+        }
     }
     w.flush()
 }

@@ -73,14 +73,37 @@ impl FreeGrid {
                 }
             }
         }
+        // The same for discs and polygons, measured through their shapes.
+        for shape in scene.shapes() {
+            let g = shape.aabb().inflated(radius + margin_px);
+            let c0 = ((g.min.x / cell_px - 0.5).ceil().max(0.0)) as usize;
+            let r0 = ((g.min.y / cell_px - 0.5).ceil().max(0.0)) as usize;
+            let c1 = ((g.max.x / cell_px - 0.5).floor()).min(cols as f64 - 1.0);
+            let r1 = ((g.max.y / cell_px - 0.5).floor()).min(rows as f64 - 1.0);
+            if c1 < 0.0 || r1 < 0.0 {
+                continue;
+            }
+            for r in r0..=r1 as usize {
+                for c in c0..=c1 as usize {
+                    let p = Point::new((c as f64 + 0.5) * cell_px, (r as f64 + 0.5) * cell_px);
+                    let d = shape.distance(p);
+                    if d < radius {
+                        free[r * cols + c] = false;
+                    } else if d < radius + margin_px {
+                        close[r * cols + c] = true;
+                    }
+                }
+            }
+        }
         // Label regions by flood fill, numbering them in the order their first cell is met.
         let mut unlinked = vec![0u8; cols * rows];
-        let maze_is_safe = match scene.source() {
-            crate::scene::SceneSource::Maze {
-                wall_thickness_px, ..
-            } => 2.0 * radius + wall_thickness_px > cell_px * std::f64::consts::SQRT_2,
-            _ => false,
-        };
+        let maze_is_safe = !scene.has_added_obstacles()
+            && match scene.source() {
+                crate::scene::SceneSource::Maze {
+                    wall_thickness_px, ..
+                } => 2.0 * radius + wall_thickness_px > cell_px * std::f64::consts::SQRT_2,
+                _ => false,
+            };
         // A link between centres both at least radius + cell/sqrt 2 clear cannot fail: every point
         // of it is within cell/sqrt 2 of one of them. The margin must cover that to skip a check.
         let exact = !maze_is_safe && margin_px * 2.0 >= cell_px * std::f64::consts::SQRT_2;

@@ -10,9 +10,11 @@
 pub mod freespace;
 pub mod map;
 pub mod maze;
+pub mod warehouse;
 
 use crate::config::{MapConfig, MazeConfig};
 use crate::geometry::index::BinIndex;
+use crate::geometry::shape::Shape;
 use crate::geometry::{Aabb, Point, Vector};
 use crate::scene::maze::Maze;
 use std::path::{Path, PathBuf};
@@ -97,6 +99,10 @@ pub struct Scene {
     boxes: Vec<Aabb>,
     index: BinIndex,
     source: SceneSource,
+    /// Discs and convex polygons, checked one by one (a scene has few).
+    shapes: Vec<Shape>,
+    /// Whether obstacles were added to the generated or loaded scene.
+    added: bool,
 }
 
 impl Scene {
@@ -122,7 +128,45 @@ impl Scene {
             boxes,
             index,
             source,
+            shapes: Vec::new(),
+            added: false,
         }
+    }
+
+    /// This scene with `boxes` (kept in the fast index) and `shapes` added to its obstacles.
+    pub fn with_obstacles(self, boxes: Vec<Aabb>, shapes: Vec<Shape>) -> Self {
+        if boxes.is_empty() && shapes.is_empty() {
+            return self;
+        }
+        let mut scene = if boxes.is_empty() {
+            self
+        } else {
+            let mut all = self.boxes;
+            all.extend(boxes);
+            let mut s = Self::build(
+                self.width,
+                self.height,
+                all,
+                self.index.reach_px(),
+                self.source,
+            );
+            s.shapes = self.shapes;
+            s
+        };
+        scene.shapes.extend(shapes);
+        scene.added = true;
+        scene
+    }
+
+    /// The discs and convex polygons among the obstacles.
+    pub fn shapes(&self) -> &[Shape] {
+        &self.shapes
+    }
+
+    /// Whether obstacles were added to the generated or loaded scene (so a maze is no longer one
+    /// free region by construction).
+    pub fn has_added_obstacles(&self) -> bool {
+        self.added
     }
 
     /// The scene of a maze, with walls as `config` says.
@@ -294,6 +338,17 @@ impl Scene {
             }
             hit.then_some(best)
         };
+        if !self.shapes.is_empty() {
+            // Few shapes: the nearest hit among them and the boxes, read whole.
+            let boxes = first_hit(origin, max_px, max_px).unwrap_or(f64::INFINITY);
+            let shapes = self
+                .shapes
+                .iter()
+                .filter_map(|s| s.cast_ray(origin, dir, max_px))
+                .fold(f64::INFINITY, f64::min);
+            let best = boxes.min(shapes);
+            return best.is_finite().then_some(best);
+        }
         let Some(piece) = self.piece_px(0.0).filter(|&p| max_px > p) else {
             return first_hit(origin, max_px, max_px);
         };
@@ -317,6 +372,7 @@ impl Scene {
             .near(p, radius)
             .iter()
             .all(|&i| self.boxes[i as usize].distance_squared(p) >= r2)
+            && self.shapes.iter().all(|s| s.distance(p) >= radius)
     }
 
     /// Whether a disc of `radius` can move in a straight line from `a` to `b` touching nothing:
@@ -325,11 +381,21 @@ impl Scene {
         let r2 = radius * radius;
         let piece_clear = |a: Point, b: Point| {
             let reach = (b - a).norm() + radius;
-            self.index
-                .near(a, reach)
-                .iter()
-                .all(|&i| self.boxes[i as usize].segment_distance_squared(a, b) >= r2)
+            // A box at least `reach` from `a` is at least `radius` from every point of the
+            // piece: the cheap test settles most of the bin's list.
+            let far2 = reach * reach;
+            self.index.near(a, reach).iter().all(|&i| {
+                let b_ = &self.boxes[i as usize];
+                b_.distance_squared(a) >= far2 || b_.segment_distance_squared(a, b) >= r2
+            })
         };
+        if !self
+            .shapes
+            .iter()
+            .all(|s| s.segment_distance(a, b) >= radius)
+        {
+            return false;
+        }
         let length = (b - a).norm();
         let Some(piece) = self.piece_px(radius).filter(|&p| length > p) else {
             return piece_clear(a, b);
@@ -342,6 +408,78 @@ impl Scene {
         })
     }
 
+    /// Whether the box `b` lies inside the scene and overlaps no obstacle (touching is allowed).
+    pub fn box_clear(&self, b: Aabb) -> bool {
+        let inside = self.bounds();
+        if !(inside.contains(b.min) && inside.contains(b.max)) {
+            return false;
+        }
+        let half = b.extents() / 2.0;
+        let center = b.min + half;
+        let overlaps = |o: &Aabb| {
+            o.min.x < b.max.x && b.min.x < o.max.x && o.min.y < b.max.y && b.min.y < o.max.y
+        };
+        !self
+            .index
+            .near(center, half.norm())
+            .iter()
+            .any(|&i| overlaps(&self.boxes[i as usize]))
+            && self.shapes.iter().all(|s| {
+                s.hull_distance(&[
+                    b.min,
+                    Point::new(b.max.x, b.min.y),
+                    b.max,
+                    Point::new(b.min.x, b.max.y),
+                ]) > 0.0
+            })
+    }
+
+    /// Whether an axis-aligned box of half extents `half` can move its centre in a straight line
+    /// from `a` to `b`, ending inside the scene, without overlapping an obstacle.
+    pub fn box_sweep_clear(&self, a: Point, b: Point, half: Vector) -> bool {
+        let end = Aabb::from_corners(b - half, b + half);
+        let inside = self.bounds();
+        if !(inside.contains(end.min) && inside.contains(end.max)) {
+            return false;
+        }
+        // The box against each obstacle box is its centre against the obstacle grown by `half`.
+        let reach = (b - a).norm() + half.norm();
+        let boxes_clear = self.index.near(a, reach).iter().all(|&i| {
+            let o = self.boxes[i as usize];
+            let grown = Aabb {
+                min: o.min - half,
+                max: o.max + half,
+            };
+            grown.segment_distance_squared(a, b) > 0.0
+        });
+        boxes_clear
+            && (self.shapes.is_empty() || {
+                let corners: Vec<Point> = [a, b]
+                    .iter()
+                    .flat_map(|&c| {
+                        [
+                            c - half,
+                            c + Vector::new(half.x, -half.y),
+                            c + half,
+                            c + Vector::new(-half.x, half.y),
+                        ]
+                    })
+                    .collect();
+                self.shapes.iter().all(|s| s.hull_distance(&corners) > 0.0)
+            })
+    }
+
+    /// The radius of a disc round `p` that touches no obstacle and stays in the scene, at most
+    /// the index's reach: anything inside it is clear, without a further query.
+    pub fn free_radius(&self, p: Point) -> f64 {
+        let reach = self.index.reach_px();
+        let border = p.x.min(self.width - p.x).min(p.y).min(self.height - p.y);
+        self.clearance(p, reach)
+            .unwrap_or(reach)
+            .min(border)
+            .max(0.0)
+    }
+
     /// Whether `p` lies inside an obstacle or outside the scene.
     pub fn occupied(&self, p: Point) -> bool {
         !self.bounds().contains(p)
@@ -350,6 +488,7 @@ impl Scene {
                 .near(p, 0.0)
                 .iter()
                 .any(|&i| self.boxes[i as usize].contains(p))
+            || self.shapes.iter().any(|s| s.distance(p) == 0.0)
     }
 
     /// Distance from `p` to the nearest obstacle, if one lies within `max_px`.
@@ -360,7 +499,11 @@ impl Scene {
             .iter()
             .map(|&i| self.boxes[i as usize].distance_squared(p))
             .fold(f64::INFINITY, f64::min);
-        let d = d2.sqrt();
+        let d = self
+            .shapes
+            .iter()
+            .map(|s| s.distance(p))
+            .fold(d2.sqrt(), f64::min);
         (d <= max_px).then_some(d)
     }
 }

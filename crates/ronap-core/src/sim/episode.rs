@@ -8,6 +8,7 @@ use crate::geometry::{wrap_deg, Point};
 use crate::scene::freespace::FreeGrid;
 use crate::scene::Scene;
 use crate::sim::lidar::Laser;
+use crate::sim::moving::Movers;
 use crate::sim::placement::{sample_placement, EpisodeError, Placement, PLACEMENT_TRIES};
 use crate::sim::rng::{stream, Rng, Stream};
 use crate::sim::robot::{Action, DiscreteAction, Pose, Robot};
@@ -111,6 +112,31 @@ pub struct Episode {
     total_reward: f64,
     path_length_px: f64,
     status: Status,
+    /// The moving obstacles, when the configuration has some.
+    movers: Option<Box<Movers>>,
+    dynamic: DynamicMetrics,
+}
+
+/// How an episode went among moving obstacles (SPEC "Moving obstacles", metrics).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DynamicMetrics {
+    /// Steps with contact between the robot and a moving obstacle, either way.
+    pub collisions: u32,
+    /// Least gap between the robot and any obstacle, still or moving, seen within the laser
+    /// range, px (infinite when none came that close).
+    pub min_clearance_px: f64,
+    /// Steps ending with a moving obstacle closer than `episode.safety_radius_px`.
+    pub near_steps: u32,
+}
+
+impl Default for DynamicMetrics {
+    fn default() -> Self {
+        Self {
+            collisions: 0,
+            min_clearance_px: f64::INFINITY,
+            near_steps: 0,
+        }
+    }
 }
 
 impl Episode {
@@ -143,6 +169,15 @@ impl Episode {
                 });
             }
         }
+        let movers = Movers::new(
+            config,
+            &scene,
+            placement.start.position(),
+            placement.goal,
+            seed,
+        )
+        .map_err(|e| EpisodeError::Moving(e.to_string()))?
+        .map(Box::new);
         let laser = Laser::new(&config.laser);
         let beams = laser.beams();
         let mut episode = Self {
@@ -163,6 +198,8 @@ impl Episode {
             path_length_px: 0.0,
             status: Status::Running,
             scene,
+            movers,
+            dynamic: DynamicMetrics::default(),
         };
         episode.sense();
         if episode.distance_px < config.episode.goal_tolerance_px {
@@ -176,6 +213,10 @@ impl Episode {
         let p = self.pose.position();
         self.laser
             .scan(&self.scene, p, self.pose.z_deg, &mut self.readings);
+        if let Some(movers) = &self.movers {
+            let gap = movers.sense(&self.laser, p, self.pose.z_deg, &mut self.readings);
+            self.note_gap(gap);
+        }
         self.laser
             .add_noise(&mut self.readings, &mut self.noise_rng);
         self.distance_px = (self.goal - p).norm();
@@ -185,6 +226,24 @@ impl Episode {
         }
         let last = self.readings.len();
         self.observation[last] = (self.direction_deg() / 360.0) as f32;
+    }
+
+    /// Records the gap to the nearest moving obstacle after a step, and to the still scene.
+    fn note_gap(&mut self, moving_gap: f64) {
+        let radius = self.config.robot.radius_px;
+        let safety = self.config.episode.safety_radius_px.unwrap_or(2.0 * radius);
+        if self.steps > 0 && moving_gap < safety {
+            self.dynamic.near_steps += 1;
+        }
+        let p = self.pose.position();
+        let still = self
+            .scene
+            .clearance(p, self.config.reach_px())
+            .map_or(f64::INFINITY, |d| d - radius);
+        let gap = moving_gap.min(still);
+        if gap < self.dynamic.min_clearance_px {
+            self.dynamic.min_clearance_px = gap;
+        }
     }
 
     /// The paper's re-posing in data collection (SPEC.md): the robot jumps to a random free pose,
@@ -225,11 +284,28 @@ impl Episode {
         }
         let action = action.into();
         let before = self.distance_px;
+        let mut touched = false;
+        if let Some(movers) = &mut self.movers {
+            touched = movers
+                .advance(self.steps + 1, &self.scene, self.pose.position())
+                .touched_robot;
+        }
         let motion = self.robot.motion(self.pose, action);
-        let collided = !self.robot.motion_clear(&self.scene, self.pose, &motion);
-        if collided {
+        let wall = !self.robot.motion_clear(&self.scene, self.pose, &motion);
+        let moving = match &self.movers {
+            Some(movers) => !self
+                .robot
+                .motion_clear_by(self.pose, &motion, |a, b, r| movers.sweep_clear(a, b, r)),
+            None => false,
+        };
+        let collided = wall || moving || touched;
+        if wall {
             self.collisions += 1;
-        } else {
+        }
+        if moving || touched {
+            self.dynamic.collisions += 1;
+        }
+        if !(wall || moving) {
             self.path_length_px += (motion.end.position() - self.pose.position()).norm();
             self.pose = motion.end;
         }
@@ -367,6 +443,16 @@ impl Episode {
     /// Current status.
     pub fn status(&self) -> Status {
         self.status
+    }
+
+    /// The moving obstacles, when the configuration has some.
+    pub fn movers(&self) -> Option<&Movers> {
+        self.movers.as_deref()
+    }
+
+    /// How the episode has gone among moving obstacles so far; `None` without any.
+    pub fn dynamic_metrics(&self) -> Option<DynamicMetrics> {
+        self.movers.as_ref().map(|_| self.dynamic)
     }
 }
 

@@ -131,6 +131,45 @@ impl Laser {
             }
             *reading = best;
         }
+        if !scene.shapes().is_empty() {
+            let near: Vec<_> = scene
+                .shapes()
+                .iter()
+                .filter(|s| s.aabb().distance_squared(position) <= r2)
+                .collect();
+            if !near.is_empty() {
+                self.refine(position, heading_deg, out, |origin, dir, best| {
+                    near.iter()
+                        .filter_map(|s| s.cast_ray(origin, dir, best))
+                        .fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.min(t))))
+                });
+            }
+        }
+    }
+
+    /// Shortens each reading in `out` (taken from `position` at `heading_deg`) to the nearer hit
+    /// `hit(origin, unit direction, reading)` reports, if any: how obstacles beyond the scene's
+    /// boxes join a scan.
+    #[inline]
+    pub fn refine(
+        &self,
+        position: Point,
+        heading_deg: f64,
+        out: &mut [f64],
+        mut hit: impl FnMut(Point, Vector, f64) -> Option<f64>,
+    ) {
+        let heading = unit(heading_deg);
+        for (reading, offset) in out.iter_mut().zip(&self.offsets) {
+            let dir = Vector::new(
+                heading.x * offset.x - heading.y * offset.y,
+                heading.x * offset.y + heading.y * offset.x,
+            );
+            if let Some(t) = hit(position, dir, *reading) {
+                if t < *reading {
+                    *reading = t;
+                }
+            }
+        }
     }
 
     /// Adds Gaussian noise (if configured) to readings, keeping each in `[0, range]`.

@@ -4,6 +4,7 @@
 
 pub mod episode;
 pub mod lidar;
+pub mod moving;
 pub mod placement;
 pub mod rng;
 pub mod robot;

@@ -35,6 +35,9 @@ pub enum EpisodeError {
         /// Diagonal of the scene, px.
         span_px: f64,
     },
+    /// The moving obstacles could not be placed.
+    #[error("{0}")]
+    Moving(String),
     /// A fixed start or goal touches an obstacle or lies outside the scene.
     #[error("episode.{which} = ({x}, {y}) is not free: a robot of radius {radius_px} px there touches an obstacle or leaves the scene")]
     Blocked {
@@ -65,8 +68,10 @@ pub struct Placement {
 /// drawn uniformly over the scene with no grid; any other scene needs the grid.
 pub fn needs_region_grid(config: &ValidConfig, scene: &Scene) -> bool {
     match scene.maze() {
-        Some((_, cell)) => cell - config.maze.wall_thickness_px <= 2.0 * config.robot.radius_px,
-        None => true,
+        Some((_, cell)) if !scene.has_added_obstacles() => {
+            cell - config.maze.wall_thickness_px <= 2.0 * config.robot.radius_px
+        }
+        _ => true,
     }
 }
 

@@ -24,6 +24,8 @@ pub enum Stream {
     Policy = 4,
     /// Re-posing after each recorded action in data collection.
     Repose = 5,
+    /// Moving obstacles: their starts, directions, turns and appearances.
+    Moving = 6,
 }
 
 /// The generator for `purpose` in the episode with `seed`.

@@ -219,6 +219,17 @@ impl Robot {
 
     /// Whether the disc can make `motion` from `pose` without touching an obstacle.
     pub fn motion_clear(&self, scene: &Scene, pose: Pose, motion: &Motion) -> bool {
+        self.motion_clear_by(pose, motion, |a, b, r| scene.sweep_clear(a, b, r))
+    }
+
+    /// Whether the disc can make `motion` from `pose` with every straight piece of its sweep
+    /// passing `sweep_clear(from, to, radius)`: the same check against any obstacles.
+    pub fn motion_clear_by(
+        &self,
+        pose: Pose,
+        motion: &Motion,
+        mut sweep_clear: impl FnMut(Point, Point, f64) -> bool,
+    ) -> bool {
         let r = self.config.radius_px;
         if motion.v == 0.0 {
             // Turning in place sweeps nothing new.
@@ -226,7 +237,7 @@ impl Robot {
         }
         let w = motion.w_deg.to_radians();
         if w.abs() < 1e-12 {
-            return scene.sweep_clear(pose.position(), motion.end.position(), r);
+            return sweep_clear(pose.position(), motion.end.position(), r);
         }
         // Follow the arc by chords short enough that the arc stays within ARC_TOLERANCE_PX of
         // them (at most 1024 chords), and check each with the radius grown by the arc's actual
@@ -243,7 +254,7 @@ impl Robot {
         for k in 1..=chords {
             let part = k as f64 / chords as f64;
             let to = arc_end(pose, motion.v * part, motion.w_deg * part);
-            if !scene.sweep_clear(
+            if !sweep_clear(
                 from.position(),
                 to.position(),
                 r + sagitta.max(ARC_TOLERANCE_PX),

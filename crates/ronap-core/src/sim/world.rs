@@ -2,10 +2,13 @@
 //! computed on first use and shared by placement, planners and path metrics; and [`Scenes`], which
 //! says where each seed's episode takes place.
 
-use crate::config::ValidConfig;
+use crate::config::{ObstacleConfig, SceneConfig, SceneKind, ValidConfig};
+use crate::geometry::shape::Shape;
+use crate::geometry::{Aabb, Point};
 use crate::scene::freespace::FreeGrid;
 use crate::scene::map::{self, MapError, MapSource};
 use crate::scene::maze::Maze;
+use crate::scene::warehouse::Warehouse;
 use crate::scene::Scene;
 use crate::sim::episode::Episode;
 use crate::sim::placement::{free_grid, needs_region_grid, sample_placement, EpisodeError};
@@ -14,10 +17,47 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
 
-/// The scene for an episode seed: a maze drawn from the seed's scene stream.
+/// The scene for an episode seed: a maze drawn from the seed's scene stream, with the
+/// configuration's static obstacles.
 pub fn maze_scene(config: &ValidConfig, scene_seed: u64) -> Scene {
     let maze = Maze::from_config(&config.maze, &mut stream(scene_seed, Stream::Scene));
-    Scene::from_maze(maze, &config.maze, config.reach_px())
+    with_static_obstacles(
+        config,
+        Scene::from_maze(maze, &config.maze, config.reach_px()),
+    )
+}
+
+/// The warehouse of a seed: clutter drawn from the seed's scene stream, with the configuration's
+/// static obstacles.
+pub fn warehouse_scene(config: &ValidConfig, scene_seed: u64) -> Scene {
+    let w = Warehouse::generate(
+        &config.warehouse,
+        config.robot.radius_px,
+        &mut stream(scene_seed, Stream::Scene),
+    );
+    let scene = Scene::from_boxes(w.width_px, w.height_px, w.boxes(), config.reach_px());
+    with_static_obstacles(config, scene)
+}
+
+/// `scene` with the static obstacles of `config.obstacles` added.
+pub fn with_static_obstacles(config: &ValidConfig, scene: Scene) -> Scene {
+    let mut boxes = Vec::new();
+    let mut shapes = Vec::new();
+    for o in &config.obstacles {
+        let p = |v: [f64; 2]| Point::new(v[0], v[1]);
+        match o {
+            ObstacleConfig::Box { min, max } => boxes.push(Aabb::from_corners(p(*min), p(*max))),
+            ObstacleConfig::Disc { center, radius_px } => {
+                shapes.push(Shape::disc(p(*center), *radius_px))
+            }
+            ObstacleConfig::Polygon { points } => {
+                let corners: Vec<Point> = points.iter().map(|&v| p(v)).collect();
+                // A validated polygon is convex with an area, so its hull exists.
+                shapes.extend(Shape::polygon(&corners));
+            }
+        }
+    }
+    scene.with_obstacles(boxes, shapes)
 }
 
 /// A scene under a configuration.
@@ -41,6 +81,12 @@ impl World {
     /// The maze world of `scene_seed`.
     pub fn maze(config: ValidConfig, scene_seed: u64) -> Self {
         let scene = Arc::new(maze_scene(&config, scene_seed));
+        Self::new(config, scene)
+    }
+
+    /// The warehouse world of `scene_seed`.
+    pub fn warehouse(config: ValidConfig, scene_seed: u64) -> Self {
+        let scene = Arc::new(warehouse_scene(&config, scene_seed));
         Self::new(config, scene)
     }
 
@@ -77,6 +123,10 @@ pub enum Scenes {
     MazePerSeed,
     /// One maze, from this seed, for every episode.
     Maze(u64),
+    /// Each seed gets its own warehouse, its clutter drawn from the seed.
+    WarehousePerSeed,
+    /// One warehouse, from this seed, for every episode.
+    Warehouse(u64),
     /// One given scene (an image or ROS map) for every episode.
     Fixed(Arc<Scene>),
 }
@@ -93,6 +143,13 @@ pub enum SceneSpec {
         /// The maze's seed.
         seed: u64,
     },
+    /// Each seed its own warehouse.
+    WarehousePerSeed,
+    /// The warehouse of `seed` for every episode.
+    Warehouse {
+        /// The warehouse's seed.
+        seed: u64,
+    },
     /// An image (PNG/PGM) or ROS `map_server` YAML file for every episode.
     Map {
         /// The map file, as given.
@@ -104,12 +161,24 @@ impl SceneSpec {
     /// The scenes of a map file when one is given, else of one maze when `maze_seed` is given,
     /// else a maze per seed.
     pub fn from_options(maze_seed: Option<u64>, map_file: Option<&Path>) -> Self {
-        match (map_file, maze_seed) {
-            (Some(file), _) => Self::Map {
+        Self::resolve(&SceneConfig::default(), maze_seed, map_file)
+    }
+
+    /// The scenes a scenario's `[scene]` section says, overridden by a map file or a scene seed
+    /// given apart from it (command-line flags, keyword arguments).
+    pub fn resolve(scene: &SceneConfig, seed: Option<u64>, map_file: Option<&Path>) -> Self {
+        if let Some(file) = map_file {
+            return Self::Map {
                 file: file.to_path_buf(),
-            },
-            (None, Some(seed)) => Self::Maze { seed },
-            (None, None) => Self::MazePerSeed,
+            };
+        }
+        let seed = seed.or(scene.seed);
+        match (scene.kind, seed, &scene.file) {
+            (SceneKind::Map, _, Some(file)) => Self::Map { file: file.clone() },
+            (SceneKind::Warehouse, Some(seed), _) => Self::Warehouse { seed },
+            (SceneKind::Warehouse, None, _) => Self::WarehousePerSeed,
+            (_, Some(seed), _) => Self::Maze { seed },
+            (_, None, _) => Self::MazePerSeed,
         }
     }
 
@@ -118,10 +187,13 @@ impl SceneSpec {
         Ok(match self {
             Self::Map { file } => {
                 let (scene, source) = map::load(file, &config.map, config.reach_px())?;
+                let scene = with_static_obstacles(config, scene);
                 (Scenes::Fixed(Arc::new(scene)), Some(source))
             }
             Self::Maze { seed } => (Scenes::Maze(*seed), None),
             Self::MazePerSeed => (Scenes::MazePerSeed, None),
+            Self::Warehouse { seed } => (Scenes::Warehouse(*seed), None),
+            Self::WarehousePerSeed => (Scenes::WarehousePerSeed, None),
         })
     }
 }
@@ -131,6 +203,8 @@ impl std::fmt::Display for SceneSpec {
         match self {
             Self::MazePerSeed => f.write_str("a maze per seed"),
             Self::Maze { seed } => write!(f, "maze of seed {seed}"),
+            Self::WarehousePerSeed => f.write_str("a warehouse per seed"),
+            Self::Warehouse { seed } => write!(f, "warehouse of seed {seed}"),
             Self::Map { file } => write!(f, "map {}", file.display()),
         }
     }
@@ -149,8 +223,9 @@ impl Worlds {
     /// The worlds of `scenes` under `config`.
     pub fn new(config: ValidConfig, scenes: Scenes) -> Self {
         let shared = match &scenes {
-            Scenes::MazePerSeed => None,
+            Scenes::MazePerSeed | Scenes::WarehousePerSeed => None,
             Scenes::Maze(seed) => Some(Arc::new(World::maze(config.clone(), *seed))),
+            Scenes::Warehouse(seed) => Some(Arc::new(World::warehouse(config.clone(), *seed))),
             Scenes::Fixed(scene) => Some(Arc::new(World::new(config.clone(), scene.clone()))),
         };
         Self {
@@ -174,6 +249,9 @@ impl Worlds {
     pub fn world(&self, seed: u64) -> Arc<World> {
         match &self.shared {
             Some(w) => w.clone(),
+            None if matches!(self.scenes, Scenes::WarehousePerSeed) => {
+                Arc::new(World::warehouse(self.config.clone(), seed))
+            }
             None => Arc::new(World::maze(self.config.clone(), seed)),
         }
     }
