@@ -245,7 +245,7 @@ fn bad_input_is_named_and_leaves_no_output() {
             "--out",
             o,
         ],
-        &["c.toml", "line 3", "beam"],
+        &["c.toml", "c.toml:3:", "beam"],
         &out,
     );
     // An output directory under a regular file cannot be created.

@@ -141,6 +141,7 @@ pub struct MovingConfig {
     pub size_px: [f64; 2],
     /// Fixed start `[x, y]` (of the centre), px. Default: drawn from the seed in free space, at
     /// least `min_robot_distance_px` from the robot's start and goal (waypoints: the first point).
+    /// A fixed start on the robot's start keeps the obstacle away until the robot has moved off.
     pub start: Option<[f64; 2]>,
     /// `still`, `linear`, `waypoints`, `random_walk` (default) or `appear`.
     pub motion: MotionKind,

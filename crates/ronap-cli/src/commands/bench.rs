@@ -1,11 +1,12 @@
-//! `ronap bench`: how fast this machine steps the default scene, on one thread and on all.
+//! `ronap bench`: how fast this machine steps the default scene (or a scenario's, moving obstacles
+//! and all), on one thread and on all.
 
 use crate::args::{positive, SimArgs};
 use anyhow::{Context, Result};
 use clap::Args;
 use ronap_core::scene::freespace::FreeGrid;
 use ronap_core::sim::placement::{free_grid, needs_region_grid, sample_placement};
-use ronap_core::sim::world::maze_scene;
+use ronap_core::sim::world::{SceneSpec, Worlds};
 use ronap_core::{Episode, Laser, Scene, ValidConfig};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -74,11 +75,19 @@ pub fn run(args: BenchArgs) -> Result<std::process::ExitCode> {
         |n| n as usize,
     );
     let duration = Duration::from_secs_f64(args.seconds);
-    let scene = Arc::new(maze_scene(&config, 0));
+    // The scenario's scene (the maze by default) of seed 0, moving obstacles and all.
+    let (scenes, _) = SceneSpec::resolve(&config.scene, Some(0), None).load(&config)?;
+    let scene = Worlds::new(config.clone(), scenes).world(0).scene().clone();
     let grid = needs_region_grid(&config, &scene).then(|| free_grid(&config, &scene));
+    let movers: u32 = config.moving.iter().map(|m| m.count).sum();
     println!(
-        "ronap bench: {} x {} maze of {} px cells, {} beams, {} s per figure",
-        config.maze.cols, config.maze.rows, config.maze.cell_px, config.laser.beams, args.seconds
+        "ronap bench: {} of {:.0} x {:.0} px, {} moving obstacles, {} beams, {} s per figure",
+        SceneSpec::resolve(&config.scene, Some(0), None),
+        scene.width(),
+        scene.height(),
+        movers,
+        config.laser.beams,
+        args.seconds
     );
 
     let start = Instant::now();

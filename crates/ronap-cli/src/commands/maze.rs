@@ -1,11 +1,12 @@
-//! `ronap maze`: draw a seeded maze as a picture or as text.
+//! `ronap maze`: draw a seeded scene (a maze, or a scenario's warehouse or map, with its static and
+//! moving obstacles) as a picture, or a maze as text.
 
 use crate::args::{positive, seed, SimArgs};
 use anyhow::{Context, Result};
 use clap::Args;
-use ronap_core::render::{Canvas, GOAL, START};
-use ronap_core::sim::placement::sample_placement;
-use ronap_core::sim::world::maze_scene;
+use ronap_core::render::{Canvas, GOAL, MOVER, START};
+use ronap_core::sim::placement::{needs_region_grid, sample_placement};
+use ronap_core::sim::world::{SceneSpec, Worlds};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -13,9 +14,14 @@ use std::process::ExitCode;
 /// Arguments of `ronap maze`.
 #[derive(Args, Debug)]
 pub struct MazeArgs {
-    /// Seed of the maze (and of the start and goal with --start-goal).
-    #[arg(long, allow_negative_numbers = true, default_value_t = 0, value_parser = seed)]
-    seed: u64,
+    /// Seed of the scene (and of the start, goal and moving obstacles) [default: the scenario's
+    /// scene.seed, else 0].
+    #[arg(long, allow_negative_numbers = true, value_parser = seed)]
+    seed: Option<u64>,
+    /// With moving obstacles: steps of their motion drawn as faded tracks from where they start
+    /// (the robot standing still).
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 300, value_parser = clap::value_parser!(u32).range(0..=100_000))]
+    track_steps: u32,
     #[command(flatten)]
     sim: SimArgs,
     /// Also draw a start (red, with a heading tick) and goal (green) drawn from the seed.
@@ -33,14 +39,35 @@ pub struct MazeArgs {
 /// Runs `ronap maze`.
 pub fn run(args: MazeArgs) -> Result<ExitCode> {
     let config = args.sim.config()?;
-    let scene = maze_scene(&config, args.seed);
+    let seed = args.seed.or(config.scene.seed).unwrap_or(0);
+    let (scenes, _) = SceneSpec::resolve(&config.scene, Some(seed), None).load(&config)?;
+    let world = Worlds::new(config.clone(), scenes).world(seed);
+    let scene = world.scene().clone();
     let placement = if args.start_goal {
-        Some(
-            sample_placement(&config, &scene, None, args.seed)
-                .context("cannot place start and goal")?,
-        )
+        let grid = needs_region_grid(&config, &scene).then(|| world.grid());
+        Some(sample_placement(&config, &scene, grid, seed).context("cannot place start and goal")?)
     } else {
         None
+    };
+    // Moving obstacles where they start, and the tracks they follow while the robot stands still.
+    let movers = if config.moving.is_empty() {
+        None
+    } else {
+        let mut episode = world
+            .episode(seed)
+            .context("cannot place the episode's robot and moving obstacles")?;
+        let first = episode.movers().cloned();
+        let mut tracks: Vec<Vec<_>> = Vec::new();
+        for _ in 0..=args.track_steps {
+            if let Some(m) = episode.movers() {
+                tracks.resize(m.items().len(), Vec::new());
+                for (t, o) in tracks.iter_mut().zip(m.items()) {
+                    t.push(o.present().then(|| o.position()));
+                }
+            }
+            episode.step(ronap_core::DiscreteAction::Left);
+        }
+        first.map(|m| (m, tracks))
     };
     match &args.out {
         Some(path) => {
@@ -51,6 +78,15 @@ pub fn run(args: MazeArgs) -> Result<ExitCode> {
                 args.scale
             );
             let mut canvas = Canvas::new(&scene, args.scale);
+            if let Some((first, tracks)) = &movers {
+                canvas.tracks(tracks);
+                // Where each one starts (or first appears), drawn over its track.
+                for (m, track) in first.items().iter().zip(tracks) {
+                    if let Some(Some(p)) = track.iter().find(|p| p.is_some()) {
+                        canvas.mover(m.body(), *p, MOVER);
+                    }
+                }
+            }
             if let Some(p) = placement {
                 // Markers are at least 8 picture pixels across, so they show on large scenes.
                 let least = 4.0 / args.scale;
@@ -60,7 +96,9 @@ pub fn run(args: MazeArgs) -> Result<ExitCode> {
             ronap_core::io::atomic::save_image(path, &canvas.into_image())?;
         }
         None => {
-            let (maze, cell) = scene.maze().context("the scene is not a maze")?;
+            let (maze, cell) = scene
+                .maze()
+                .context("the scene is not a maze: give --out FILE.png for a picture")?;
             let cell_of = |x: f64, y: f64| ((x / cell) as usize, (y / cell) as usize);
             let start = placement.map(|p| cell_of(p.start.x, p.start.y));
             let goal = placement.map(|p| cell_of(p.goal.x, p.goal.y));

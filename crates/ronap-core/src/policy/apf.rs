@@ -17,6 +17,7 @@ use crate::config::ApfConfig;
 use crate::geometry::{Point, Vector};
 use crate::scene::Scene;
 use crate::sim::episode::Episode;
+use crate::sim::robot::DiscreteAction;
 use crate::sim::world::World;
 use std::collections::HashSet;
 
@@ -168,8 +169,43 @@ impl Policy for Apf {
         } else {
             "trapped in a local minimum of the potential"
         };
-        Ok(follower.next(episode).decision(end_reason))
+        let decision = follower.next(episode).decision(end_reason);
+        if !episode.config().apf.repel_moving {
+            return Ok(decision);
+        }
+        Ok(match decision {
+            Decision::Act(a) if a == DiscreteAction::Ahead.into() => {
+                Decision::Act(repel(episode).unwrap_or(DiscreteAction::Ahead).into())
+            }
+            other => other,
+        })
     }
+}
+
+/// With `apf.repel_moving`: the turn away from the strongest repulsion of the obstacles the laser
+/// sees and the still scene does not have, within `influence_px` of the robot's disc and in front
+/// of it, weighted as the potential's gradient `(1/c - 1/d0) / c^2`; `None` when none repels.
+fn repel(episode: &Episode) -> Option<DiscreteAction> {
+    let c = episode.config();
+    let d0 = c.apf.influence_px;
+    let radius = c.robot.radius_px;
+    let mut push = 0.0;
+    let mut any = false;
+    for (angle, d) in super::dodge::unexpected(episode) {
+        let clearance = (d - radius).max(0.5);
+        if clearance > d0 || angle.abs() > 90.0 {
+            continue;
+        }
+        any = true;
+        // Obstacles to the left (positive angles) push right, and the other way round.
+        push -=
+            angle.to_radians().sin().signum() * (1.0 / clearance - 1.0 / d0) / clearance.powi(2);
+    }
+    any.then_some(if push >= 0.0 {
+        DiscreteAction::Left
+    } else {
+        DiscreteAction::Right
+    })
 }
 
 #[cfg(test)]

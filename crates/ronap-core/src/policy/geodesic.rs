@@ -30,6 +30,55 @@ impl Geodesic {
     }
 }
 
+/// `geodesic-wait`: how near ahead (px beyond the robot's radius) an unexpected obstacle makes
+/// it wait, and over what angle either side of the heading.
+const WAIT_WITHIN_PX: f64 = 15.0;
+const WAIT_HALF_ANGLE_DEG: f64 = 40.0;
+/// Most steps in a row it waits before going on regardless (a still obstacle that appeared in the
+/// corridor would otherwise hold it for ever).
+const MAX_WAIT_STEPS: u32 = 40;
+
+/// Shortest-path following that gives way: where the laser sees an obstacle the still scene does
+/// not have close ahead (a moving or appeared one), it waits, turning on the spot left then right,
+/// until the way is clear (at most [`MAX_WAIT_STEPS`] in a row).
+#[derive(Debug, Default)]
+pub struct GeodesicWait {
+    inner: Geodesic,
+    waited: u32,
+    last_wait: Option<DiscreteAction>,
+}
+
+impl Policy for GeodesicWait {
+    fn reset(&mut self, world: &World, episode: &Episode) -> Result<(), PolicyError> {
+        self.waited = 0;
+        self.last_wait = None;
+        self.inner.reset(world, episode)
+    }
+
+    fn act(&mut self, episode: &Episode) -> Result<Decision, PolicyError> {
+        // Finish a wait's turn back to the heading first.
+        if self.last_wait == Some(DiscreteAction::Left) {
+            self.last_wait = Some(DiscreteAction::Right);
+            return Ok(Decision::Act(DiscreteAction::Right.into()));
+        }
+        let decision = self.inner.act(episode)?;
+        let ahead = matches!(decision, Decision::Act(a) if a == DiscreteAction::Ahead.into());
+        let reach = episode.config().robot.radius_px + WAIT_WITHIN_PX;
+        let blocked = ahead
+            && super::dodge::unexpected(episode)
+                .iter()
+                .any(|&(angle, d)| angle.abs() <= WAIT_HALF_ANGLE_DEG && d <= reach);
+        if blocked && self.waited < MAX_WAIT_STEPS {
+            self.waited += 1;
+            self.last_wait = Some(DiscreteAction::Left);
+            return Ok(Decision::Act(DiscreteAction::Left.into()));
+        }
+        self.waited = 0;
+        self.last_wait = None;
+        Ok(decision)
+    }
+}
+
 /// Grid points of the path an [`Expert`] smooths: about the next 400 px, plenty for its label
 /// (smoothing the whole path for every sample costs 3x the time and changes 0.5% of labels).
 const EXPERT_PATH_POINTS: usize = 80;

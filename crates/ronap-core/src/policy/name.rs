@@ -1,4 +1,5 @@
-//! Policies by name, as users give them: a built-in (`apf`, `geodesic`, `random`) or
+//! Policies by name, as users give them: a built-in (`apf`, `geodesic`, `geodesic-wait`,
+//! `random`) or
 //! `mlp:FILE[@RULE]`.
 
 use crate::policy::mlp::{self, DecisionRule, MlpFactory};
@@ -11,13 +12,15 @@ pub enum Builtin {
     Apf,
     /// Descent on the geodesic distance to the goal: a navigation function with no local minima.
     Geodesic,
+    /// Shortest-path following that waits while the laser sees a moving obstacle close ahead.
+    GeodesicWait,
     /// Uniformly random discrete actions: the floor.
     Random,
 }
 
 impl Builtin {
     /// Every built-in policy with its name and a one-line description.
-    pub const ALL: [(Builtin, &'static str, &'static str); 3] = [
+    pub const ALL: [(Builtin, &'static str, &'static str); 4] = [
         (
             Builtin::Apf,
             "apf",
@@ -27,6 +30,11 @@ impl Builtin {
             Builtin::Geodesic,
             "geodesic",
             "follows the shortest path (descent on geodesic distance: no local minima)",
+        ),
+        (
+            Builtin::GeodesicWait,
+            "geodesic-wait",
+            "geodesic, but waits (turning on the spot) while the laser sees a moving obstacle close ahead",
         ),
         (
             Builtin::Random,
@@ -57,6 +65,7 @@ impl PolicyFactory for Builtin {
         Ok(match self {
             Builtin::Apf => Box::new(apf::Apf::default()),
             Builtin::Geodesic => Box::new(geodesic::Geodesic::default()),
+            Builtin::GeodesicWait => Box::new(geodesic::GeodesicWait::default()),
             Builtin::Random => Box::new(random::RandomPolicy::default()),
         })
     }

@@ -28,6 +28,10 @@ pub const START: Rgb<u8> = Rgb([220, 30, 30]);
 pub const GOAL: Rgb<u8> = Rgb([30, 170, 60]);
 /// Path colour.
 pub const PATH: Rgb<u8> = Rgb([40, 80, 230]);
+/// Moving obstacle colour.
+pub const MOVER: Rgb<u8> = Rgb([235, 120, 20]);
+/// Moving obstacles' tracks: the mover colour faded.
+pub const MOVER_TRACK: Rgb<u8> = Rgb([250, 210, 170]);
 
 /// Colour of a laser ray of class `class`.
 pub fn ray_colour(class: RayClass) -> Rgb<u8> {
@@ -56,7 +60,81 @@ impl Canvas {
         for b in scene.boxes() {
             canvas.fill_box(b, WALL);
         }
+        for shape in scene.shapes() {
+            match shape.as_disc() {
+                Some((c, r)) => canvas.fill_disc(c, r, WALL),
+                None => canvas.fill_polygon(&shape.corners(), WALL),
+            }
+        }
         canvas
+    }
+
+    /// Fills the pixels whose centres lie in the convex polygon of `corners` (counter-clockwise).
+    pub fn fill_polygon(&mut self, corners: &[Point], colour: Rgb<u8>) {
+        let (w, h) = self.image.dimensions();
+        let (lo, hi) = corners.iter().fold(
+            (
+                Point::new(f64::MAX, f64::MAX),
+                Point::new(f64::MIN, f64::MIN),
+            ),
+            |(lo, hi), p| {
+                (
+                    Point::new(lo.x.min(p.x), lo.y.min(p.y)),
+                    Point::new(hi.x.max(p.x), hi.y.max(p.y)),
+                )
+            },
+        );
+        let (Some((c0, c1)), Some((r0, r1))) = (
+            self.pixel_span(lo.x, hi.x, w),
+            self.pixel_span(lo.y, hi.y, h),
+        ) else {
+            return;
+        };
+        let n = corners.len();
+        for r in r0..=r1 {
+            for c in c0..=c1 {
+                let p = Point::new((c as f64 + 0.5) / self.scale, (r as f64 + 0.5) / self.scale);
+                let inside = (0..n).all(|i| {
+                    let (a, b) = (corners[i], corners[(i + 1) % n]);
+                    (b - a).perp(&(p - a)) >= 0.0
+                });
+                if inside {
+                    self.image.put_pixel(c, h - 1 - r, colour);
+                }
+            }
+        }
+    }
+
+    /// Draws the present moving obstacles where they are.
+    pub fn movers(&mut self, movers: &crate::sim::moving::Movers) {
+        for m in movers.items().iter().filter(|m| m.present()) {
+            self.mover(m.body(), m.position(), MOVER);
+        }
+    }
+
+    /// Draws a moving obstacle's `body` at `center`.
+    pub fn mover(&mut self, body: crate::sim::moving::Body, center: Point, colour: Rgb<u8>) {
+        match body {
+            crate::sim::moving::Body::Disc(r) => self.fill_disc(center, r, colour),
+            crate::sim::moving::Body::Box(_) => self.fill_box(&body.aabb(center), colour),
+        }
+    }
+
+    /// Draws moving obstacles' tracks faded: each a polyline of its positions while present.
+    pub fn tracks(&mut self, tracks: &[Vec<Option<Point>>]) {
+        for track in tracks {
+            let mut piece: Vec<Point> = Vec::new();
+            for p in track {
+                match p {
+                    Some(p) => piece.push(*p),
+                    None => piece.clear(),
+                }
+                if piece.len() > 1 && p.is_some() {
+                    let n = piece.len();
+                    self.line(piece[n - 2], piece[n - 1], 1.5, MOVER_TRACK);
+                }
+            }
+        }
     }
 
     /// Image pixels per scene px.
@@ -191,6 +269,9 @@ pub fn top_down(episode: &crate::sim::episode::Episode, path: &[Point], scale: f
         GOAL,
     );
     canvas.path(path, 2.0, PATH);
+    if let Some(movers) = episode.movers() {
+        canvas.movers(movers);
+    }
     canvas.scan(episode.laser(), episode.pose(), episode.readings());
     canvas.robot(episode.start(), config.robot.radius_px.max(least), START);
     canvas.robot(episode.pose(), config.robot.radius_px.max(least), PATH);
@@ -202,7 +283,7 @@ pub const RANGE_CIRCLE: Rgb<u8> = Rgb([150, 150, 150]);
 
 /// Every colour the pictures of this module use: floor, walls, markers, path, rays and the range
 /// circle. An animation encodes with exactly these ([`crate::render::gif`]).
-pub const PALETTE: [Rgb<u8>; 9] = [
+pub const PALETTE: [Rgb<u8>; 11] = [
     FLOOR,
     WALL,
     START,
@@ -212,6 +293,8 @@ pub const PALETTE: [Rgb<u8>; 9] = [
     Rgb([235, 190, 20]),
     Rgb([225, 40, 40]),
     RANGE_CIRCLE,
+    MOVER,
+    MOVER_TRACK,
 ];
 
 #[cfg(test)]

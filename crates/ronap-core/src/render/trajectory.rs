@@ -1,11 +1,12 @@
 //! Trajectory pictures like the paper's Figures 7-9: a finished episode over its whole scene.
 
 use crate::eval::EpisodeRecord;
-use crate::render::{Canvas, GOAL, PATH, START};
+use crate::render::{Canvas, GOAL, MOVER, PATH, START};
 use crate::sim::lidar::Laser;
 
 /// The picture of an episode: the whole scene, the path in blue, the start in red, the goal in
-/// green, and the last laser scan in its colour classes. Needs the record's trajectory and world
+/// green, the last laser scan in its colour classes, and moving obstacles' tracks faded with each
+/// obstacle where it was at the end. Needs the record's trajectory and world
 /// (`None` once the record is stripped).
 pub fn trajectory_image(record: &EpisodeRecord, scale: f64) -> Option<image::RgbImage> {
     let world = record.world.as_ref()?;
@@ -18,6 +19,20 @@ pub fn trajectory_image(record: &EpisodeRecord, scale: f64) -> Option<image::Rgb
         GOAL,
     );
     let points: Vec<_> = record.trajectory.iter().map(|p| p.position()).collect();
+    if !record.mover_tracks.is_empty() {
+        let episode = world.episode(record.seed).ok()?;
+        canvas.tracks(&record.mover_tracks);
+        for (m, track) in episode
+            .movers()
+            .map_or(&[][..], |m| m.items())
+            .iter()
+            .zip(&record.mover_tracks)
+        {
+            if let Some(Some(last)) = track.iter().rev().find(|p| p.is_some()) {
+                canvas.mover(m.body(), *last, MOVER);
+            }
+        }
+    }
     canvas.path(&points, 2.0, PATH);
     let laser = Laser::new(&config.laser);
     canvas.scan(&laser, record.end, &record.last_readings);

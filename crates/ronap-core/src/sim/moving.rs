@@ -143,6 +143,8 @@ pub struct Mover {
     motion: Motion,
     /// `appear`: the step it appears in, until it has.
     appears_at: Option<u32>,
+    /// Its fixed start overlaps the robot: absent until the robot is clear of it.
+    held: bool,
     min_gap: f64,
     /// A disc round `free_center` clear of the still scene: moves that stay inside it need no
     /// query (radius 0 until first measured).
@@ -218,7 +220,7 @@ impl Mover {
 
     /// Whether it is in the scene (an `appear` obstacle is not, until its step).
     pub fn present(&self) -> bool {
-        self.appears_at.is_none()
+        self.appears_at.is_none() && !self.held
     }
 }
 
@@ -320,12 +322,8 @@ impl Movers {
                 })?
             }
         };
-        if appears_at.is_none() && body.gap(position, start, robot_radius) < 0.0 {
-            return Err(format!(
-                "start ({}, {}) overlaps the robot's start ({:.1}, {:.1})",
-                position.x, position.y, start.x, start.y
-            ));
-        }
+        // A fixed start on the robot's drawn start: held back until the robot has left it.
+        let held = appears_at.is_none() && body.gap(position, start, robot_radius) < 0.0;
         let motion = match kind {
             MotionKind::Still | MotionKind::Appear => Motion::Still,
             MotionKind::Linear | MotionKind::RandomWalk => {
@@ -355,6 +353,7 @@ impl Movers {
             speed: m.speed_px,
             motion,
             appears_at,
+            held,
             min_gap: m.min_robot_distance_px,
             free_center: position,
             free_radius: 0.0,
@@ -383,6 +382,12 @@ impl Movers {
                     }
                 }
                 continue;
+            }
+            if m.held {
+                if m.body.gap(m.position, robot, radius) < 0.0 {
+                    continue;
+                }
+                m.held = false;
             }
             let from = m.position;
             let to = match &mut m.motion {
