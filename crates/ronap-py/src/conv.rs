@@ -1,15 +1,70 @@
 //! Every conversion between Python and Rust values: the validated configuration (which crosses
-//! the boundary once, as a [`Config`] object), scenes, actions, info dictionaries, images and
+//! the boundary once, as a [`Config`] object), scenario files and dicts (a [`Scenario`], the base
+//! a configuration's keyword arguments override), scenes, actions, info dictionaries, images and
 //! JSON values.
 
 use crate::errors;
 use numpy::{PyArray1, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
+use ronap_core::config::ConfigFile;
 use ronap_core::scene::map::MapSource;
 use ronap_core::sim::world::{SceneSpec, Scenes};
 use ronap_core::{Action, DiscreteAction, Episode, SimConfig, Status, ValidConfig};
-use std::path::Path;
+use serde_json::{Map, Value};
+use std::path::{Path, PathBuf};
+
+/// A scenario: the configuration a TOML file or a dict sets (every unset field at its default),
+/// not yet checked, since keyword arguments may still override it. A file keeps its text, so a
+/// bad value it sets is named by file and line.
+#[pyclass(module = "ronap._ronap", frozen)]
+pub struct Scenario {
+    config: SimConfig,
+    file: Option<ConfigFile>,
+}
+
+#[pymethods]
+impl Scenario {
+    /// Reads a scenario file (TOML, the CLI's `--scenario`); a map scene's file is taken relative
+    /// to it. An unreadable file, an unknown key or a wrong type raises `ConfigError` naming the
+    /// file, line, key and value.
+    #[staticmethod]
+    fn read(path: PathBuf) -> PyResult<Self> {
+        let file =
+            ConfigFile::read(&path).map_err(|e| errors::ConfigError::new_err(e.to_string()))?;
+        let config = file
+            .parse()
+            .map_err(|e| errors::ConfigError::new_err(e.to_string()))?;
+        Ok(Self {
+            config,
+            file: Some(file),
+        })
+    }
+
+    /// A scenario from JSON text nested like the TOML file (`{"scene": {"kind": "warehouse"},
+    /// "moving": [{"count": 5}]}`); a map scene's file stays relative to the current directory.
+    /// An unknown key or a wrong type raises `ConfigError` naming the key and value.
+    #[staticmethod]
+    fn from_json(json: &str) -> PyResult<Self> {
+        let value: Value = serde_json::from_str(json)
+            .map_err(|e| errors::ConfigError::new_err(format!("scenario: {e}")))?;
+        let config = sim_config(value)
+            .map_err(|e| errors::ConfigError::new_err(format!("scenario: {e}")))?;
+        Ok(Self { config, file: None })
+    }
+
+    /// The complete configuration the scenario sets, as JSON text.
+    #[getter]
+    fn json(&self) -> String {
+        serde_json::to_string(&self.config).unwrap_or_default()
+    }
+
+    /// The scenario file, or None for a dict.
+    #[getter]
+    fn path(&self) -> Option<PathBuf> {
+        self.file.as_ref().map(|f| f.path().to_path_buf())
+    }
+}
 
 /// A checked configuration: made once from the JSON of the Python-side dict, then handed to
 /// environments and the evaluator as it is.
@@ -21,14 +76,19 @@ pub struct Config {
 #[pymethods]
 impl Config {
     /// Reads a configuration from JSON text (nested like the TOML file), fills in every default
-    /// and checks it; a bad field raises `ConfigError` naming it.
+    /// and checks it; a bad field raises `ConfigError` naming it. `scenario` is the scenario the
+    /// JSON was built on (its values, then the keyword arguments): a bad value that came from a
+    /// scenario file is named by file and line.
     #[new]
-    fn new(json: &str) -> PyResult<Self> {
-        let sim: SimConfig =
+    #[pyo3(signature = (json, scenario = None))]
+    fn new(json: &str, scenario: Option<&Scenario>) -> PyResult<Self> {
+        let value: Value =
             serde_json::from_str(json).map_err(|e| errors::ConfigError::new_err(e.to_string()))?;
+        let sim = sim_config(value).map_err(errors::ConfigError::new_err)?;
         let valid = sim
+            .clone()
             .validate()
-            .map_err(|e| errors::ConfigError::new_err(e.to_string()))?;
+            .map_err(|e| errors::ConfigError::new_err(invalid(e, &sim, scenario)))?;
         Ok(Self { valid })
     }
 
@@ -52,13 +112,117 @@ impl Config {
     }
 }
 
-/// Where episodes take place: a map file, one maze, or a maze per seed.
+/// A configuration from a JSON value nested like the TOML file. An unknown key or a wrong type is
+/// an error naming the key (`maze.cols`, `moving[0].motion`) and the value.
+fn sim_config(value: Value) -> Result<SimConfig, String> {
+    serde_json::from_value(value.clone())
+        .map_err(|e| culprit(&value).unwrap_or_else(|| e.to_string()))
+}
+
+/// The first key of `value` that a configuration does not take, as `key = value: why`: each
+/// section, each field and each array entry is read on its own until one fails.
+fn culprit(value: &Value) -> Option<String> {
+    let Value::Object(top) = value else {
+        return Some(format!(
+            "{value}: expected a dict of sections (`{{\"maze\": {{\"cols\": 5}}}}`)"
+        ));
+    };
+    for (section, v) in top {
+        let probe = |inner: Value| {
+            let mut m = Map::new();
+            m.insert(section.clone(), inner);
+            serde_json::from_value::<SimConfig>(Value::Object(m)).err()
+        };
+        // The section itself: an unknown name, or a table where an array belongs (or the reverse).
+        let empty = match v {
+            Value::Object(_) => Value::Object(Map::new()),
+            Value::Array(_) => Value::Array(Vec::new()),
+            other => other.clone(),
+        };
+        if let Some(e) = probe(empty) {
+            return Some(format!("{section} = {v}: {e}"));
+        }
+        let one = |field: &String, x: &Value| {
+            let mut m = Map::new();
+            m.insert(field.clone(), x.clone());
+            Value::Object(m)
+        };
+        match v {
+            Value::Object(fields) => {
+                for (field, x) in fields {
+                    if let Some(e) = probe(one(field, x)) {
+                        return Some(format!("{section}.{field} = {x}: {e}"));
+                    }
+                }
+            }
+            Value::Array(items) => {
+                for (i, item) in items.iter().enumerate() {
+                    // An obstacle's fields depend on its shape, so it is read whole.
+                    if let (Value::Object(fields), "moving") = (item, section.as_str()) {
+                        for (field, x) in fields {
+                            if let Some(e) = probe(Value::Array(vec![one(field, x)])) {
+                                return Some(format!("{section}[{i}].{field} = {x}: {e}"));
+                            }
+                        }
+                    }
+                    if let Some(e) = probe(Value::Array(vec![item.clone()])) {
+                        return Some(format!("{section}[{i}] = {item}: {e}"));
+                    }
+                }
+            }
+            _ => {}
+        }
+        if let Some(e) = probe(v.clone()) {
+            return Some(format!("{section} = {v}: {e}"));
+        }
+    }
+    None
+}
+
+/// The message of a validation error of `sim`, built on `scenario`: a value the scenario file
+/// set is named by file and line (as `ronap run --scenario` does), one a scenario dict set is
+/// said to come from the scenario; a value from the keyword arguments is named as it is.
+fn invalid(e: ronap_core::ConfigError, sim: &SimConfig, scenario: Option<&Scenario>) -> String {
+    let Some(scenario) = scenario else {
+        return e.to_string();
+    };
+    let ronap_core::ConfigError::OutOfRange { field, .. } = &e else {
+        return e.to_string();
+    };
+    let pointer = format!(
+        "/{}",
+        field.replace('[', "/").replace(']', "").replace('.', "/")
+    );
+    let (ours, theirs) = (
+        serde_json::to_value(sim).unwrap_or_default(),
+        serde_json::to_value(&scenario.config).unwrap_or_default(),
+    );
+    if ours.pointer(&pointer) != theirs.pointer(&pointer) {
+        return e.to_string();
+    }
+    let Some(file) = &scenario.file else {
+        return format!("scenario: {e}");
+    };
+    let overridden = *sim != scenario.config;
+    match file.locate(e) {
+        located @ ronap_core::ConfigError::File { .. } => located.to_string(),
+        other if overridden => format!(
+            "invalid configuration from scenario {} and keyword arguments: {other}",
+            file.path().display()
+        ),
+        other => format!("{}: {other}", file.path().display()),
+    }
+}
+
+/// Where episodes take place: the configuration's `[scene]` (a maze or warehouse per seed, one
+/// of them, or a map file), unless `maze_seed` (one scene of that seed) or `map_path` overrides
+/// it, as the CLI's `--maze-seed` and `--map` override a scenario's.
 pub fn scenes(
     config: &ValidConfig,
     maze_seed: Option<u64>,
     map_path: Option<&str>,
 ) -> PyResult<(SceneSpec, Scenes, Option<MapSource>)> {
-    let spec = SceneSpec::from_options(maze_seed, map_path.map(Path::new));
+    let spec = SceneSpec::resolve(&config.scene, maze_seed, map_path.map(Path::new));
     let (scenes, source) = spec.load(config).map_err(errors::scene)?;
     Ok((spec, scenes, source))
 }
@@ -121,6 +285,9 @@ pub fn info<'py>(
     d.set_item("steps", episode.steps())?;
     d.set_item("collisions", episode.collisions())?;
     d.set_item("seed", episode.seed())?;
+    if let Some(dynamic) = episode.dynamic_metrics() {
+        d.set_item("dynamic_collisions", dynamic.collisions)?;
+    }
     Ok(d)
 }
 
@@ -179,5 +346,13 @@ pub fn record<'py>(
     row.set_item("end", (r.end.x, r.end.y, r.end.z_deg))?;
     row.set_item("reason", r.reason.clone())?;
     row.set_item("wall_time_s", r.wall_time_s)?;
+    // Among moving obstacles, the columns `episodes.csv` gains.
+    if let Some(d) = r.dynamic {
+        row.set_item("dynamic_collisions", d.collisions)?;
+        let clearance = d.min_clearance_px.is_finite().then_some(d.min_clearance_px);
+        row.set_item("min_clearance_px", clearance)?;
+        let near = f64::from(d.near_steps) / f64::from(r.steps.max(1));
+        row.set_item("near_moving_fraction", near)?;
+    }
     Ok(row)
 }

@@ -14,7 +14,8 @@ pyo3::create_exception!(
     ronap,
     ConfigError,
     RonapError,
-    "A configuration value is out of range or unknown; the message names the field and value."
+    "A configuration value is out of range or unknown, or a scenario file cannot be read; the message \
+     names the field and value (and the file and line for a value a scenario file sets)."
 );
 pyo3::create_exception!(
     ronap,

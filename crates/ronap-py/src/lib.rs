@@ -11,7 +11,7 @@ mod errors;
 mod evaluate;
 mod vec_env;
 
-use conv::Config;
+use conv::{Config, Scenario};
 use numpy::{PyArray2, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use ronap_core::SimConfig;
@@ -78,6 +78,7 @@ fn builtin_policies() -> Vec<(&'static str, &'static str)> {
 fn _ronap(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
     m.add_class::<Config>()?;
+    m.add_class::<Scenario>()?;
     m.add_class::<env::Env>()?;
     m.add_class::<vec_env::VecEnv>()?;
     m.add_function(wrap_pyfunction!(default_config_json, m)?)?;

@@ -163,4 +163,4 @@ def test_mazes_as_arrays():
     assert img.shape == (500, 500, 3)
     small = ronap.maze_occupancy(7, scale=0.5)
     assert np.array_equal(small, np.all(img == 0, axis=-1))
-    assert set(ronap.policies()) == {"apf", "geodesic", "random"}
+    assert set(ronap.policies()) == {"apf", "geodesic", "geodesic-wait", "random"}

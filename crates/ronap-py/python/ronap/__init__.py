@@ -6,7 +6,13 @@
   built-in policy.
 - ``maze_occupancy`` / ``maze_image``: scenes as numpy arrays; ``default_config()``, ``policies()``.
 
-Every error is a ``RonapError``; configuration errors (``ConfigError``) name the field and value.
+``NavEnv``, ``VecNavEnv``, ``evaluate`` and ``make_config`` take ``scenario=``: a TOML scenario
+file, as ``ronap run --scenario`` reads, or a dict nested like one (scene, static and moving
+obstacles, robot, laser, episode, reward), which keyword arguments (``laser_beams=9``,
+``config={...}``, ``maze_seed=``, ``map=``) override.
+
+Every error is a ``RonapError``; configuration errors (``ConfigError``) name the field and value,
+and the file and line for a value a scenario file sets.
 """
 
 from ._ronap import (

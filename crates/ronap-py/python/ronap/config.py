@@ -1,15 +1,24 @@
-"""Configuration: the same fields as the CLI's TOML file, as a nested dict or keyword arguments."""
+"""Configuration: the same fields as the CLI's TOML file, as a nested dict or keyword arguments,
+on top of an optional scenario (a TOML file or a dict of the same structure)."""
 
 from __future__ import annotations
 
 import json
-from typing import Any, Mapping
+import os
+from typing import Any, Mapping, Union
 
 from . import _ronap
 from ._ronap import ConfigError
 
+ScenarioLike = Union[str, os.PathLike, Mapping[str, Any]]
+"""A scenario: the path of a TOML scenario file (as ``ronap run --scenario`` takes) or a dict
+nested like it (``{"scene": {"kind": "warehouse"}, "moving": [{"count": 5}]}``)."""
 
-def default_config() -> dict[str, dict[str, Any]]:
+# Top-level entries of a configuration that are arrays of tables, not sections.
+_ARRAYS = ("obstacles", "moving")
+
+
+def default_config() -> dict[str, Any]:
     """Every field with its default, nested by section like ``ronap config`` prints it."""
     return json.loads(_ronap.default_config_json())
 
@@ -17,30 +26,80 @@ def default_config() -> dict[str, dict[str, Any]]:
 def _merge(into: dict, section: str, field: str, value: Any) -> None:
     if section not in into:
         raise ConfigError(f"unknown configuration section {section!r} (in {section}.{field})")
+    if section in _ARRAYS:
+        raise ConfigError(f"{section}.{field}: {section} is a list of entries; give the whole list ({section}=[{{...}}, ...] in config)")
     into[section][field] = value
 
 
-def checked_config(config: Mapping[str, Any] | None, fields: Mapping[str, Any]) -> _ronap.Config:
-    """The configuration as the extension takes it: merged here, then checked once in Rust."""
-    return _ronap.Config(json.dumps(_merged(config, fields)))
+def _plain(value: Any) -> Any:
+    """A value json cannot write as it is: a path as its text, a numpy scalar or array as numbers."""
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    raise ConfigError(f"{value!r}: not a configuration value (expected numbers, strings, booleans, lists or dicts)")
 
 
-def make_config(config: Mapping[str, Any] | None = None, **fields: Any) -> dict[str, dict[str, Any]]:
+def _json(value: Any) -> str:
+    return json.dumps(value, default=_plain)
+
+
+def load_scenario(scenario: ScenarioLike | _ronap.Scenario | None) -> _ronap.Scenario | None:
+    """The scenario as the extension takes it, read (a file) or checked for unknown keys and
+    wrong types (a dict); ``ConfigError`` names the file, line, key and value."""
+    if scenario is None or isinstance(scenario, _ronap.Scenario):
+        return scenario
+    if isinstance(scenario, (str, os.PathLike)):
+        return _ronap.Scenario.read(os.fspath(scenario))
+    if isinstance(scenario, Mapping):
+        return _ronap.Scenario.from_json(_json(dict(scenario)))
+    raise ConfigError(f"scenario {scenario!r}: expected the path of a TOML scenario file or a dict nested like one")
+
+
+def checked_config(
+    config: Mapping[str, Any] | None,
+    fields: Mapping[str, Any],
+    scenario: ScenarioLike | _ronap.Scenario | None = None,
+) -> _ronap.Config:
+    """The configuration as the extension takes it: the scenario (else the defaults), then
+    ``config``, then ``fields``, merged here and checked once in Rust."""
+    base = load_scenario(scenario)
+    merged = _merged(config, fields, None if base is None else json.loads(base.json))
+    return _ronap.Config(_json(merged), base)
+
+
+def make_config(
+    config: Mapping[str, Any] | None = None,
+    *,
+    scenario: ScenarioLike | None = None,
+    **fields: Any,
+) -> dict[str, Any]:
     """A complete, checked configuration.
 
-    ``config`` is nested (``{"maze": {"cols": 5}}``) or flat with dotted keys
-    (``{"maze.cols": 5}``); keyword arguments name ``section_field`` (``maze_cols=5``) and win.
-    Raises ``ConfigError`` naming the field and value for anything unknown or out of range.
+    ``scenario`` (a TOML scenario file or a dict nested like one) gives the starting values,
+    else the defaults. ``config`` is nested (``{"maze": {"cols": 5}}``, ``{"moving": [...]}``) or
+    flat with dotted keys (``{"maze.cols": 5}``) and overrides it; keyword arguments name
+    ``section_field`` (``maze_cols=5``) and win over both. Raises ``ConfigError`` naming the
+    field and value for anything unknown or out of range, and the file and line for a bad value
+    a scenario file sets.
     """
-    return json.loads(checked_config(config, fields).json)
+    return json.loads(checked_config(config, fields, scenario).json)
 
 
-def _merged(config: Mapping[str, Any] | None, fields: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
-    merged = default_config()
+def _merged(
+    config: Mapping[str, Any] | None,
+    fields: Mapping[str, Any],
+    base: dict[str, Any] | None = None,
+) -> dict[str, Any]:
+    merged = default_config() if base is None else base
     for key, value in (config or {}).items():
         if "." in key:
             section, field = key.split(".", 1)
             _merge(merged, section, field, value)
+        elif key in _ARRAYS:
+            if isinstance(value, (str, bytes, Mapping)) or not hasattr(value, "__iter__"):
+                raise ConfigError(f"configuration key {key!r}: expected a list of entries (dicts), got {value!r}")
+            merged[key] = list(value)
         elif isinstance(value, Mapping):
             if key not in merged:
                 raise ConfigError(f"unknown configuration section {key!r}")

@@ -12,7 +12,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from . import _ronap
-from .config import checked_config
+from .config import ScenarioLike, checked_config
 
 _SEED_LIMIT = 2**63
 
@@ -25,7 +25,16 @@ class NavEnv(gym.Env):
     2 RIGHT), or with ``continuous=True`` ``Box(-1, 1, (2,))``: ``(v / v_max, w / w_max)``.
     ``terminated`` on success (and on collision with ``robot_on_collision="terminate"``, or at
     ``episode_reward_min``); ``truncated`` on time-out. ``info`` holds distance, collided,
-    success, pose, goal, status, steps, collisions and the episode seed.
+    success, pose, goal, status, steps, collisions and the episode seed, and with moving
+    obstacles ``dynamic_collisions`` (steps with contact between the robot and one, so far).
+
+    The configuration: ``scenario`` (the path of a TOML scenario file, as ``ronap run
+    --scenario`` takes, or a dict nested like one) gives the base and the scene, else the
+    defaults; ``config`` (a nested or dotted dict) overrides it and keyword arguments
+    ``section_field=value`` (``laser_beams=9``) override both; ``maze_seed`` (one maze or
+    warehouse of that seed) and ``map`` (an image or ROS map file) override the scenario's
+    ``[scene]``. A bad value raises ``ConfigError`` naming the field and value, and the file and
+    line when a scenario file sets it.
 
     ``reset(seed=s)`` plays the episode of seed ``s`` (the same as ``ronap run`` seed ``s``);
     ``reset()`` draws the next episode seed from the environment's generator.
@@ -37,6 +46,7 @@ class NavEnv(gym.Env):
         self,
         render_mode: str | None = None,
         *,
+        scenario: ScenarioLike | None = None,
         config: Mapping[str, Any] | None = None,
         continuous: bool = False,
         maze_seed: int | None = None,
@@ -49,7 +59,7 @@ class NavEnv(gym.Env):
             raise _ronap.ConfigError(f"render_mode {render_mode!r}: expected None or 'rgb_array'")
         if render_view not in ("top", "first_person"):
             raise _ronap.ConfigError(f"render_view {render_view!r}: expected 'top' or 'first_person'")
-        checked = checked_config(config, fields)
+        checked = checked_config(config, fields, scenario)
         self._env = _ronap.Env(checked, maze_seed, None if map is None else str(map), continuous)
         self.config = json.loads(checked.json)
         self.render_mode = render_mode
@@ -94,6 +104,9 @@ class VecNavEnv(VectorEnv):
     Next-step autoreset: the step after an episode ends resets that environment (its action is
     ignored) and returns the new episode's first observation with reward 0. ``reset(seed=s)`` gives
     environment ``i`` the episode seeds ``s + i``, ``s + i + n``, ``s + i + 2n``, ...
+
+    ``scenario``, ``config``, keyword arguments, ``maze_seed`` and ``map`` configure every
+    environment as they do ``NavEnv``.
     """
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
@@ -102,13 +115,16 @@ class VecNavEnv(VectorEnv):
         self,
         num_envs: int,
         *,
+        scenario: ScenarioLike | None = None,
         config: Mapping[str, Any] | None = None,
         maze_seed: int | None = None,
         map: str | None = None,
         threads: int = 0,
         **fields: Any,
     ) -> None:
-        self._vec = _ronap.VecEnv(num_envs, checked_config(config, fields), maze_seed, None if map is None else str(map), threads)
+        checked = checked_config(config, fields, scenario)
+        self.config = json.loads(checked.json)
+        self._vec = _ronap.VecEnv(num_envs, checked, maze_seed, None if map is None else str(map), threads)
         self.num_envs = num_envs
         n = self._vec.observation_size
         self.single_observation_space = spaces.Box(0.0, 1.0, (n,), np.float32)

@@ -5,13 +5,14 @@ from __future__ import annotations
 from typing import Any, Callable, Iterable, Mapping
 
 from . import _ronap
-from .config import checked_config
+from .config import ScenarioLike, checked_config
 
 
 def evaluate(
     policy: str | Callable[[Any], Any],
     seeds: Iterable[int] = range(1000),
     *,
+    scenario: ScenarioLike | None = None,
     config: Mapping[str, Any] | None = None,
     maze_seed: int | None = None,
     map: str | None = None,
@@ -36,6 +37,19 @@ def evaluate(
     ``timing.csv``, ``summary.json`` and, as asked, ``png/`` pictures (``png``: a count, ``"failures"``
     or ``"all"``) and ``steps/`` logs, as ``ronap run`` does.
 
+    The configuration: ``scenario`` (the path of a TOML scenario file, as ``ronap run --scenario``
+    takes, or a dict nested like one) gives the base and the scene; ``config`` and keyword
+    arguments ``section_field=value`` override it, and ``maze_seed`` / ``map`` override its
+    ``[scene]``, as flags do on the command line. ``summary.json`` records the whole configuration
+    (obstacles, moving obstacles, scene) and where episodes took place, so ``ronap replay`` can
+    replay the run's step logs.
+
+    With moving obstacles, each episode row also has ``dynamic_collisions`` (steps with contact
+    between the robot and a moving obstacle), ``min_clearance_px`` (least gap to any obstacle
+    seen within laser range, None if none came that close) and ``near_moving_fraction`` (the
+    fraction of steps within ``episode_safety_radius_px`` of one), and the summary a ``moving``
+    dict of their figures.
+
     A policy that raises or returns an invalid action or NaN raises ``PolicyError`` naming the seed
     and step.
     """
@@ -43,7 +57,7 @@ def evaluate(
     return _ronap.evaluate(
         policy,
         seeds,
-        checked_config(config, fields),
+        checked_config(config, fields, scenario),
         maze_seed,
         None if map is None else str(map),
         threads,
