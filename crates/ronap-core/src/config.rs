@@ -264,6 +264,28 @@ pub struct WarehouseConfig {
     pub wall_thickness_px: f64,
 }
 
+impl WarehouseConfig {
+    /// Width and height of the warehouse, px: walls, side aisles, the racks along a row with a
+    /// cross aisle after every `cross_aisle_every` of them (not after the last), and bottom to top
+    /// the loading area, the border aisle and each rack pair with the aisle above it.
+    pub fn size_px(&self) -> (f64, f64) {
+        let n = self.racks_per_row as usize;
+        let cross_aisles = n
+            .saturating_sub(1)
+            .checked_div(self.cross_aisle_every as usize)
+            .unwrap_or(0);
+        let width = 2.0 * self.wall_thickness_px
+            + 2.0 * self.aisle_px
+            + n as f64 * self.rack_length_px
+            + cross_aisles as f64 * self.aisle_px;
+        let height = 2.0 * self.wall_thickness_px
+            + self.loading_px
+            + self.aisle_px
+            + f64::from(self.rack_pairs) * (2.0 * self.rack_depth_px + self.aisle_px);
+        (width, height)
+    }
+}
+
 impl Default for WarehouseConfig {
     fn default() -> Self {
         Self {
@@ -759,13 +781,7 @@ impl SimConfig {
             format!("{:?}", w.clutter),
             "must be between 0 and 1",
         )?;
-        let wide = f64::from(w.racks_per_row) * w.rack_length_px
-            + f64::from(w.racks_per_row) * w.aisle_px
-            + 2.0 * w.wall_thickness_px;
-        let tall = w.loading_px
-            + f64::from(w.rack_pairs) * (2.0 * w.rack_depth_px + w.aisle_px)
-            + w.aisle_px
-            + 2.0 * w.wall_thickness_px;
+        let (wide, tall) = w.size_px();
         check(
             wide.max(tall) <= MAX_LENGTH_PX,
             "warehouse.racks_per_row",

@@ -108,12 +108,6 @@ impl Warehouse {
         }
     }
 
-    /// Width and height, px, of the warehouse `config` describes.
-    pub fn size(config: &WarehouseConfig) -> (f64, f64) {
-        let layout = Layout::new(config);
-        (layout.width, layout.height)
-    }
-
     /// The free loading area along the bottom, inside the walls.
     pub fn loading_area(config: &WarehouseConfig) -> Aabb {
         let layout = Layout::new(config);
@@ -166,15 +160,13 @@ impl Layout {
         let rack_x: Vec<f64> = (0..n)
             .map(|i| wall + aisle + i as f64 * rack_length + cross_before(i) as f64 * aisle)
             .collect();
-        let cross_aisles = cross_before(n.saturating_sub(1));
-        let width = 2.0 * wall + 2.0 * aisle + n as f64 * rack_length + cross_aisles as f64 * aisle;
+        let (width, height) = config.size_px();
         let pair_pitch = 2.0 * rack_depth + aisle;
         let first_pair = wall + config.loading_px + aisle;
         let pairs = config.rack_pairs as usize;
         let pair_y: Vec<f64> = (0..pairs)
             .map(|k| first_pair + k as f64 * pair_pitch)
             .collect();
-        let height = first_pair + pairs as f64 * pair_pitch + wall;
         Self {
             wall,
             aisle,
@@ -506,7 +498,7 @@ mod tests {
             };
             let warehouse = generate(&config, radius, seed);
             prop_assert_eq!(warehouse.racks.len(), 2 * (rack_pairs * racks_per_row) as usize);
-            prop_assert_eq!(Warehouse::size(&config), (warehouse.width_px, warehouse.height_px));
+            prop_assert_eq!(config.size_px(), (warehouse.width_px, warehouse.height_px));
         }
     }
 
@@ -515,7 +507,7 @@ mod tests {
         let config = WarehouseConfig::default();
         let warehouse = generate(&config, 5.0, 1);
         assert_eq!((warehouse.width_px, warehouse.height_px), (764.0, 544.0));
-        assert_eq!(Warehouse::size(&config), (764.0, 544.0));
+        assert_eq!(config.size_px(), (764.0, 544.0));
         assert_eq!(warehouse.racks.len(), 2 * 5 * 12);
         assert_eq!(warehouse.walls.len(), 4);
         for rack in &warehouse.racks {
@@ -553,7 +545,7 @@ mod tests {
             racks_per_row: 3,
             ..WarehouseConfig::default()
         };
-        let (w, h) = Warehouse::size(&plain);
+        let (w, h) = plain.size_px();
         assert_eq!(w, 2.0 * 2.0 + 2.0 * 40.0 + 3.0 * 50.0);
         assert_eq!(h, 2.0 * 2.0 + 150.0 + 40.0 + 2.0 * (30.0 + 40.0));
         assert_eq!(generate(&plain, 5.0, 0).racks.len(), 2 * 2 * 3);
