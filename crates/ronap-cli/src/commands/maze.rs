@@ -50,24 +50,20 @@ pub fn run(args: MazeArgs) -> Result<ExitCode> {
         None
     };
     // Moving obstacles where they start, and the tracks they follow while the robot stands still.
-    let movers = if config.moving.is_empty() {
-        None
+    let tracks = if config.moving.is_empty() {
+        Vec::new()
     } else {
         let mut episode = world
             .episode(seed)
             .context("cannot place the episode's robot and moving obstacles")?;
-        let first = episode.movers().cloned();
-        let mut tracks: Vec<Vec<_>> = Vec::new();
+        let mut tracks = Vec::new();
         for _ in 0..=args.track_steps {
             if let Some(m) = episode.movers() {
-                tracks.resize(m.items().len(), Vec::new());
-                for (t, o) in tracks.iter_mut().zip(m.items()) {
-                    t.push(o.present().then(|| o.position()));
-                }
+                m.record(&mut tracks);
             }
             episode.step(ronap_core::DiscreteAction::Left);
         }
-        first.map(|m| (m, tracks))
+        tracks
     };
     match &args.out {
         Some(path) => {
@@ -78,13 +74,11 @@ pub fn run(args: MazeArgs) -> Result<ExitCode> {
                 args.scale
             );
             let mut canvas = Canvas::new(&scene, args.scale);
-            if let Some((first, tracks)) = &movers {
-                canvas.tracks(tracks);
-                // Where each one starts (or first appears), drawn over its track.
-                for (m, track) in first.items().iter().zip(tracks) {
-                    if let Some(Some(p)) = track.iter().find(|p| p.is_some()) {
-                        canvas.mover(m.body(), *p, MOVER);
-                    }
+            canvas.tracks(&tracks);
+            // Where each one starts (or first appears), drawn over its track.
+            for track in &tracks {
+                if let Some(p) = track.first() {
+                    canvas.mover(track.body, p, MOVER);
                 }
             }
             if let Some(p) = placement {

@@ -91,16 +91,11 @@ impl Evaluator {
         let mut trajectory = Vec::new();
         let mut step_log = Vec::new();
         let mut tracks = Vec::new();
-        let record_tracks =
-            |e: &crate::sim::episode::Episode,
-             tracks: &mut Vec<Vec<Option<crate::geometry::Point>>>| {
-                if let Some(movers) = e.movers() {
-                    tracks.resize(movers.items().len(), Vec::new());
-                    for (t, m) in tracks.iter_mut().zip(movers.items()) {
-                        t.push(m.present().then(|| m.position()));
-                    }
-                }
-            };
+        let record_tracks = |e: &crate::sim::episode::Episode, tracks: &mut Vec<_>| {
+            if let Some(movers) = e.movers() {
+                movers.record(tracks);
+            }
+        };
         if recording.trajectory {
             trajectory.push(rollout.episode().pose());
             record_tracks(rollout.episode(), &mut tracks);

@@ -3,6 +3,7 @@
 
 use crate::geometry::Point;
 use crate::sim::episode::{DynamicMetrics, Status};
+use crate::sim::moving::Track;
 use crate::sim::robot::{Action, Pose};
 use crate::sim::world::World;
 use serde::Serialize;
@@ -114,9 +115,8 @@ pub struct EpisodeRecord {
     pub last_readings: Vec<f64>,
     /// Poses from start to end, when recorded.
     pub trajectory: Vec<Pose>,
-    /// Each moving obstacle's centre at each pose of `trajectory` (`None` while absent), when
-    /// recorded.
-    pub mover_tracks: Vec<Vec<Option<Point>>>,
+    /// Each moving obstacle's body and centre at each pose of `trajectory`, when recorded.
+    pub mover_tracks: Vec<Track>,
     /// How the episode went among moving obstacles; `None` without any.
     pub dynamic: Option<DynamicMetrics>,
     /// Steps, when recorded.

@@ -121,17 +121,11 @@ impl Canvas {
     }
 
     /// Draws moving obstacles' tracks faded: each a polyline of its positions while present.
-    pub fn tracks(&mut self, tracks: &[Vec<Option<Point>>]) {
+    pub fn tracks(&mut self, tracks: &[crate::sim::moving::Track]) {
         for track in tracks {
-            let mut piece: Vec<Point> = Vec::new();
-            for p in track {
-                match p {
-                    Some(p) => piece.push(*p),
-                    None => piece.clear(),
-                }
-                if piece.len() > 1 && p.is_some() {
-                    let n = piece.len();
-                    self.line(piece[n - 2], piece[n - 1], 1.5, MOVER_TRACK);
+            for pair in track.points.windows(2) {
+                if let [Some(a), Some(b)] = pair {
+                    self.line(*a, *b, 1.5, MOVER_TRACK);
                 }
             }
         }

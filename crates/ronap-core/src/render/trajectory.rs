@@ -19,18 +19,10 @@ pub fn trajectory_image(record: &EpisodeRecord, scale: f64) -> Option<image::Rgb
         GOAL,
     );
     let points: Vec<_> = record.trajectory.iter().map(|p| p.position()).collect();
-    if !record.mover_tracks.is_empty() {
-        let episode = world.episode(record.seed).ok()?;
-        canvas.tracks(&record.mover_tracks);
-        for (m, track) in episode
-            .movers()
-            .map_or(&[][..], |m| m.items())
-            .iter()
-            .zip(&record.mover_tracks)
-        {
-            if let Some(Some(last)) = track.iter().rev().find(|p| p.is_some()) {
-                canvas.mover(m.body(), *last, MOVER);
-            }
+    canvas.tracks(&record.mover_tracks);
+    for track in &record.mover_tracks {
+        if let Some(last) = track.last() {
+            canvas.mover(track.body, last, MOVER);
         }
     }
     canvas.path(&points, 2.0, PATH);

@@ -224,6 +224,28 @@ impl Mover {
     }
 }
 
+/// A moving obstacle's body and its centre at each recorded step (`None` while absent): what
+/// pictures draw of it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Track {
+    /// The body.
+    pub body: Body,
+    /// The centre at each recorded step, `None` while absent.
+    pub points: Vec<Option<Point>>,
+}
+
+impl Track {
+    /// Where it first was present.
+    pub fn first(&self) -> Option<Point> {
+        self.points.iter().flatten().next().copied()
+    }
+
+    /// Where it last was present.
+    pub fn last(&self) -> Option<Point> {
+        self.points.iter().flatten().next_back().copied()
+    }
+}
+
 /// Where a moving obstacle could not be placed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("moving[{entry}]: {message}")]
@@ -363,6 +385,19 @@ impl Movers {
     /// The obstacles.
     pub fn items(&self) -> &[Mover] {
         &self.items
+    }
+
+    /// Adds where each obstacle is now to `tracks` (one per obstacle, made on the first call).
+    pub fn record(&self, tracks: &mut Vec<Track>) {
+        if tracks.is_empty() {
+            tracks.extend(self.items.iter().map(|m| Track {
+                body: m.body,
+                points: Vec::new(),
+            }));
+        }
+        for (t, m) in tracks.iter_mut().zip(&self.items) {
+            t.points.push(m.present().then_some(m.position));
+        }
     }
 
     /// Moves every obstacle one step (step `step` of the episode, from 1), with the robot (a disc
