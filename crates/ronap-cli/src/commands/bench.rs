@@ -76,13 +76,14 @@ pub fn run(args: BenchArgs) -> Result<std::process::ExitCode> {
     );
     let duration = Duration::from_secs_f64(args.seconds);
     // The scenario's scene (the maze by default) of seed 0, moving obstacles and all.
-    let (scenes, _) = SceneSpec::resolve(&config.scene, Some(0), None).load(&config)?;
+    let spec = SceneSpec::resolve(&config.scene, Some(0), None);
+    let (scenes, _) = spec.load(&config)?;
     let scene = Worlds::new(config.clone(), scenes).world(0).scene().clone();
     let grid = needs_region_grid(&config, &scene).then(|| free_grid(&config, &scene));
     let movers: u32 = config.moving.iter().map(|m| m.count).sum();
     println!(
         "ronap bench: {} of {:.0} x {:.0} px, {} moving obstacles, {} beams, {} s per figure",
-        SceneSpec::resolve(&config.scene, Some(0), None),
+        spec,
         scene.width(),
         scene.height(),
         movers,

@@ -12,6 +12,15 @@ use rand_distr::{Distribution, Normal};
 /// boxes in range to the stack.
 const MAX_LOCAL_BOXES: usize = 48;
 
+/// `offset` (a beam's unit vector in the robot frame) turned to the scene frame of `heading`.
+#[inline]
+fn turn(heading: Vector, offset: Vector) -> Vector {
+    Vector::new(
+        heading.x * offset.x - heading.y * offset.y,
+        heading.x * offset.y + heading.y * offset.x,
+    )
+}
+
 /// Colour class of a reading, for drawing rays (SPEC "Sensors").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RayClass {
@@ -110,10 +119,7 @@ impl Laser {
             }
         }
         for (reading, offset) in out.iter_mut().zip(&self.offsets) {
-            let dir = Vector::new(
-                heading.x * offset.x - heading.y * offset.y,
-                heading.x * offset.y + heading.y * offset.x,
-            );
+            let dir = turn(heading, *offset);
             let inv = Vector::new(1.0 / dir.x, 1.0 / dir.y);
             let mut best = range;
             if overflow {
@@ -160,10 +166,7 @@ impl Laser {
     ) {
         let heading = unit(heading_deg);
         for (reading, offset) in out.iter_mut().zip(&self.offsets) {
-            let dir = Vector::new(
-                heading.x * offset.x - heading.y * offset.y,
-                heading.x * offset.y + heading.y * offset.x,
-            );
+            let dir = turn(heading, *offset);
             if let Some(t) = hit(position, dir, *reading) {
                 if t < *reading {
                     *reading = t;

@@ -84,11 +84,7 @@ impl Body {
     /// Whether the body can move in a straight line from `a` to `b` in `scene`.
     fn sweep_clear(&self, scene: &Scene, a: Point, b: Point) -> bool {
         match *self {
-            Body::Disc(r) => {
-                let inside = scene.bounds();
-                let grown = Aabb::from_corners(inside.min, inside.max).inflated(-r);
-                grown.contains(b) && scene.sweep_clear(a, b, r)
-            }
+            Body::Disc(r) => scene.bounds().inflated(-r).contains(b) && scene.sweep_clear(a, b, r),
             Body::Box(h) => scene.box_sweep_clear(a, b, h),
         }
     }
@@ -564,31 +560,26 @@ impl Movers {
         if count == 0 {
             return least_gap;
         }
-        let items = &self.items;
-        let hit = |origin: Point, dir: Vector, best: f64, m: &Mover| {
-            m.body.ray(m.position, origin, dir, best)
-        };
-        if overflow {
-            laser.refine(position, heading_deg, out, |o, dir, best| {
-                let mut best_hit: Option<f64> = None;
-                for m in items.iter().filter(|m| m.present()) {
-                    if let Some(t) = hit(o, dir, best_hit.unwrap_or(best), m) {
-                        best_hit = Some(t);
-                    }
-                }
-                best_hit
-            });
+        // More obstacles in range than the list holds (rare): read every present one.
+        let all: Vec<u32>;
+        let list = if overflow {
+            all = (0..self.items.len() as u32)
+                .filter(|&i| self.items[i as usize].present())
+                .collect();
+            &all[..]
         } else {
-            laser.refine(position, heading_deg, out, |o, dir, best| {
-                let mut best_hit: Option<f64> = None;
-                for &i in &near[..count] {
-                    if let Some(t) = hit(o, dir, best_hit.unwrap_or(best), &items[i as usize]) {
-                        best_hit = Some(t);
-                    }
+            &near[..count]
+        };
+        laser.refine(position, heading_deg, out, |origin, dir, best| {
+            let mut nearest: Option<f64> = None;
+            for &i in list {
+                let m = &self.items[i as usize];
+                if let Some(t) = m.body.ray(m.position, origin, dir, nearest.unwrap_or(best)) {
+                    nearest = Some(t);
                 }
-                best_hit
-            });
-        }
+            }
+            nearest
+        });
         least_gap
     }
 }
