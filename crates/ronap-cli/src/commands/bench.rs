@@ -8,6 +8,7 @@ use ronap_core::scene::freespace::FreeGrid;
 use ronap_core::sim::placement::{free_grid, needs_region_grid, sample_placement};
 use ronap_core::sim::world::{SceneSpec, Worlds};
 use ronap_core::{Episode, Laser, Scene, ValidConfig};
+use std::io::Write;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -81,7 +82,10 @@ pub fn run(args: BenchArgs) -> Result<std::process::ExitCode> {
     let scene = Worlds::new(config.clone(), scenes).world(0).scene().clone();
     let grid = needs_region_grid(&config, &scene).then(|| free_grid(&config, &scene));
     let movers: u32 = config.moving.iter().map(|m| m.count).sum();
-    println!(
+    // Written, not printed: `ronap bench | head` ends quietly instead of panicking.
+    let mut out = std::io::stdout().lock();
+    writeln!(
+        out,
         "ronap bench: {} of {:.0} x {:.0} px, {} moving obstacles, {} beams, {} s per figure",
         spec,
         scene.width(),
@@ -89,12 +93,12 @@ pub fn run(args: BenchArgs) -> Result<std::process::ExitCode> {
         movers,
         config.laser.beams,
         args.seconds
-    );
+    )?;
 
     let start = Instant::now();
     let steps = step_for(&config, &scene, grid.as_ref(), 0, duration)?;
     let single = steps as f64 / start.elapsed().as_secs_f64();
-    println!("  one thread       {:>14} steps/s", group(single));
+    writeln!(out, "  one thread       {:>14} steps/s", group(single))?;
 
     let start = Instant::now();
     let total: u64 = std::thread::scope(|s| {
@@ -113,11 +117,12 @@ pub fn run(args: BenchArgs) -> Result<std::process::ExitCode> {
             .sum::<Result<u64>>()
     })?;
     let all = total as f64 / start.elapsed().as_secs_f64();
-    println!(
+    writeln!(
+        out,
         "  {threads} thread{}        {:>14} steps/s",
         if threads == 1 { " " } else { "s" },
         group(all)
-    );
+    )?;
 
     // Scans from 1000 placements spread over the scene, so the figure is not one lucky pose.
     let laser = Laser::new(&config.laser);
@@ -133,11 +138,12 @@ pub fn run(args: BenchArgs) -> Result<std::process::ExitCode> {
         }
     }
     let ns = start.elapsed().as_secs_f64() * 1e9 / (rounds * poses.len()) as f64;
-    println!(
+    writeln!(
+        out,
         "  one laser scan   {:>14.0} ns ({} beams)",
         ns,
         laser.beams()
-    );
+    )?;
     Ok(std::process::ExitCode::SUCCESS)
 }
 
