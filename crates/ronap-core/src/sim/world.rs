@@ -158,12 +158,6 @@ pub enum SceneSpec {
 }
 
 impl SceneSpec {
-    /// The scenes of a map file when one is given, else of one maze when `maze_seed` is given,
-    /// else a maze per seed.
-    pub fn from_options(maze_seed: Option<u64>, map_file: Option<&Path>) -> Self {
-        Self::resolve(&SceneConfig::default(), maze_seed, map_file)
-    }
-
     /// The scenes a scenario's `[scene]` section says, overridden by a map file or a scene seed
     /// given apart from it (command-line flags, keyword arguments).
     pub fn resolve(scene: &SceneConfig, seed: Option<u64>, map_file: Option<&Path>) -> Self {
