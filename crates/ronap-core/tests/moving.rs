@@ -171,7 +171,7 @@ fn a_fast_disc_crossing_the_path_still_collides() {
         let scene = Arc::new(Scene::from_boxes(1000.0, 3000.0, vec![], 50.0));
         let mut e = Episode::new(&config, scene, 0).unwrap();
         let collided = e.step(ronap_core::DiscreteAction::Left).collided;
-        let at = e.movers().unwrap().items()[0].position();
+        let at = e.movers().unwrap().items().next().unwrap().position();
         (collided, at, e.dynamic_metrics().unwrap().collisions)
     };
     // 40 px to the side of its track: it passes.
@@ -204,7 +204,7 @@ fn head_on_robot_and_obstacle_never_pass_through_each_other() {
         let mut e = Episode::new(&config, scene, 0).unwrap();
         for _ in 0..300 {
             e.step(ronap_core::DiscreteAction::Ahead);
-            let m = &e.movers().unwrap().items()[0];
+            let m = e.movers().unwrap().items().next().unwrap();
             assert!(
                 m.position().x > e.pose().x,
                 "speed {speed}: the obstacle at {:?} got past the robot at {:?}",
@@ -234,15 +234,20 @@ proptest! {
         let scene = Arc::new(maze_scene(&config, seed));
         let Ok(mut e) = Episode::new(&config, scene, seed) else { return Ok(()) };
         let r = config.robot.radius_px;
-        let mut present: Vec<bool> = e.movers().unwrap().items().iter().map(|m| m.present()).collect();
+        let mut present: Vec<bool> = e.movers().unwrap().items().map(|m| m.present()).collect();
         for a in actions {
             e.step(ronap_core::DiscreteAction::from_index(a).unwrap());
             let p = e.pose().position();
             prop_assert!(e.scene().disc_clear(p, r), "robot overlaps the still scene at {:?}", p);
-            for (i, m) in e.movers().unwrap().items().iter().enumerate() {
+            for (i, m) in e.movers().unwrap().items().enumerate() {
                 if !m.present() { continue; }
                 let gap = m.body().gap(m.position(), p, r);
                 prop_assert!(gap >= -1e-9, "obstacle {} overlaps the robot: gap {}", i, gap);
+                let in_scene = match m.body() {
+                    Body::Disc(r) => e.scene().disc_clear(m.position(), r),
+                    Body::Box(_) => e.scene().box_clear(m.body().aabb(m.position())),
+                };
+                prop_assert!(in_scene, "obstacle {} overlaps the still scene at {:?}", i, m.position());
                 if !present[i] {
                     prop_assert!(gap >= 40.0 - 5.0 - 1e-9, "obstacle {} appeared {} px from the robot", i, gap);
                     present[i] = true;

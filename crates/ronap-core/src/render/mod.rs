@@ -107,7 +107,7 @@ impl Canvas {
 
     /// Draws the present moving obstacles where they are.
     pub fn movers(&mut self, movers: &crate::sim::moving::Movers) {
-        for m in movers.items().iter().filter(|m| m.present()) {
+        for m in movers.items().filter(|m| m.present()) {
             self.mover(m.body(), m.position(), MOVER);
         }
     }

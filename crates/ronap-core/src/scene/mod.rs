@@ -469,15 +469,62 @@ impl Scene {
             })
     }
 
-    /// The radius of a disc round `p` that touches no obstacle and stays in the scene, at most
-    /// the index's reach: anything inside it is clear, without a further query.
-    pub fn free_radius(&self, p: Point) -> f64 {
+    /// A box round `p`, inside the scene, whose interior no obstacle enters (obstacles may touch
+    /// its sides), within the index's reach of `p`: anything strictly inside it is clear, without
+    /// a further query. Grown from `p` along x first, then y (or y first with `y_first`), so a
+    /// corridor gives a box as long as the reach allows. A point box when `p` is in an obstacle.
+    pub fn free_box(&self, p: Point, y_first: bool) -> Aabb {
         let reach = self.index.reach_px();
-        let border = p.x.min(self.width - p.x).min(p.y).min(self.height - p.y);
-        self.clearance(p, reach)
-            .unwrap_or(reach)
-            .min(border)
-            .max(0.0)
+        let point = Aabb { min: p, max: p };
+        if !self.bounds().contains(p) {
+            return point;
+        }
+        let cap = Aabb {
+            min: Point::new((p.x - reach).max(0.0), (p.y - reach).max(0.0)),
+            max: Point::new(
+                (p.x + reach).min(self.width),
+                (p.y + reach).min(self.height),
+            ),
+        };
+        // Shapes by their bounding boxes: the box stays clear, if smaller than it could be.
+        let near = self
+            .index
+            .near(p, reach)
+            .iter()
+            .map(|&i| self.boxes[i as usize]);
+        let obstacles = near.chain(self.shapes.iter().map(Shape::aabb));
+        let mut free = point;
+        // Two passes: the first axis grows across the point, the second across that span.
+        for (pass, axis) in [usize::from(y_first), usize::from(!y_first)]
+            .into_iter()
+            .enumerate()
+        {
+            let other = 1 - axis;
+            let (mut lo, mut hi) = (cap.min[axis], cap.max[axis]);
+            for o in obstacles.clone() {
+                // Only obstacles across the span of the other axis bound it: across the point
+                // itself (touching counts) in the first pass, across the open span in the second.
+                let apart = if pass == 0 {
+                    o.min[other] > free.max[other] || o.max[other] < free.min[other]
+                } else {
+                    o.min[other] >= free.max[other] || o.max[other] <= free.min[other]
+                };
+                if apart {
+                    continue;
+                }
+                if o.max[axis] <= free.min[axis] {
+                    lo = lo.max(o.max[axis]);
+                } else if o.min[axis] >= free.max[axis] {
+                    hi = hi.min(o.min[axis]);
+                } else {
+                    // It overlaps what is already free, so `p` is on an obstacle.
+                    return point;
+                }
+            }
+            free.min[axis] = lo;
+            free.max[axis] = hi;
+        }
+        free
     }
 
     /// Whether `p` lies inside an obstacle or outside the scene.
@@ -557,5 +604,47 @@ mod tests {
         assert!(!scene.sweep_clear(a, Point::new(1050.0, 100.0), 5.0));
         assert!(scene.sweep_clear(a, Point::new(93.0, 100.0), 5.0));
         assert!(!scene.sweep_clear(a, Point::new(94.5, 100.0), 5.0));
+    }
+
+    #[test]
+    fn a_free_box_holds_no_obstacle_and_reaches_the_walls_it_meets() {
+        use rand::{Rng, SeedableRng};
+        let config = crate::ValidConfig::default();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        for seed in 0..20 {
+            let scene = crate::sim::world::maze_scene(&config, seed).with_obstacles(
+                vec![],
+                vec![
+                    Shape::disc(Point::new(250.0, 250.0), 20.0),
+                    Shape::polygon(&[
+                        Point::new(600.0, 600.0),
+                        Point::new(660.0, 610.0),
+                        Point::new(620.0, 680.0),
+                    ])
+                    .unwrap(),
+                ],
+            );
+            for _ in 0..200 {
+                let p = Point::new(rng.random_range(0.0..1000.0), rng.random_range(0.0..1000.0));
+                let free = scene.free_box(p, rng.random());
+                assert!(free.min.x <= p.x && p.x <= free.max.x, "{p:?} {free:?}");
+                assert!(free.min.y <= p.y && p.y <= free.max.y, "{p:?} {free:?}");
+                if free.extents().x > 0.0 && free.extents().y > 0.0 {
+                    // Obstacles may touch its sides: its interior is clear.
+                    let inside = free.inflated(-1e-9);
+                    assert!(scene.box_clear(inside), "seed {seed}: {free:?} round {p:?}");
+                    assert!(!scene.occupied(p));
+                }
+                // Shapes count by their bounding boxes: away from those, room at least as
+                // wide as the clearance in some direction.
+                let off_shapes = scene
+                    .shapes()
+                    .iter()
+                    .all(|s| !s.aabb().inflated(3.0).contains(p));
+                if off_shapes && scene.disc_clear(p, 3.0) {
+                    assert!(free.extents().x.max(free.extents().y) >= 3.0, "{free:?}");
+                }
+            }
+        }
     }
 }

@@ -113,13 +113,12 @@ impl Body {
     }
 }
 
-/// How one obstacle moves, with its state.
+/// How one obstacle moves, with the state its heading and speed (kept in [`State`]) leave out.
 #[derive(Clone, Debug)]
 enum Motion {
     Still,
     /// `linear` (no turning) or `random_walk` (turning by N(0, sigma^2) rad each step).
     Heading {
-        dir: Vector,
         sigma_rad: f64,
     },
     Waypoints {
@@ -130,63 +129,188 @@ enum Motion {
     },
 }
 
-/// One moving obstacle in an episode.
+/// What one moving obstacle is, apart from where it is and where it heads.
 #[derive(Clone, Debug)]
-pub struct Mover {
+struct Entry {
     body: Body,
-    position: Point,
-    speed: f64,
     motion: Motion,
     /// `appear`: the step it appears in, until it has.
     appears_at: Option<u32>,
     /// Its fixed start overlaps the robot: absent until the robot is clear of it.
     held: bool,
     min_gap: f64,
-    /// A disc round `free_center` clear of the still scene: moves that stay inside it need no
-    /// query (radius 0 until first measured).
-    free_center: Point,
-    free_radius: f64,
 }
 
-impl Mover {
-    /// Whether the body can move from its position to `to` without touching the still scene.
-    /// Exact: the cached free disc only answers when the whole sweep lies inside it.
-    #[inline]
-    fn still_clear(&mut self, scene: &Scene, to: Point) -> bool {
-        let bound = self.body.bounding_radius();
-        let inside = |c: Point, r: f64| {
-            let room = r - bound;
-            room > 0.0 && (to - c).norm_squared() < room * room
-        };
-        if inside(self.free_center, self.free_radius) {
-            return true;
+impl Entry {
+    fn present(&self) -> bool {
+        self.appears_at.is_none() && !self.held
+    }
+}
+
+/// Where the obstacles are and where they head, one array per quantity, so that the turns, the
+/// moves and the fast clearance test of every obstacle run as one vectorised pass.
+#[derive(Clone, Debug, Default)]
+struct State {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    /// Unit heading (`linear`, `random_walk`).
+    dx: Vec<f64>,
+    dy: Vec<f64>,
+    speed: Vec<f64>,
+    /// Where the centre may go with no query: a box clear of the still scene shrunk by the body
+    /// (empty until first measured). A straight move between two points inside it is clear.
+    lo_x: Vec<f64>,
+    lo_y: Vec<f64>,
+    hi_x: Vec<f64>,
+    hi_y: Vec<f64>,
+    /// Bounding radius of the body, px.
+    bound: Vec<f64>,
+    /// Whether it is in the scene (its entry's `present`, kept here for the quick scans).
+    present: Vec<bool>,
+    /// Squared distance from the robot's centre within which a move must be checked against it.
+    near_robot2: Vec<f64>,
+    /// Whether it moves along its heading this step (present, `linear` or `random_walk`).
+    walks: Vec<bool>,
+    /// This step's turn, rad (0 for the obstacles not turning), and its sine and cosine.
+    turn: Vec<f64>,
+    sin: Vec<f64>,
+    cos: Vec<f64>,
+    /// This step's intended centre, and whether it lies in the free box.
+    ahead_x: Vec<f64>,
+    ahead_y: Vec<f64>,
+    fits: Vec<bool>,
+    /// Whether the pass has moved it (a walk in its free box and far from the robot).
+    moved: Vec<bool>,
+    /// This step's turns beyond 1 rad, as `(obstacle, sin, cos)`, applied after the pass.
+    wide: Vec<(usize, f64, f64)>,
+}
+
+/// Margin by which a centre must lie inside its free box, px: the fast test never accepts what
+/// the exact one might refuse by a rounding.
+const FIT_MARGIN: f64 = 1e-9;
+
+impl State {
+    fn push(&mut self, entry: &Entry, position: Point, dir: Vector, speed: f64, near_robot: f64) {
+        self.bound.push(entry.body.bounding_radius());
+        self.present.push(entry.present());
+        self.near_robot2.push(near_robot * near_robot);
+        self.walks.push(false);
+        self.moved.push(false);
+        self.x.push(position.x);
+        self.y.push(position.y);
+        self.dx.push(dir.x);
+        self.dy.push(dir.y);
+        self.speed.push(speed);
+        self.lo_x.push(f64::INFINITY);
+        self.lo_y.push(f64::INFINITY);
+        self.hi_x.push(f64::NEG_INFINITY);
+        self.hi_y.push(f64::NEG_INFINITY);
+        self.turn.push(0.0);
+        self.sin.push(0.0);
+        self.cos.push(1.0);
+        self.ahead_x.push(0.0);
+        self.ahead_y.push(0.0);
+        self.fits.push(false);
+    }
+
+    fn position(&self, i: usize) -> Point {
+        Point::new(self.x[i], self.y[i])
+    }
+
+    /// Turns every heading by this step's turn and moves it `speed` ahead into `ahead`, marking
+    /// in `fits` those whose move stays in their free box; moves there, and marks `moved`, the
+    /// walks that fit and are not near the robot at `robot`. Plain arithmetic over the arrays,
+    /// so it vectorises; turns beyond 1 rad are applied one by one first.
+    fn turn_and_look_ahead(&mut self, robot: Point) {
+        for &(i, s, c) in &self.wide {
+            let (dx, dy) = (self.dx[i], self.dy[i]);
+            self.dx[i] = dx * c - dy * s;
+            self.dy[i] = dx * s + dy * c;
         }
-        let from = self.position;
-        self.free_center = from;
-        self.free_radius = scene.free_radius(from);
-        inside(from, self.free_radius) || self.body.sweep_clear(scene, from, to)
+        let n = self.x.len();
+        let (x, y, speed) = (&mut self.x[..n], &mut self.y[..n], &self.speed[..n]);
+        let (dx, dy, turn) = (&mut self.dx[..n], &mut self.dy[..n], &self.turn[..n]);
+        let (lo_x, lo_y) = (&self.lo_x[..n], &self.lo_y[..n]);
+        let (hi_x, hi_y) = (&self.hi_x[..n], &self.hi_y[..n]);
+        let (ax, ay) = (&mut self.ahead_x[..n], &mut self.ahead_y[..n]);
+        let (fits, moved) = (&mut self.fits[..n], &mut self.moved[..n]);
+        let (walks, near2) = (&self.walks[..n], &self.near_robot2[..n]);
+        let (sin, cos) = (&mut self.sin[..n], &mut self.cos[..n]);
+        // The series alone first: a short loop the compiler interleaves, hiding the latency of
+        // the long chains of multiplications.
+        for i in 0..n {
+            (sin[i], cos[i]) = sin_cos_within_1(turn[i]);
+        }
+        for i in 0..n {
+            let (s, c) = (sin[i], cos[i]);
+            let (tx, ty) = (dx[i] * c - dy[i] * s, dx[i] * s + dy[i] * c);
+            // A rotation keeps the length to within rounding; one Newton step towards length 1
+            // stops the drift without a square root or a division.
+            let k = 1.5 - 0.5 * (tx * tx + ty * ty);
+            dx[i] = tx * k;
+            dy[i] = ty * k;
+            ax[i] = x[i] + dx[i] * speed[i];
+            ay[i] = y[i] + dy[i] * speed[i];
+            // The move is clear when both ends lie in the box (it is convex).
+            fits[i] = (ax[i] > lo_x[i])
+                & (ax[i] < hi_x[i])
+                & (ay[i] > lo_y[i])
+                & (ay[i] < hi_y[i])
+                & (x[i] > lo_x[i])
+                & (x[i] < hi_x[i])
+                & (y[i] > lo_y[i])
+                & (y[i] < hi_y[i]);
+            let (rx, ry) = (x[i] - robot.x, y[i] - robot.y);
+            moved[i] = walks[i] & fits[i] & (rx * rx + ry * ry >= near2[i]);
+            x[i] = if moved[i] { ax[i] } else { x[i] };
+            y[i] = if moved[i] { ay[i] } else { y[i] };
+        }
+    }
+
+    /// Sets this step's turn of obstacle `i` to `a` rad.
+    #[inline]
+    fn set_turn(&mut self, i: usize, a: f64) {
+        if a.abs() <= 1.0 {
+            self.turn[i] = a;
+        } else {
+            // Turned before the vectorised pass, which then only renormalises it.
+            self.turn[i] = 0.0;
+            let (s, c) = sin_cos(a);
+            self.wide.push((i, s, c));
+        }
+    }
+
+    /// Sets obstacle `i`'s free box to `free` shrunk by `half` (the body's half extents).
+    fn set_free(&mut self, i: usize, free: Aabb, half: Vector) {
+        self.lo_x[i] = free.min.x + half.x + FIT_MARGIN;
+        self.lo_y[i] = free.min.y + half.y + FIT_MARGIN;
+        self.hi_x[i] = free.max.x - half.x - FIT_MARGIN;
+        self.hi_y[i] = free.max.y - half.y - FIT_MARGIN;
+    }
+
+    /// Whether `p` lies in obstacle `i`'s free box (a straight move to it is then clear).
+    fn in_free(&self, i: usize, p: Point) -> bool {
+        p.x > self.lo_x[i] && p.x < self.hi_x[i] && p.y > self.lo_y[i] && p.y < self.hi_y[i]
     }
 }
 
-/// `(sin a, cos a)`, for the small turns of a random walk: a Taylor series where it is exact to
-/// within 1e-15 (|a| <= 0.5), `sin_cos` beyond. Plain arithmetic, so the same on every platform.
-#[inline]
-fn small_sin_cos(a: f64) -> (f64, f64) {
-    if a.abs() > 0.5 {
-        return a.sin_cos();
-    }
+/// `(sin a, cos a)` for |a| <= 1 by Taylor series (to a^17 and a^18: the first term left out is
+/// below 1e-17), plain multiplications and additions, so the same bits on every platform and one
+/// vectorised pass for many turns. Wrong beyond |a| = 1: see [`sin_cos`].
+#[inline(always)]
+fn sin_cos_within_1(a: f64) -> (f64, f64) {
     let a2 = a * a;
-    // Up to a^13 / 13! and a^14 / 14! (Horner form, multiplications only): the first term left
-    // out is below 3e-17 for |a| <= 0.5.
-    const S: [f64; 6] = [
+    const S: [f64; 8] = [
         -1.0 / 6.0,
         1.0 / 120.0,
         -1.0 / 5040.0,
         1.0 / 362_880.0,
         -1.0 / 39_916_800.0,
         1.0 / 6_227_020_800.0,
+        -1.0 / 1_307_674_368_000.0,
+        1.0 / 355_687_428_096_000.0,
     ];
-    const C: [f64; 7] = [
+    const C: [f64; 9] = [
         -1.0 / 2.0,
         1.0 / 24.0,
         -1.0 / 720.0,
@@ -194,13 +318,42 @@ fn small_sin_cos(a: f64) -> (f64, f64) {
         -1.0 / 3_628_800.0,
         1.0 / 479_001_600.0,
         -1.0 / 87_178_291_200.0,
+        1.0 / 20_922_789_888_000.0,
+        -1.0 / 6_402_373_705_728_000.0,
     ];
-    let s =
-        a * (1.0 + a2 * (S[0] + a2 * (S[1] + a2 * (S[2] + a2 * (S[3] + a2 * (S[4] + a2 * S[5]))))));
-    let c = 1.0
-        + a2 * (C[0]
-            + a2 * (C[1] + a2 * (C[2] + a2 * (C[3] + a2 * (C[4] + a2 * (C[5] + a2 * C[6]))))));
+    let mut s = S[7];
+    for k in (0..7).rev() {
+        s = S[k] + a2 * s;
+    }
+    let mut c = C[8];
+    for k in (0..8).rev() {
+        c = C[k] + a2 * c;
+    }
+    (a * (1.0 + a2 * s), 1.0 + a2 * c)
+}
+
+/// `(sin a, cos a)` for any `a`: halved until within 1 rad, then doubled back. Plain arithmetic,
+/// so the same on every platform (a random walk's turns beyond 1 rad are rare).
+fn sin_cos(a: f64) -> (f64, f64) {
+    let mut halvings = 0;
+    let mut h = a;
+    while h.abs() > 1.0 && halvings < 1100 {
+        h *= 0.5;
+        halvings += 1;
+    }
+    let (mut s, mut c) = sin_cos_within_1(h);
+    for _ in 0..halvings {
+        (s, c) = (2.0 * s * c, c * c - s * s);
+    }
     (s, c)
+}
+
+/// A moving obstacle as pictures and tests see it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mover {
+    body: Body,
+    position: Point,
+    present: bool,
 }
 
 impl Mover {
@@ -216,7 +369,7 @@ impl Mover {
 
     /// Whether it is in the scene (an `appear` obstacle is not, until its step).
     pub fn present(&self) -> bool {
-        self.appears_at.is_none() && !self.held
+        self.present
     }
 }
 
@@ -255,7 +408,8 @@ pub struct MovingError {
 /// The moving obstacles of one episode.
 #[derive(Clone, Debug)]
 pub struct Movers {
-    items: Vec<Mover>,
+    entries: Vec<Entry>,
+    state: State,
     rng: Rng,
     /// Largest bounding radius plus step, for the quick distance tests.
     reach: f64,
@@ -284,7 +438,8 @@ impl Movers {
         }
         let robot_radius = config.robot.radius_px;
         let mut rng = stream(seed, Stream::Moving);
-        let mut items = Vec::new();
+        let mut entries = Vec::new();
+        let mut state = State::default();
         let mut reach: f64 = 0.0;
         for (entry, m) in config.moving.iter().enumerate() {
             let err = |message: String| MovingError { entry, message };
@@ -294,19 +449,23 @@ impl Movers {
             };
             reach = reach.max(body.bounding_radius() + m.speed_px);
             for _ in 0..m.count {
-                let mover =
+                let (e, position, dir) =
                     Self::make(m, body, scene, start, goal, robot_radius, &mut rng).map_err(err)?;
-                items.push(mover);
+                let near = m.speed_px + body.bounding_radius() + robot_radius;
+                state.push(&e, position, dir, m.speed_px, near);
+                entries.push(e);
             }
         }
         Ok(Some(Self {
-            items,
+            entries,
+            state,
             rng,
             reach,
             robot_radius,
         }))
     }
 
+    /// One obstacle: what it is, where it starts and where it heads.
     fn make(
         m: &MovingConfig,
         body: Body,
@@ -315,7 +474,7 @@ impl Movers {
         goal: Point,
         robot_radius: f64,
         rng: &mut Rng,
-    ) -> Result<Mover, String> {
+    ) -> Result<(Entry, Point, Vector), String> {
         let kind = if m.motion == MotionKind::Appear {
             m.then
         } else {
@@ -342,6 +501,7 @@ impl Movers {
         };
         // A fixed start on the robot's drawn start: held back until the robot has left it.
         let held = appears_at.is_none() && body.gap(position, start, robot_radius) < 0.0;
+        let mut dir = Vector::new(1.0, 0.0);
         let motion = match kind {
             MotionKind::Still | MotionKind::Appear => Motion::Still,
             MotionKind::Linear | MotionKind::RandomWalk => {
@@ -349,8 +509,8 @@ impl Movers {
                     Some(d) => d,
                     None => rng.random_range(0.0..360.0),
                 };
+                dir = unit(deg);
                 Motion::Heading {
-                    dir: unit(deg),
                     sigma_rad: if kind == MotionKind::RandomWalk {
                         m.turn_sigma_deg.to_radians()
                     } else {
@@ -365,100 +525,97 @@ impl Movers {
                 mode: m.mode,
             },
         };
-        Ok(Mover {
+        let entry = Entry {
             body,
-            position,
-            speed: m.speed_px,
             motion,
             appears_at,
             held,
             min_gap: m.min_robot_distance_px,
-            free_center: position,
-            free_radius: 0.0,
-        })
+        };
+        Ok((entry, position, dir))
     }
 
-    /// The obstacles.
-    pub fn items(&self) -> &[Mover] {
-        &self.items
+    /// The obstacles, present or not.
+    pub fn items(&self) -> impl ExactSizeIterator<Item = Mover> + '_ {
+        self.entries.iter().enumerate().map(|(i, e)| Mover {
+            body: e.body,
+            position: self.state.position(i),
+            present: e.present(),
+        })
     }
 
     /// Adds where each obstacle is now to `tracks` (one per obstacle, made on the first call).
     pub fn record(&self, tracks: &mut Vec<Track>) {
         if tracks.is_empty() {
-            tracks.extend(self.items.iter().map(|m| Track {
-                body: m.body,
+            tracks.extend(self.entries.iter().map(|e| Track {
+                body: e.body,
                 points: Vec::new(),
             }));
         }
-        for (t, m) in tracks.iter_mut().zip(&self.items) {
-            t.points.push(m.present().then_some(m.position));
+        for (t, m) in tracks.iter_mut().zip(self.items()) {
+            t.points.push(m.present().then_some(m.position()));
         }
     }
 
     /// Moves every obstacle one step (step `step` of the episode, from 1), with the robot (a disc
     /// of the configured radius) standing at `robot`.
+    ///
+    /// In three passes: appearances and releases, then this step's turns from the random stream
+    /// in obstacle order, then the turns and moves of all headings at once (vectorised, with a
+    /// free box per obstacle answering most clearance questions); what the free box cannot
+    /// answer, waypoints and the contact with the robot are settled one by one.
     pub fn advance(&mut self, step: u32, scene: &Scene, robot: Point) -> Advance {
-        let mut out = Advance::default();
         let radius = self.robot_radius;
-        let rng = &mut self.rng;
-        for m in &mut self.items {
-            if let Some(at) = m.appears_at {
+        let state = &mut self.state;
+        for (i, e) in self.entries.iter_mut().enumerate() {
+            if let Some(at) = e.appears_at {
                 if step >= at {
-                    let (body, min_gap) = (m.body, m.min_gap);
+                    let (body, min_gap) = (e.body, e.min_gap);
                     let far = |p: Point| body.gap(p, robot, radius) >= min_gap;
-                    if let Some(p) = free_spot(body, scene, rng, far) {
-                        m.position = p;
-                        m.appears_at = None;
+                    if let Some(p) = free_spot(body, scene, &mut self.rng, far) {
+                        state.x[i] = p.x;
+                        state.y[i] = p.y;
+                        e.appears_at = None;
+                        state.present[i] = true;
                     }
                 }
+            } else if e.held && e.body.gap(state.position(i), robot, radius) >= 0.0 {
+                e.held = false;
+                state.present[i] = true;
+            }
+        }
+        state.wide.clear();
+        for (i, e) in self.entries.iter().enumerate() {
+            let (walks, sigma) = match e.motion {
+                Motion::Heading { sigma_rad } if e.present() => (true, sigma_rad),
+                _ => (false, 0.0),
+            };
+            state.walks[i] = walks;
+            if sigma > 0.0 {
+                let z: f64 = StandardNormal.sample(&mut self.rng);
+                state.set_turn(i, sigma * z);
+            } else {
+                state.turn[i] = 0.0;
+            }
+        }
+        state.turn_and_look_ahead(robot);
+        let mut out = Advance::default();
+        for (i, e) in self.entries.iter_mut().enumerate() {
+            if state.moved[i] || !e.present() {
                 continue;
             }
-            if m.held {
-                if m.body.gap(m.position, robot, radius) < 0.0 {
-                    continue;
-                }
-                m.held = false;
-            }
-            let from = m.position;
-            let to = match &mut m.motion {
+            let from = state.position(i);
+            let speed = state.speed[i];
+            let to = match &mut e.motion {
                 Motion::Still => continue,
-                Motion::Heading { dir, sigma_rad } => {
-                    if *sigma_rad > 0.0 {
-                        let turn: f64 = StandardNormal.sample(rng);
-                        let (s, c) = small_sin_cos(*sigma_rad * turn);
-                        let turned = Vector::new(dir.x * c - dir.y * s, dir.x * s + dir.y * c);
-                        // A rotation keeps the length to within rounding; renormalise only once that
-                        // drifts (rarely), sparing a square root and a division in most steps.
-                        let n2 = turned.norm_squared();
-                        *dir = if (n2 - 1.0).abs() > 1e-12 {
-                            turned / n2.sqrt()
-                        } else {
-                            turned
-                        };
-                    }
-                    let heading = *dir;
-                    let ahead = from + heading * m.speed;
-                    if m.still_clear(scene, ahead) {
-                        ahead
+                Motion::Heading { .. } => {
+                    if state.fits[i] {
+                        Point::new(state.ahead_x[i], state.ahead_y[i])
                     } else {
-                        // Reflect off what is in the way: the x component, the y, or both.
-                        let flips = [
-                            Vector::new(-1.0, 1.0),
-                            Vector::new(1.0, -1.0),
-                            Vector::new(-1.0, -1.0),
-                        ];
-                        let Some(flipped) = flips
-                            .iter()
-                            .map(|f| heading.component_mul(f))
-                            .find(|d| m.body.sweep_clear(scene, from, from + d * m.speed))
-                        else {
-                            continue;
-                        };
-                        if let Motion::Heading { dir, .. } = &mut m.motion {
-                            *dir = flipped;
+                        match Self::bounce(state, i, e.body, scene, from) {
+                            Some(to) => to,
+                            None => continue,
                         }
-                        from + flipped * m.speed
                     }
                 }
                 Motion::Waypoints {
@@ -468,7 +625,7 @@ impl Movers {
                     mode,
                 } => {
                     let mut at = from;
-                    let mut left = m.speed;
+                    let mut left = speed;
                     // Each leg at least as long as a step is entered once per call.
                     for _ in 0..points.len() * 2 {
                         let goal = points[*target];
@@ -488,16 +645,48 @@ impl Movers {
                 }
             };
             // Every motion moves at most `speed` a step.
-            let near = m.speed + m.body.bounding_radius() + radius;
-            if (from - robot).norm_squared() < near * near
-                && m.body.sweep_touches(from, to, robot, radius)
+            if (from - robot).norm_squared() < state.near_robot2[i]
+                && e.body.sweep_touches(from, to, robot, radius)
             {
                 out.touched_robot = true;
                 continue;
             }
-            m.position = to;
+            state.x[i] = to.x;
+            state.y[i] = to.y;
         }
         out
+    }
+
+    /// Where heading obstacle `i` at `from` goes when its move ahead is not known clear: ahead
+    /// if it is, else reflected off what is in the way (the x component, the y, or both), else
+    /// nowhere. Measures a new free box round `from` first.
+    fn bounce(
+        state: &mut State,
+        i: usize,
+        body: Body,
+        scene: &Scene,
+        from: Point,
+    ) -> Option<Point> {
+        let (dx, dy, speed) = (state.dx[i], state.dy[i], state.speed[i]);
+        let half = match body {
+            Body::Disc(r) => Vector::new(r, r),
+            Body::Box(h) => h,
+        };
+        state.set_free(i, scene.free_box(from, dy.abs() > dx.abs()), half);
+        let clear = |state: &State, to: Point| {
+            (state.in_free(i, from) && state.in_free(i, to)) || body.sweep_clear(scene, from, to)
+        };
+        let ahead = Point::new(state.ahead_x[i], state.ahead_y[i]);
+        if clear(state, ahead) {
+            return Some(ahead);
+        }
+        let flips = [(-dx, dy), (dx, -dy), (-dx, -dy)];
+        let (fx, fy) = flips
+            .into_iter()
+            .find(|&(fx, fy)| clear(state, from + Vector::new(fx, fy) * speed))?;
+        state.dx[i] = fx;
+        state.dy[i] = fy;
+        Some(from + Vector::new(fx, fy) * speed)
     }
 
     /// Whether a disc of `radius` can move in a straight line from `a` to `b` without touching a
@@ -505,15 +694,20 @@ impl Movers {
     pub fn sweep_clear(&self, a: Point, b: Point, radius: f64) -> bool {
         let reach = self.reach + radius + (b - a).norm();
         let r2 = reach * reach;
-        self.items.iter().all(|m| {
-            !m.present()
-                || (m.position - a).norm_squared() > r2
-                || match m.body {
+        let st = &self.state;
+        (0..self.entries.len()).all(|i| {
+            let (px, py) = (st.x[i] - a.x, st.y[i] - a.y);
+            !st.present[i]
+                || px * px + py * py > r2
+                || match self.entries[i].body {
                     Body::Disc(r) => {
-                        point_segment_distance_squared(m.position, a, b) >= (r + radius).powi(2)
+                        point_segment_distance_squared(st.position(i), a, b) >= (r + radius).powi(2)
                     }
-                    Body::Box(_) => {
-                        m.body.aabb(m.position).segment_distance_squared(a, b) >= radius * radius
+                    Body::Box(h) => {
+                        Body::Box(h)
+                            .aabb(st.position(i))
+                            .segment_distance_squared(a, b)
+                            >= radius * radius
                     }
                 }
         })
@@ -534,19 +728,19 @@ impl Movers {
         let mut overflow = false;
         let mut least_gap = f64::INFINITY;
         let range = laser.range_px();
-        for (i, m) in self.items.iter().enumerate() {
-            if !m.present() {
+        let st = &self.state;
+        let reach = range + self.robot_radius;
+        for i in 0..self.entries.len() {
+            let (px, py) = (st.x[i] - position.x, st.y[i] - position.y);
+            let d2 = px * px + py * py;
+            let far = reach + st.bound[i];
+            if d2 > far * far || !st.present[i] {
                 continue;
             }
-            let bound = m.body.bounding_radius();
-            let d2 = (m.position - position).norm_squared();
-            let far = range + self.robot_radius + bound;
-            if d2 > far * far {
-                continue;
-            }
+            let (e, p, bound) = (&self.entries[i], st.position(i), st.bound[i]);
             let d = d2.sqrt();
             if d - bound <= range + self.robot_radius {
-                least_gap = least_gap.min(m.body.gap(m.position, position, self.robot_radius));
+                least_gap = least_gap.min(e.body.gap(p, position, self.robot_radius));
                 if d - bound <= range {
                     if count < near.len() {
                         near[count] = i as u32;
@@ -563,8 +757,8 @@ impl Movers {
         // More obstacles in range than the list holds (rare): read every present one.
         let all: Vec<u32>;
         let list = if overflow {
-            all = (0..self.items.len() as u32)
-                .filter(|&i| self.items[i as usize].present())
+            all = (0..self.entries.len() as u32)
+                .filter(|&i| self.entries[i as usize].present())
                 .collect();
             &all[..]
         } else {
@@ -573,8 +767,9 @@ impl Movers {
         laser.refine(position, heading_deg, out, |origin, dir, best| {
             let mut nearest: Option<f64> = None;
             for &i in list {
-                let m = &self.items[i as usize];
-                if let Some(t) = m.body.ray(m.position, origin, dir, nearest.unwrap_or(best)) {
+                let e = &self.entries[i as usize];
+                let p = self.state.position(i as usize);
+                if let Some(t) = e.body.ray(p, origin, dir, nearest.unwrap_or(best)) {
                     nearest = Some(t);
                 }
             }
@@ -626,12 +821,17 @@ mod tests {
     use super::*;
 
     #[test]
-    fn small_sin_cos_matches_the_library() {
-        for k in -1000..=1000 {
+    fn sin_cos_matches_the_library() {
+        for k in -3000..=3000 {
             let a = k as f64 * 0.0011;
-            let (s, c) = small_sin_cos(a);
+            let (s, c) = sin_cos(a);
             let (s0, c0) = a.sin_cos();
-            assert!((s - s0).abs() < 1e-15 && (c - c0).abs() < 1e-15, "{a}");
+            assert!((s - s0).abs() < 4e-15 && (c - c0).abs() < 4e-15, "{a}");
+        }
+        for a in [-1.0, 1.0, 20.0, -1e3] {
+            let (s, c) = sin_cos(a);
+            let (s0, c0) = f64::sin_cos(a);
+            assert!((s - s0).abs() < 1e-9 && (c - c0).abs() < 1e-9, "{a}");
         }
     }
 }
