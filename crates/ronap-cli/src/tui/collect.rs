@@ -192,6 +192,7 @@ fn side_lines(view: &HumanView) -> Vec<Line<'static>> {
     ];
     draw::side_panel(
         lines,
+        e.movers().is_some(),
         &[
             ("← ↑ →", "LEFT / AHEAD / RIGHT"),
             ("↓", "re-arm after each action"),

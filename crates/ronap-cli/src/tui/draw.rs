@@ -6,7 +6,8 @@
 //! Colours, in the terminal's 16 named ones: walls white (grey beyond the laser's range), rays in
 //! their classes green / yellow / red, the circle of range grey, the goal arrow magenta (the
 //! paper's arrow is red, which here would read as a close ray), the robot cyan, the path light
-//! blue, start red, goal green, and the distance to the goal in green digits at the upper right.
+//! blue, start red, goal green, moving obstacles light red (the pictures' orange), and the
+//! distance to the goal in green digits at the upper right.
 
 use ratatui::layout::{Alignment, Rect};
 use ratatui::style::{Color, Modifier, Style};
@@ -18,6 +19,7 @@ use ratatui::Frame;
 use ronap_core::geometry::{unit, Point};
 use ronap_core::render::{HeadingUp, FIRST_PERSON_HALF_SPAN};
 use ronap_core::sim::lidar::RayClass;
+use ronap_core::sim::moving::Body;
 use ronap_core::Episode;
 
 /// Walls within the laser's range (first-person) and everywhere (whole scene).
@@ -38,6 +40,8 @@ pub const START: Color = Color::Red;
 pub const GOAL: Color = Color::Green;
 /// The distance to the goal.
 pub const DISTANCE: Color = Color::LightGreen;
+/// Moving obstacles.
+pub const MOVER: Color = Color::LightRed;
 
 /// The colour of a laser ray of `class`.
 pub fn ray_colour(class: RayClass) -> Color {
@@ -306,6 +310,29 @@ fn rays(episode: &Episode, to: impl Fn(Point) -> (f64, f64)) -> Vec<((f64, f64),
         .collect()
 }
 
+/// The present moving obstacles of `episode` in the coordinates `to` gives: discs filled (at
+/// least a dot), boxes outlined with their centre filled.
+fn movers(pen: &mut Pen, episode: &Episode, to: impl Fn(Point) -> (f64, f64)) {
+    let Some(movers) = episode.movers() else {
+        return;
+    };
+    let least = pen.grid.px_per_dot * 0.5;
+    for m in movers.items().filter(|m| m.present()) {
+        let c = m.position();
+        match m.body() {
+            Body::Disc(r) => pen.disc(to(c), r.max(least), MOVER),
+            Body::Box(h) => {
+                let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                    .map(|(sx, sy)| to(Point::new(c.x + sx * h.x, c.y + sy * h.y)));
+                for k in 0..4 {
+                    pen.line(corners[k], corners[(k + 1) % 4], MOVER);
+                }
+                pen.disc(to(c), h.x.min(h.y).max(least), MOVER);
+            }
+        }
+    }
+}
+
 /// The paper's first-person view: heading up, walls within the laser's range brighter than those
 /// beyond, the circle of range, the rays in their colour classes, the goal arrow at the paper's
 /// angle `theta_a = 90 + (theta - z)`, and the robot in the middle.
@@ -324,6 +351,7 @@ fn first_person(area: Rect, episode: &Episode) -> Pen {
             pen.dots.push((i, j, colour));
         }
     }
+    movers(&mut pen, episode, |p| view.to_view(p));
     pen.circle((0.0, 0.0), range, RANGE);
     for (end, colour) in rays(episode, |p| view.to_view(p)) {
         pen.line((0.0, 0.0), end, colour);
@@ -373,6 +401,7 @@ fn whole_scene(area: Rect, episode: &Episode, path: &[Point]) -> Pen {
     for pair in trail.windows(2) {
         pen.line(pair[0], pair[1], PATH);
     }
+    movers(&mut pen, episode, |p| (p.x, p.y));
     for (end, colour) in rays(episode, |p| (p.x, p.y)) {
         pen.line((pose.x, pose.y), end, colour);
     }
@@ -399,10 +428,11 @@ pub fn direction_text(direction_deg: f64) -> String {
     }
 }
 
-/// The legend of the scene's colours, as lines for a side panel.
-pub fn legend() -> Vec<Line<'static>> {
+/// The legend of the scene's colours, as lines for a side panel (with the moving obstacles'
+/// when there are some).
+pub fn legend(moving: bool) -> Vec<Line<'static>> {
     let mark = |text: &'static str, colour: Color| Span::styled(text, Style::default().fg(colour));
-    vec![
+    let mut lines = vec![
         Line::from(vec![
             Span::raw("rays  "),
             mark("━ far ", Color::Green),
@@ -414,7 +444,11 @@ pub fn legend() -> Vec<Line<'static>> {
             mark("● robot  ", ROBOT),
             mark("━ path", PATH),
         ]),
-    ]
+    ];
+    if moving {
+        lines.push(Line::from(mark("● moving obstacle", MOVER)));
+    }
+    lines
 }
 
 /// A side-panel line: a label in a fixed column, then `value`.
@@ -436,10 +470,15 @@ pub fn key_help(keys: &str, what: &str) -> Line<'static> {
     ])
 }
 
-/// A side panel: `fields`, the colour legend, then each key with what it does.
-pub fn side_panel(mut fields: Vec<Line<'static>>, keys: &[(&str, &str)]) -> Vec<Line<'static>> {
+/// A side panel: `fields`, the colour legend (`moving`: with moving obstacles), then each key
+/// with what it does.
+pub fn side_panel(
+    mut fields: Vec<Line<'static>>,
+    moving: bool,
+    keys: &[(&str, &str)],
+) -> Vec<Line<'static>> {
     fields.push(Line::raw(""));
-    fields.extend(legend());
+    fields.extend(legend(moving));
     fields.push(Line::raw(""));
     fields.extend(keys.iter().map(|(k, what)| key_help(k, what)));
     fields

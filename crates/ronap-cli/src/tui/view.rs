@@ -252,6 +252,7 @@ fn side_lines(state: &ViewState) -> Vec<Line<'static>> {
     ];
     draw::side_panel(
         lines,
+        e.movers().is_some(),
         &[
             ("space", "pause / resume"),
             ("+ -", "faster / slower"),
@@ -562,6 +563,38 @@ mod tests {
         insta::assert_snapshot!("view_whole_scene_seed_7", TestBackendView(&buf));
         handle_key(&mut state, &m);
         assert_eq!(state.mode, SceneMode::FirstPerson);
+    }
+
+    #[test]
+    fn moving_obstacles_are_drawn_and_in_the_legend() {
+        let sim = ronap_core::SimConfig {
+            moving: vec![ronap_core::config::MovingConfig {
+                count: 30,
+                ..Default::default()
+            }],
+            ..Default::default()
+        };
+        let evaluator = Evaluator::new(
+            sim.validate().unwrap(),
+            ronap_core::sim::world::Scenes::MazePerSeed,
+        );
+        let mut p = Builtin::Geodesic.make().unwrap();
+        let rollout = start_episode(&evaluator, p.as_mut(), 7).unwrap();
+        let mut state = ViewState::new(rollout, "geodesic", 20);
+        let buf = render(&state, 80, 24);
+        let scene = inner(draw::layout(buf.area).scene);
+        // 30 discs of radius 8 px: some dots in the first-person view are not needed, but the
+        // legend says what the colour means.
+        assert!((0..24).any(|y| row(&buf, y).contains("moving obstacle")));
+        let m = KeyEvent::new(KeyCode::Char('m'), KeyModifiers::NONE);
+        handle_key(&mut state, &m);
+        let before = dots(&render(&state, 80, 24), scene, draw::MOVER);
+        assert!(before.len() >= 15, "{} moving-obstacle cells", before.len());
+        for _ in 0..20 {
+            state.advance(p.as_mut());
+        }
+        let after = dots(&render(&state, 80, 24), scene, draw::MOVER);
+        assert_ne!(before, after, "the obstacles moved");
     }
 
     #[test]
