@@ -145,7 +145,7 @@ fn setup(c: &mut Criterion) {
 #[allow(missing_docs)]
 mod group {
     use super::*;
-    criterion_group!(benches, step, scan, movers, setup);
+    criterion_group!(benches, step, scan, movers, setup, mlp);
 }
 use group::benches;
 criterion_main!(benches);
@@ -175,6 +175,26 @@ fn movers(c: &mut Criterion) {
                 5.0,
             )
         })
+    });
+    group.finish();
+}
+
+/// The shipped behaviour-cloning network (18-64-128-64-32-8-3) on one observation, as the policy
+/// runs it: without allocation (`mlp/forward_into`), and through the allocating `forward`.
+fn mlp(c: &mut Criterion) {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../policies/bc.safetensors");
+    let net = ronap_core::policy::mlp::Mlp::load(std::path::Path::new(path)).expect("shipped");
+    let config = ValidConfig::default();
+    let episode = Episode::new(&config, Arc::new(maze_scene(&config, 0)), 0).expect("places");
+    let observation = episode.observation().to_vec();
+    let mut scratch = ronap_core::policy::mlp::Scratch::default();
+    let mut group = c.benchmark_group("mlp");
+    group.throughput(Throughput::Elements(1));
+    group.bench_function("forward_into", |b| {
+        b.iter(|| net.action_into(black_box(&observation), &mut scratch))
+    });
+    group.bench_function("forward", |b| {
+        b.iter(|| net.forward(black_box(&observation)))
     });
     group.finish();
 }

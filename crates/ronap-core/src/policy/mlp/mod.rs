@@ -23,7 +23,7 @@ pub mod network;
 
 pub use file::MlpError;
 pub use network::{
-    observation_layout, Activation, DecisionRule, Layer, Mlp, FORMAT, OBSERVATION_LAYOUT,
+    observation_layout, Activation, DecisionRule, Layer, Mlp, Scratch, FORMAT, OBSERVATION_LAYOUT,
     RRELU_SLOPE,
 };
 
@@ -40,6 +40,7 @@ pub struct MlpPolicy {
     mlp: Arc<Mlp>,
     rule: DecisionRule,
     rng: crate::sim::rng::Rng,
+    scratch: Scratch,
 }
 
 impl MlpPolicy {
@@ -50,6 +51,7 @@ impl MlpPolicy {
             mlp,
             rule,
             rng: crate::sim::rng::stream(0, crate::sim::rng::Stream::Policy),
+            scratch: Scratch::default(),
         }
     }
 }
@@ -72,14 +74,15 @@ impl Policy for MlpPolicy {
     fn act(&mut self, episode: &Episode) -> Result<Decision, PolicyError> {
         let observation = episode.observation();
         let action = match self.rule {
-            DecisionRule::Argmax => self.mlp.action(observation),
+            DecisionRule::Argmax => self.mlp.action_into(observation, &mut self.scratch),
             DecisionRule::Sample { temperature } => {
-                let out = self.mlp.forward(observation);
-                let top = out.max();
-                let weights: Vec<f32> = out
-                    .iter()
-                    .map(|v| ((v - top) / temperature).exp())
-                    .collect();
+                let out = self.mlp.forward_into(observation, &mut self.scratch);
+                let top = out.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+                // A network has one output per action (checked when it is made).
+                let mut weights = [0f32; DiscreteAction::ALL.len()];
+                for (w, v) in weights.iter_mut().zip(out) {
+                    *w = ((v - top) / temperature).exp();
+                }
                 let mut u = rand::Rng::random::<f32>(&mut self.rng) * weights.iter().sum::<f32>();
                 let mut pick = weights.len() - 1;
                 for (i, w) in weights.iter().enumerate() {
@@ -174,6 +177,52 @@ mod tests {
             HashMap::new(),
         )
         .unwrap()
+    }
+
+    /// The forward pass as it was written with nalgebra's `gemv`, for comparison.
+    fn gemv_forward(m: &Mlp, observation: &[f32]) -> Vec<f32> {
+        let mut x = DVector::from_column_slice(observation);
+        for (i, l) in m.layers.iter().enumerate() {
+            let mut y = l.bias.clone();
+            y.gemv(1.0, &l.weight, &x, 1.0);
+            if i + 1 < m.layers.len() {
+                let mut v: Vec<f32> = y.iter().copied().collect();
+                m.activation.apply(&mut v);
+                y = DVector::from_vec(v);
+            }
+            x = y;
+        }
+        x.iter().copied().collect()
+    }
+
+    #[test]
+    fn the_allocation_free_pass_gives_gemvs_bits() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+        // The shipped network's shape, random weights, each activation.
+        let sizes = [18, 64, 128, 64, 32, 8, 3];
+        for activation in [
+            Activation::Relu,
+            Activation::Tanh,
+            Activation::LeakyRelu(RRELU_SLOPE),
+        ] {
+            let layers = sizes
+                .windows(2)
+                .map(|w| Layer {
+                    weight: DMatrix::from_fn(w[1], w[0], |_, _| rng.random_range(-0.5..0.5)),
+                    bias: DVector::from_fn(w[1], |_, _| rng.random_range(-0.1..0.1)),
+                })
+                .collect();
+            let m = Mlp::new(layers, activation, HashMap::new()).unwrap();
+            let mut scratch = Scratch::default();
+            for _ in 0..200 {
+                let x: Vec<f32> = (0..18).map(|_| rng.random_range(0.0..1.0)).collect();
+                let want = gemv_forward(&m, &x);
+                let got = m.forward_into(&x, &mut scratch);
+                let bits = |v: &[f32]| v.iter().map(|f| f.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(got), bits(&want));
+            }
+        }
     }
 
     #[test]

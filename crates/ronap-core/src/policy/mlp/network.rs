@@ -60,11 +60,12 @@ impl Activation {
         }
     }
 
-    fn apply(self, v: &mut DVector<f32>) {
+    /// Applies the activation to every value.
+    pub(crate) fn apply(self, v: &mut [f32]) {
         match self {
-            Self::Relu => v.apply(|x| *x = x.max(0.0)),
-            Self::Tanh => v.apply(|x| *x = x.tanh()),
-            Self::LeakyRelu(s) => v.apply(|x| {
+            Self::Relu => v.iter_mut().for_each(|x| *x = x.max(0.0)),
+            Self::Tanh => v.iter_mut().for_each(|x| *x = x.tanh()),
+            Self::LeakyRelu(s) => v.iter_mut().for_each(|x| {
                 if *x < 0.0 {
                     *x *= s;
                 }
@@ -161,22 +162,39 @@ impl Mlp {
 
     /// The network's outputs for `observation`.
     pub fn forward(&self, observation: &[f32]) -> DVector<f32> {
-        let mut x = DVector::from_column_slice(observation);
+        DVector::from_column_slice(self.forward_into(observation, &mut Scratch::default()))
+    }
+
+    /// The network's outputs for `observation`, computed in `scratch` (no allocation once it
+    /// has grown to the widest layer). Each layer adds the weights' columns, scaled by the
+    /// inputs, to the bias in input order: the same sums, bit for bit, as nalgebra's `gemv`,
+    /// in a loop the compiler vectorises over the outputs.
+    pub fn forward_into<'s>(&self, observation: &[f32], scratch: &'s mut Scratch) -> &'s [f32] {
+        let Scratch { x, y } = scratch;
+        x.clear();
+        x.extend_from_slice(observation);
         let last = self.layers.len() - 1;
         for (i, l) in self.layers.iter().enumerate() {
-            let mut y = l.bias.clone();
-            y.gemv(1.0, &l.weight, &x, 1.0);
+            let outputs = l.weight.nrows();
+            y.clear();
+            y.extend_from_slice(l.bias.as_slice());
+            add_columns(y, x, l.weight.as_slice(), outputs);
             if i < last {
-                self.activation.apply(&mut y);
+                self.activation.apply(y);
             }
-            x = y;
+            std::mem::swap(x, y);
         }
         x
     }
 
     /// The action with the largest output (the first of equals).
     pub fn action(&self, observation: &[f32]) -> DiscreteAction {
-        let out = self.forward(observation);
+        self.action_into(observation, &mut Scratch::default())
+    }
+
+    /// [`Mlp::action`], computed in `scratch`.
+    pub fn action_into(&self, observation: &[f32], scratch: &mut Scratch) -> DiscreteAction {
+        let out = self.forward_into(observation, scratch);
         let mut best = 0;
         for i in 1..out.len() {
             if out[i] > out[best] {
@@ -185,6 +203,23 @@ impl Mlp {
         }
         DiscreteAction::ALL[best]
     }
+}
+
+/// `y += W x` for the column-major `weights` (column j holds the weights from input j), adding
+/// the columns in input order: a loop over the outputs that vectorises.
+fn add_columns(y: &mut [f32], x: &[f32], weights: &[f32], outputs: usize) {
+    for (&xj, column) in x.iter().zip(weights.chunks_exact(outputs)) {
+        for (yi, &w) in y.iter_mut().zip(column) {
+            *yi += xj * w;
+        }
+    }
+}
+
+/// Buffers for [`Mlp::forward_into`], reused from step to step.
+#[derive(Clone, Debug, Default)]
+pub struct Scratch {
+    x: Vec<f32>,
+    y: Vec<f32>,
 }
 
 /// How a policy turns the network's outputs into an action.
