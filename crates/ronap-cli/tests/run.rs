@@ -180,6 +180,19 @@ fn bad_input_is_named_and_leaves_no_output() {
         &[
             "run",
             "--policy",
+            "random",
+            "--seeds",
+            "18446744073709551615",
+            "--out",
+            o,
+        ],
+        &["--seeds 18446744073709551615", "--seed-start"],
+        &out,
+    );
+    assert_rejected_leaving_nothing(
+        &[
+            "run",
+            "--policy",
             "apf",
             "--map",
             "/no/such/map.png",

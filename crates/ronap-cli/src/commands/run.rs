@@ -68,6 +68,16 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
             end - 1
         );
     }
+    // The seed list is held whole: a count too large for memory is refused before anything is
+    // written (streaming runs of any length are issue work still open).
+    let mut seeds = Vec::new();
+    seeds.try_reserve_exact(args.seeds as usize).map_err(|_| {
+        anyhow::anyhow!(
+            "--seeds {}: too many seeds to hold in memory for one run; split it with --seed-start",
+            args.seeds
+        )
+    })?;
+    seeds.extend(first..end);
     // A scene with no room for a start and goal fails the same way for every seed: say so now.
     evaluator
         .worlds()
@@ -93,7 +103,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         format!("ronap run {}", args.policy),
     );
     let options = EvalOptions {
-        seeds: (first..end).collect(),
+        seeds,
         threads,
         recording: Recording::default(),
     };
