@@ -585,6 +585,16 @@ fn length(field: &str, v: f64, zero_ok: bool) -> Result<(), ConfigError> {
         },
     )
 }
+/// Checks that `v` is a fraction, 0 to 1.
+fn fraction(field: &str, v: f64) -> Result<(), ConfigError> {
+    check(
+        (0.0..=1.0).contains(&v),
+        field,
+        format!("{v:?}"),
+        "must be between 0 and 1",
+    )
+}
+
 /// Largest number of laser beams.
 pub const MAX_BEAMS: u32 = 360;
 
@@ -631,12 +641,7 @@ impl SimConfig {
             format!("{:?}", m.cell_px),
             side,
         )?;
-        check(
-            (0.0..=1.0).contains(&m.loops),
-            "maze.loops",
-            format!("{:?}", m.loops),
-            "must be between 0 and 1",
-        )?;
+        fraction("maze.loops", m.loops)?;
         length("maze.wall_thickness_px", m.wall_thickness_px, false)?;
         check(
             m.wall_thickness_px < m.cell_px,
@@ -775,12 +780,7 @@ impl SimConfig {
         length("warehouse.loading_px", w.loading_px, true)?;
         length("warehouse.pallet_px", w.pallet_px, false)?;
         length("warehouse.wall_thickness_px", w.wall_thickness_px, false)?;
-        check(
-            (0.0..=1.0).contains(&w.clutter),
-            "warehouse.clutter",
-            format!("{:?}", w.clutter),
-            "must be between 0 and 1",
-        )?;
+        fraction("warehouse.clutter", w.clutter)?;
         let (wide, tall) = w.size_px();
         check(
             wide.max(tall) <= MAX_LENGTH_PX,

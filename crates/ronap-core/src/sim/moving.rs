@@ -36,12 +36,17 @@ impl Body {
         }
     }
 
-    /// The box the body covers at `center` (a disc's bounding box).
-    pub fn aabb(&self, center: Point) -> Aabb {
-        let h = match *self {
+    /// Half extents of the box the body covers (a disc's bounding box), px.
+    pub fn half_extents(&self) -> Vector {
+        match *self {
             Body::Disc(r) => Vector::new(r, r),
             Body::Box(h) => h,
-        };
+        }
+    }
+
+    /// The box the body covers at `center` (a disc's bounding box).
+    pub fn aabb(&self, center: Point) -> Aabb {
+        let h = self.half_extents();
         Aabb::from_corners(center - h, center + h)
     }
 
@@ -165,8 +170,6 @@ struct State {
     hi_y: Vec<f64>,
     /// Bounding radius of the body, px.
     bound: Vec<f64>,
-    /// Whether it is in the scene (its entry's `present`, kept here for the quick scans).
-    present: Vec<bool>,
     /// Squared distance from the robot's centre within which a move must be checked against it.
     near_robot2: Vec<f64>,
     /// Whether it moves along its heading this step (present, `linear` or `random_walk`).
@@ -192,7 +195,6 @@ const FIT_MARGIN: f64 = 1e-9;
 impl State {
     fn push(&mut self, entry: &Entry, position: Point, dir: Vector, speed: f64, near_robot: f64) {
         self.bound.push(entry.body.bounding_radius());
-        self.present.push(entry.present());
         self.near_robot2.push(near_robot * near_robot);
         self.walks.push(false);
         self.moved.push(false);
@@ -576,12 +578,10 @@ impl Movers {
                         state.x[i] = p.x;
                         state.y[i] = p.y;
                         e.appears_at = None;
-                        state.present[i] = true;
                     }
                 }
             } else if e.held && e.body.gap(state.position(i), robot, radius) >= 0.0 {
                 e.held = false;
-                state.present[i] = true;
             }
         }
         state.wide.clear();
@@ -668,11 +668,8 @@ impl Movers {
         from: Point,
     ) -> Option<Point> {
         let (dx, dy, speed) = (state.dx[i], state.dy[i], state.speed[i]);
-        let half = match body {
-            Body::Disc(r) => Vector::new(r, r),
-            Body::Box(h) => h,
-        };
-        state.set_free(i, scene.free_box(from, dy.abs() > dx.abs()), half);
+        let free = scene.free_box(from, dy.abs() > dx.abs());
+        state.set_free(i, free, body.half_extents());
         let clear = |state: &State, to: Point| {
             (state.in_free(i, from) && state.in_free(i, to)) || body.sweep_clear(scene, from, to)
         };
@@ -695,18 +692,16 @@ impl Movers {
         let reach = self.reach + radius + (b - a).norm();
         let r2 = reach * reach;
         let st = &self.state;
-        (0..self.entries.len()).all(|i| {
+        self.entries.iter().enumerate().all(|(i, e)| {
             let (px, py) = (st.x[i] - a.x, st.y[i] - a.y);
-            !st.present[i]
-                || px * px + py * py > r2
-                || match self.entries[i].body {
+            px * px + py * py > r2
+                || !e.present()
+                || match e.body {
                     Body::Disc(r) => {
                         point_segment_distance_squared(st.position(i), a, b) >= (r + radius).powi(2)
                     }
-                    Body::Box(h) => {
-                        Body::Box(h)
-                            .aabb(st.position(i))
-                            .segment_distance_squared(a, b)
+                    Body::Box(_) => {
+                        e.body.aabb(st.position(i)).segment_distance_squared(a, b)
                             >= radius * radius
                     }
                 }
@@ -730,14 +725,14 @@ impl Movers {
         let range = laser.range_px();
         let st = &self.state;
         let reach = range + self.robot_radius;
-        for i in 0..self.entries.len() {
+        for (i, e) in self.entries.iter().enumerate() {
             let (px, py) = (st.x[i] - position.x, st.y[i] - position.y);
             let d2 = px * px + py * py;
             let far = reach + st.bound[i];
-            if d2 > far * far || !st.present[i] {
+            if d2 > far * far || !e.present() {
                 continue;
             }
-            let (e, p, bound) = (&self.entries[i], st.position(i), st.bound[i]);
+            let (p, bound) = (st.position(i), st.bound[i]);
             let d = d2.sqrt();
             if d - bound <= range + self.robot_radius {
                 least_gap = least_gap.min(e.body.gap(p, position, self.robot_radius));
