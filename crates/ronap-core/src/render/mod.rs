@@ -1,11 +1,13 @@
 //! Pictures, above `eval`: the canvas, the top view, the first-person view, trajectory pictures of
-//! finished episodes and animated GIFs. Uses every layer below it.
+//! finished episodes, animated GIFs and the charts that compare policies ([`chart`]). Uses every
+//! layer below it.
 //!
 //! Drawing scenes to images: white floor, black walls, y flipped so up is up.
 //!
 //! A [`Canvas`] maps scene px to image pixels at `scale` pixels per px. Markers and paths are drawn
 //! in scene coordinates, so callers never deal with the flip.
 
+pub mod chart;
 pub mod first_person;
 pub mod gif;
 pub mod trajectory;

@@ -1,0 +1,1669 @@
+//! Charts that compare policies: the success-rate and SPL panels of a comparison
+//! ([`compare_chart`]), the per-seed outcome strip ([`outcome_strip`]), contact sheets of episode
+//! pictures ([`contact_sheet`]) and success rates grouped by bin ([`grouped_bars`]).
+//!
+//! Every function is pure: plain figures in, an [`RgbImage`] out; no files, no printing. Odd input
+//! never panics and still gives a readable picture: an empty list gives a small image that says
+//! so, a figure that is not finite is left out (its label reads "n/a"), rates are clamped to 0-1,
+//! and names are cut to fit (ending in ".."). A picture is at most [`MAX_SIDE`] pixels a side;
+//! past that it is cut off.
+//!
+//! Text uses Noto Sans Mono glyphs that the `noto-sans-mono-bitmap` crate stores pre-rasterised,
+//! so no system font is needed. Only printable ASCII is drawn: any other character shows as `?`.
+//!
+//! Policy `i` (its index in the slice passed in) has colour [`policy_colour`]`(i)` in every chart,
+//! and each outcome has colour [`outcome_colour`].
+
+use crate::eval::Outcome;
+use image::imageops::{self, FilterType};
+use image::{Rgb, RgbImage};
+use noto_sans_mono_bitmap::{get_raster, get_raster_width, FontWeight, RasterHeight};
+
+/// The longest side of any chart, in pixels; drawing past it is cut off.
+pub const MAX_SIDE: u32 = 30_000;
+
+/// Background colour of every chart.
+pub const BACKGROUND: Rgb<u8> = Rgb([255, 255, 255]);
+/// Text and axis colour.
+const INK: Rgb<u8> = Rgb([33, 33, 33]);
+/// Secondary text: tick labels, values under bars, seed ranges.
+const MUTED: Rgb<u8> = Rgb([100, 100, 100]);
+/// Grid lines.
+const GRID: Rgb<u8> = Rgb([225, 225, 225]);
+/// Picture frames in contact sheets.
+const FRAME: Rgb<u8> = Rgb([190, 190, 190]);
+/// Strip cells without an outcome, and the disagreement row where the policies agree.
+pub const NO_DATA: Rgb<u8> = Rgb([236, 236, 236]);
+/// Disagreement row of the outcome strip where the policies disagree.
+pub const DISAGREE: Rgb<u8> = Rgb([40, 40, 40]);
+
+/// Policy colours: matplotlib's "tab10", ten hues that stay apart on screen and in print.
+const POLICY_COLOURS: [Rgb<u8>; 10] = [
+    Rgb([31, 119, 180]),
+    Rgb([255, 127, 14]),
+    Rgb([44, 160, 44]),
+    Rgb([214, 39, 40]),
+    Rgb([148, 103, 189]),
+    Rgb([140, 86, 75]),
+    Rgb([227, 119, 194]),
+    Rgb([127, 127, 127]),
+    Rgb([188, 189, 34]),
+    Rgb([23, 190, 207]),
+];
+
+/// The colour of the `index`-th policy of a chart (ten colours, then they repeat).
+pub fn policy_colour(index: usize) -> Rgb<u8> {
+    POLICY_COLOURS[index % POLICY_COLOURS.len()]
+}
+
+/// The colour of an outcome in the outcome strip: success green, timeout amber, stuck grey,
+/// collision red, reward floor purple.
+pub fn outcome_colour(outcome: Outcome) -> Rgb<u8> {
+    match outcome {
+        Outcome::Success => Rgb([46, 160, 67]),
+        Outcome::Timeout => Rgb([242, 169, 0]),
+        Outcome::Stuck => Rgb([150, 150, 150]),
+        Outcome::Collision => Rgb([215, 48, 39]),
+        Outcome::RewardMin => Rgb([128, 64, 176]),
+    }
+}
+
+const OUTCOMES: [Outcome; 5] = [
+    Outcome::Success,
+    Outcome::Timeout,
+    Outcome::Stuck,
+    Outcome::Collision,
+    Outcome::RewardMin,
+];
+
+// ---------------------------------------------------------------------------------------------
+// Input types
+// ---------------------------------------------------------------------------------------------
+
+/// One policy's figures for [`compare_chart`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PolicyBars {
+    /// The policy's name, shown under its bar and box (cut to fit).
+    pub name: String,
+    /// Fraction of the episodes that reached the goal, 0-1 (not per cent).
+    pub success_rate: f64,
+    /// The 95% interval of the success rate, `[low, high]`, as fractions 0-1.
+    pub success_ci95: [f64; 2],
+    /// SPL of every episode, 0 for the failures. The box plot shows the entries above 0 (the
+    /// successful episodes); the diamond marks the mean over all entries. Entries that are not
+    /// finite are left out.
+    pub spl: Vec<f64>,
+}
+
+/// One row of a [`contact_sheet`]: a label on the left and one captioned picture per column.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SheetRow {
+    /// The row's label, e.g. "seed 17".
+    pub label: String,
+    /// One picture and its caption per column, in column order; a 0 x 0 picture leaves its cell
+    /// empty (its caption is still written).
+    pub cells: Vec<(RgbImage, String)>,
+}
+
+/// One policy's success rates per bin for [`grouped_bars`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Series {
+    /// The policy's name, shown in the legend.
+    pub name: String,
+    /// Per bin, in the order of the bins: the success rate (0-1) and its 95% interval
+    /// `[low, high]`. A missing or non-finite rate draws no bar.
+    pub values: Vec<(f64, [f64; 2])>,
+}
+
+// ---------------------------------------------------------------------------------------------
+// Drawing primitives
+// ---------------------------------------------------------------------------------------------
+
+/// A white canvas of `w` x `h` pixels, each side clamped to 1..=[`MAX_SIDE`].
+fn canvas(w: i64, h: i64) -> RgbImage {
+    let side = |v: i64| v.clamp(1, i64::from(MAX_SIDE)) as u32;
+    RgbImage::from_pixel(side(w), side(h), BACKGROUND)
+}
+
+/// Fills the pixels `x0..x1` x `y0..y1` (either order), cut to the image.
+fn fill_rect(img: &mut RgbImage, x0: i64, y0: i64, x1: i64, y1: i64, colour: Rgb<u8>) {
+    let (w, h) = (i64::from(img.width()), i64::from(img.height()));
+    let (xa, xb) = (x0.min(x1).max(0), x0.max(x1).min(w));
+    let (ya, yb) = (y0.min(y1).max(0), y0.max(y1).min(h));
+    for y in ya..yb {
+        for x in xa..xb {
+            img.put_pixel(x as u32, y as u32, colour);
+        }
+    }
+}
+
+/// The outline, `t` pixels thick, of the rectangle `x0..x1` x `y0..y1`.
+fn outline(img: &mut RgbImage, (x0, y0, x1, y1): (i64, i64, i64, i64), t: i64, colour: Rgb<u8>) {
+    fill_rect(img, x0, y0, x1, y0 + t, colour);
+    fill_rect(img, x0, y1 - t, x1, y1, colour);
+    fill_rect(img, x0, y0, x0 + t, y1, colour);
+    fill_rect(img, x1 - t, y0, x1, y1, colour);
+}
+
+/// Mixes `colour` into the pixel at `(x, y)` with coverage `alpha` (255 = all `colour`).
+fn blend(img: &mut RgbImage, x: i64, y: i64, colour: Rgb<u8>, alpha: u8) {
+    if x < 0 || y < 0 || x >= i64::from(img.width()) || y >= i64::from(img.height()) {
+        return;
+    }
+    let a = u32::from(alpha);
+    let p = img.get_pixel_mut(x as u32, y as u32);
+    for k in 0..3 {
+        p.0[k] = ((u32::from(p.0[k]) * (255 - a) + u32::from(colour.0[k]) * a + 127) / 255) as u8;
+    }
+}
+
+/// `colour` faded towards white: `amount` 0 is white, 1 is `colour`.
+fn tint(colour: Rgb<u8>, amount: f64) -> Rgb<u8> {
+    let mix = |c: u8| (255.0 - (255.0 - f64::from(c)) * amount).round() as u8;
+    Rgb([mix(colour.0[0]), mix(colour.0[1]), mix(colour.0[2])])
+}
+
+/// Fills the diamond of half-diagonal `r` around `(cx, cy)`.
+fn fill_diamond(img: &mut RgbImage, cx: i64, cy: i64, r: i64, colour: Rgb<u8>) {
+    for dy in -r..=r {
+        let half = r - dy.abs();
+        fill_rect(img, cx - half, cy + dy, cx + half + 1, cy + dy + 1, colour);
+    }
+}
+
+/// Fills the disc of radius `r` around `(cx, cy)`.
+fn fill_disc(img: &mut RgbImage, cx: i64, cy: i64, r: i64, colour: Rgb<u8>) {
+    for dy in -r..=r {
+        for dx in -r..=r {
+            if dx * dx + dy * dy <= r * r + r {
+                fill_rect(img, cx + dx, cy + dy, cx + dx + 1, cy + dy + 1, colour);
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Text
+// ---------------------------------------------------------------------------------------------
+
+/// The three text styles of the charts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Font {
+    /// Labels and ticks: regular, 16 px line, 7 px per character.
+    Body,
+    /// Headers: bold, 16 px line.
+    Bold,
+    /// Titles: bold, 20 px line, 9 px per character.
+    Title,
+}
+
+impl Font {
+    fn style(self) -> (FontWeight, RasterHeight) {
+        match self {
+            Font::Body => (FontWeight::Regular, RasterHeight::Size16),
+            Font::Bold => (FontWeight::Bold, RasterHeight::Size16),
+            Font::Title => (FontWeight::Bold, RasterHeight::Size20),
+        }
+    }
+
+    /// Pixels from one character to the next.
+    fn advance(self) -> i64 {
+        let (weight, height) = self.style();
+        get_raster_width(weight, height) as i64
+    }
+
+    /// Line height in pixels.
+    fn height(self) -> i64 {
+        self.style().1.val() as i64
+    }
+
+    /// How many characters fit in `px` pixels.
+    fn chars_in(self, px: i64) -> usize {
+        (px / self.advance()).max(0) as usize
+    }
+
+    /// Width of `s` in pixels.
+    fn width(self, s: &str) -> i64 {
+        s.chars().count() as i64 * self.advance()
+    }
+}
+
+/// `s` in printable ASCII (other characters as `?`, white space as a space), cut to at most
+/// `max_chars` characters: a cut name ends in "..".
+fn fit(s: &str, max_chars: usize) -> String {
+    let clean: Vec<char> = s
+        .chars()
+        .map(|c| {
+            if c == ' ' || c.is_ascii_graphic() {
+                c
+            } else if c.is_whitespace() {
+                ' '
+            } else {
+                '?'
+            }
+        })
+        .collect();
+    if clean.len() <= max_chars {
+        clean.into_iter().collect()
+    } else if max_chars >= 4 {
+        clean[..max_chars - 2]
+            .iter()
+            .chain(['.', '.'].iter())
+            .collect()
+    } else {
+        clean[..max_chars].iter().collect()
+    }
+}
+
+/// Where the `x` of a text is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Align {
+    Left,
+    Centre,
+    Right,
+}
+
+/// Writes `s` (already [`fit`]) with its line's top at `y`, aligned on `x`.
+fn text(
+    img: &mut RgbImage,
+    (x, y): (i64, i64),
+    s: &str,
+    font: Font,
+    colour: Rgb<u8>,
+    align: Align,
+) {
+    let x0 = match align {
+        Align::Left => x,
+        Align::Centre => x - font.width(s) / 2,
+        Align::Right => x - font.width(s),
+    };
+    let (weight, height) = font.style();
+    for (i, c) in s.chars().enumerate() {
+        let Some(glyph) = get_raster(c, weight, height).or_else(|| get_raster('?', weight, height))
+        else {
+            continue;
+        };
+        let gx0 = x0 + i as i64 * font.advance();
+        for (gy, row) in glyph.rows().enumerate() {
+            for (gx, &alpha) in row.iter().enumerate() {
+                if alpha > 0 {
+                    blend(img, gx0 + gx as i64, y + gy as i64, colour, alpha);
+                }
+            }
+        }
+    }
+}
+
+/// Writes `s` turned a quarter anticlockwise (reading upwards), its line's top at column `x`,
+/// centred on row `cy`.
+fn text_up(img: &mut RgbImage, x: i64, cy: i64, s: &str, font: Font, colour: Rgb<u8>) {
+    let bottom = cy + font.width(s) / 2;
+    let (weight, height) = font.style();
+    for (i, c) in s.chars().enumerate() {
+        let Some(glyph) = get_raster(c, weight, height).or_else(|| get_raster('?', weight, height))
+        else {
+            continue;
+        };
+        let along = i as i64 * font.advance();
+        for (gy, row) in glyph.rows().enumerate() {
+            for (gx, &alpha) in row.iter().enumerate() {
+                if alpha > 0 {
+                    blend(
+                        img,
+                        x + gy as i64,
+                        bottom - along - gx as i64,
+                        colour,
+                        alpha,
+                    );
+                }
+            }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Legend
+// ---------------------------------------------------------------------------------------------
+
+/// What a legend entry shows before its text.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Key {
+    /// A filled square.
+    Square(Rgb<u8>),
+    /// A thin bar, as the disagreement row.
+    Thin(Rgb<u8>),
+}
+
+const LEGEND_ROW: i64 = 22;
+const KEY_PX: i64 = 13;
+
+/// Entries flowed left to right in rows `width` wide: each entry's `(dx, row)`, and the rows.
+fn legend_layout(width: i64, entries: &[(Key, String)]) -> (Vec<(i64, i64)>, i64) {
+    let mut places = Vec::with_capacity(entries.len());
+    let (mut dx, mut row) = (0, 0);
+    for (_, label) in entries {
+        let w = KEY_PX + 6 + Font::Body.width(label);
+        if dx > 0 && dx + w > width {
+            dx = 0;
+            row += 1;
+        }
+        places.push((dx, row));
+        dx += w + 20;
+    }
+    (places, if entries.is_empty() { 0 } else { row + 1 })
+}
+
+/// Draws a legend laid out by [`legend_layout`] with its top-left at `(x, y)`.
+fn draw_legend(img: &mut RgbImage, (x, y): (i64, i64), width: i64, entries: &[(Key, String)]) {
+    let (places, _) = legend_layout(width, entries);
+    for ((key, label), (dx, row)) in entries.iter().zip(places) {
+        let (ex, ey) = (x + dx, y + row * LEGEND_ROW);
+        match *key {
+            Key::Square(c) => fill_rect(img, ex, ey + 2, ex + KEY_PX, ey + 2 + KEY_PX, c),
+            Key::Thin(c) => fill_rect(img, ex, ey + 6, ex + KEY_PX, ey + 10, c),
+        }
+        text(
+            img,
+            (ex + KEY_PX + 6, ey),
+            label,
+            Font::Body,
+            INK,
+            Align::Left,
+        );
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Plot frames and axes
+// ---------------------------------------------------------------------------------------------
+
+/// A plot area in image pixels, values 0-1 from `bottom` up to `top`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Frame {
+    left: i64,
+    top: i64,
+    right: i64,
+    bottom: i64,
+}
+
+impl Frame {
+    /// The row of value `v` (clamped to 0-1).
+    fn y(&self, v: f64) -> i64 {
+        self.bottom - (v.clamp(0.0, 1.0) * (self.bottom - self.top) as f64).round() as i64
+    }
+
+    /// Left edge and width of slot `i` of `n` equal slots across the frame.
+    fn slot(&self, i: usize, n: usize) -> (i64, i64) {
+        let (w, n, i) = (self.right - self.left, n.max(1) as i64, i as i64);
+        let (a, b) = (self.left + w * i / n, self.left + w * (i + 1) / n);
+        (a, b - a)
+    }
+
+    /// Grid lines and labelled ticks every 0.2, the axis lines, and `label` up the left side.
+    fn axes(&self, img: &mut RgbImage, percent: bool, label: &str) {
+        let mut widest = 0;
+        for k in 0..=5 {
+            let v = f64::from(k) / 5.0;
+            let y = self.y(v);
+            if k > 0 {
+                fill_rect(img, self.left + 1, y, self.right, y + 1, GRID);
+            }
+            fill_rect(img, self.left - 4, y, self.left, y + 1, INK);
+            let tick = if percent {
+                format!("{}%", k * 20)
+            } else {
+                format!("{v:.1}")
+            };
+            widest = widest.max(Font::Body.width(&tick));
+            let at = (self.left - 7, y - Font::Body.height() / 2);
+            text(img, at, &tick, Font::Body, MUTED, Align::Right);
+        }
+        fill_rect(
+            img,
+            self.left,
+            self.top,
+            self.left + 1,
+            self.bottom + 1,
+            INK,
+        );
+        fill_rect(
+            img,
+            self.left,
+            self.bottom,
+            self.right,
+            self.bottom + 1,
+            INK,
+        );
+        let x = self.left - 7 - widest - 6 - Font::Body.height();
+        let label = fit(label, Font::Body.chars_in(self.bottom - self.top));
+        text_up(
+            img,
+            x,
+            (self.top + self.bottom) / 2,
+            &label,
+            Font::Body,
+            INK,
+        );
+    }
+
+    /// "no policies" (or another note) in the middle of the frame.
+    fn note(&self, img: &mut RgbImage, note: &str) {
+        let mid = (
+            (self.left + self.right) / 2,
+            (self.top + self.bottom) / 2 - 8,
+        );
+        let note = fit(note, Font::Body.chars_in(self.right - self.left));
+        text(img, mid, &note, Font::Body, MUTED, Align::Centre);
+    }
+}
+
+/// `v` if finite, clamped to 0-1.
+fn unit(v: f64) -> Option<f64> {
+    v.is_finite().then(|| v.clamp(0.0, 1.0))
+}
+
+/// A 2 px interval whisker at column `cx` from `ci[0]` to `ci[1]`, with caps `cap` px either side.
+fn whisker(img: &mut RgbImage, frame: &Frame, cx: i64, ci: [f64; 2], cap: i64) {
+    let (Some(a), Some(b)) = (unit(ci[0]), unit(ci[1])) else {
+        return;
+    };
+    let (ya, yb) = (frame.y(a.min(b)), frame.y(a.max(b)));
+    fill_rect(img, cx - 1, yb, cx + 1, ya + 1, INK);
+    for y in [ya, yb] {
+        fill_rect(img, cx - cap, y - 1, cx + cap + 1, y + 1, INK);
+    }
+}
+
+/// Quartiles and Tukey whiskers of sorted values.
+#[derive(Clone, Debug, PartialEq)]
+struct BoxStats {
+    low: f64,
+    q1: f64,
+    median: f64,
+    q3: f64,
+    high: f64,
+    outliers: Vec<f64>,
+}
+
+/// The value at quantile `q` of `sorted` (non-empty), interpolated linearly between ranks.
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    let pos = q * (sorted.len() - 1) as f64;
+    let (i, frac) = (pos.floor() as usize, pos - pos.floor());
+    match sorted.get(i + 1) {
+        Some(next) => sorted[i] + (next - sorted[i]) * frac,
+        None => sorted[i],
+    }
+}
+
+/// Median, quartiles, whiskers at the furthest values within 1.5 IQR of the box, and the values
+/// beyond them; `None` for no values.
+fn box_stats(sorted: &[f64]) -> Option<BoxStats> {
+    if sorted.is_empty() {
+        return None;
+    }
+    let (q1, median, q3) = (
+        quantile(sorted, 0.25),
+        quantile(sorted, 0.5),
+        quantile(sorted, 0.75),
+    );
+    let reach = 1.5 * (q3 - q1);
+    let inside = |v: &&f64| **v >= q1 - reach && **v <= q3 + reach;
+    let low = sorted.iter().find(inside).copied().unwrap_or(q1);
+    let high = sorted.iter().rev().find(inside).copied().unwrap_or(q3);
+    let outliers = sorted.iter().filter(|v| !inside(v)).copied().collect();
+    Some(BoxStats {
+        low,
+        q1,
+        median,
+        q3,
+        high,
+        outliers,
+    })
+}
+
+/// How the x-axis labels of [`slot_labels`] name the policies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Naming {
+    /// Every name in full: no legend needed.
+    Full,
+    /// Some names cut to fit: a legend gives them in full.
+    Cut,
+    /// Too narrow for names: the labels are 1, 2, ... and a legend says which is which.
+    Numbered,
+}
+
+/// The x-axis labels of `names` for slots `slot_px` wide: the names, cut to fit if need be; or,
+/// when names would be cut to fewer than 8 characters (too short to tell apart), the numbers
+/// 1, 2, ...
+fn slot_labels<'a>(names: impl Iterator<Item = &'a str>, slot_px: i64) -> (Vec<String>, Naming) {
+    let names: Vec<&str> = names.collect();
+    let room = Font::Body.chars_in(slot_px - 4);
+    let fitted: Vec<String> = names.iter().map(|n| fit(n, room)).collect();
+    let cut = fitted.iter().zip(&names).any(|(f, n)| f != n);
+    if cut && room < 8 {
+        let numbers = (1..=names.len())
+            .map(|i| fit(&i.to_string(), room))
+            .collect();
+        return (numbers, Naming::Numbered);
+    }
+    (fitted, if cut { Naming::Cut } else { Naming::Full })
+}
+
+/// The first of `choices` that fits in `px` pixels, or the last one cut to fit.
+fn first_fitting(choices: &[String], px: i64) -> String {
+    let room = Font::Body.chars_in(px);
+    choices
+        .iter()
+        .find(|c| c.len() <= room)
+        .or(choices.last())
+        .map_or(String::new(), |c| fit(c, room))
+}
+
+/// Legend entries naming each policy in its colour (empty when the labels name them in full).
+fn policy_legend<'a>(names: impl Iterator<Item = &'a str>, naming: Naming) -> Vec<(Key, String)> {
+    if naming == Naming::Full {
+        return Vec::new();
+    }
+    names
+        .enumerate()
+        .map(|(i, name)| {
+            let label = match naming {
+                Naming::Numbered => format!("{} {}", i + 1, fit(name, 40)),
+                _ => fit(name, 40),
+            };
+            (Key::Square(policy_colour(i)), label)
+        })
+        .collect()
+}
+
+// ---------------------------------------------------------------------------------------------
+// compare.png
+// ---------------------------------------------------------------------------------------------
+
+const COMPARE_W: i64 = 1000;
+const COMPARE_H: i64 = 450;
+
+/// The two panels of [`compare_chart`]: success rate on the left, SPL on the right.
+fn compare_frames() -> (Frame, Frame) {
+    let left = Frame {
+        left: 76,
+        top: 86,
+        right: 478,
+        bottom: COMPARE_H - 64,
+    };
+    let right = Frame {
+        left: 590,
+        top: 86,
+        right: COMPARE_W - 20,
+        bottom: COMPARE_H - 64,
+    };
+    (left, right)
+}
+
+/// The comparison chart, about 1000 x 450 px: a title line, then on the left each policy's
+/// success rate as a bar with its 95% interval whiskers (y 0-100%), and on the right each
+/// policy's SPL over its successful episodes as a box plot (median, quartiles, whiskers to the
+/// furthest values within 1.5 IQR, dots beyond) with a diamond at the mean SPL over all episodes
+/// (y 0-1). Under each bar and box: the policy's name and its success rate or mean SPL. Each
+/// policy has its own colour ([`policy_colour`]), the same in both panels; when names had to be
+/// cut or numbered to fit, a legend underneath gives them in full.
+///
+/// `title` is the line on top, e.g. "success = reached the goal within 10 px, 1000 seeds".
+pub fn compare_chart(title: &str, policies: &[PolicyBars]) -> RgbImage {
+    let (left, right) = compare_frames();
+    let n = policies.len();
+    let slot_px = left.slot(0, n).1.min(right.slot(0, n).1);
+    let names = || policies.iter().map(|p| p.name.as_str());
+    let (labels, naming) = slot_labels(names(), slot_px);
+    let legend = policy_legend(names(), naming);
+    let legend_width = COMPARE_W - 2 * 24;
+    let (_, legend_rows) = legend_layout(legend_width, &legend);
+    let height = COMPARE_H + legend_rows * LEGEND_ROW;
+    let mut img = canvas(COMPARE_W, height);
+
+    let title = fit(title, Font::Title.chars_in(COMPARE_W - 2 * 20));
+    text(&mut img, (20, 14), &title, Font::Title, INK, Align::Left);
+
+    // Panel headers, with the key of the SPL markers on the right.
+    let header_y = 50;
+    text(
+        &mut img,
+        (left.left, header_y),
+        "Success rate, 95% interval",
+        Font::Bold,
+        INK,
+        Align::Left,
+    );
+    text(
+        &mut img,
+        (right.left, header_y),
+        "SPL of successful episodes",
+        Font::Bold,
+        INK,
+        Align::Left,
+    );
+    let key = "mean, all episodes";
+    let key_x = right.right - Font::Body.width(key);
+    fill_diamond(&mut img, key_x - 12, header_y + 8, 5, INK);
+    text(
+        &mut img,
+        (key_x, header_y),
+        key,
+        Font::Body,
+        MUTED,
+        Align::Left,
+    );
+
+    left.axes(&mut img, true, "success rate");
+    right.axes(&mut img, false, "SPL");
+    if n == 0 {
+        left.note(&mut img, "no policies");
+        right.note(&mut img, "no policies");
+    }
+
+    for (i, (p, label)) in policies.iter().zip(&labels).enumerate() {
+        success_bar(&mut img, &left, (i, n), p, label);
+        spl_box(&mut img, &right, (i, n), p, label);
+    }
+    draw_legend(&mut img, (24, COMPARE_H - 4), legend_width, &legend);
+    img
+}
+
+/// Under slot `x..x + w` of `frame`: the policy's `label` and, greyed, its `value`.
+fn slot_caption(img: &mut RgbImage, frame: &Frame, (x, w): (i64, i64), label: &str, value: &str) {
+    let (cx, y) = (x + w / 2, frame.bottom + 8);
+    text(img, (cx, y), label, Font::Body, INK, Align::Centre);
+    text(img, (cx, y + 18), value, Font::Body, MUTED, Align::Centre);
+}
+
+/// Policy `i` of `n`'s success-rate bar, whiskers and caption in the left panel of
+/// [`compare_chart`].
+fn success_bar(
+    img: &mut RgbImage,
+    frame: &Frame,
+    (i, n): (usize, usize),
+    p: &PolicyBars,
+    label: &str,
+) {
+    let (x, w) = frame.slot(i, n);
+    let cx = x + w / 2;
+    let bar = ((w as f64 * 0.55).round() as i64).clamp(3, 70);
+    let rate = unit(p.success_rate);
+    if let Some(rate) = rate {
+        let x0 = cx - bar / 2;
+        fill_rect(
+            img,
+            x0,
+            frame.y(rate),
+            x0 + bar,
+            frame.bottom,
+            policy_colour(i),
+        );
+    }
+    whisker(img, frame, cx, p.success_ci95, (bar / 4).clamp(2, 10));
+    let value = match rate {
+        Some(r) => first_fitting(
+            &[format!("{:.1}%", r * 100.0), format!("{:.0}", r * 100.0)],
+            w,
+        ),
+        None => first_fitting(&["n/a".to_owned()], w),
+    };
+    slot_caption(img, frame, (x, w), label, &value);
+}
+
+/// Policy `i` of `n`'s SPL box over its successes, the diamond at its mean SPL over all episodes
+/// and its caption in the right panel of [`compare_chart`].
+fn spl_box(img: &mut RgbImage, frame: &Frame, (i, n): (usize, usize), p: &PolicyBars, label: &str) {
+    let colour = policy_colour(i);
+    let (x, w) = frame.slot(i, n);
+    let cx = x + w / 2;
+    let all: Vec<f64> = p.spl.iter().copied().filter(|v| v.is_finite()).collect();
+    let mut wins: Vec<f64> = all
+        .iter()
+        .filter(|&&v| v > 0.0)
+        .map(|v| v.min(1.0))
+        .collect();
+    wins.sort_by(f64::total_cmp);
+    if let Some(b) = box_stats(&wins) {
+        let bw = ((w as f64 * 0.5).round() as i64).clamp(3, 64);
+        let cap = (bw / 4).clamp(2, 10);
+        let (y_low, y_q1, y_q3, y_high) = (
+            frame.y(b.low),
+            frame.y(b.q1),
+            frame.y(b.q3),
+            frame.y(b.high),
+        );
+        fill_rect(img, cx, y_high, cx + 1, y_q3, INK);
+        fill_rect(img, cx, y_q1, cx + 1, y_low + 1, INK);
+        fill_rect(img, cx - cap, y_high, cx + cap + 1, y_high + 1, INK);
+        fill_rect(img, cx - cap, y_low, cx + cap + 1, y_low + 1, INK);
+        let (bx0, bx1) = (cx - bw / 2, cx - bw / 2 + bw);
+        fill_rect(img, bx0, y_q3, bx1, y_q1 + 1, tint(colour, 0.4));
+        outline(img, (bx0, y_q3, bx1, y_q1 + 1), 2, colour);
+        let y_med = frame.y(b.median);
+        fill_rect(img, bx0, y_med - 1, bx1, y_med + 2, INK);
+        for v in &b.outliers {
+            fill_disc(img, cx, frame.y(*v), 2, colour);
+        }
+    }
+    let mean = (!all.is_empty())
+        .then(|| all.iter().sum::<f64>() / all.len() as f64)
+        .and_then(unit);
+    if let Some(mean) = mean {
+        let y = frame.y(mean);
+        fill_diamond(img, cx, y, 7, BACKGROUND);
+        fill_diamond(img, cx, y, 5, INK);
+    }
+    let value = match mean {
+        Some(m) => first_fitting(&[format!("mean {m:.2}"), format!("{m:.2}")], w),
+        None => first_fitting(&["no episodes".to_owned(), "n/a".to_owned()], w),
+    };
+    slot_caption(img, frame, (x, w), label, &value);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Outcome strip
+// ---------------------------------------------------------------------------------------------
+
+const STRIP_MARGIN: i64 = 12;
+/// Seed columns a band holds at most, in pixels.
+const STRIP_BAND_PX: i64 = 1200;
+const STRIP_HEADER: i64 = 20;
+const STRIP_ROW: i64 = 16;
+const STRIP_ROW_GAP: i64 = 3;
+/// The disagreement row's slot; its mark is the `4..12` px of it.
+const STRIP_DISAGREE: i64 = 16;
+const STRIP_BAND_GAP: i64 = 14;
+
+/// Where everything of an outcome strip goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct StripLayout {
+    /// Width of one seed's column: 4 px for up to 300 seeds, down to 1 px.
+    cell_w: i64,
+    /// Seed columns per band.
+    per_band: usize,
+    /// Bands of seeds, one under the other.
+    bands: usize,
+    /// Policy rows.
+    rows: usize,
+    /// Width of the name column.
+    label_w: i64,
+    /// Image width.
+    width: i64,
+}
+
+impl StripLayout {
+    fn new(seeds: usize, rows: usize, label_chars: usize) -> Self {
+        let cell_w = match seeds {
+            0..=300 => 4,
+            301..=400 => 3,
+            401..=600 => 2,
+            _ => 1,
+        };
+        let per_band = (STRIP_BAND_PX / cell_w) as usize;
+        let bands = seeds.div_ceil(per_band);
+        let label_w = label_chars as i64 * Font::Body.advance() + 12;
+        let columns = seeds.min(per_band) as i64;
+        let width = (2 * STRIP_MARGIN + label_w + columns * cell_w).max(560);
+        Self {
+            cell_w,
+            per_band,
+            bands,
+            rows,
+            label_w,
+            width,
+        }
+    }
+
+    fn band_h(&self) -> i64 {
+        STRIP_HEADER
+            + self.rows as i64 * (STRIP_ROW + STRIP_ROW_GAP)
+            + STRIP_DISAGREE
+            + STRIP_BAND_GAP
+    }
+
+    fn band_top(&self, band: usize) -> i64 {
+        STRIP_MARGIN + band as i64 * self.band_h()
+    }
+
+    /// Left edge of seed column `s`, and the top of its band.
+    fn column(&self, s: usize) -> (i64, i64) {
+        let (band, col) = (s / self.per_band, (s % self.per_band) as i64);
+        (
+            STRIP_MARGIN + self.label_w + col * self.cell_w,
+            self.band_top(band),
+        )
+    }
+
+    /// Top-left of the cell of policy `p` at seed `s`.
+    fn cell(&self, p: usize, s: usize) -> (i64, i64) {
+        let (x, top) = self.column(s);
+        (
+            x,
+            top + STRIP_HEADER + p as i64 * (STRIP_ROW + STRIP_ROW_GAP),
+        )
+    }
+
+    /// Top of the disagreement row's slot at seed `s`.
+    fn disagree(&self, s: usize) -> (i64, i64) {
+        let (x, top) = self.column(s);
+        (
+            x,
+            top + STRIP_HEADER + self.rows as i64 * (STRIP_ROW + STRIP_ROW_GAP),
+        )
+    }
+
+    /// Top of the legend.
+    fn legend_top(&self) -> i64 {
+        STRIP_MARGIN + (self.bands.max(1) as i64) * self.band_h()
+    }
+}
+
+/// Seed columns from one tick over the strip to the next: the first of 10, 20, 25, 50, ... that
+/// puts the ticks at least 90 px apart.
+fn strip_tick_step(cell_w: i64) -> usize {
+    [10, 20, 25, 50, 100, 200, 250, 500]
+        .into_iter()
+        .find(|&step| step as i64 * cell_w >= 90)
+        .unwrap_or(1000)
+}
+
+/// Whether the policies with an outcome at seed `s` differ in success (at least one succeeded and
+/// at least one failed).
+fn disagrees(outcomes: &[Vec<Outcome>], s: usize) -> bool {
+    let mut seen = outcomes.iter().filter_map(|row| row.get(s));
+    let Some(first) = seen.next() else {
+        return false;
+    };
+    let won = *first == Outcome::Success;
+    seen.any(|o| (*o == Outcome::Success) != won)
+}
+
+/// The per-seed outcome strip: one row per policy, its name on the left, and one column per seed
+/// in the order given, coloured by outcome ([`outcome_colour`]; a missing outcome is light grey).
+/// Columns are 4 px wide for up to 300 seeds, down to 1 px; past 1200 px the seeds wrap into
+/// bands, one under the other, each headed by its first and last seed. Under each band's policy
+/// rows a thin row is dark at the seeds where the policies disagree (some succeeded, some did
+/// not). A legend of the outcomes closes the picture.
+///
+/// `outcomes[p][s]` is policy `p`'s outcome at `seeds[s]`; there is one row per name (or per
+/// outcome list, if there are more of those) and one column per seed; outcomes past the last seed
+/// are ignored.
+pub fn outcome_strip(names: &[String], seeds: &[u64], outcomes: &[Vec<Outcome>]) -> RgbImage {
+    let rows = names.len().max(outcomes.len());
+    let row_names: Vec<String> = (0..rows)
+        .map(|p| match names.get(p) {
+            Some(name) => fit(name, 24),
+            None => format!("policy {}", p + 1),
+        })
+        .collect();
+    let label_chars = row_names
+        .iter()
+        .map(|n| n.len())
+        .chain([8])
+        .max()
+        .unwrap_or(8);
+    let layout = StripLayout::new(seeds.len(), rows, label_chars);
+    let mut legend: Vec<(Key, String)> = OUTCOMES
+        .iter()
+        .map(|&o| (Key::Square(outcome_colour(o)), o.name().to_owned()))
+        .collect();
+    legend.push((Key::Thin(DISAGREE), "policies disagree".to_owned()));
+    let legend_width = layout.width - 2 * STRIP_MARGIN;
+    let (_, legend_rows) = legend_layout(legend_width, &legend);
+    let height = layout.legend_top() + legend_rows * LEGEND_ROW + STRIP_MARGIN;
+    let mut img = canvas(layout.width, height);
+
+    if seeds.is_empty() {
+        let at = (STRIP_MARGIN, STRIP_MARGIN);
+        text(&mut img, at, "no seeds", Font::Body, MUTED, Align::Left);
+    }
+    for band in 0..layout.bands {
+        let first = band * layout.per_band;
+        let last = (first + layout.per_band).min(seeds.len()) - 1;
+        let (x0, top) = layout.column(first);
+        let x1 = layout.column(last).0 + layout.cell_w;
+        text(
+            &mut img,
+            (STRIP_MARGIN, top),
+            "seeds",
+            Font::Body,
+            MUTED,
+            Align::Left,
+        );
+        let (a, b) = (seeds[first].to_string(), seeds[last].to_string());
+        if Font::Body.width(&a) + Font::Body.width(&b) + 14 <= x1 - x0 {
+            text(&mut img, (x0, top), &a, Font::Body, MUTED, Align::Left);
+            text(&mut img, (x1, top), &b, Font::Body, MUTED, Align::Right);
+            // Ticks every few seeds, labelled with their seed where the label has room.
+            let step = strip_tick_step(layout.cell_w);
+            let free = (
+                x0 + Font::Body.width(&a) + 12,
+                x1 - Font::Body.width(&b) - 12,
+            );
+            for col in (0..=last - first).step_by(step).chain([last - first]) {
+                let x = layout.column(first + col).0 + layout.cell_w / 2;
+                fill_rect(&mut img, x, top + 16, x + 1, top + STRIP_HEADER - 1, MUTED);
+                let label = seeds[first + col].to_string();
+                let half = Font::Body.width(&label) / 2;
+                if col > 0 && x - half >= free.0 && x + half <= free.1 {
+                    text(&mut img, (x, top), &label, Font::Body, MUTED, Align::Centre);
+                }
+            }
+        } else {
+            let both = fit(&format!("{a}-{b}"), Font::Body.chars_in(x1 - x0).max(1));
+            text(&mut img, (x0, top), &both, Font::Body, MUTED, Align::Left);
+        }
+        for (p, name) in row_names.iter().enumerate() {
+            let y = layout.cell(p, first).1;
+            text(
+                &mut img,
+                (STRIP_MARGIN, y),
+                name,
+                Font::Body,
+                INK,
+                Align::Left,
+            );
+        }
+        let y = layout.disagree(first).1;
+        text(
+            &mut img,
+            (STRIP_MARGIN, y),
+            "disagree",
+            Font::Body,
+            MUTED,
+            Align::Left,
+        );
+    }
+    for s in 0..seeds.len() {
+        for p in 0..rows {
+            let colour = outcomes
+                .get(p)
+                .and_then(|row| row.get(s))
+                .map_or(NO_DATA, |&o| outcome_colour(o));
+            let (x, y) = layout.cell(p, s);
+            fill_rect(&mut img, x, y, x + layout.cell_w, y + STRIP_ROW, colour);
+        }
+        let colour = if disagrees(outcomes, s) {
+            DISAGREE
+        } else {
+            NO_DATA
+        };
+        let (x, y) = layout.disagree(s);
+        fill_rect(&mut img, x, y + 4, x + layout.cell_w, y + 12, colour);
+    }
+    let at = (STRIP_MARGIN, layout.legend_top());
+    draw_legend(&mut img, at, legend_width, &legend);
+    img
+}
+
+// ---------------------------------------------------------------------------------------------
+// Contact sheet
+// ---------------------------------------------------------------------------------------------
+
+const SHEET_MARGIN: i64 = 10;
+const SHEET_HEADER: i64 = 26;
+const SHEET_CAPTION: i64 = 22;
+const SHEET_ROW_GAP: i64 = 12;
+const SHEET_COL_GAP: i64 = 12;
+/// The most pixels a contact sheet has: past it the cells shrink.
+const SHEET_MAX_PIXELS: i64 = 100_000_000;
+
+/// Where everything of a contact sheet goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct SheetLayout {
+    /// Side of a picture's square cell.
+    cell: i64,
+    /// Width of the label column.
+    label_w: i64,
+    /// Columns.
+    cols: usize,
+    /// Rows.
+    rows: usize,
+}
+
+impl SheetLayout {
+    fn new(cell_px: u32, label_chars: usize, cols: usize, rows: usize) -> Self {
+        let label_w = if label_chars == 0 {
+            0
+        } else {
+            label_chars as i64 * Font::Body.advance() + 12
+        };
+        let mut layout = Self {
+            cell: i64::from(cell_px).clamp(16, 4096),
+            label_w,
+            cols,
+            rows,
+        };
+        while layout.cell > 16 && layout.width() * layout.height() > SHEET_MAX_PIXELS {
+            layout.cell = (layout.cell * 3 / 4).max(16);
+        }
+        layout
+    }
+
+    fn width(&self) -> i64 {
+        let cols = self.cols as i64 * (self.cell + SHEET_COL_GAP);
+        (2 * SHEET_MARGIN + self.label_w + cols).max(160)
+    }
+
+    fn height(&self) -> i64 {
+        let rows = self.rows as i64 * (self.cell + SHEET_CAPTION + SHEET_ROW_GAP);
+        (2 * SHEET_MARGIN + SHEET_HEADER + rows).max(60)
+    }
+
+    /// Top-left of the cell of row `r`, column `c`.
+    fn cell_at(&self, r: usize, c: usize) -> (i64, i64) {
+        (
+            SHEET_MARGIN + self.label_w + c as i64 * (self.cell + SHEET_COL_GAP),
+            SHEET_MARGIN + SHEET_HEADER + r as i64 * (self.cell + SHEET_CAPTION + SHEET_ROW_GAP),
+        )
+    }
+}
+
+/// `picture` scaled to fit a `cell` x `cell` square, keeping its aspect: smoothed (bilinear) when
+/// shrunk, nearest-neighbour when enlarged so that scene pixels stay crisp. `None` for an empty
+/// picture.
+fn fit_picture(picture: &RgbImage, cell: i64) -> Option<RgbImage> {
+    let (w, h) = (i64::from(picture.width()), i64::from(picture.height()));
+    if w == 0 || h == 0 {
+        return None;
+    }
+    let scale = (cell as f64 / w as f64).min(cell as f64 / h as f64);
+    let side = |v: i64| ((v as f64 * scale).round() as i64).clamp(1, cell) as u32;
+    let (nw, nh) = (side(w), side(h));
+    if (i64::from(nw), i64::from(nh)) == (w, h) {
+        return Some(picture.clone());
+    }
+    let filter = if scale < 1.0 {
+        FilterType::Triangle
+    } else {
+        FilterType::Nearest
+    };
+    Some(imageops::resize(picture, nw, nh, filter))
+}
+
+/// A contact sheet: a header with the `columns`' names (e.g. the policies), then one row per
+/// entry of `rows`, its label on the left (e.g. "seed 17") and its pictures in the columns, each
+/// scaled to fit a square of `cell_px` (keeping its aspect, centred, framed) with its caption
+/// under it (e.g. "success, 212 steps").
+///
+/// There are as many columns as names or as pictures in the longest row, whichever is more.
+/// `cell_px` is kept within 16-4096, and shrunk further if the sheet would pass 100 megapixels.
+pub fn contact_sheet(columns: &[String], rows: &[SheetRow], cell_px: u32) -> RgbImage {
+    let cols = rows
+        .iter()
+        .map(|r| r.cells.len())
+        .chain([columns.len()])
+        .max()
+        .unwrap_or(0);
+    let labels: Vec<String> = rows.iter().map(|r| fit(&r.label, 20)).collect();
+    let label_chars = labels.iter().map(|l| l.len()).max().unwrap_or(0);
+    let layout = SheetLayout::new(cell_px, label_chars, cols, rows.len());
+    let mut img = canvas(layout.width(), layout.height());
+    let cell = layout.cell;
+    let room = Font::Body.chars_in(cell + SHEET_COL_GAP - 2);
+
+    if cols == 0 || rows.is_empty() {
+        let at = (SHEET_MARGIN, SHEET_MARGIN + SHEET_HEADER);
+        text(&mut img, at, "no pictures", Font::Body, MUTED, Align::Left);
+    }
+    for (c, name) in columns.iter().enumerate() {
+        let x = layout.cell_at(0, c).0 + cell / 2;
+        let name = fit(name, room);
+        let at = (x, SHEET_MARGIN);
+        text(
+            &mut img,
+            at,
+            &name,
+            Font::Bold,
+            policy_colour_dark(c),
+            Align::Centre,
+        );
+    }
+    for (r, (row, label)) in rows.iter().zip(&labels).enumerate() {
+        let (_, y) = layout.cell_at(r, 0);
+        let at = (SHEET_MARGIN, y + cell / 2 - Font::Body.height() / 2);
+        text(&mut img, at, label, Font::Body, INK, Align::Left);
+        for (c, (picture, caption)) in row.cells.iter().enumerate() {
+            let (x, y) = layout.cell_at(r, c);
+            if let Some(scaled) = fit_picture(picture, cell) {
+                let (w, h) = (i64::from(scaled.width()), i64::from(scaled.height()));
+                let (px, py) = (x + (cell - w) / 2, y + (cell - h) / 2);
+                outline(&mut img, (px - 1, py - 1, px + w + 1, py + h + 1), 1, FRAME);
+                imageops::replace(&mut img, &scaled, px, py);
+            } else {
+                outline(&mut img, (x, y, x + cell, y + cell), 1, GRID);
+            }
+            let caption = fit(caption, room);
+            let at = (x + cell / 2, y + cell + 4);
+            text(&mut img, at, &caption, Font::Body, INK, Align::Centre);
+        }
+    }
+    img
+}
+
+/// A policy's colour darkened for text on white.
+fn policy_colour_dark(index: usize) -> Rgb<u8> {
+    let c = policy_colour(index);
+    Rgb(c.0.map(|v| (f64::from(v) * 0.7).round() as u8))
+}
+
+// ---------------------------------------------------------------------------------------------
+// Grouped bars
+// ---------------------------------------------------------------------------------------------
+
+const GROUPED_LEFT: i64 = 76;
+const GROUPED_TOP: i64 = 62;
+const GROUPED_PLOT_H: i64 = 300;
+const GROUPED_RIGHT_MARGIN: i64 = 24;
+/// Widest plot area of [`grouped_bars`]; past it bars and groups get narrower.
+const GROUPED_MAX_PLOT_W: i64 = 1300;
+
+/// The plot frame of [`grouped_bars`] for `bins` bins of `series` series.
+fn grouped_frame(bins: usize, series: usize, label_chars: usize) -> Frame {
+    let want_group = (series.max(1) as i64 * 26 + 28).max(label_chars as i64 * 7 + 14);
+    let plot_w = (bins.max(1) as i64)
+        .saturating_mul(want_group)
+        .clamp(520, GROUPED_MAX_PLOT_W);
+    Frame {
+        left: GROUPED_LEFT,
+        top: GROUPED_TOP,
+        right: GROUPED_LEFT + plot_w,
+        bottom: GROUPED_TOP + GROUPED_PLOT_H,
+    }
+}
+
+/// Grouped bars: along x one group per bin (labelled with the bin's name, e.g. "ratio 1.0-1.3"),
+/// in each group one bar per series (policy) for its success rate with 95% interval whiskers;
+/// y 0-100%. A legend under the plot names the series in their colours ([`policy_colour`]).
+/// `title` is the line on top.
+///
+/// There is a group per bin name, or per value in the longest series if more; a series without a
+/// value (or with a non-finite one) in a bin has no bar there.
+pub fn grouped_bars(title: &str, bins: &[String], series: &[Series]) -> RgbImage {
+    let n_bins = series
+        .iter()
+        .map(|s| s.values.len())
+        .chain([bins.len()])
+        .max()
+        .unwrap_or(0);
+    let n_series = series.len();
+    let label_chars = bins
+        .iter()
+        .map(|b| b.chars().count())
+        .max()
+        .unwrap_or(0)
+        .min(18);
+    let frame = grouped_frame(n_bins, n_series, label_chars);
+    let width = frame.right + GROUPED_RIGHT_MARGIN;
+    let legend: Vec<(Key, String)> = series
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (Key::Square(policy_colour(i)), fit(&s.name, 40)))
+        .collect();
+    let legend_width = width - frame.left;
+    let (_, legend_rows) = legend_layout(legend_width, &legend);
+    let legend_top = frame.bottom + 34;
+    let height = legend_top + legend_rows * LEGEND_ROW + 10;
+    let mut img = canvas(width, height);
+
+    let title = fit(title, Font::Title.chars_in(width - 40));
+    text(&mut img, (20, 14), &title, Font::Title, INK, Align::Left);
+    frame.axes(&mut img, true, "success rate");
+    if n_bins == 0 || n_series == 0 {
+        frame.note(&mut img, "no data");
+    }
+    for b in 0..n_bins {
+        let (x, w) = frame.slot(b, n_bins);
+        let gap = (w / 5).clamp(2, 28);
+        let bar = ((w - gap) / n_series.max(1) as i64).clamp(1, 30);
+        let group_x = x + (w - bar * n_series as i64) / 2;
+        for (i, s) in series.iter().enumerate() {
+            let Some(&(rate, ci)) = s.values.get(b) else {
+                continue;
+            };
+            let bx = group_x + i as i64 * bar;
+            if let Some(rate) = unit(rate) {
+                let inset = i64::from(bar >= 6);
+                let y = frame.y(rate);
+                fill_rect(
+                    &mut img,
+                    bx + inset,
+                    y,
+                    bx + bar - inset,
+                    frame.bottom,
+                    policy_colour(i),
+                );
+                whisker(&mut img, &frame, bx + bar / 2, ci, (bar / 4).clamp(1, 6));
+            }
+        }
+        let label = bins
+            .get(b)
+            .map_or(String::new(), |l| fit(l, Font::Body.chars_in(w - 2)));
+        text(
+            &mut img,
+            (x + w / 2, frame.bottom + 8),
+            &label,
+            Font::Body,
+            INK,
+            Align::Centre,
+        );
+    }
+    draw_legend(&mut img, (frame.left, legend_top), legend_width, &legend);
+    img
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bars(name: &str, rate: f64, spl: Vec<f64>) -> PolicyBars {
+        PolicyBars {
+            name: name.to_owned(),
+            success_rate: rate,
+            success_ci95: [(rate - 0.05).max(0.0), (rate + 0.05).min(1.0)],
+            spl,
+        }
+    }
+
+    /// Rows of column `x` within `top..=bottom` that have `colour`.
+    fn count_in_column(img: &RgbImage, x: i64, top: i64, bottom: i64, colour: Rgb<u8>) -> i64 {
+        (top..=bottom)
+            .filter(|&y| *img.get_pixel(x as u32, y as u32) == colour)
+            .count() as i64
+    }
+
+    fn px(img: &RgbImage, (x, y): (i64, i64)) -> Rgb<u8> {
+        *img.get_pixel(x as u32, y as u32)
+    }
+
+    #[test]
+    fn fit_cuts_long_names_and_replaces_what_it_cannot_draw() {
+        assert_eq!(fit("greedy", 10), "greedy");
+        assert_eq!(fit("a very long policy name", 10), "a very l..");
+        assert_eq!(fit("a very long policy name", 10).len(), 10);
+        assert_eq!(fit("abcdef", 3), "abc");
+        assert_eq!(fit("abc", 0), "");
+        assert_eq!(fit("déjà\tvu", 20), "d?j? vu");
+    }
+
+    #[test]
+    fn labels_are_names_cut_names_or_numbers() {
+        let names = ["greedy", "a-rather-long-policy-name"];
+        let (labels, naming) = slot_labels(names.iter().copied(), 300);
+        assert_eq!(
+            (labels, naming),
+            (vec!["greedy".to_owned(), names[1].to_owned()], Naming::Full)
+        );
+        // 12 characters of room: the long name is cut, and a legend gives it.
+        let (labels, naming) = slot_labels(names.iter().copied(), 12 * 7 + 4);
+        assert_eq!(labels[1], "a-rather-l..");
+        assert_eq!(naming, Naming::Cut);
+        assert_eq!(policy_legend(names.iter().copied(), naming)[1].1, names[1]);
+        // 5 characters: numbers.
+        let (labels, naming) = slot_labels(names.iter().copied(), 5 * 7 + 4);
+        assert_eq!(
+            (labels, naming),
+            (vec!["1".to_owned(), "2".to_owned()], Naming::Numbered)
+        );
+        assert_eq!(
+            policy_legend(names.iter().copied(), naming)[0].1,
+            "1 greedy"
+        );
+        assert!(policy_legend(names.iter().copied(), Naming::Full).is_empty());
+    }
+
+    #[test]
+    fn a_full_success_bar_is_taller_than_a_fifth() {
+        let img = compare_chart(
+            "t",
+            &[bars("full", 1.0, vec![1.0]), bars("fifth", 0.2, vec![])],
+        );
+        assert_eq!(img.dimensions(), (1000, 450));
+        let (left, _) = compare_frames();
+        let mut heights = Vec::new();
+        for i in 0..2 {
+            let (x, w) = left.slot(i, 2);
+            // A quarter of the bar's width off its centre, clear of the whisker.
+            let col = x + w / 2 + (w as f64 * 0.55 / 4.0) as i64;
+            heights.push(count_in_column(
+                &img,
+                col,
+                left.top,
+                left.bottom,
+                policy_colour(i),
+            ));
+        }
+        let plot = left.bottom - left.top;
+        assert!((heights[0] - plot).abs() <= 2, "{heights:?} of {plot}");
+        assert!((heights[1] - plot / 5).abs() <= 2, "{heights:?} of {plot}");
+        // Halfway up, the first bar is there and the second is not.
+        let (x1, w1) = left.slot(1, 2);
+        assert_eq!(px(&img, (x1 + w1 / 2 + 10, left.y(0.5) + 2)), BACKGROUND);
+    }
+
+    #[test]
+    fn the_whisker_spans_the_interval() {
+        let mut p = bars("p", 0.5, vec![]);
+        p.success_ci95 = [0.3, 0.8];
+        let img = compare_chart("t", &[p]);
+        let (left, _) = compare_frames();
+        let (x, w) = left.slot(0, 1);
+        let cx = x + w / 2;
+        // Above the bar the whisker is the only ink in the centre column: from 0.8 down to 0.5.
+        let ink = count_in_column(&img, cx, left.top, left.y(0.5) - 1, INK);
+        let expected = left.y(0.5) - left.y(0.8);
+        assert!((ink - expected).abs() <= 2, "{ink} vs {expected}");
+        assert_eq!(px(&img, (cx, left.y(0.9))), BACKGROUND);
+    }
+
+    #[test]
+    fn the_spl_box_spans_the_quartiles_and_the_mean_is_marked() {
+        // Successes 0.2, 0.4, 0.6, 0.8 (quartiles 0.35 and 0.65) and one failure: mean 0.4.
+        let spl = vec![0.2, 0.4, 0.6, 0.8, 0.0];
+        let stats = box_stats(&[0.2, 0.4, 0.6, 0.8]).expect("values");
+        assert!((stats.q1 - 0.35).abs() < 1e-12 && (stats.q3 - 0.65).abs() < 1e-12);
+        assert!((stats.median - 0.5).abs() < 1e-12);
+        assert_eq!((stats.low, stats.high), (0.2, 0.8));
+        let img = compare_chart("t", &[bars("p", 0.8, spl)]);
+        let (_, right) = compare_frames();
+        let (x, w) = right.slot(0, 1);
+        let cx = x + w / 2;
+        let fill = tint(policy_colour(0), 0.4);
+        // Box fill between the quartiles (off the centre column and the median line), none
+        // outside them.
+        let col = cx + 8;
+        let inside = count_in_column(&img, col, right.top, right.bottom, fill);
+        let box_h = right.y(0.35) - right.y(0.65);
+        assert!(
+            inside > box_h - 10 && inside <= box_h,
+            "{inside} vs {box_h}"
+        );
+        assert_eq!(px(&img, (col, right.y(0.7))), BACKGROUND);
+        // The mean diamond at 0.4, the median line at 0.5.
+        assert_eq!(px(&img, (cx, right.y(0.4))), INK);
+        assert_eq!(px(&img, (col, right.y(0.5))), INK);
+        // The same policy colour as the bar on the left.
+        let outline_px = count_in_column(&img, cx, right.top, right.bottom, policy_colour(0));
+        assert!(outline_px >= 2, "{outline_px}");
+    }
+
+    #[test]
+    fn box_stats_set_apart_outliers() {
+        let mut v = vec![0.5, 0.52, 0.54, 0.56, 0.58, 0.6, 0.05];
+        v.sort_by(f64::total_cmp);
+        let s = box_stats(&v).expect("values");
+        assert_eq!(s.outliers, vec![0.05]);
+        assert_eq!(s.low, 0.5);
+        assert_eq!(box_stats(&[]), None);
+        let one = box_stats(&[0.7]).expect("one");
+        assert_eq!(
+            (one.low, one.q1, one.median, one.q3, one.high),
+            (0.7, 0.7, 0.7, 0.7, 0.7)
+        );
+    }
+
+    #[test]
+    fn odd_figures_do_not_panic_and_many_long_names_get_a_legend() {
+        let odd = PolicyBars {
+            name: String::new(),
+            success_rate: f64::NAN,
+            success_ci95: [f64::NAN, f64::INFINITY],
+            spl: vec![f64::NAN, f64::NEG_INFINITY, -3.0, 7.0],
+        };
+        let img = compare_chart(
+            "",
+            &[odd.clone(), bars("x", 2.0, vec![]), bars("y", -1.0, vec![])],
+        );
+        assert_eq!(img.dimensions(), (1000, 450));
+        let many: Vec<PolicyBars> = (0..10)
+            .map(|i| {
+                bars(
+                    &format!("policy number {i} with a very long name indeed"),
+                    0.1 * i as f64,
+                    vec![0.5; 3],
+                )
+            })
+            .collect();
+        let img = compare_chart(&"a very long title ".repeat(20), &many);
+        assert_eq!(img.width(), 1000);
+        assert!(img.height() > 450, "a legend row or more: {}", img.height());
+        let one = compare_chart("one", &many[..1]);
+        assert_eq!(one.dimensions(), (1000, 450));
+        let empty = compare_chart("nothing", &[]);
+        assert_eq!(empty.dimensions(), (1000, 450));
+    }
+
+    #[test]
+    fn text_is_drawn_in_ink() {
+        let img = compare_chart("TITLE", &[]);
+        let inked = (14..34)
+            .flat_map(|y| (20..70).map(move |x| (x, y)))
+            .filter(|&(x, y)| img.get_pixel(x, y).0[0] < 128)
+            .count();
+        assert!(inked > 40, "{inked} dark pixels in the title");
+    }
+
+    fn pattern(p: usize, s: usize) -> Outcome {
+        match (p, s % 7) {
+            (_, 0) => Outcome::Success,
+            (0, _) if s % 3 == 0 => Outcome::Success,
+            (1, 1 | 2) => Outcome::Success,
+            (_, 1) => Outcome::Collision,
+            (_, 2) => Outcome::Stuck,
+            (_, 3) => Outcome::RewardMin,
+            _ => Outcome::Timeout,
+        }
+    }
+
+    #[test]
+    fn strip_size_follows_seeds_and_policies() {
+        let names = |n: usize| (0..n).map(|i| format!("p{i}")).collect::<Vec<_>>();
+        let strip = |policies: usize, seeds: usize| {
+            let seeds_v: Vec<u64> = (1..=seeds as u64).collect();
+            let outcomes = vec![vec![Outcome::Success; seeds]; policies];
+            outcome_strip(&names(policies), &seeds_v, &outcomes)
+        };
+        let label_w = 8 * Font::Body.advance() + 12;
+        for (seeds, cell_w, columns) in [
+            (250, 4, 250),
+            (300, 4, 300),
+            (350, 3, 350),
+            (600, 2, 600),
+            (1000, 1, 1000),
+            (1200, 1, 1200),
+            (3000, 1, 1200),
+        ] {
+            let img = strip(2, seeds);
+            let want = (2 * STRIP_MARGIN + label_w + columns * cell_w).max(560);
+            assert_eq!(i64::from(img.width()), want, "{seeds} seeds");
+        }
+        // Each policy adds one row to every band; each band of 1200 seeds adds a band.
+        let band_row = STRIP_ROW + STRIP_ROW_GAP;
+        let h = |p, s| i64::from(strip(p, s).height());
+        assert_eq!(h(3, 100) - h(1, 100), 2 * band_row);
+        assert_eq!(h(3, 2500) - h(1, 2500), 3 * 2 * band_row);
+        let band_h = STRIP_HEADER + 2 * band_row + STRIP_DISAGREE + STRIP_BAND_GAP;
+        assert_eq!(h(2, 2400) - h(2, 1200), band_h);
+        assert_eq!(h(2, 2401) - h(2, 1200), 2 * band_h);
+    }
+
+    #[test]
+    fn strip_cells_have_their_outcome_and_disagreement_is_marked_exactly() {
+        for seeds in [40, 2500] {
+            let names: Vec<String> = ["a", "b", "c"].iter().map(|s| s.to_string()).collect();
+            let seed_ids: Vec<u64> = (0..seeds as u64).map(|s| 1000 + s).collect();
+            let outcomes: Vec<Vec<Outcome>> = (0..3)
+                .map(|p| (0..seeds).map(|s| pattern(p, s)).collect())
+                .collect();
+            let img = outcome_strip(&names, &seed_ids, &outcomes);
+            let layout = StripLayout::new(seeds, 3, 8);
+            let mut marked = 0;
+            for s in 0..seeds {
+                for (p, row) in outcomes.iter().enumerate() {
+                    let (x, y) = layout.cell(p, s);
+                    assert_eq!(px(&img, (x, y + 8)), outcome_colour(row[s]), "p {p} s {s}");
+                }
+                let won: Vec<bool> = outcomes.iter().map(|r| r[s] == Outcome::Success).collect();
+                let differ = won.iter().any(|&w| w != won[0]);
+                let (x, y) = layout.disagree(s);
+                let want = if differ { DISAGREE } else { NO_DATA };
+                assert_eq!(px(&img, (x, y + 8)), want, "seeds {seeds}: seed {s}");
+                marked += usize::from(differ);
+            }
+            assert!(marked > seeds / 4 && marked < seeds, "{marked} of {seeds}");
+        }
+    }
+
+    #[test]
+    fn strip_copes_with_ragged_and_missing_outcomes() {
+        let names = vec!["only".to_owned()];
+        let seeds: Vec<u64> = (0..10).collect();
+        // Two outcome rows for one name, the first too short, the second too long.
+        let outcomes = vec![vec![Outcome::Success; 4], vec![Outcome::Collision; 30]];
+        let img = outcome_strip(&names, &seeds, &outcomes);
+        let layout = StripLayout::new(10, 2, 8);
+        assert_eq!(
+            px(&img, layout.cell(0, 3)),
+            outcome_colour(Outcome::Success)
+        );
+        assert_eq!(px(&img, layout.cell(0, 4)), NO_DATA);
+        assert_eq!(
+            px(&img, layout.cell(1, 9)),
+            outcome_colour(Outcome::Collision)
+        );
+        let (x, y) = layout.disagree(3);
+        assert_eq!(px(&img, (x, y + 8)), DISAGREE);
+        let (x, y) = layout.disagree(4);
+        assert_eq!(
+            px(&img, (x, y + 8)),
+            NO_DATA,
+            "one policy alone never disagrees"
+        );
+        // One policy: never a disagreement.
+        let img = outcome_strip(&names, &seeds, &outcomes[..1]);
+        let layout = StripLayout::new(10, 1, 8);
+        for s in 0..10 {
+            let (x, y) = layout.disagree(s);
+            assert_eq!(px(&img, (x, y + 8)), NO_DATA);
+        }
+    }
+
+    fn solid(w: u32, h: u32, colour: [u8; 3]) -> RgbImage {
+        RgbImage::from_pixel(w, h, Rgb(colour))
+    }
+
+    #[test]
+    fn contact_sheet_is_header_plus_rows_of_cells() {
+        let columns = vec!["greedy".to_owned(), "mlp".to_owned()];
+        let rows: Vec<SheetRow> = (0..3)
+            .map(|r| SheetRow {
+                label: format!("seed {r}"),
+                cells: vec![
+                    (
+                        solid(200, 100, [255, 0, 0]),
+                        "success, 212 steps".to_owned(),
+                    ),
+                    (solid(30, 60, [0, 0, 255]), "timeout".to_owned()),
+                ],
+            })
+            .collect();
+        let img = contact_sheet(&columns, &rows, 100);
+        let label_w = 6 * Font::Body.advance() + 12;
+        let width = 2 * SHEET_MARGIN + label_w + 2 * (100 + SHEET_COL_GAP);
+        let height = 2 * SHEET_MARGIN + SHEET_HEADER + 3 * (100 + SHEET_CAPTION + SHEET_ROW_GAP);
+        assert_eq!(
+            (i64::from(img.width()), i64::from(img.height())),
+            (width, height)
+        );
+        let layout = SheetLayout::new(100, 6, 2, 3);
+        // 200 x 100 shrinks to 100 x 50, centred: rows 25..75 of the cell.
+        let (x, y) = layout.cell_at(2, 0);
+        assert_eq!(px(&img, (x + 50, y + 50)), Rgb([255, 0, 0]));
+        assert_eq!(px(&img, (x, y + 25)), Rgb([255, 0, 0]));
+        assert_eq!(px(&img, (x + 99, y + 74)), Rgb([255, 0, 0]));
+        assert_eq!(px(&img, (x + 50, y + 10)), BACKGROUND);
+        assert_eq!(px(&img, (x + 50, y + 90)), BACKGROUND);
+        // 30 x 60 grows to 50 x 100: columns 25..75.
+        let (x, y) = layout.cell_at(1, 1);
+        assert_eq!(px(&img, (x + 25, y)), Rgb([0, 0, 255]));
+        assert_eq!(px(&img, (x + 74, y + 99)), Rgb([0, 0, 255]));
+        assert_eq!(px(&img, (x + 10, y + 50)), BACKGROUND);
+    }
+
+    #[test]
+    fn contact_sheet_copes_with_odd_cells() {
+        let rows = vec![
+            SheetRow {
+                label: "x".repeat(200),
+                cells: vec![(RgbImage::new(0, 0), String::new())],
+            },
+            SheetRow {
+                label: String::new(),
+                cells: vec![
+                    (solid(1, 1, [0, 0, 0]), "c".repeat(100)),
+                    (solid(3000, 2, [0, 0, 0]), "wide".to_owned()),
+                    (solid(1, 1, [0, 0, 0]), "third, no column name".to_owned()),
+                ],
+            },
+        ];
+        let img = contact_sheet(&["one".to_owned()], &rows, 0);
+        let layout = SheetLayout::new(16, 20, 3, 2);
+        assert_eq!(
+            (i64::from(img.width()), i64::from(img.height())),
+            (layout.width(), layout.height())
+        );
+    }
+
+    #[test]
+    fn grouped_bar_heights_follow_the_rates() {
+        let bins: Vec<String> = ["ratio 1.0-1.3", "ratio 1.3-1.6", "ratio 1.6+"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        let series = vec![
+            Series {
+                name: "greedy".to_owned(),
+                values: vec![(0.9, [0.85, 0.95]), (0.5, [0.4, 0.6]), (0.1, [0.05, 0.2])],
+            },
+            Series {
+                name: "mlp".to_owned(),
+                values: vec![(0.6, [0.5, 0.7]), (f64::NAN, [f64::NAN, 0.5])],
+            },
+        ];
+        let img = grouped_bars("by difficulty", &bins, &series);
+        let frame = grouped_frame(3, 2, 13);
+        assert_eq!(i64::from(img.width()), frame.right + GROUPED_RIGHT_MARGIN);
+        let plot = frame.bottom - frame.top;
+        for (b, want) in [(0, [0.9, 0.6]), (1, [0.5, 0.0]), (2, [0.1, 0.0])] {
+            let (x, w) = frame.slot(b, 3);
+            let gap = (w / 5).clamp(2, 28);
+            let bar = ((w - gap) / 2).clamp(1, 30);
+            let group_x = x + (w - bar * 2) / 2;
+            for (i, rate) in want.iter().enumerate() {
+                let col = group_x + i as i64 * bar + 2;
+                let h = count_in_column(&img, col, frame.top, frame.bottom, policy_colour(i));
+                let expected = (rate * plot as f64).round() as i64;
+                assert!(
+                    (h - expected).abs() <= 1,
+                    "bin {b} series {i}: {h} vs {expected}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn empty_inputs_give_small_valid_images() {
+        for img in [
+            compare_chart("", &[]),
+            outcome_strip(&[], &[], &[]),
+            outcome_strip(&["a".to_owned()], &[], &[vec![Outcome::Success]]),
+            contact_sheet(&[], &[], 128),
+            grouped_bars("", &[], &[]),
+            grouped_bars("", &["a".to_owned()], &[]),
+        ] {
+            let (w, h) = img.dimensions();
+            assert!(w >= 100 && h >= 50 && w <= 1400 && h <= 600, "{w} x {h}");
+        }
+    }
+}
