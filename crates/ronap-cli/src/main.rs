@@ -8,7 +8,7 @@ mod py_policy;
 mod tui;
 
 use clap::{Parser, Subcommand};
-use commands::{bench, collect, config, maze, replay, run, train, view};
+use commands::{bench, collect, compare, config, maze, replay, run, train, view};
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -36,6 +36,9 @@ enum Command {
     Maze(maze::MazeArgs),
     /// Evaluate a policy over many seeded episodes: summary table, CSV logs, PNG trajectories.
     Run(run::RunArgs),
+    /// Compare policies on the same seeds: success with 95% intervals, paired tests (McNemar,
+    /// bootstrap), pictures and a report (report.html, report.md).
+    Compare(compare::CompareArgs),
     /// Record (observation, action) rows for behaviour cloning, in the data-log format: labelled
     /// by an expert planner, or by you at the keys (--human, the paper's Collect Data screen).
     Collect(collect::CollectArgs),
@@ -85,6 +88,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Maze(args) => maze::run(args),
         Command::Run(args) => run::run(args),
+        Command::Compare(args) => compare::run(args),
         Command::View(args) => view::run(args),
         Command::Replay(args) => replay::run(args),
         Command::Bench(args) => bench::run(args),

@@ -68,3 +68,18 @@ pub fn utc_now() -> (i64, u32, u32, u32, u32, u32) {
         (rem % 60) as u32,
     )
 }
+
+/// `base`, or `base-2`, `base-3`... the first that does not exist yet.
+pub fn unused_dir(base: String) -> std::path::PathBuf {
+    use std::path::PathBuf;
+    (1..)
+        .map(|k| {
+            if k == 1 {
+                PathBuf::from(&base)
+            } else {
+                PathBuf::from(format!("{base}-{k}"))
+            }
+        })
+        .find(|p| !p.exists())
+        .unwrap_or_else(|| PathBuf::from(base))
+}

@@ -21,8 +21,10 @@
 //! | [`render`] | pictures: canvas, first-person view, trajectories, GIFs |
 //! | [`io`] | files: atomic writes, run directories and their manifest, data logs, step logs |
 //! | [`collect`] | labelled data: expert and human collection |
+//! | [`compare`] | several policies on the same seeds: paired statistics, pictures, a report |
 
 pub mod collect;
+pub mod compare;
 pub mod config;
 pub mod eval;
 pub mod geometry;

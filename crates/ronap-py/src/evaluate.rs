@@ -116,6 +116,38 @@ impl PolicyFactory for PyPolicyFactory {
     }
 }
 
+/// The policy `policy` names or is: a built-in or network name, or a callable (observation ->
+/// action), with the name reports give it.
+fn policy_factory(
+    policy: &Bound<'_, PyAny>,
+    config: &ronap_core::ValidConfig,
+    continuous: bool,
+    thread_safe: bool,
+) -> PyResult<(Box<dyn PolicyFactory>, String)> {
+    Ok(if let Ok(name) = policy.extract::<String>() {
+        let factory = ronap_core::policy::factory(&name, config.observation_size())
+            .map_err(|e| errors::ConfigError::new_err(e.to_string()))?;
+        (factory, name)
+    } else if policy.is_callable() {
+        let name = policy
+            .getattr("__name__")
+            .and_then(|n| n.extract::<String>())
+            .unwrap_or_else(|_| "python".into());
+        let factory = PyPolicyFactory {
+            callable: policy.clone().unbind(),
+            continuous,
+            name: name.clone(),
+            turn: (!thread_safe).then(|| Arc::new(Turn::default())),
+        };
+        (Box::new(factory), name)
+    } else {
+        return Err(errors::ConfigError::new_err(format!(
+            "policy {policy}: expected a built-in policy name or a callable (observation -> \
+                 action)"
+        )));
+    })
+}
+
 /// Runs `policy` (a built-in name or a callable) over `seeds`; returns {"summary": ...,
 /// "episodes": [...]} with the figures and rows `ronap run` reports, and writes its files (the
 /// same files, `summary.json` in the same schema) into `out` when given.
@@ -142,29 +174,7 @@ pub fn evaluate<'py>(
             "seeds is empty: give at least one seed",
         ));
     };
-    let (factory, name): (Box<dyn PolicyFactory>, String) =
-        if let Ok(name) = policy.extract::<String>() {
-            let factory = ronap_core::policy::factory(&name, config.observation_size())
-                .map_err(|e| errors::ConfigError::new_err(e.to_string()))?;
-            (factory, name)
-        } else if policy.is_callable() {
-            let name = policy
-                .getattr("__name__")
-                .and_then(|n| n.extract::<String>())
-                .unwrap_or_else(|_| "python".into());
-            let factory = PyPolicyFactory {
-                callable: policy.clone().unbind(),
-                continuous,
-                name: name.clone(),
-                turn: (!thread_safe).then(|| Arc::new(Turn::default())),
-            };
-            (Box::new(factory), name)
-        } else {
-            return Err(errors::ConfigError::new_err(format!(
-                "policy {policy}: expected a built-in policy name or a callable (observation -> \
-                 action)"
-            )));
-        };
+    let (factory, name) = policy_factory(policy, config, continuous, thread_safe)?;
     let pictures: Option<Pictures> = png
         .as_deref()
         .map(str::parse)
@@ -222,4 +232,100 @@ pub fn evaluate<'py>(
     }
     d.set_item("episodes", rows)?;
     Ok(d)
+}
+
+/// Compares `policies` (built-in names or callables) on the same `seeds` as `ronap compare` does;
+/// returns the figures of `compare.json` as a dict, and writes every file of `ronap compare` into
+/// `out` when given. `runs`: finished run directories to reuse.
+#[pyfunction]
+#[pyo3(signature = (policies, seeds, config, maze_seed = None, map_path = None, threads = 0, continuous = false, out = None, runs = Vec::new(), by_difficulty = false, bins = 3, resamples = 10_000, sheet = 6, thread_safe = false, command = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn compare<'py>(
+    py: Python<'py>,
+    policies: Vec<Bound<'py, PyAny>>,
+    seeds: Vec<u64>,
+    config: &Config,
+    maze_seed: Option<u64>,
+    map_path: Option<&str>,
+    threads: usize,
+    continuous: bool,
+    out: Option<std::path::PathBuf>,
+    runs: Vec<std::path::PathBuf>,
+    by_difficulty: bool,
+    bins: usize,
+    resamples: usize,
+    sheet: usize,
+    thread_safe: bool,
+    command: Option<String>,
+) -> PyResult<PyObject> {
+    use ronap_core::compare::{self as cmp, CompareInfo, CompareOptions, Contender};
+    let config = config.valid();
+    if bins == 0 {
+        return Err(errors::ConfigError::new_err("bins = 0: must be at least 1"));
+    }
+    let mut contenders = Vec::new();
+    for policy in &policies {
+        let (factory, name) = policy_factory(policy, config, continuous, thread_safe)?;
+        contenders.push(Contender {
+            name,
+            factory,
+            reuse: None,
+        });
+    }
+    // Runs of the named policies are reused; a run of another policy joins the comparison.
+    let names: Vec<String> = contenders.iter().map(|c| c.name.clone()).collect();
+    let chosen =
+        cmp::with_runs(&names, &runs).map_err(|e| errors::ConfigError::new_err(e.to_string()))?;
+    for (i, (name, reuse)) in chosen.into_iter().enumerate() {
+        match contenders.get_mut(i) {
+            Some(c) => c.reuse = reuse,
+            None => {
+                let factory = ronap_core::policy::factory(&name, config.observation_size())
+                    .map_err(|e| errors::ConfigError::new_err(format!("runs: {e}")))?;
+                contenders.push(Contender {
+                    name,
+                    factory,
+                    reuse,
+                });
+            }
+        }
+    }
+    let (spec, scenes, map) = conv::scenes(config, maze_seed, map_path)?;
+    let evaluator = Evaluator::new(config.clone(), scenes);
+    let options = CompareOptions {
+        seeds,
+        threads,
+        by_difficulty,
+        difficulty_bins: bins,
+        resamples,
+        sheet_rows: sheet,
+    };
+    let info = CompareInfo {
+        scenes: spec,
+        map,
+        command: command.unwrap_or_else(|| "ronap.compare(...) from Python".to_string()),
+    };
+    let cancel = AtomicBool::new(false);
+    let comparison = py
+        .allow_threads(|| {
+            cmp::compare(
+                &evaluator,
+                &contenders,
+                &options,
+                &info,
+                out.as_deref(),
+                &cancel,
+                &|_| {},
+            )
+        })
+        .map_err(|e| match e {
+            cmp::CompareError::Output(e) => errors::output(e),
+            cmp::CompareError::Policy { .. } | cmp::CompareError::Run { .. } => {
+                errors::PolicyError::new_err(e.to_string())
+            }
+            e => errors::ConfigError::new_err(e.to_string()),
+        })?;
+    let value = serde_json::to_value(&comparison)
+        .map_err(|e| errors::OutputError::new_err(e.to_string()))?;
+    conv::json(py, &value)
 }

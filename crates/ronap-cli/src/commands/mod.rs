@@ -3,6 +3,7 @@
 
 pub mod bench;
 pub mod collect;
+pub mod compare;
 pub mod config;
 pub mod maze;
 pub mod replay;

@@ -231,15 +231,7 @@ fn default_out_dir(policy: &str) -> PathBuf {
             }
         })
         .collect();
-    let base = format!("runs/{name}-{y:04}{mo:02}{d:02}-{h:02}{mi:02}{s:02}");
-    (1..)
-        .map(|k| {
-            if k == 1 {
-                PathBuf::from(&base)
-            } else {
-                PathBuf::from(format!("{base}-{k}"))
-            }
-        })
-        .find(|p| !p.exists())
-        .unwrap_or_else(|| PathBuf::from(base))
+    crate::output::unused_dir(format!(
+        "runs/{name}-{y:04}{mo:02}{d:02}-{h:02}{mi:02}{s:02}"
+    ))
 }

@@ -26,6 +26,20 @@ pub enum Outcome {
 }
 
 impl Outcome {
+    /// Every outcome, success first.
+    pub const ALL: [Outcome; 5] = [
+        Outcome::Success,
+        Outcome::Timeout,
+        Outcome::Stuck,
+        Outcome::Collision,
+        Outcome::RewardMin,
+    ];
+
+    /// The outcome named `name` (as [`Outcome::name`] writes it).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|o| o.name() == name)
+    }
+
     /// How an episode with `status` ended; a running one ended because the policy gave up.
     pub fn of(status: Status) -> Self {
         match status {

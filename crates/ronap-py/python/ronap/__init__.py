@@ -4,6 +4,8 @@
 - ``VecNavEnv(num_envs)``: a ``gymnasium.vector.VectorEnv`` stepped in Rust across cores.
 - ``evaluate(policy, seeds)``: the batch evaluator of ``ronap run`` with a Python callable or a
   built-in policy.
+- ``compare(policies, seeds)``: several policies on the same seeds with paired statistics, as
+  ``ronap compare``.
 - ``maze_occupancy`` / ``maze_image``: scenes as numpy arrays; ``default_config()``, ``policies()``.
 
 ``NavEnv``, ``VecNavEnv``, ``evaluate`` and ``make_config`` take ``scenario=``: a TOML scenario
@@ -24,6 +26,7 @@ from ._ronap import (
     SceneError,
     __version__,
 )
+from .compare import compare
 from .config import default_config, make_config
 from .env import NavEnv, VecNavEnv
 from .evaluate import evaluate
@@ -39,6 +42,7 @@ __all__ = [
     "SceneError",
     "VecNavEnv",
     "__version__",
+    "compare",
     "default_config",
     "evaluate",
     "make_config",

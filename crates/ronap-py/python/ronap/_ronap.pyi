@@ -66,3 +66,20 @@ def evaluate(
     log_steps: bool = False,
     thread_safe: bool = False,
 ) -> dict[str, Any]: ...
+def compare(
+    policies: list[Any],
+    seeds: list[int],
+    config: Config,
+    maze_seed: int | None = None,
+    map_path: str | None = None,
+    threads: int = 0,
+    continuous: bool = False,
+    out: str | None = None,
+    runs: list[str] = ...,
+    by_difficulty: bool = False,
+    bins: int = 3,
+    resamples: int = 10000,
+    sheet: int = 6,
+    thread_safe: bool = False,
+    command: str | None = None,
+) -> dict[str, Any]: ...

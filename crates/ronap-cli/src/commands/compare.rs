@@ -1,0 +1,192 @@
+//! `ronap compare`: several policies on the same seeds, with paired statistics, pictures and a
+//! report.
+
+use crate::args::{count, policy_factory, seed, EpisodeArgs, ThreadArgs};
+use crate::output::cancel_on_ctrl_c;
+use anyhow::{bail, Context, Result};
+use clap::{Args, ValueEnum};
+use ronap_core::compare::{
+    compare, with_runs, CompareError, CompareInfo, CompareOptions, Contender, Progress,
+};
+use ronap_core::eval::Evaluator;
+use std::io::Write as _;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// What results can be broken down by.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum By {
+    /// Each seed's scene difficulty: the shortest path's length over the straight line, the
+    /// narrowest gap on it and its turns.
+    Difficulty,
+}
+
+/// Arguments of `ronap compare`.
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// A policy to compare (repeat for each; at least two in all, counting --run): apf, geodesic,
+    /// random, mlp:FILE.safetensors[@RULE] or py:FILE.py:FUNCTION, as for `ronap run`.
+    #[arg(long, value_name = "NAME")]
+    policy: Vec<String>,
+    /// A finished `ronap run` (or a compare's runs/<policy>) directory to reuse instead of running
+    /// its policy again: its summary.json must record the same configuration, scenes and seeds.
+    /// Its policy joins the comparison if not named by --policy. Repeatable.
+    #[arg(long, value_name = "DIR")]
+    run: Vec<PathBuf>,
+    /// Number of episodes per policy; episode i has seed seed-start + i.
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 1000, value_parser = count)]
+    seeds: u64,
+    /// First seed.
+    #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 0, value_parser = seed)]
+    seed_start: u64,
+    #[command(flatten)]
+    threads: ThreadArgs,
+    #[command(flatten)]
+    episodes: EpisodeArgs,
+    /// Output directory [default: runs/compare-<UTC time>].
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+    /// Also break results down by this [default: none].
+    #[arg(long, value_name = "WHAT")]
+    by: Option<By>,
+    /// Bins per difficulty figure (seeds cut at quantiles into about equal groups).
+    #[arg(long, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=20))]
+    bins: u32,
+    /// Bootstrap resamples for the paired intervals.
+    #[arg(long, value_name = "N", default_value_t = 10_000, value_parser = clap::value_parser!(u32).range(100..=1_000_000))]
+    resamples: u32,
+    /// Seeds in the contact sheet of the most disagreeing seeds (disagreements.png); 0 for none.
+    #[arg(long, value_name = "N", default_value_t = 6, value_parser = clap::value_parser!(u32).range(0..=50))]
+    sheet: u32,
+}
+
+/// Runs `ronap compare`.
+pub fn run(args: CompareArgs) -> Result<ExitCode> {
+    let (config, scenes, map) = args.episodes.resolve()?;
+    // Every policy is made (and every reused run read) before anything runs.
+    let chosen = with_runs(&args.policy, &args.run)?;
+    let names: Vec<String> = chosen.iter().map(|(n, _)| n.clone()).collect();
+    if names.len() < 2 {
+        bail!(
+            "{} polic{} given: compare needs at least two (--policy NAME, repeated, or --run DIR)",
+            names.len(),
+            if names.len() == 1 { "y" } else { "ies" }
+        );
+    }
+    let mut contenders = Vec::new();
+    for (name, reuse) in chosen {
+        contenders.push(Contender {
+            factory: policy_factory(&name, &config)?,
+            name,
+            reuse,
+        });
+    }
+    let first = args.seed_start;
+    let end = first.checked_add(args.seeds).with_context(|| {
+        format!(
+            "--seed-start {first} --seeds {}: the seed range passes 2^64",
+            args.seeds
+        )
+    })?;
+    let mut seeds = Vec::new();
+    seeds.try_reserve_exact(args.seeds as usize).map_err(|_| {
+        anyhow::anyhow!(
+            "--seeds {}: too many seeds to hold in memory; split the range with --seed-start",
+            args.seeds
+        )
+    })?;
+    seeds.extend(first..end);
+    let evaluator = Evaluator::new(config.clone(), scenes);
+    evaluator
+        .worlds()
+        .check_start(first)
+        .with_context(|| format!("cannot start episodes in this scene (seed {first})"))?;
+    let out_dir = args.out.clone().unwrap_or_else(default_out_dir);
+    let threads = args.threads.count();
+    let options = CompareOptions {
+        seeds,
+        threads,
+        by_difficulty: args.by == Some(By::Difficulty),
+        difficulty_bins: args.bins as usize,
+        resamples: args.resamples as usize,
+        sheet_rows: args.sheet as usize,
+    };
+    let info = CompareInfo {
+        scenes: args.episodes.scenes.spec(&config),
+        map,
+        command: command_line(),
+    };
+    let cancel = cancel_on_ctrl_c("finishing running episodes and saving the runs");
+    let to_run = contenders.iter().filter(|c| c.reuse.is_none()).count() as u64;
+    let bar = crate::output::progress_bar(
+        args.seeds * to_run,
+        "{prefix} {wide_bar} {pos}/{len} episodes, {per_sec}, eta {eta}",
+        "ronap compare".to_string(),
+    );
+    let result = compare(
+        &evaluator,
+        &contenders,
+        &options,
+        &info,
+        Some(&out_dir),
+        &cancel,
+        &|p| match p {
+            Progress::Running { label, .. } => bar.set_prefix(format!("ronap compare: {label}")),
+            Progress::Episode => bar.inc(1),
+            Progress::Difficulty { seeds } => {
+                bar.set_prefix(format!("difficulty of {seeds} seeds"))
+            }
+            Progress::Report => bar.set_prefix("pictures and report"),
+        },
+    );
+    bar.finish_and_clear();
+    let comparison = match result {
+        Ok(c) => c,
+        Err(e @ CompareError::Cancelled { .. }) => {
+            eprintln!("ronap compare: {e}");
+            return Ok(ExitCode::from(130));
+        }
+        Err(e) => return Err(e.into()),
+    };
+    let mut stdout = std::io::stdout().lock();
+    writeln!(
+        stdout,
+        "ronap compare: {}, seeds {first}..{}, {threads} threads",
+        names.join(" vs "),
+        end - 1
+    )?;
+    write!(stdout, "{}", comparison.table())?;
+    writeln!(
+        stdout,
+        "report in {} (report.html, report.md, compare.png)",
+        out_dir.display()
+    )?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The command line as typed, quoted for a POSIX shell where needed.
+fn command_line() -> String {
+    std::env::args()
+        .enumerate()
+        .map(|(i, a)| {
+            let a = if i == 0 { "ronap".to_string() } else { a };
+            if !a.is_empty()
+                && a.chars()
+                    .all(|c| c.is_ascii_alphanumeric() || "-_./:@=,+".contains(c))
+            {
+                a
+            } else {
+                format!("'{}'", a.replace('\'', "'\\''"))
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// `runs/compare-<UTC time>` (`-2`, `-3`... when taken).
+fn default_out_dir() -> PathBuf {
+    let (y, mo, d, h, mi, s) = crate::output::utc_now();
+    crate::output::unused_dir(format!(
+        "runs/compare-{y:04}{mo:02}{d:02}-{h:02}{mi:02}{s:02}"
+    ))
+}

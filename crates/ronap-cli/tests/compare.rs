@@ -1,0 +1,224 @@
+//! End-to-end tests of `ronap compare`: the table and every file read back, the same episodes as
+//! separate `ronap run`s, identical policies, reused runs, difficulty bins and bad input.
+
+use crate::util::{assert_rejected, json, ok, ronap, rows};
+use std::path::Path;
+
+fn compare(out: &Path, extra: &[&str]) -> String {
+    let mut args = vec!["compare", "--seeds", "16", "--out", out.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    ok(&ronap(&args))
+}
+
+#[test]
+fn compare_prints_the_table_and_writes_the_report_and_the_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cmp");
+    let table = compare(&out, &["--policy", "apf", "--policy", "geodesic"]);
+    for needle in [
+        "success = the robot's centre comes within 10 px",
+        "success (95% CI)",
+        "apf vs geodesic",
+        "McNemar p",
+    ] {
+        assert!(table.contains(needle), "{needle:?} not in\n{table}");
+    }
+    let report = json(&out.join("compare.json"));
+    assert_eq!(report["policies"].as_array().unwrap().len(), 2);
+    assert_eq!(report["pairs"].as_array().unwrap().len(), 1);
+    assert!(report["success_rule"].as_str().unwrap().contains("10 px"));
+    let pair = &report["pairs"][0];
+    // geodesic succeeds wherever apf does in the default maze.
+    assert_eq!(pair["a_only"], 0);
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(md.contains("| apf |") && md.contains("![") && md.contains("ronap compare --seeds 16"));
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.starts_with("<!DOCTYPE html>") && html.trim_end().ends_with("</html>"));
+    assert_eq!(
+        html.matches("<table>").count(),
+        html.matches("</table>").count()
+    );
+    // Pictures are inlined as PNGs that decode.
+    let b64 = html.split("data:image/png;base64,").nth(1).unwrap();
+    let b64 = &b64[..b64.find('"').unwrap()];
+    use base64::Engine as _;
+    let bytes = base64::engine::general_purpose::STANDARD
+        .decode(b64)
+        .unwrap();
+    image::load_from_memory(&bytes).unwrap();
+    for png in ["compare.png", "outcomes.png"] {
+        image::open(out.join(png)).unwrap();
+    }
+    // Nothing half-written is left behind.
+    let leftovers: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().starts_with('.'))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    // Each policy's run is the one `ronap run` makes.
+    let alone = dir.path().join("alone");
+    ok(&ronap(&[
+        "run",
+        "--policy",
+        "apf",
+        "--seeds",
+        "16",
+        "--out",
+        alone.to_str().unwrap(),
+    ]));
+    assert_eq!(
+        std::fs::read(alone.join("episodes.csv")).unwrap(),
+        std::fs::read(out.join("runs/apf/episodes.csv")).unwrap()
+    );
+    let seeds = rows(&out.join("seeds.csv"));
+    assert_eq!(seeds.len(), 17);
+    assert_eq!(seeds[0][..3], ["seed", "apf_outcome", "apf_spl"]);
+}
+
+#[test]
+fn two_identical_policies_show_no_difference() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cmp");
+    compare(&out, &["--policy", "apf", "--policy", "apf"]);
+    let report = json(&out.join("compare.json"));
+    let pair = &report["pairs"][0];
+    assert_eq!(
+        (pair["a"].as_str(), pair["b"].as_str()),
+        (Some("apf"), Some("apf-2"))
+    );
+    assert_eq!(
+        (pair["a_only"].as_u64(), pair["b_only"].as_u64()),
+        (Some(0), Some(0))
+    );
+    assert_eq!(pair["mcnemar_p"].as_f64(), Some(1.0));
+    assert_eq!(pair["spl_diff"].as_f64(), Some(0.0));
+    assert_eq!(
+        pair["verdict"].as_str(),
+        Some("success: no difference; SPL: no difference")
+    );
+    // They agree on every seed: no contact sheet.
+    assert!(!out.join("disagreements.png").exists());
+}
+
+#[test]
+fn a_reused_run_gives_the_same_comparison() {
+    let dir = tempfile::tempdir().unwrap();
+    let fresh = dir.path().join("fresh");
+    compare(&fresh, &["--policy", "apf", "--policy", "geodesic"]);
+    let reused = dir.path().join("reused");
+    let geodesic_run = fresh.join("runs/geodesic");
+    let table = compare(
+        &reused,
+        &["--policy", "apf", "--run", geodesic_run.to_str().unwrap()],
+    );
+    assert!(table.contains("apf vs geodesic"), "{table}");
+    let (a, b) = (
+        json(&fresh.join("compare.json")),
+        json(&reused.join("compare.json")),
+    );
+    assert_eq!(a["pairs"], b["pairs"]);
+    assert_eq!(b["policies"][1]["reused"], true);
+    assert!(!reused.join("runs/geodesic").exists());
+    // A run of other seeds, or of another policy under its name, is refused by name.
+    assert_rejected(
+        &[
+            "compare",
+            "--seeds",
+            "10",
+            "--policy",
+            "apf",
+            "--run",
+            geodesic_run.to_str().unwrap(),
+            "--out",
+            dir.path().join("x").to_str().unwrap(),
+        ],
+        &["--run", "seeds 0..15", "0..9"],
+    );
+    assert_rejected(
+        &[
+            "compare",
+            "--seeds",
+            "16",
+            "--policy",
+            "apf",
+            "--run",
+            geodesic_run.to_str().unwrap(),
+            "--max-steps",
+            "900",
+            "--out",
+            dir.path().join("y").to_str().unwrap(),
+        ],
+        &["--run", "episode.max_steps", "2000", "900"],
+    );
+}
+
+#[test]
+fn by_difficulty_bins_every_seed() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cmp");
+    let table = compare(
+        &out,
+        &[
+            "--policy",
+            "apf",
+            "--policy",
+            "geodesic",
+            "--by",
+            "difficulty",
+        ],
+    );
+    assert!(table.contains("by path / straight ratio"), "{table}");
+    let report = json(&out.join("compare.json"));
+    let by = report["by_difficulty"].as_array().unwrap();
+    assert_eq!(by.len(), 3);
+    for figure in by {
+        let seeds: u64 = figure["bins"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|b| b["seeds"].as_u64().unwrap())
+            .sum();
+        assert_eq!(seeds + figure["unbinned"].as_u64().unwrap(), 16);
+    }
+    let seeds = rows(&out.join("seeds.csv"));
+    let ratio = seeds[0].iter().position(|h| h == "ratio").unwrap();
+    assert!(seeds[1..]
+        .iter()
+        .all(|r| r[ratio].parse::<f64>().unwrap() >= 0.99));
+    image::open(out.join("difficulty.png")).unwrap();
+}
+
+#[test]
+fn bad_input_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("never");
+    let o = out.to_str().unwrap();
+    assert_rejected(
+        &["compare", "--policy", "apf", "--out", o],
+        &["at least two"],
+    );
+    assert_rejected(
+        &["compare", "--policy", "apf", "--policy", "nope", "--out", o],
+        &["nope"],
+    );
+    assert_rejected(
+        &[
+            "compare",
+            "--policy",
+            "apf",
+            "--run",
+            "/no/such/run",
+            "--out",
+            o,
+        ],
+        &["/no/such/run"],
+    );
+    assert_rejected(
+        &[
+            "compare", "--policy", "apf", "--policy", "geodesic", "--by", "luck",
+        ],
+        &["--by", "luck"],
+    );
+    assert!(!out.exists());
+}

@@ -1,0 +1,776 @@
+//! Comparisons, above `io`: several policies on the same seeds and scenes, with paired
+//! statistics (which differences are real), pictures and a report a person reads. Uses every
+//! layer below it.
+//!
+//! Each policy's episodes are an ordinary run directory (`DIR/runs/<policy>/`), the same files
+//! `ronap run` writes, so each can be replayed or reused; a run given for reuse must have been made
+//! with the same configuration, scenes and seeds. The figures are deterministic: the bootstrap
+//! draws from a fixed seed.
+
+pub mod difficulty;
+pub mod report;
+pub mod result;
+pub mod stats;
+
+use crate::config::{OnCollision, ValidConfig};
+use crate::eval::{EvalOptions, Evaluator, Recording};
+use crate::io::atomic::OutputError;
+use crate::io::manifest::{ManifestError, RunManifest};
+use crate::io::run_dir::{evaluate_into, RunFiles, RunInfo, RunWriter};
+use crate::policy::{PolicyError, PolicyFactory};
+use crate::render::chart;
+use crate::scene::map::MapSource;
+use crate::sim::world::SceneSpec;
+use difficulty::{Difficulty, Figure};
+use rayon::prelude::*;
+pub use result::{BinResult, Breakdown, Comparison, PairResult, PolicyResult, SeedResult};
+use stats::ALPHA;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+/// The seed of the bootstrap's generator: the intervals are the same on every run.
+pub const BOOTSTRAP_SEED: u64 = 0x5eed_b007;
+
+/// One policy to compare.
+pub struct Contender {
+    /// The policy as named to the front end (`apf`, `mlp:policies/bc.safetensors`...).
+    pub name: String,
+    /// Makes it.
+    pub factory: Box<dyn PolicyFactory>,
+    /// A run directory of this policy to read instead of running it again.
+    pub reuse: Option<PathBuf>,
+}
+
+/// How a comparison runs.
+#[derive(Clone, Debug)]
+pub struct CompareOptions {
+    /// The episode seeds, the same for every policy.
+    pub seeds: Vec<u64>,
+    /// Worker threads (0: all cores).
+    pub threads: usize,
+    /// Also compute each seed's difficulty and break results down by it.
+    pub by_difficulty: bool,
+    /// Bins per difficulty figure.
+    pub difficulty_bins: usize,
+    /// Bootstrap resamples for the paired intervals.
+    pub resamples: usize,
+    /// Seeds in the contact sheet of disagreements.
+    pub sheet_rows: usize,
+}
+
+impl Default for CompareOptions {
+    fn default() -> Self {
+        Self {
+            seeds: Vec::new(),
+            threads: 0,
+            by_difficulty: false,
+            difficulty_bins: 3,
+            resamples: 10_000,
+            sheet_rows: 6,
+        }
+    }
+}
+
+/// What a comparison is, for its files: where episodes took place and how to run it again.
+#[derive(Clone, Debug)]
+pub struct CompareInfo {
+    /// Where episodes take place.
+    pub scenes: SceneSpec,
+    /// What the map file was read as, for runs on a map.
+    pub map: Option<MapSource>,
+    /// The command that reproduces the comparison, for the report.
+    pub command: String,
+}
+
+/// Why a comparison could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum CompareError {
+    /// Fewer than two policies, or no seeds.
+    #[error("{0}")]
+    Input(String),
+    /// A run given for reuse cannot be read.
+    #[error("--run {}: {source}", dir.display())]
+    Manifest {
+        /// The run directory.
+        dir: PathBuf,
+        /// Why (boxed: it is large, and rare).
+        source: Box<ManifestError>,
+    },
+    /// A run given for reuse does not match this comparison.
+    #[error("--run {}: {message}", dir.display())]
+    Mismatch {
+        /// The run directory.
+        dir: PathBuf,
+        /// What differs.
+        message: String,
+    },
+    /// A policy could not be made.
+    #[error("policy {policy}: {source}")]
+    Policy {
+        /// The policy.
+        policy: String,
+        /// Why.
+        source: PolicyError,
+    },
+    /// A policy's run stopped on a failing episode; its finished episodes are in `dir`.
+    #[error("policy {policy}: {message} (its finished episodes are saved in {})", dir.display())]
+    Run {
+        /// The policy.
+        policy: String,
+        /// The error.
+        message: String,
+        /// Its run directory.
+        dir: PathBuf,
+    },
+    /// Interrupted; the runs finished so far are saved.
+    #[error("interrupted; the finished episodes are saved in {}", dir.display())]
+    Cancelled {
+        /// Where the runs are.
+        dir: PathBuf,
+    },
+    /// An output file could not be written.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+}
+
+/// What counts as a success under `config`, in words (named in every comparison output).
+pub fn success_rule(config: &ValidConfig) -> String {
+    let e = &config.episode;
+    let collisions = match config.robot.on_collision {
+        OnCollision::Revert => "collisions are reverted and counted, and do not end it",
+        OnCollision::Terminate => "a collision ends it as a failure",
+    };
+    let reward = e
+        .reward_min
+        .map(|r| format!("; a summed reward down to {r} ends it as a failure"))
+        .unwrap_or_default();
+    format!(
+        "success = the robot's centre comes within {} px of the goal within {} steps ({collisions}{reward}; a policy that gives up fails)",
+        e.goal_tolerance_px, e.max_steps
+    )
+}
+
+/// Short, unique, file-safe labels for policy names: `mlp:policies/bc.safetensors` -> `bc`, and
+/// `-2`, `-3`... for repeats.
+pub fn labels(names: &[String]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for name in names {
+        let base = name.split('@').next().unwrap_or(name);
+        let base = base.rsplit(['/', ':']).next().unwrap_or(base);
+        let base = base.strip_suffix(".safetensors").unwrap_or(base);
+        let base = base.strip_suffix(".py").unwrap_or(base);
+        let mut base: String = base
+            .chars()
+            .map(|c| {
+                if c.is_ascii_alphanumeric() || c == '-' || c == '_' || c == '.' {
+                    c
+                } else {
+                    '_'
+                }
+            })
+            .collect();
+        if base.is_empty() || base.starts_with('.') {
+            base.insert_str(0, "policy");
+        }
+        let label = (1..)
+            .map(|k| {
+                if k == 1 {
+                    base.clone()
+                } else {
+                    format!("{base}-{k}")
+                }
+            })
+            .find(|l| !out.contains(l))
+            .unwrap_or(base);
+        out.push(label);
+    }
+    out
+}
+
+/// The policies of a comparison: `names`, each paired with the run in `runs` that recorded it
+/// (read from each run's `summary.json`); a run of a policy not in `names` adds it. Fails when a
+/// run's summary cannot be read.
+pub fn with_runs(
+    names: &[String],
+    runs: &[PathBuf],
+) -> Result<Vec<(String, Option<PathBuf>)>, CompareError> {
+    let mut out: Vec<(String, Option<PathBuf>)> = names.iter().map(|n| (n.clone(), None)).collect();
+    for dir in runs {
+        let manifest = RunManifest::read(&dir.join("summary.json")).map_err(|source| {
+            CompareError::Manifest {
+                dir: dir.clone(),
+                source: Box::new(source),
+            }
+        })?;
+        match out
+            .iter_mut()
+            .find(|(n, reuse)| *n == manifest.policy && reuse.is_none())
+        {
+            Some((_, reuse)) => *reuse = Some(dir.clone()),
+            None => out.push((manifest.policy, Some(dir.clone()))),
+        }
+    }
+    Ok(out)
+}
+
+/// Progress of a comparison, for a front end's bar.
+#[derive(Clone, Copy, Debug)]
+pub enum Progress<'a> {
+    /// Policy `index` started running `episodes` episodes.
+    Running {
+        /// Which policy.
+        index: usize,
+        /// Its label.
+        label: &'a str,
+        /// How many episodes.
+        episodes: usize,
+    },
+    /// An episode of the running policy finished.
+    Episode,
+    /// Difficulty figures are being computed for `seeds` seeds.
+    Difficulty {
+        /// How many.
+        seeds: usize,
+    },
+    /// Pictures and the report are being drawn.
+    Report,
+}
+
+/// Runs (or reads) every contender on `options.seeds` and compares them; with `out`, writes the
+/// runs to `out/runs/<label>/` and the comparison's files to `out`.
+pub fn compare(
+    evaluator: &Evaluator,
+    contenders: &[Contender],
+    options: &CompareOptions,
+    info: &CompareInfo,
+    out: Option<&Path>,
+    cancel: &AtomicBool,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<Comparison, CompareError> {
+    if contenders.len() < 2 {
+        return Err(CompareError::Input(format!(
+            "{} polic{} given: a comparison needs at least two",
+            contenders.len(),
+            if contenders.len() == 1 { "y" } else { "ies" }
+        )));
+    }
+    if options.seeds.is_empty() {
+        return Err(CompareError::Input("no seeds: give at least one".into()));
+    }
+    let config = evaluator.config();
+    let names: Vec<String> = contenders.iter().map(|c| c.name.clone()).collect();
+    let labels = labels(&names);
+    // Every reused run is checked before anything runs or is written.
+    let mut reused: Vec<Option<(PathBuf, RunManifest, Vec<SeedResult>)>> = Vec::new();
+    for c in contenders {
+        reused.push(match &c.reuse {
+            Some(dir) => {
+                let (manifest, rows) = read_run(dir, &c.name, config, info, &options.seeds)?;
+                Some((dir.clone(), manifest, rows))
+            }
+            None => None,
+        });
+    }
+    if let Some(dir) = out {
+        let runs = dir.join("runs");
+        std::fs::create_dir_all(&runs).map_err(|source| OutputError::Io { path: runs, source })?;
+    }
+    let mut policies = Vec::new();
+    for (index, (c, reuse)) in contenders.iter().zip(reused).enumerate() {
+        let label = labels[index].clone();
+        let result = match reuse {
+            Some((dir, manifest, seeds)) => PolicyResult {
+                name: c.name.clone(),
+                label,
+                run_dir: Some(dir),
+                reused: true,
+                summary: manifest.summary,
+                seeds,
+            },
+            None => run_one(
+                evaluator, c, &label, options, info, out, cancel, index, progress,
+            )?,
+        };
+        policies.push(result);
+    }
+    let difficulty = if options.by_difficulty {
+        progress(Progress::Difficulty {
+            seeds: options.seeds.len(),
+        });
+        difficulties(evaluator, &options.seeds, options.threads)
+    } else {
+        Vec::new()
+    };
+    let pairs = pairs(&policies, options.resamples);
+    let by_difficulty = options.by_difficulty.then(|| {
+        Figure::ALL
+            .iter()
+            .map(|&f| breakdown(&policies, &difficulty, f, options.difficulty_bins))
+            .collect()
+    });
+    let comparison = Comparison {
+        ronap_version: env!("CARGO_PKG_VERSION").to_string(),
+        success_rule: success_rule(config),
+        scenes: info.scenes.to_string(),
+        seed_start: options.seeds[0],
+        seed_count: options.seeds.len(),
+        policies,
+        pairs,
+        by_difficulty,
+        difficulty,
+        command: info.command.clone(),
+        config: config.clone(),
+    };
+    if let Some(dir) = out {
+        progress(Progress::Report);
+        let sheet = disagreement_sheet(evaluator, contenders, &comparison, options.sheet_rows)?;
+        report::write_all(dir, &comparison, sheet.as_ref())?;
+    }
+    Ok(comparison)
+}
+
+/// Runs contender `c` into `out/runs/<label>` (when there is an `out`).
+#[allow(clippy::too_many_arguments)]
+fn run_one(
+    evaluator: &Evaluator,
+    c: &Contender,
+    label: &str,
+    options: &CompareOptions,
+    info: &CompareInfo,
+    out: Option<&Path>,
+    cancel: &AtomicBool,
+    index: usize,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<PolicyResult, CompareError> {
+    let dir = out.map(|d| d.join("runs").join(label));
+    let writer = dir
+        .as_deref()
+        .map(|d| RunWriter::create(d, RunFiles::default(), options.seeds[0]))
+        .transpose()?;
+    progress(Progress::Running {
+        index,
+        label,
+        episodes: options.seeds.len(),
+    });
+    let eval_options = EvalOptions {
+        seeds: options.seeds.clone(),
+        threads: options.threads,
+        recording: Recording::default(),
+    };
+    let run_info = RunInfo {
+        policy: c.name.clone(),
+        scenes: info.scenes.clone(),
+        map: info.map.clone(),
+    };
+    let evaluation = evaluate_into(
+        evaluator,
+        c.factory.as_ref(),
+        &eval_options,
+        &run_info,
+        writer,
+        cancel,
+        &|_| progress(Progress::Episode),
+    )
+    .map_err(|source| CompareError::Policy {
+        policy: c.name.clone(),
+        source,
+    })?;
+    let where_ = dir.clone().unwrap_or_default();
+    if let Some(e) = evaluation.write_error {
+        return Err(e.into());
+    }
+    if let Some(e) = &evaluation.result.error {
+        return Err(CompareError::Run {
+            policy: c.name.clone(),
+            message: e.to_string(),
+            dir: where_,
+        });
+    }
+    if evaluation.result.cancelled {
+        return Err(CompareError::Cancelled {
+            dir: out.map(|d| d.join("runs")).unwrap_or_default(),
+        });
+    }
+    Ok(PolicyResult {
+        name: c.name.clone(),
+        label: label.to_string(),
+        run_dir: dir,
+        reused: false,
+        summary: evaluation.summary,
+        seeds: evaluation
+            .result
+            .records
+            .iter()
+            .map(SeedResult::of)
+            .collect(),
+    })
+}
+
+/// Reads the run in `dir` for reuse by policy `name`: its manifest must record the same policy,
+/// configuration, scenes and seeds, and a finished run.
+fn read_run(
+    dir: &Path,
+    name: &str,
+    config: &ValidConfig,
+    info: &CompareInfo,
+    seeds: &[u64],
+) -> Result<(RunManifest, Vec<SeedResult>), CompareError> {
+    let mismatch = |message: String| CompareError::Mismatch {
+        dir: dir.to_path_buf(),
+        message,
+    };
+    let manifest =
+        RunManifest::read(&dir.join("summary.json")).map_err(|source| CompareError::Manifest {
+            dir: dir.to_path_buf(),
+            source: Box::new(source),
+        })?;
+    if manifest.policy != name {
+        return Err(mismatch(format!(
+            "a run of policy {:?}, not {name:?}",
+            manifest.policy
+        )));
+    }
+    let (first, count) = (seeds[0], seeds.len() as u64);
+    if manifest.seed_start != first || manifest.seeds_requested != count {
+        return Err(mismatch(format!(
+            "seeds {}..{} were run there; this comparison uses {first}..{}",
+            manifest.seed_start,
+            manifest.seed_start + manifest.seeds_requested.saturating_sub(1),
+            first + count - 1
+        )));
+    }
+    if manifest.interrupted || manifest.error.is_some() {
+        return Err(mismatch(
+            "that run did not finish every seed; run it again".into(),
+        ));
+    }
+    if manifest.scenes != info.scenes {
+        return Err(mismatch(format!(
+            "run on {}; this comparison is on {}",
+            manifest.scenes, info.scenes
+        )));
+    }
+    if &manifest.config != config.as_sim_config() {
+        let field = first_difference(&manifest.config, config.as_sim_config());
+        return Err(mismatch(format!(
+            "its configuration differs from this comparison's ({field})"
+        )));
+    }
+    let rows = read_episodes(&dir.join("episodes.csv")).map_err(mismatch)?;
+    if rows.iter().map(|r| r.seed).ne(seeds.iter().copied()) {
+        return Err(mismatch(
+            "episodes.csv does not hold exactly this comparison's seeds".into(),
+        ));
+    }
+    Ok((manifest, rows))
+}
+
+/// The first field (dotted path) where two configurations differ, with both values.
+fn first_difference(a: &crate::SimConfig, b: &crate::SimConfig) -> String {
+    fn walk(path: &str, a: &serde_json::Value, b: &serde_json::Value) -> Option<String> {
+        match (a, b) {
+            (serde_json::Value::Object(x), serde_json::Value::Object(y)) => {
+                let mut keys: Vec<&String> = x.keys().chain(y.keys()).collect();
+                keys.sort();
+                keys.dedup();
+                keys.into_iter().find_map(|k| {
+                    let null = serde_json::Value::Null;
+                    let p = if path.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{path}.{k}")
+                    };
+                    walk(&p, x.get(k).unwrap_or(&null), y.get(k).unwrap_or(&null))
+                })
+            }
+            _ if a == b => None,
+            _ => Some(format!("{path}: {a} there, {b} here")),
+        }
+    }
+    let (a, b) = (serde_json::to_value(a), serde_json::to_value(b));
+    match (a, b) {
+        (Ok(a), Ok(b)) => walk("", &a, &b).unwrap_or_else(|| "no field differs".into()),
+        _ => "cannot be compared".into(),
+    }
+}
+
+/// The per-seed results in a run's `episodes.csv`.
+fn read_episodes(path: &Path) -> Result<Vec<SeedResult>, String> {
+    let what = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+    let mut reader = csv::Reader::from_path(path).map_err(|e| what(&e))?;
+    let headers = reader.headers().map_err(|e| what(&e))?.clone();
+    let column = |name: &str| {
+        headers
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| what(&format!("no column {name:?}")))
+    };
+    let cols = [
+        column("seed")?,
+        column("outcome")?,
+        column("steps")?,
+        column("collisions")?,
+        column("path_length_px")?,
+        column("spl")?,
+    ];
+    let mut rows = Vec::new();
+    for (line, record) in reader.records().enumerate() {
+        let record = record.map_err(|e| what(&e))?;
+        let at = |k: usize| record.get(cols[k]).unwrap_or("");
+        let bad = |k: usize| {
+            what(&format!(
+                "line {}: {} = {:?}",
+                line + 2,
+                headers.get(cols[k]).unwrap_or(""),
+                at(k)
+            ))
+        };
+        let outcome = crate::eval::Outcome::from_name(at(1)).ok_or_else(|| bad(1))?;
+        rows.push(SeedResult {
+            seed: at(0).parse().map_err(|_| bad(0))?,
+            outcome,
+            steps: at(2).parse().map_err(|_| bad(2))?,
+            collisions: at(3).parse().map_err(|_| bad(3))?,
+            path_length_px: at(4).parse().map_err(|_| bad(4))?,
+            spl: at(5).parse().map_err(|_| bad(5))?,
+        });
+    }
+    Ok(rows)
+}
+
+/// Every seed's difficulty, in seed order, computed on `threads` threads.
+fn difficulties(evaluator: &Evaluator, seeds: &[u64], threads: usize) -> Vec<Option<Difficulty>> {
+    let compute = || {
+        seeds
+            .par_iter()
+            .map(|&s| Difficulty::of(&evaluator.world(s), s))
+            .collect()
+    };
+    match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+        Ok(pool) => pool.install(compute),
+        Err(_) => seeds
+            .iter()
+            .map(|&s| Difficulty::of(&evaluator.world(s), s))
+            .collect(),
+    }
+}
+
+/// The paired statistics of every pair of policies.
+fn pairs(policies: &[PolicyResult], resamples: usize) -> Vec<PairResult> {
+    let mut out = Vec::new();
+    for i in 0..policies.len() {
+        for j in i + 1..policies.len() {
+            let (a, b) = (&policies[i], &policies[j]);
+            let both = a.seeds.iter().zip(&b.seeds);
+            let a_only = both
+                .clone()
+                .filter(|(x, y)| x.success() && !y.success())
+                .count() as u64;
+            let b_only = both
+                .clone()
+                .filter(|(x, y)| !x.success() && y.success())
+                .count() as u64;
+            let success: Vec<f64> = both
+                .clone()
+                .map(|(x, y)| f64::from(u8::from(x.success())) - f64::from(u8::from(y.success())))
+                .collect();
+            let spl: Vec<f64> = both.map(|(x, y)| x.spl - y.spl).collect();
+            let seed = BOOTSTRAP_SEED ^ ((i as u64) << 32 | j as u64);
+            let (success_diff, success_diff_ci95) =
+                stats::bootstrap_mean95(&success, resamples, seed);
+            let (spl_diff, spl_diff_ci95) = stats::bootstrap_mean95(&spl, resamples, seed + 1);
+            out.push(PairResult {
+                a: a.label.clone(),
+                b: b.label.clone(),
+                success_diff,
+                success_diff_ci95,
+                a_only,
+                b_only,
+                mcnemar_p: stats::mcnemar_exact(a_only, b_only),
+                holm_p: 1.0,
+                spl_diff,
+                spl_diff_ci95,
+                verdict: String::new(),
+            });
+        }
+    }
+    let p: Vec<f64> = out.iter().map(|p| p.mcnemar_p).collect();
+    for (pair, holm) in out.iter_mut().zip(stats::holm(&p)) {
+        pair.holm_p = holm;
+        pair.verdict = verdict(pair);
+    }
+    out
+}
+
+/// A pair's result in a few words: which policy is better in success and in SPL, where the
+/// difference is real.
+fn verdict(p: &PairResult) -> String {
+    let success = if p.holm_p < ALPHA {
+        if p.success_diff > 0.0 {
+            &p.a
+        } else {
+            &p.b
+        }
+    } else {
+        "no difference"
+    };
+    let [lo, hi] = p.spl_diff_ci95;
+    let spl = if lo > 0.0 {
+        &p.a
+    } else if hi < 0.0 {
+        &p.b
+    } else {
+        "no difference"
+    };
+    format!("success: {success}; SPL: {spl}")
+}
+
+/// Results broken down into bins of figure `by`.
+fn breakdown(
+    policies: &[PolicyResult],
+    difficulty: &[Option<Difficulty>],
+    by: Figure,
+    bins: usize,
+) -> Breakdown {
+    let values: Vec<Option<f64>> = difficulty
+        .iter()
+        .map(|d| d.and_then(|d| d.figure(by)))
+        .collect();
+    let cut = difficulty::bins(&values, bins, by);
+    let binned: usize = cut.iter().map(|b| b.members.len()).sum();
+    let bins = cut
+        .into_iter()
+        .map(|bin| {
+            let n = bin.members.len();
+            let mut result = BinResult {
+                seeds: n,
+                success_rate: Vec::new(),
+                success_ci95: Vec::new(),
+                spl: Vec::new(),
+                bin,
+            };
+            for p in policies {
+                let rows: Vec<&SeedResult> =
+                    result.bin.members.iter().map(|&i| &p.seeds[i]).collect();
+                let k = rows.iter().filter(|r| r.success()).count();
+                result.success_rate.push(k as f64 / n.max(1) as f64);
+                result
+                    .success_ci95
+                    .push(crate::eval::summary::wilson95(k, n));
+                result
+                    .spl
+                    .push(rows.iter().map(|r| r.spl).sum::<f64>() / n.max(1) as f64);
+            }
+            result
+        })
+        .collect();
+    Breakdown {
+        figure: by,
+        bins,
+        unbinned: values.len() - binned,
+    }
+}
+
+/// The seeds where the policies disagree most (a split between success and failure first, the
+/// most even splits first, then the widest SPL spread), at most `rows` of them.
+pub fn disagreements(policies: &[PolicyResult], rows: usize) -> Vec<usize> {
+    let n = policies.first().map_or(0, |p| p.seeds.len());
+    let mut scored: Vec<(usize, f64, usize)> = (0..n)
+        .filter_map(|i| {
+            let wins = policies.iter().filter(|p| p.seeds[i].success()).count();
+            let split = wins.min(policies.len() - wins);
+            let spl = policies.iter().map(|p| p.seeds[i].spl);
+            let spread =
+                spl.clone().fold(f64::NEG_INFINITY, f64::max) - spl.fold(f64::INFINITY, f64::min);
+            (split > 0 || spread > 0.05).then_some((split, spread, i))
+        })
+        .collect();
+    scored.sort_by(|a, b| b.0.cmp(&a.0).then(b.1.total_cmp(&a.1)).then(a.2.cmp(&b.2)));
+    scored.into_iter().take(rows).map(|(_, _, i)| i).collect()
+}
+
+/// The contact sheet of the seeds where the policies disagree most: each policy's trajectory
+/// there (the episode run again, recording its path). `None` when they agree everywhere.
+fn disagreement_sheet(
+    evaluator: &Evaluator,
+    contenders: &[Contender],
+    comparison: &Comparison,
+    rows: usize,
+) -> Result<Option<image::RgbImage>, CompareError> {
+    let chosen = disagreements(&comparison.policies, rows);
+    if chosen.is_empty() {
+        return Ok(None);
+    }
+    let mut policies = Vec::new();
+    for c in contenders {
+        policies.push(c.factory.make().map_err(|source| CompareError::Policy {
+            policy: c.name.clone(),
+            source,
+        })?);
+    }
+    let recording = Recording {
+        trajectory: true,
+        steps: false,
+    };
+    let mut sheet_rows = Vec::new();
+    for &i in &chosen {
+        let seed = comparison.policies[0].seeds[i].seed;
+        let mut cells = Vec::new();
+        for policy in policies.iter_mut() {
+            let cell = match evaluator.run_episode(policy.as_mut(), seed, recording) {
+                Ok(record) => {
+                    let scale = 160.0
+                        / record
+                            .world
+                            .as_ref()
+                            .map_or(160.0, |w| w.scene().width().max(w.scene().height()));
+                    let picture = crate::render::trajectory::trajectory_image(&record, scale)
+                        .unwrap_or_else(|| image::RgbImage::new(1, 1));
+                    let caption = format!("{}, {} steps", record.outcome.name(), record.steps);
+                    (picture, caption)
+                }
+                Err(e) => (image::RgbImage::new(1, 1), format!("failed: {e}")),
+            };
+            cells.push(cell);
+        }
+        sheet_rows.push(chart::SheetRow {
+            label: format!("seed {seed}"),
+            cells,
+        });
+    }
+    let columns: Vec<String> = comparison
+        .policies
+        .iter()
+        .map(|p| p.label.clone())
+        .collect();
+    Ok(Some(chart::contact_sheet(&columns, &sheet_rows, 160)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn labels_are_short_and_unique() {
+        let names: Vec<String> = [
+            "apf",
+            "mlp:policies/bc.safetensors",
+            "mlp:other/bc.safetensors@argmax",
+            "py:scripts/p.py:act",
+            "apf",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        assert_eq!(labels(&names), ["apf", "bc", "bc-2", "act", "apf-2"]);
+    }
+
+    #[test]
+    fn the_success_rule_names_the_tolerance_and_the_limit() {
+        let rule = success_rule(&ValidConfig::default());
+        assert!(
+            rule.contains("10 px") && rule.contains("2000 steps"),
+            "{rule}"
+        );
+    }
+}

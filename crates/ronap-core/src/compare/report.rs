@@ -1,0 +1,579 @@
+//! A comparison's files: the tables (for a terminal, Markdown and HTML from one description),
+//! the pictures, `compare.json`, `seeds.csv`, and `report.md` / `report.html` (self-contained,
+//! pictures inlined). Every file is written atomically.
+
+use super::result::{Comparison, PolicyResult};
+use super::stats::ALPHA;
+use crate::eval::Outcome;
+use crate::io::atomic::{write_atomic, OutputError};
+use crate::render::chart;
+use base64::Engine as _;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// A table: a header row and rows of cells.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Table {
+    /// Column names.
+    pub header: Vec<String>,
+    /// Rows, each as long as the header.
+    pub rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    /// The table aligned in columns for a terminal (first column left, the rest right).
+    pub fn text(&self) -> String {
+        let cols = self.header.len();
+        let width = |c: usize| {
+            std::iter::once(&self.header)
+                .chain(&self.rows)
+                .map(|r| r.get(c).map_or(0, |s| s.chars().count()))
+                .max()
+                .unwrap_or(0)
+        };
+        let widths: Vec<usize> = (0..cols).map(width).collect();
+        let line = |r: &Vec<String>| {
+            let cells: Vec<String> = (0..cols)
+                .map(|c| {
+                    let s = r.get(c).map_or("", String::as_str);
+                    let w = widths[c];
+                    if c == 0 {
+                        format!("{s:<w$}")
+                    } else {
+                        format!("{s:>w$}")
+                    }
+                })
+                .collect();
+            cells.join("  ").trim_end().to_string() + "\n"
+        };
+        let rule = "-".repeat(widths.iter().sum::<usize>() + 2 * cols.saturating_sub(1)) + "\n";
+        let mut out = line(&self.header);
+        out.push_str(&rule);
+        for r in &self.rows {
+            out.push_str(&line(r));
+        }
+        out
+    }
+
+    fn markdown(&self) -> String {
+        let esc = |s: &str| s.replace('|', "\\|");
+        let mut out = format!(
+            "| {} |\n|{}\n",
+            self.header
+                .iter()
+                .map(|h| esc(h))
+                .collect::<Vec<_>>()
+                .join(" | "),
+            self.header
+                .iter()
+                .enumerate()
+                .map(|(i, _)| if i == 0 { " --- |" } else { " ---: |" })
+                .collect::<String>()
+        );
+        for r in &self.rows {
+            let _ = writeln!(
+                out,
+                "| {} |",
+                r.iter().map(|c| esc(c)).collect::<Vec<_>>().join(" | ")
+            );
+        }
+        out
+    }
+
+    fn html(&self) -> String {
+        let mut out = String::from("<table>\n<tr>");
+        for h in &self.header {
+            let _ = write!(out, "<th>{}</th>", escape(h));
+        }
+        out.push_str("</tr>\n");
+        for r in &self.rows {
+            out.push_str("<tr>");
+            for c in r {
+                let _ = write!(out, "<td>{}</td>", escape(c));
+            }
+            out.push_str("</tr>\n");
+        }
+        out.push_str("</table>\n");
+        out
+    }
+}
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+fn pct(x: f64) -> String {
+    format!("{:.1}%", 100.0 * x)
+}
+
+/// A difference of rates in percentage points, signed.
+fn signed(x: f64) -> String {
+    format!("{:+.1}", 100.0 * x)
+}
+
+fn p_value(p: f64) -> String {
+    if p < 1e-4 {
+        format!("{p:.1e}")
+    } else {
+        format!("{p:.4}")
+    }
+}
+
+impl Comparison {
+    /// The per-policy table.
+    pub fn policy_table(&self) -> Table {
+        let moving = self.policies.iter().any(|p| p.summary.moving.is_some());
+        let mut header: Vec<String> = [
+            "policy",
+            "success (95% CI)",
+            "SPL",
+            "collisions/ep",
+            "mean steps",
+            "mean path px",
+            "time-outs",
+            "gave up",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        if moving {
+            header.push("moving contacts/ep".into());
+        }
+        let rows = self
+            .policies
+            .iter()
+            .map(|p| {
+                let s = &p.summary;
+                let mut row = vec![
+                    p.label.clone(),
+                    format!(
+                        "{} ({}-{})",
+                        pct(s.success_rate),
+                        pct(s.success_ci95[0]),
+                        pct(s.success_ci95[1])
+                    ),
+                    format!("{:.3}", s.spl),
+                    format!("{:.2}", s.collisions_per_episode),
+                    format!("{:.1}", s.mean_steps),
+                    format!("{:.1}", s.mean_path_length_px),
+                    s.timeouts.to_string(),
+                    s.stuck.to_string(),
+                ];
+                if moving {
+                    row.push(s.moving.as_ref().map_or(String::new(), |m| {
+                        format!("{:.2}", m.dynamic_collisions_per_episode)
+                    }));
+                }
+                row
+            })
+            .collect();
+        Table { header, rows }
+    }
+
+    /// The per-pair table.
+    pub fn pair_table(&self) -> Table {
+        let header = [
+            "pair (a vs b)",
+            "success a-b, pp (95% CI)",
+            "only a / only b",
+            "McNemar p",
+            "Holm p",
+            "SPL a-b (95% CI)",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .chain([format!("better (Holm p < {ALPHA}; SPL CI)")])
+        .collect();
+        let rows = self
+            .pairs
+            .iter()
+            .map(|p| {
+                vec![
+                    format!("{} vs {}", p.a, p.b),
+                    format!(
+                        "{} pp ({:+.1} to {:+.1})",
+                        signed(p.success_diff),
+                        100.0 * p.success_diff_ci95[0],
+                        100.0 * p.success_diff_ci95[1]
+                    ),
+                    format!("{} / {}", p.a_only, p.b_only),
+                    p_value(p.mcnemar_p),
+                    p_value(p.holm_p),
+                    format!(
+                        "{:+.3} ({:+.3} to {:+.3})",
+                        p.spl_diff, p.spl_diff_ci95[0], p.spl_diff_ci95[1]
+                    ),
+                    p.verdict.clone(),
+                ]
+            })
+            .collect();
+        Table { header, rows }
+    }
+
+    /// Success by difficulty bin, one table per figure.
+    pub fn difficulty_tables(&self) -> Vec<(String, Table)> {
+        let Some(by) = &self.by_difficulty else {
+            return Vec::new();
+        };
+        by.iter()
+            .map(|b| {
+                let mut header = vec![b.figure.name().to_string(), "seeds".to_string()];
+                header.extend(self.policies.iter().map(|p| format!("{} success", p.label)));
+                let rows =
+                    b.bins
+                        .iter()
+                        .map(|bin| {
+                            let mut row = vec![bin.bin.label.clone(), bin.seeds.to_string()];
+                            row.extend(bin.success_rate.iter().zip(&bin.success_ci95).map(
+                                |(r, ci)| format!("{} ({}-{})", pct(*r), pct(ci[0]), pct(ci[1])),
+                            ));
+                            row
+                        })
+                        .collect();
+                let title = if b.unbinned > 0 {
+                    format!(
+                        "by {} ({} seeds without a path left out)",
+                        b.figure.name(),
+                        b.unbinned
+                    )
+                } else {
+                    format!("by {}", b.figure.name())
+                };
+                (title, Table { header, rows })
+            })
+            .collect()
+    }
+
+    /// Everything a terminal shows at the end of `ronap compare`.
+    pub fn table(&self) -> String {
+        let mut out = format!(
+            "{} seeds from {} on {}\n{}\n\n",
+            self.seed_count, self.seed_start, self.scenes, self.success_rule
+        );
+        out.push_str(&self.policy_table().text());
+        out.push('\n');
+        out.push_str(&self.pair_table().text());
+        for (title, t) in self.difficulty_tables() {
+            let _ = write!(out, "\n{title}\n{}", t.text());
+        }
+        out
+    }
+
+    /// `seeds.csv`: each seed's difficulty (when computed) and each policy's outcome, SPL and
+    /// steps there.
+    pub fn write_seeds(&self, out: &mut dyn std::io::Write) -> std::io::Result<()> {
+        let mut w = csv::Writer::from_writer(out);
+        let with_difficulty = !self.difficulty.is_empty();
+        let mut header = vec!["seed".to_string()];
+        if with_difficulty {
+            for h in [
+                "straight_px",
+                "geodesic_px",
+                "ratio",
+                "narrowest_gap_px",
+                "turns",
+            ] {
+                header.push(h.into());
+            }
+        }
+        for p in &self.policies {
+            for h in ["outcome", "spl", "steps"] {
+                header.push(format!("{}_{h}", p.label));
+            }
+        }
+        w.write_record(&header)?;
+        let opt =
+            |v: Option<f64>, digits: usize| v.map_or(String::new(), |v| format!("{v:.digits$}"));
+        for i in 0..self.seed_count {
+            let mut row = vec![self.policies[0].seeds[i].seed.to_string()];
+            if with_difficulty {
+                match self.difficulty.get(i).copied().flatten() {
+                    Some(d) => {
+                        row.push(format!("{:.3}", d.straight_px));
+                        row.push(opt(d.geodesic_px, 3));
+                        row.push(opt(d.ratio, 4));
+                        row.push(opt(d.narrowest_gap_px, 3));
+                        row.push(d.turns.map_or(String::new(), |t| t.to_string()));
+                    }
+                    None => row.extend(std::iter::repeat_n(String::new(), 5)),
+                }
+            }
+            for p in &self.policies {
+                let s = &p.seeds[i];
+                row.push(s.outcome.name().into());
+                row.push(format!("{:.4}", s.spl));
+                row.push(s.steps.to_string());
+            }
+            w.write_record(&row)?;
+        }
+        w.flush()
+    }
+}
+
+/// A picture of the report: its file name, what it shows, and the PNG.
+struct Picture {
+    file: &'static str,
+    alt: String,
+    png: Vec<u8>,
+}
+
+fn png(image: &image::RgbImage) -> Result<Vec<u8>, image::ImageError> {
+    let mut bytes = Vec::new();
+    image.write_to(
+        &mut std::io::Cursor::new(&mut bytes),
+        image::ImageFormat::Png,
+    )?;
+    Ok(bytes)
+}
+
+/// The comparison's pictures.
+fn pictures(
+    c: &Comparison,
+    sheet: Option<&image::RgbImage>,
+) -> Vec<(&'static str, String, image::RgbImage)> {
+    let bars: Vec<chart::PolicyBars> = c
+        .policies
+        .iter()
+        .map(|p: &PolicyResult| chart::PolicyBars {
+            name: p.label.clone(),
+            success_rate: p.summary.success_rate,
+            success_ci95: p.summary.success_ci95,
+            spl: p.seeds.iter().map(|s| s.spl).collect(),
+        })
+        .collect();
+    let e = &c.config.episode;
+    let title = format!(
+        "{} seeds, {}; success: within {} px of the goal in {} steps",
+        c.seed_count, c.scenes, e.goal_tolerance_px, e.max_steps
+    );
+    let names: Vec<String> = c.policies.iter().map(|p| p.label.clone()).collect();
+    let seeds: Vec<u64> = c.policies[0].seeds.iter().map(|s| s.seed).collect();
+    let outcomes: Vec<Vec<Outcome>> = c
+        .policies
+        .iter()
+        .map(|p| p.seeds.iter().map(|s| s.outcome).collect())
+        .collect();
+    let mut out = vec![
+        (
+            "compare.png",
+            "Success rate with 95% intervals, and SPL distributions".to_string(),
+            chart::compare_chart(&title, &bars),
+        ),
+        (
+            "outcomes.png",
+            "Each seed's outcome per policy; the bottom row marks disagreements".to_string(),
+            chart::outcome_strip(&names, &seeds, &outcomes),
+        ),
+    ];
+    if let Some(sheet) = sheet {
+        out.push((
+            "disagreements.png",
+            "Trajectories on the seeds where the policies disagree most".to_string(),
+            sheet.clone(),
+        ));
+    }
+    if let Some(by) = &c.by_difficulty {
+        if let Some(first) = by.first() {
+            let bins: Vec<String> = first.bins.iter().map(|b| b.bin.label.clone()).collect();
+            let series: Vec<chart::Series> = c
+                .policies
+                .iter()
+                .enumerate()
+                .map(|(k, p)| chart::Series {
+                    name: p.label.clone(),
+                    values: first
+                        .bins
+                        .iter()
+                        .map(|b| (b.success_rate[k], b.success_ci95[k]))
+                        .collect(),
+                })
+                .collect();
+            out.push((
+                "difficulty.png",
+                format!("Success by {}", first.figure.name()),
+                chart::grouped_bars(
+                    &format!(
+                        "success by {} ({} bins of about equal size)",
+                        first.figure.name(),
+                        first.bins.len()
+                    ),
+                    &bins,
+                    &series,
+                ),
+            ));
+        }
+    }
+    out
+}
+
+/// Writes every file of the comparison into `dir`.
+pub fn write_all(
+    dir: &Path,
+    c: &Comparison,
+    sheet: Option<&image::RgbImage>,
+) -> Result<(), OutputError> {
+    let mut shown = Vec::new();
+    for (file, alt, image) in pictures(c, sheet) {
+        let bytes = png(&image).map_err(|e| OutputError::Format {
+            path: dir.join(file),
+            message: e.to_string(),
+        })?;
+        write_atomic(&dir.join(file), |w| w.write_all(&bytes))?;
+        shown.push(Picture {
+            file,
+            alt,
+            png: bytes,
+        });
+    }
+    write_atomic(&dir.join("seeds.csv"), |w| c.write_seeds(w))?;
+    write_atomic(&dir.join("compare.json"), |w| {
+        serde_json::to_writer_pretty(&mut *w, c)?;
+        w.write_all(b"\n")
+    })?;
+    let config = toml::to_string(c.config.as_sim_config()).unwrap_or_default();
+    save_text(&dir.join("report.md"), &markdown(c, &shown, &config))?;
+    save_text(&dir.join("report.html"), &html(c, &shown, &config))?;
+    Ok(())
+}
+
+/// Writes `text` to `path` atomically.
+fn save_text(path: &Path, text: &str) -> Result<(), OutputError> {
+    write_atomic(path, |w| w.write_all(text.as_bytes()))
+}
+
+fn intro(c: &Comparison) -> String {
+    let names: Vec<&str> = c.policies.iter().map(|p| p.name.as_str()).collect();
+    format!(
+        "{} policies ({}) on the same {} seeds ({} to {}), {}. Each pair is tested on the seeds \
+         where exactly one of them succeeded (McNemar's exact test, p-values Holm-adjusted over \
+         the {} pairs; a difference is called real below {}); SPL differences are paired by seed \
+         with a 95% bootstrap interval.",
+        c.policies.len(),
+        names.join(", "),
+        c.seed_count,
+        c.seed_start,
+        c.seed_start + c.seed_count as u64 - 1,
+        c.scenes,
+        c.pairs.len(),
+        ALPHA
+    )
+}
+
+fn runs_note(c: &Comparison) -> Vec<String> {
+    c.policies
+        .iter()
+        .map(|p| {
+            let dir = p
+                .run_dir
+                .as_ref()
+                .map_or("(not written)".to_string(), |d| d.display().to_string());
+            format!(
+                "{}: `{}` {} {}",
+                p.label,
+                p.name,
+                if p.reused { "read from" } else { "run into" },
+                dir
+            )
+        })
+        .collect()
+}
+
+fn markdown(c: &Comparison, pictures: &[Picture], config: &str) -> String {
+    let mut md = String::from("# ronap compare\n\n");
+    let _ = writeln!(md, "{}\n\n**{}**\n", intro(c), c.success_rule);
+    let _ = writeln!(md, "## Policies\n\n{}", c.policy_table().markdown());
+    let _ = writeln!(md, "## Pairs\n\n{}", c.pair_table().markdown());
+    for p in pictures {
+        let _ = writeln!(md, "![{}]({})\n", p.alt, p.file);
+    }
+    let tables = c.difficulty_tables();
+    if !tables.is_empty() {
+        md.push_str("## By difficulty\n\n");
+        for (title, t) in tables {
+            let _ = writeln!(md, "### {title}\n\n{}", t.markdown());
+        }
+    }
+    md.push_str("## Runs\n\n");
+    for line in runs_note(c) {
+        let _ = writeln!(md, "- {line}");
+    }
+    let _ = writeln!(
+        md,
+        "\n## Reproduce\n\n```sh\n{}\n```\n\nronap {}\n\n## Configuration\n\n```toml\n{}```",
+        c.command, c.ronap_version, config
+    );
+    md
+}
+
+fn html(c: &Comparison, pictures: &[Picture], config: &str) -> String {
+    let mut h = String::from(
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
+         <title>ronap compare</title>\n<style>\n\
+         body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;color:#222}\n\
+         table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #ccc;padding:4px 8px}\n\
+         td{text-align:right}td:first-child{text-align:left}th{background:#f3f3f3}\n\
+         img{max-width:100%;border:1px solid #ddd;margin:0.5em 0}pre{background:#f6f6f6;padding:1em;overflow:auto}\n\
+         </style>\n</head>\n<body>\n<h1>ronap compare</h1>\n",
+    );
+    let _ = writeln!(
+        h,
+        "<p>{}</p>\n<p><strong>{}</strong></p>",
+        escape(&intro(c)),
+        escape(&c.success_rule)
+    );
+    let _ = writeln!(h, "<h2>Policies</h2>\n{}", c.policy_table().html());
+    let _ = writeln!(h, "<h2>Pairs</h2>\n{}", c.pair_table().html());
+    let b64 = base64::engine::general_purpose::STANDARD;
+    for p in pictures {
+        let _ = writeln!(
+            h,
+            "<figure><img alt=\"{}\" src=\"data:image/png;base64,{}\"><figcaption>{}</figcaption></figure>",
+            escape(&p.alt),
+            b64.encode(&p.png),
+            escape(&p.alt)
+        );
+    }
+    let tables = c.difficulty_tables();
+    if !tables.is_empty() {
+        h.push_str("<h2>By difficulty</h2>\n");
+        for (title, t) in tables {
+            let _ = writeln!(h, "<h3>{}</h3>\n{}", escape(&title), t.html());
+        }
+    }
+    h.push_str("<h2>Runs</h2>\n<ul>\n");
+    for line in runs_note(c) {
+        let _ = writeln!(h, "<li>{}</li>", escape(&line.replace('`', "")));
+    }
+    let _ = write!(
+        h,
+        "</ul>\n<h2>Reproduce</h2>\n<pre>{}</pre>\n<p>ronap {}</p>\n<h2>Configuration</h2>\n<pre>{}</pre>\n</body>\n</html>\n",
+        escape(&c.command),
+        escape(&c.ronap_version),
+        escape(config)
+    );
+    h
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tables_align_and_escape() {
+        let t = Table {
+            header: vec!["policy".into(), "success".into()],
+            rows: vec![
+                vec!["a|b".into(), "50.0%".into()],
+                vec!["<c>".into(), "5%".into()],
+            ],
+        };
+        let text = t.text();
+        assert_eq!(text.lines().nth(2), Some("a|b       50.0%"));
+        assert_eq!(text.lines().nth(1), Some("-".repeat(15).as_str()));
+        assert!(t.markdown().contains("a\\|b"));
+        assert!(t.html().contains("&lt;c&gt;"));
+    }
+}

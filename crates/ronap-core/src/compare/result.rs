@@ -1,0 +1,147 @@
+//! What a comparison found: each policy's figures and per-seed results, the paired statistics
+//! of every pair, and results by difficulty. `compare.json` is this, serialised.
+
+use super::difficulty::{Bin, Difficulty, Figure};
+use crate::config::ValidConfig;
+use crate::eval::{EpisodeRecord, Outcome, Summary};
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// One policy's result on one seed: what the comparison pairs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SeedResult {
+    /// The seed.
+    pub seed: u64,
+    /// How the episode ended.
+    pub outcome: Outcome,
+    /// Steps taken.
+    pub steps: u32,
+    /// Colliding steps.
+    pub collisions: u32,
+    /// Distance driven, px.
+    pub path_length_px: f64,
+    /// SPL.
+    pub spl: f64,
+}
+
+impl SeedResult {
+    /// The result in `r`, rounded as `episodes.csv` writes it, so a comparison gives the same
+    /// figures whether a run is fresh or read back with `--run`.
+    pub(crate) fn of(r: &EpisodeRecord) -> Self {
+        let round = |x: f64, digits: usize| format!("{x:.digits$}").parse().unwrap_or(x);
+        Self {
+            seed: r.seed,
+            outcome: r.outcome,
+            steps: r.steps,
+            collisions: r.collisions,
+            path_length_px: round(r.path_length_px, 3),
+            spl: round(r.spl, 4),
+        }
+    }
+
+    /// Whether the episode succeeded.
+    pub fn success(&self) -> bool {
+        self.outcome == Outcome::Success
+    }
+}
+
+/// One policy's figures.
+#[derive(Clone, Debug, Serialize)]
+pub struct PolicyResult {
+    /// The policy as named.
+    pub name: String,
+    /// Its short name in files and tables (unique in the comparison).
+    pub label: String,
+    /// Its run directory.
+    pub run_dir: Option<PathBuf>,
+    /// Whether the run was read from `--run` rather than run again.
+    pub reused: bool,
+    /// The figures.
+    pub summary: Summary,
+    /// Each seed's result, in seed order.
+    #[serde(skip)]
+    pub seeds: Vec<SeedResult>,
+}
+
+/// Two policies on the same seeds.
+#[derive(Clone, Debug, Serialize)]
+pub struct PairResult {
+    /// The first policy's label.
+    pub a: String,
+    /// The second policy's label.
+    pub b: String,
+    /// Success rate of `a` minus that of `b`.
+    pub success_diff: f64,
+    /// Its 95% paired bootstrap interval.
+    pub success_diff_ci95: [f64; 2],
+    /// Seeds only `a` succeeded on.
+    pub a_only: u64,
+    /// Seeds only `b` succeeded on.
+    pub b_only: u64,
+    /// McNemar's exact two-sided p-value on those seeds.
+    pub mcnemar_p: f64,
+    /// The p-value after Holm's adjustment over all pairs.
+    pub holm_p: f64,
+    /// Mean SPL of `a` minus that of `b` (paired by seed).
+    pub spl_diff: f64,
+    /// Its 95% paired bootstrap interval.
+    pub spl_diff_ci95: [f64; 2],
+    /// What a reader should take from it.
+    pub verdict: String,
+}
+
+/// Results within one bin of a difficulty figure.
+#[derive(Clone, Debug, Serialize)]
+pub struct BinResult {
+    /// The bin.
+    #[serde(flatten)]
+    pub bin: Bin,
+    /// Seeds in it.
+    pub seeds: usize,
+    /// Each policy's success rate there, in policy order.
+    pub success_rate: Vec<f64>,
+    /// Each policy's 95% Wilson interval there.
+    pub success_ci95: Vec<[f64; 2]>,
+    /// Each policy's mean SPL there.
+    pub spl: Vec<f64>,
+}
+
+/// Results broken down by one difficulty figure.
+#[derive(Clone, Debug, Serialize)]
+pub struct Breakdown {
+    /// The figure.
+    pub figure: Figure,
+    /// Its bins, easiest values first.
+    pub bins: Vec<BinResult>,
+    /// Seeds without the figure (no path to the goal).
+    pub unbinned: usize,
+}
+
+/// A finished comparison: what `compare.json` holds.
+#[derive(Clone, Debug, Serialize)]
+pub struct Comparison {
+    /// The ronap version that made it.
+    pub ronap_version: String,
+    /// What counts as a success, in words.
+    pub success_rule: String,
+    /// Where episodes took place.
+    pub scenes: String,
+    /// The first seed.
+    pub seed_start: u64,
+    /// Seeds, the same for every policy.
+    pub seed_count: usize,
+    /// Each policy's figures, in the order given.
+    pub policies: Vec<PolicyResult>,
+    /// Every pair, in the order given.
+    pub pairs: Vec<PairResult>,
+    /// Results by difficulty, when asked for.
+    pub by_difficulty: Option<Vec<Breakdown>>,
+    /// Each seed's difficulty, when asked for.
+    #[serde(skip)]
+    pub difficulty: Vec<Option<Difficulty>>,
+    /// The command that reproduces it.
+    pub command: String,
+    /// The whole configuration.
+    #[serde(skip)]
+    pub config: ValidConfig,
+}

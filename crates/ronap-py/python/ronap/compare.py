@@ -1,0 +1,92 @@
+"""Several policies on the same seeds, as ``ronap compare`` compares them."""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Iterable, Mapping, Sequence
+
+from . import _ronap
+from .config import ScenarioLike, checked_config
+
+
+def compare(
+    policies: Sequence[str | Callable[[Any], Any]],
+    seeds: Iterable[int] = range(1000),
+    *,
+    scenario: ScenarioLike | None = None,
+    config: Mapping[str, Any] | None = None,
+    maze_seed: int | None = None,
+    map: str | None = None,
+    threads: int = 0,
+    continuous: bool = False,
+    out: str | None = None,
+    runs: Sequence[str] = (),
+    by_difficulty: bool = False,
+    bins: int = 3,
+    resamples: int = 10_000,
+    sheet: int = 6,
+    thread_safe: bool = False,
+    **fields: Any,
+) -> dict[str, Any]:
+    """Runs every policy in ``policies`` on the same ``seeds`` and scenes and compares them, as
+    ``ronap compare`` does; returns the figures of its ``compare.json`` as a dict:
+
+    - ``success_rule``: what counts as a success, in words;
+    - ``policies``: per policy its ``name``, ``label`` and ``summary`` (success rate with its 95%
+      Wilson interval, SPL, collisions, steps, path length, time-outs, gave-up...);
+    - ``pairs``: per pair the success difference with a paired bootstrap interval, the seeds only
+      one of them succeeded on, McNemar's exact p-value (and Holm-adjusted), the paired SPL
+      difference with its bootstrap interval, and a ``verdict``;
+    - ``by_difficulty`` (with ``by_difficulty=True``): success per bin of each seed's difficulty
+      (shortest path over straight line, narrowest gap, turns).
+
+    When pandas is installed, ``"frame"`` (one row per policy) and ``"pairs_frame"`` (one row per
+    pair) hold the same figures as DataFrames.
+
+    Policies are named as for ``evaluate`` (``"apf"``, ``"mlp:policies/bc.safetensors"``...) or
+    are callables (observation -> action). ``runs``: directories of finished runs
+    (``ronap run`` / ``evaluate(out=...)``) to reuse instead of running their policy again; each
+    must record the same configuration, scenes and seeds. With ``out``, writes everything
+    ``ronap compare --out`` writes: ``runs/<policy>/``, ``compare.png``, ``outcomes.png``,
+    ``disagreements.png``, ``seeds.csv``, ``compare.json``, ``report.md`` and ``report.html``.
+    The configuration is given as for ``evaluate``.
+    """
+    seeds = [int(s) for s in seeds]
+    names = [p if isinstance(p, str) else getattr(p, "__name__", "python") for p in policies]
+    command = f"ronap.compare({names!r}, seeds=range({seeds[0]}, {seeds[-1] + 1}))" if seeds else None
+    result: dict[str, Any] = _ronap.compare(
+        list(policies),
+        seeds,
+        checked_config(config, fields, scenario),
+        maze_seed,
+        None if map is None else str(map),
+        threads,
+        continuous,
+        None if out is None else str(out),
+        [str(r) for r in runs],
+        by_difficulty,
+        bins,
+        resamples,
+        sheet,
+        thread_safe,
+        command,
+    )
+    try:
+        import pandas
+    except ImportError:
+        return result
+    rows = [{"policy": p["label"], "name": p["name"], **_flat(p["summary"])} for p in result["policies"]]
+    result["frame"] = pandas.DataFrame(rows).set_index("policy")
+    result["pairs_frame"] = pandas.DataFrame(result["pairs"])
+    return result
+
+
+def _flat(summary: Mapping[str, Any]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for k, v in summary.items():
+        if k == "success_ci95":
+            out["success_ci95_low"], out["success_ci95_high"] = v
+        elif isinstance(v, Mapping):
+            out.update({f"{k}_{kk}": vv for kk, vv in v.items()})
+        else:
+            out[k] = v
+    return out
