@@ -95,7 +95,7 @@ fn two_identical_policies_show_no_difference() {
     assert_eq!(pair["spl_diff"].as_f64(), Some(0.0));
     assert_eq!(
         pair["verdict"].as_str(),
-        Some("success: no difference; SPL: no difference")
+        Some("success: too few discordant seeds; SPL: not significant")
     );
     // They agree on every seed: no contact sheet.
     assert!(!out.join("disagreements.png").exists());
@@ -120,7 +120,7 @@ fn a_reused_run_gives_the_same_comparison() {
     assert_eq!(a["pairs"], b["pairs"]);
     assert_eq!(b["policies"][1]["reused"], true);
     assert!(!reused.join("runs/geodesic").exists());
-    // A run of other seeds, or of another policy under its name, is refused by name.
+    // A run of other seeds, or of another configuration, is refused by name.
     assert_rejected(
         &[
             "compare",
@@ -221,4 +221,76 @@ fn bad_input_is_named() {
         &["--by", "luck"],
     );
     assert!(!out.exists());
+}
+
+#[test]
+fn one_seed_calls_nothing_and_an_earlier_comparison_leaves_nothing_behind() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cmp");
+    compare(
+        &out,
+        &[
+            "--policy",
+            "apf",
+            "--policy",
+            "geodesic",
+            "--by",
+            "difficulty",
+        ],
+    );
+    assert!(out.join("difficulty.png").exists());
+    let o = ok(&ronap(&[
+        "compare",
+        "--seeds",
+        "1",
+        "--seed-start",
+        "3",
+        "--policy",
+        "apf",
+        "--policy",
+        "geodesic",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    assert!(o.contains("1 seeds (3 to 3)"), "{o}");
+    let pair = &json(&out.join("compare.json"))["pairs"][0];
+    assert!(pair["spl_diff_ci95"].is_null(), "{pair}");
+    assert_eq!(
+        pair["verdict"].as_str(),
+        Some("success: too few discordant seeds; SPL: too few seeds")
+    );
+    // The earlier comparison's difficulty picture is gone with it.
+    assert!(!out.join("difficulty.png").exists());
+}
+
+#[test]
+fn a_fresh_run_never_overwrites_a_reused_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cmp");
+    compare(&out, &["--policy", "apf", "--policy", "geodesic"]);
+    let apf = out.join("runs/apf");
+    let before = std::fs::read(apf.join("episodes.csv")).unwrap();
+    // Reuse runs/apf while running another policy whose label is also `apf` into the same --out.
+    let weights = dir.path().join("apf.safetensors");
+    std::fs::copy(
+        crate::util::repo_root().join("policies/bc.safetensors"),
+        &weights,
+    )
+    .unwrap();
+    let policy = format!("mlp:{}", weights.display());
+    assert_rejected(
+        &[
+            "compare",
+            "--seeds",
+            "16",
+            "--policy",
+            &policy,
+            "--run",
+            apf.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &["--run", "give another --out"],
+    );
+    assert_eq!(std::fs::read(apf.join("episodes.csv")).unwrap(), before);
 }

@@ -63,3 +63,10 @@ def test_bad_input_is_a_ronap_error(tmp_path):
         ronap.compare(["apf", "nope"], range(3))
     with pytest.raises(ronap.RonapError, match="no_such_run"):
         ronap.compare(["apf", "geodesic"], range(3), runs=[str(tmp_path / "no_such_run")])
+
+
+def test_repeated_seeds_and_too_few_resamples_are_refused():
+    with pytest.raises(ronap.ConfigError, match="seed 1 is given twice"):
+        ronap.compare(["apf", "geodesic"], [1, 2, 1])
+    with pytest.raises(ronap.ConfigError, match="resamples = 0"):
+        ronap.compare(["apf", "geodesic"], range(3), resamples=0)

@@ -46,6 +46,23 @@ pub fn fraction(s: &str) -> Result<f64, String> {
     }
 }
 
+/// The seeds `first`, `first + 1`, ... (`count` of them) held in memory, or a one-line error
+/// naming the flags when the range passes 2^64 or cannot be held.
+pub fn seed_range(first: u64, count: u64) -> anyhow::Result<Vec<u64>> {
+    let end = first.checked_add(count).ok_or_else(|| {
+        anyhow::anyhow!("--seed-start {first} --seeds {count}: the seed range passes 2^64")
+    })?;
+    let mut seeds = Vec::new();
+    seeds.try_reserve_exact(count as usize).map_err(|_| {
+        anyhow::anyhow!(
+            "--seeds {count}: too many seeds to hold in memory for one run; split it with \
+             --seed-start"
+        )
+    })?;
+    seeds.extend(first..end);
+    Ok(seeds)
+}
+
 /// The worker-thread flag.
 #[derive(Args, Debug, Clone, Copy, Default)]
 pub struct ThreadArgs {

@@ -1,9 +1,9 @@
 //! `ronap compare`: several policies on the same seeds, with paired statistics, pictures and a
 //! report.
 
-use crate::args::{count, policy_factory, seed, EpisodeArgs, ThreadArgs};
+use crate::args::{count, policy_factory, seed, seed_range, EpisodeArgs, ThreadArgs};
 use crate::output::cancel_on_ctrl_c;
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use ronap_core::compare::{
     compare, with_runs, CompareError, CompareInfo, CompareOptions, Contender, Progress,
@@ -50,7 +50,7 @@ pub struct CompareArgs {
     #[arg(long, value_name = "WHAT")]
     by: Option<By>,
     /// Bins per difficulty figure (seeds cut at quantiles into about equal groups).
-    #[arg(long, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=20))]
+    #[arg(long, value_name = "N", default_value_t = 3, requires = "by", value_parser = clap::value_parser!(u32).range(1..=20))]
     bins: u32,
     /// Bootstrap resamples for the paired intervals.
     #[arg(long, value_name = "N", default_value_t = 10_000, value_parser = clap::value_parser!(u32).range(100..=1_000_000))]
@@ -66,13 +66,6 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
     // Every policy is made (and every reused run read) before anything runs.
     let chosen = with_runs(&args.policy, &args.run)?;
     let names: Vec<String> = chosen.iter().map(|(n, _)| n.clone()).collect();
-    if names.len() < 2 {
-        bail!(
-            "{} polic{} given: compare needs at least two (--policy NAME, repeated, or --run DIR)",
-            names.len(),
-            if names.len() == 1 { "y" } else { "ies" }
-        );
-    }
     let mut contenders = Vec::new();
     for (name, reuse) in chosen {
         contenders.push(Contender {
@@ -82,20 +75,8 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
         });
     }
     let first = args.seed_start;
-    let end = first.checked_add(args.seeds).with_context(|| {
-        format!(
-            "--seed-start {first} --seeds {}: the seed range passes 2^64",
-            args.seeds
-        )
-    })?;
-    let mut seeds = Vec::new();
-    seeds.try_reserve_exact(args.seeds as usize).map_err(|_| {
-        anyhow::anyhow!(
-            "--seeds {}: too many seeds to hold in memory; split the range with --seed-start",
-            args.seeds
-        )
-    })?;
-    seeds.extend(first..end);
+    let seeds = seed_range(first, args.seeds)?;
+    let end = first + args.seeds;
     let evaluator = Evaluator::new(config.clone(), scenes);
     evaluator
         .worlds()

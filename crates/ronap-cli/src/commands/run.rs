@@ -1,6 +1,6 @@
 //! `ronap run`: evaluate a policy over many seeded episodes and write what happened.
 
-use crate::args::{count, fraction, policy_factory, seed, EpisodeArgs, ThreadArgs};
+use crate::args::{count, fraction, policy_factory, seed, seed_range, EpisodeArgs, ThreadArgs};
 use crate::output::cancel_on_ctrl_c;
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -56,28 +56,14 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     let factory = policy_factory(&args.policy, &config)?;
     let evaluator = Evaluator::new(config.clone(), scenes);
     let first = args.seed_start;
-    let end = first.checked_add(args.seeds).with_context(|| {
-        format!(
-            "--seed-start {first} --seeds {}: the seed range passes 2^64",
-            args.seeds
-        )
-    })?;
+    let seeds = seed_range(first, args.seeds)?;
+    let end = first + args.seeds;
     if let Some(s) = args.gif.iter().find(|&&s| s < first || s >= end) {
         bail!(
             "--gif {s}: not one of this run's seeds ({first}..={})",
             end - 1
         );
     }
-    // The seed list is held whole: a count too large for memory is refused before anything is
-    // written (streaming runs of any length are issue work still open).
-    let mut seeds = Vec::new();
-    seeds.try_reserve_exact(args.seeds as usize).map_err(|_| {
-        anyhow::anyhow!(
-            "--seeds {}: too many seeds to hold in memory for one run; split it with --seed-start",
-            args.seeds
-        )
-    })?;
-    seeds.extend(first..end);
     // A scene with no room for a start and goal fails the same way for every seed: say so now.
     evaluator
         .worlds()

@@ -140,13 +140,13 @@ impl Figure {
         }
     }
 
-    /// How a value of it is written.
-    pub fn format(self, v: f64) -> String {
-        match self {
-            Figure::Ratio => format!("{v:.2}"),
-            Figure::NarrowestGap => format!("{v:.0}"),
-            Figure::Turns => format!("{v:.0}"),
-        }
+    /// How a value of it is written, with `extra` more decimals than usual.
+    pub fn format(self, v: f64, extra: usize) -> String {
+        let digits = match self {
+            Figure::Ratio => 2,
+            Figure::NarrowestGap | Figure::Turns => 0,
+        } + extra;
+        format!("{v:.digits$}")
     }
 }
 
@@ -191,16 +191,34 @@ pub fn bins(values: &[Option<f64>], count: usize, by: Figure) -> Vec<Bin> {
         let slice = &known[start..end];
         let (low, high) = (slice[0].0, slice[slice.len() - 1].0);
         out.push(Bin {
-            label: if by.format(low) == by.format(high) {
-                by.format(low)
-            } else {
-                format!("{}-{}", by.format(low), by.format(high))
-            },
+            label: String::new(),
             low,
             high,
             members: slice.iter().map(|&(_, i)| i).collect(),
         });
         start = end;
+    }
+    // Labels with as many decimals as it takes for neighbouring bins not to read the same.
+    for extra in 0..=4 {
+        let label = |b: &Bin| {
+            let (lo, hi) = (by.format(b.low, extra), by.format(b.high, extra));
+            if lo == hi {
+                lo
+            } else {
+                format!("{lo}-{hi}")
+            }
+        };
+        let edges: Vec<String> = out
+            .iter()
+            .flat_map(|b| [by.format(b.low, extra), by.format(b.high, extra)])
+            .collect();
+        let distinct = edges.windows(2).skip(1).step_by(2).all(|w| w[0] != w[1]);
+        if distinct || extra == 4 {
+            for b in &mut out {
+                b.label = label(b);
+            }
+            break;
+        }
     }
     out
 }

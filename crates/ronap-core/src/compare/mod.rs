@@ -254,8 +254,29 @@ pub fn compare(
             if contenders.len() == 1 { "y" } else { "ies" }
         )));
     }
-    if options.seeds.is_empty() {
+    let seeds = &options.seeds;
+    let (Some(&first), Some(&last)) = (seeds.first(), seeds.last()) else {
         return Err(CompareError::Input("no seeds: give at least one".into()));
+    };
+    let mut sorted = seeds.clone();
+    sorted.sort_unstable();
+    if let Some(w) = sorted.windows(2).find(|w| w[0] == w[1]) {
+        return Err(CompareError::Input(format!(
+            "seed {} is given twice: each seed is one pair of episodes",
+            w[0]
+        )));
+    }
+    if options.resamples < stats::MIN_RESAMPLES {
+        return Err(CompareError::Input(format!(
+            "resamples = {}: the bootstrap needs at least {}",
+            options.resamples,
+            stats::MIN_RESAMPLES
+        )));
+    }
+    if options.difficulty_bins == 0 {
+        return Err(CompareError::Input(
+            "bins = 0: results need at least one bin".into(),
+        ));
     }
     let config = evaluator.config();
     let names: Vec<String> = contenders.iter().map(|c| c.name.clone()).collect();
@@ -265,15 +286,32 @@ pub fn compare(
     for c in contenders {
         reused.push(match &c.reuse {
             Some(dir) => {
-                let (manifest, rows) = read_run(dir, &c.name, config, info, &options.seeds)?;
+                let (manifest, rows) = read_run(evaluator, dir, &c.name, info, &options.seeds)?;
                 Some((dir.clone(), manifest, rows))
             }
             None => None,
         });
     }
     if let Some(dir) = out {
+        // A fresh run never writes into a run being reused.
+        let canonical = |p: &Path| std::fs::canonicalize(p).ok();
+        for (c, label) in contenders.iter().zip(&labels) {
+            let target = canonical(&dir.join("runs").join(label));
+            let taken = contenders
+                .iter()
+                .filter_map(|o| o.reuse.as_deref())
+                .find(|r| c.reuse.is_none() && target.is_some() && canonical(r) == target);
+            if let Some(r) = taken {
+                return Err(CompareError::Input(format!(
+                    "--run {}: policy {} would be run into that directory; give another --out",
+                    r.display(),
+                    c.name
+                )));
+            }
+        }
         let runs = dir.join("runs");
         std::fs::create_dir_all(&runs).map_err(|source| OutputError::Io { path: runs, source })?;
+        report::remove_earlier(dir)?;
     }
     let mut policies = Vec::new();
     for (index, (c, reuse)) in contenders.iter().zip(reused).enumerate() {
@@ -312,8 +350,10 @@ pub fn compare(
         ronap_version: env!("CARGO_PKG_VERSION").to_string(),
         success_rule: success_rule(config),
         scenes: info.scenes.to_string(),
-        seed_start: options.seeds[0],
-        seed_count: options.seeds.len(),
+        seed_start: first,
+        seed_count: seeds.len(),
+        seed_last: last,
+        seeds_contiguous: seeds.windows(2).all(|w| w[0].checked_add(1) == Some(w[1])),
         policies,
         pairs,
         by_difficulty,
@@ -409,12 +449,13 @@ fn run_one(
 /// Reads the run in `dir` for reuse by policy `name`: its manifest must record the same policy,
 /// configuration, scenes and seeds, and a finished run.
 fn read_run(
+    evaluator: &Evaluator,
     dir: &Path,
     name: &str,
-    config: &ValidConfig,
     info: &CompareInfo,
     seeds: &[u64],
 ) -> Result<(RunManifest, Vec<SeedResult>), CompareError> {
+    let config = evaluator.config();
     let mismatch = |message: String| CompareError::Mismatch {
         dir: dir.to_path_buf(),
         message,
@@ -431,12 +472,14 @@ fn read_run(
         )));
     }
     let (first, count) = (seeds[0], seeds.len() as u64);
+    let last = seeds[seeds.len() - 1];
     if manifest.seed_start != first || manifest.seeds_requested != count {
         return Err(mismatch(format!(
-            "seeds {}..{} were run there; this comparison uses {first}..{}",
+            "seeds {}..{} were run there; this comparison uses {first}..{last}",
             manifest.seed_start,
-            manifest.seed_start + manifest.seeds_requested.saturating_sub(1),
-            first + count - 1
+            manifest
+                .seed_start
+                .saturating_add(manifest.seeds_requested.saturating_sub(1)),
         )));
     }
     if manifest.interrupted || manifest.error.is_some() {
@@ -456,11 +499,30 @@ fn read_run(
             "its configuration differs from this comparison's ({field})"
         )));
     }
-    let rows = read_episodes(&dir.join("episodes.csv")).map_err(mismatch)?;
+    let (rows, places) = read_episodes(&dir.join("episodes.csv")).map_err(mismatch)?;
     if rows.iter().map(|r| r.seed).ne(seeds.iter().copied()) {
         return Err(mismatch(
             "episodes.csv does not hold exactly this comparison's seeds".into(),
         ));
+    }
+    // The same seeds in the same scenes start and end in the same places: a changed map file or
+    // maze generator shows here even when the manifest reads the same.
+    let moved = rows
+        .par_iter()
+        .zip(&places)
+        .find_map_first(|(r, recorded)| {
+            let here = evaluator.worlds().episode(r.seed).ok().map(|e| {
+                let (s, g) = (e.start(), e.goal());
+                [s.x, s.y, s.z_deg, g.x, g.y].map(|v| format!("{v:.3}"))
+            });
+            (here.as_ref() != Some(recorded)).then(|| (r.seed, here))
+        });
+    if let Some((seed, here)) = moved {
+        return Err(mismatch(format!(
+            "seed {seed} has another start or goal there ({}) than here ({}): its scenes differ",
+            places[rows.iter().position(|r| r.seed == seed).unwrap_or(0)].join(", "),
+            here.map_or("none".to_string(), |h| h.join(", "))
+        )));
     }
     Ok((manifest, rows))
 }
@@ -494,8 +556,11 @@ fn first_difference(a: &crate::SimConfig, b: &crate::SimConfig) -> String {
     }
 }
 
-/// The per-seed results in a run's `episodes.csv`.
-fn read_episodes(path: &Path) -> Result<Vec<SeedResult>, String> {
+/// The per-seed results in a run's `episodes.csv`, and each seed's start and goal as written
+/// (`start_x, start_y, start_heading_deg, goal_x, goal_y`).
+type Places = Vec<[String; 5]>;
+
+fn read_episodes(path: &Path) -> Result<(Vec<SeedResult>, Places), String> {
     let what = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
     let mut reader = csv::Reader::from_path(path).map_err(|e| what(&e))?;
     let headers = reader.headers().map_err(|e| what(&e))?.clone();
@@ -513,7 +578,15 @@ fn read_episodes(path: &Path) -> Result<Vec<SeedResult>, String> {
         column("path_length_px")?,
         column("spl")?,
     ];
+    let place_cols = [
+        column("start_x")?,
+        column("start_y")?,
+        column("start_heading_deg")?,
+        column("goal_x")?,
+        column("goal_y")?,
+    ];
     let mut rows = Vec::new();
+    let mut places = Vec::new();
     for (line, record) in reader.records().enumerate() {
         let record = record.map_err(|e| what(&e))?;
         let at = |k: usize| record.get(cols[k]).unwrap_or("");
@@ -534,8 +607,9 @@ fn read_episodes(path: &Path) -> Result<Vec<SeedResult>, String> {
             path_length_px: at(4).parse().map_err(|_| bad(4))?,
             spl: at(5).parse().map_err(|_| bad(5))?,
         });
+        places.push(place_cols.map(|c| record.get(c).unwrap_or("").to_string()));
     }
-    Ok(rows)
+    Ok((rows, places))
 }
 
 /// Every seed's difficulty, in seed order, computed on `threads` threads.
@@ -602,25 +676,26 @@ fn pairs(policies: &[PolicyResult], resamples: usize) -> Vec<PairResult> {
     out
 }
 
-/// A pair's result in a few words: which policy is better in success and in SPL, where the
-/// difference is real.
+/// A pair's result in a few words: which policy is better in success and in SPL where the
+/// difference is significant, "not significant" where it is not, and "too few seeds" where the
+/// test could not have found a difference.
 fn verdict(p: &PairResult) -> String {
-    let success = if p.holm_p < ALPHA {
+    let success = if p.a_only + p.b_only < stats::min_discordant() {
+        "too few discordant seeds"
+    } else if p.holm_p < ALPHA {
         if p.success_diff > 0.0 {
             &p.a
         } else {
             &p.b
         }
     } else {
-        "no difference"
+        "not significant"
     };
-    let [lo, hi] = p.spl_diff_ci95;
-    let spl = if lo > 0.0 {
-        &p.a
-    } else if hi < 0.0 {
-        &p.b
-    } else {
-        "no difference"
+    let spl = match p.spl_diff_ci95 {
+        None => "too few seeds",
+        Some([lo, _]) if lo > 0.0 => &p.a,
+        Some([_, hi]) if hi < 0.0 => &p.b,
+        Some(_) => "not significant",
     };
     format!("success: {success}; SPL: {spl}")
 }

@@ -115,7 +115,10 @@ fn signed(x: f64) -> String {
 }
 
 fn p_value(p: f64) -> String {
-    if p < 1e-4 {
+    if p < 1e-300 {
+        // Below what a double holds after the adjustment.
+        "< 1e-300".to_string()
+    } else if p < 1e-4 {
         format!("{p:.1e}")
     } else {
         format!("{p:.4}")
@@ -123,6 +126,21 @@ fn p_value(p: f64) -> String {
 }
 
 impl Comparison {
+    /// The seeds in words: `1000 seeds (0 to 999)`, or `12 seeds (a list from 3 to 40)`.
+    pub fn seeds_text(&self) -> String {
+        if self.seeds_contiguous {
+            format!(
+                "{} seeds ({} to {})",
+                self.seed_count, self.seed_start, self.seed_last
+            )
+        } else {
+            format!(
+                "{} seeds (a list from {} to {})",
+                self.seed_count, self.seed_start, self.seed_last
+            )
+        }
+    }
+
     /// The per-policy table.
     pub fn policy_table(&self) -> Table {
         let moving = self.policies.iter().any(|p| p.summary.moving.is_some());
@@ -141,6 +159,14 @@ impl Comparison {
         .collect();
         if moving {
             header.push("moving contacts/ep".into());
+        }
+        let ends_collision = self.policies.iter().any(|p| p.summary.collision_ends > 0);
+        let ends_reward = self.policies.iter().any(|p| p.summary.reward_min_ends > 0);
+        if ends_collision {
+            header.push("ended by collision".into());
+        }
+        if ends_reward {
+            header.push("ended by reward_min".into());
         }
         let rows = self
             .policies
@@ -167,6 +193,12 @@ impl Comparison {
                         format!("{:.2}", m.dynamic_collisions_per_episode)
                     }));
                 }
+                if ends_collision {
+                    row.push(s.collision_ends.to_string());
+                }
+                if ends_reward {
+                    row.push(s.reward_min_ends.to_string());
+                }
                 row
             })
             .collect();
@@ -185,7 +217,9 @@ impl Comparison {
         ]
         .iter()
         .map(|s| s.to_string())
-        .chain([format!("better (Holm p < {ALPHA}; SPL CI)")])
+        .chain([format!(
+            "better (success: Holm p < {ALPHA}; SPL: 95% CI excludes 0)"
+        )])
         .collect();
         let rows = self
             .pairs
@@ -193,19 +227,22 @@ impl Comparison {
             .map(|p| {
                 vec![
                     format!("{} vs {}", p.a, p.b),
-                    format!(
-                        "{} pp ({:+.1} to {:+.1})",
-                        signed(p.success_diff),
-                        100.0 * p.success_diff_ci95[0],
-                        100.0 * p.success_diff_ci95[1]
-                    ),
+                    match p.success_diff_ci95 {
+                        Some([lo, hi]) => format!(
+                            "{} ({:+.1} to {:+.1})",
+                            signed(p.success_diff),
+                            100.0 * lo,
+                            100.0 * hi
+                        ),
+                        None => signed(p.success_diff),
+                    },
                     format!("{} / {}", p.a_only, p.b_only),
                     p_value(p.mcnemar_p),
                     p_value(p.holm_p),
-                    format!(
-                        "{:+.3} ({:+.3} to {:+.3})",
-                        p.spl_diff, p.spl_diff_ci95[0], p.spl_diff_ci95[1]
-                    ),
+                    match p.spl_diff_ci95 {
+                        Some([lo, hi]) => format!("{:+.3} ({lo:+.3} to {hi:+.3})", p.spl_diff),
+                        None => format!("{:+.3}", p.spl_diff),
+                    },
                     p.verdict.clone(),
                 ]
             })
@@ -250,8 +287,10 @@ impl Comparison {
     /// Everything a terminal shows at the end of `ronap compare`.
     pub fn table(&self) -> String {
         let mut out = format!(
-            "{} seeds from {} on {}\n{}\n\n",
-            self.seed_count, self.seed_start, self.scenes, self.success_rule
+            "{} on {}\n{}\n\n",
+            self.seeds_text(),
+            self.scenes,
+            self.success_rule
         );
         out.push_str(&self.policy_table().text());
         out.push('\n');
@@ -409,6 +448,32 @@ fn pictures(
     out
 }
 
+/// Every file a comparison writes into its directory (besides `runs/`).
+pub const FILES: [&str; 8] = [
+    "compare.png",
+    "outcomes.png",
+    "disagreements.png",
+    "difficulty.png",
+    "seeds.csv",
+    "compare.json",
+    "report.md",
+    "report.html",
+];
+
+/// Removes what an earlier comparison wrote into `dir` (the files of [`FILES`], not `runs/`), so
+/// a directory never mixes two comparisons.
+pub fn remove_earlier(dir: &Path) -> Result<(), OutputError> {
+    for f in FILES {
+        let path = dir.join(f);
+        match std::fs::remove_file(&path) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(source) => return Err(OutputError::Io { path, source }),
+        }
+    }
+    Ok(())
+}
+
 /// Writes every file of the comparison into `dir`.
 pub fn write_all(
     dir: &Path,
@@ -447,18 +512,18 @@ fn save_text(path: &Path, text: &str) -> Result<(), OutputError> {
 fn intro(c: &Comparison) -> String {
     let names: Vec<&str> = c.policies.iter().map(|p| p.name.as_str()).collect();
     format!(
-        "{} policies ({}) on the same {} seeds ({} to {}), {}. Each pair is tested on the seeds \
-         where exactly one of them succeeded (McNemar's exact test, p-values Holm-adjusted over \
-         the {} pairs; a difference is called real below {}); SPL differences are paired by seed \
-         with a 95% bootstrap interval.",
+        "{} policies ({}) on the same {}, {}. Each pair is tested on the seeds where exactly one \
+         of them succeeded (McNemar's exact test, p-values Holm-adjusted over the {} pairs; a \
+         difference is called significant below {}); SPL differences are paired by seed with a \
+         95% bootstrap interval (not adjusted for the number of pairs). A pair with fewer than {} \
+         seeds where exactly one succeeded cannot show a significant success difference at all.",
         c.policies.len(),
         names.join(", "),
-        c.seed_count,
-        c.seed_start,
-        c.seed_start + c.seed_count as u64 - 1,
+        c.seeds_text(),
         c.scenes,
         c.pairs.len(),
-        ALPHA
+        ALPHA,
+        super::stats::min_discordant()
     )
 }
 

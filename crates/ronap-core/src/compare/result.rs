@@ -72,8 +72,8 @@ pub struct PairResult {
     pub b: String,
     /// Success rate of `a` minus that of `b`.
     pub success_diff: f64,
-    /// Its 95% paired bootstrap interval.
-    pub success_diff_ci95: [f64; 2],
+    /// Its 95% paired bootstrap interval (none from a single seed).
+    pub success_diff_ci95: Option<[f64; 2]>,
     /// Seeds only `a` succeeded on.
     pub a_only: u64,
     /// Seeds only `b` succeeded on.
@@ -84,8 +84,9 @@ pub struct PairResult {
     pub holm_p: f64,
     /// Mean SPL of `a` minus that of `b` (paired by seed).
     pub spl_diff: f64,
-    /// Its 95% paired bootstrap interval.
-    pub spl_diff_ci95: [f64; 2],
+    /// Its 95% paired bootstrap interval, not adjusted for the number of pairs (none from a
+    /// single seed).
+    pub spl_diff_ci95: Option<[f64; 2]>,
     /// What a reader should take from it.
     pub verdict: String,
 }
@@ -111,7 +112,7 @@ pub struct BinResult {
 pub struct Breakdown {
     /// The figure.
     pub figure: Figure,
-    /// Its bins, easiest values first.
+    /// Its bins, lowest values first.
     pub bins: Vec<BinResult>,
     /// Seeds without the figure (no path to the goal).
     pub unbinned: usize,
@@ -130,6 +131,10 @@ pub struct Comparison {
     pub seed_start: u64,
     /// Seeds, the same for every policy.
     pub seed_count: usize,
+    /// The last seed.
+    pub seed_last: u64,
+    /// Whether the seeds run from `seed_start` to `seed_last` one by one.
+    pub seeds_contiguous: bool,
     /// Each policy's figures, in the order given.
     pub policies: Vec<PolicyResult>,
     /// Every pair, in the order given.

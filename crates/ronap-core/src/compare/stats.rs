@@ -32,24 +32,39 @@ pub fn mcnemar_exact(a_only: u64, b_only: u64) -> f64 {
     (2.0 * tail).min(1.0)
 }
 
+/// The fewest discordant seeds with which McNemar's exact test can reach [`ALPHA`]: with `n`,
+/// the smallest two-sided p-value is `2^(1 - n)`.
+pub fn min_discordant() -> u64 {
+    (1..64)
+        .find(|&n| 2f64.powi(1 - n as i32) < ALPHA)
+        .unwrap_or(64)
+}
+
+/// The least number of bootstrap resamples a comparison takes.
+pub const MIN_RESAMPLES: usize = 100;
+
 /// The mean of `d` and its 95% percentile bootstrap interval from `resamples` resamples of the
 /// seeds with replacement, drawn from a generator seeded with `seed` (so the interval is the same
-/// on every run). `[mean, mean]` for fewer than two values.
-pub fn bootstrap_mean95(d: &[f64], resamples: usize, seed: u64) -> (f64, [f64; 2]) {
+/// on every run). No interval (`None`) from fewer than two values or no resamples: one seed
+/// says nothing about the spread.
+pub fn bootstrap_mean95(d: &[f64], resamples: usize, seed: u64) -> (f64, Option<[f64; 2]>) {
     let n = d.len();
     if n == 0 {
-        return (0.0, [0.0, 0.0]);
+        return (0.0, None);
     }
     let mean = d.iter().sum::<f64>() / n as f64;
     if n < 2 || resamples == 0 {
-        return (mean, [mean, mean]);
+        return (mean, None);
     }
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut means: Vec<f64> = (0..resamples)
         .map(|_| (0..n).map(|_| d[rng.random_range(0..n)]).sum::<f64>() / n as f64)
         .collect();
     means.sort_by(f64::total_cmp);
-    (mean, [quantile(&means, 0.025), quantile(&means, 0.975)])
+    (
+        mean,
+        Some([quantile(&means, 0.025), quantile(&means, 0.975)]),
+    )
 }
 
 /// The `q` quantile of sorted `v` (linear interpolation between order statistics).
@@ -110,8 +125,10 @@ mod tests {
 
     #[test]
     fn bootstrap_of_a_constant_is_that_constant() {
-        let (m, [lo, hi]) = bootstrap_mean95(&[0.25; 50], 500, 1);
-        assert_eq!((m, lo, hi), (0.25, 0.25, 0.25));
+        let (m, ci) = bootstrap_mean95(&[0.25; 50], 500, 1);
+        assert_eq!((m, ci), (0.25, Some([0.25, 0.25])));
+        // One seed gives no interval.
+        assert_eq!(bootstrap_mean95(&[0.5], 500, 1), (0.5, None));
     }
 
     #[test]
@@ -119,14 +136,23 @@ mod tests {
         // Half zeros, half ones: mean 0.5, standard error sqrt(0.25 / 400) = 0.025, so the 95%
         // interval is 0.5 -+ 0.049 to within the resampling noise.
         let d: Vec<f64> = (0..400).map(|i| (i % 2) as f64).collect();
-        let (m, [lo, hi]) = bootstrap_mean95(&d, 4000, 7);
+        let (m, ci) = bootstrap_mean95(&d, 4000, 7);
+        let [lo, hi] = ci.unwrap();
         assert_eq!(m, 0.5);
         assert!(
             (lo - 0.451).abs() < 0.01 && (hi - 0.549).abs() < 0.01,
             "{lo} {hi}"
         );
         // The same seed gives the same interval.
-        assert_eq!(bootstrap_mean95(&d, 4000, 7).1, [lo, hi]);
+        assert_eq!(bootstrap_mean95(&d, 4000, 7).1, Some([lo, hi]));
+    }
+
+    #[test]
+    fn bootstrap_of_two_values_spans_their_resample_means() {
+        // Resampling {0, 1} twice gives means 0, 1/2 and 1 with chances 1/4, 1/2, 1/4: the 2.5%
+        // and 97.5% quantiles of many resamples are 0 and 1.
+        let (m, ci) = bootstrap_mean95(&[0.0, 1.0], 2000, 3);
+        assert_eq!((m, ci), (0.5, Some([0.0, 1.0])));
     }
 
     #[test]

@@ -51,8 +51,9 @@ def compare(
     The configuration is given as for ``evaluate``.
     """
     seeds = [int(s) for s in seeds]
-    names = [p if isinstance(p, str) else getattr(p, "__name__", "python") for p in policies]
-    command = f"ronap.compare({names!r}, seeds=range({seeds[0]}, {seeds[-1] + 1}))" if seeds else None
+    command = _call(policies, seeds, scenario=scenario, config=config, maze_seed=maze_seed, map=map,
+                    continuous=continuous, runs=list(runs), by_difficulty=by_difficulty, bins=bins,
+                    resamples=resamples, **fields)
     result: dict[str, Any] = _ronap.compare(
         list(policies),
         seeds,
@@ -90,3 +91,15 @@ def _flat(summary: Mapping[str, Any]) -> dict[str, Any]:
         else:
             out[k] = v
     return out
+
+
+def _call(policies: Sequence[Any], seeds: list[int], **given: Any) -> str:
+    """The call as Python source, for the report's "Reproduce" section (a callable by its name)."""
+    names = [p if isinstance(p, str) else getattr(p, "__name__", "policy") for p in policies]
+    if seeds and seeds == list(range(seeds[0], seeds[-1] + 1)):
+        seed_text = f"range({seeds[0]}, {seeds[-1] + 1})"
+    else:
+        seed_text = repr(seeds)
+    defaults = {"continuous": False, "runs": [], "by_difficulty": False, "bins": 3, "resamples": 10_000}
+    kwargs = [f"{k}={v!r}" for k, v in given.items() if v is not None and defaults.get(k, None) != v]
+    return "ronap.compare(" + ", ".join([repr(names), seed_text, *kwargs]) + ")"
