@@ -391,6 +391,9 @@ pub struct EpisodeConfig {
     /// A step counts as near a moving obstacle when the gap to one is below this, px.
     /// Default: two robot radii.
     pub safety_radius_px: Option<f64>,
+    /// Several robots: the episode ends as a deadlock when no robot has moved for this many
+    /// steps. Default 100.
+    pub deadlock_steps: u32,
 }
 
 impl Default for EpisodeConfig {
@@ -404,6 +407,7 @@ impl Default for EpisodeConfig {
             goal: None,
             grid_px: 5.0,
             safety_radius_px: None,
+            deadlock_steps: 100,
         }
     }
 }
@@ -498,7 +502,72 @@ pub struct SimConfig {
     pub obstacles: Vec<ObstacleConfig>,
     /// Moving obstacles.
     pub moving: Vec<MovingConfig>,
+    /// Several robots (SPEC "Several robots"); none: the one robot of `[robot]`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub robots: Vec<TeamRobotConfig>,
 }
+
+/// What a robot of a team does on reaching its goal.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum OnArrival {
+    /// It stops there and stays an obstacle (default).
+    #[default]
+    Stay,
+    /// It leaves the scene.
+    Vanish,
+}
+
+/// A `[[robots]]` entry: `count` robots alike, each field left unset taking `[robot]`'s,
+/// `[laser]`'s or `[episode]`'s value.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TeamRobotConfig {
+    /// How many robots this entry makes. Default 1.
+    pub count: u32,
+    /// Fixed start pose `[x px, y px, z deg]` (count 1 only). Default: drawn from the seed, clear
+    /// of the other robots.
+    pub start: Option<[f64; 3]>,
+    /// Fixed goal `[x px, y px]` (count 1 only). Default: drawn from the seed.
+    pub goal: Option<[f64; 2]>,
+    /// The policy that drives these robots (any `--policy` name). Default: the run's.
+    pub policy: Option<String>,
+    /// Disc radius, px. Default: `robot.radius_px`.
+    pub radius_px: Option<f64>,
+    /// Distance of one AHEAD step, px. Default: `robot.move_speed_px`.
+    pub move_speed_px: Option<f64>,
+    /// Heading change of one LEFT or RIGHT step, degrees. Default: `robot.turn_speed_deg`.
+    pub turn_speed_deg: Option<f64>,
+    /// Laser beams. Default: `laser.beams`.
+    pub laser_beams: Option<u32>,
+    /// Laser range, px. Default: `laser.range_px`.
+    pub laser_range_px: Option<f64>,
+    /// Laser field of view, degrees. Default: `laser.fov_deg`.
+    pub laser_fov_deg: Option<f64>,
+    /// On reaching its goal: `stay` (default; it stays an obstacle there) or `vanish`.
+    pub on_arrival: OnArrival,
+}
+
+impl Default for TeamRobotConfig {
+    fn default() -> Self {
+        Self {
+            count: 1,
+            start: None,
+            goal: None,
+            policy: None,
+            radius_px: None,
+            move_speed_px: None,
+            turn_speed_deg: None,
+            laser_beams: None,
+            laser_range_px: None,
+            laser_fov_deg: None,
+            on_arrival: OnArrival::Stay,
+        }
+    }
+}
+
+/// Largest number of robots in a team.
+pub const MAX_ROBOTS: u32 = 10_000;
 
 /// A [`SimConfig`] whose every field has been checked. Dereferences to the `SimConfig`.
 /// The default is the (valid) default configuration.
@@ -522,6 +591,54 @@ impl ValidConfig {
     /// direction (SPEC "Observation and reward").
     pub fn observation_size(&self) -> usize {
         self.laser.beams as usize + 1
+    }
+
+    /// Robots in a team (0: no `[[robots]]`, the one robot of `[robot]`).
+    pub fn team_size(&self) -> usize {
+        self.robots.iter().map(|r| r.count as usize).sum()
+    }
+
+    /// The `[[robots]]` entry of team robot `k` (from 0, in entry order).
+    pub fn team_entry(&self, k: usize) -> Option<&TeamRobotConfig> {
+        let mut left = k;
+        self.robots.iter().find(|r| {
+            if left < r.count as usize {
+                true
+            } else {
+                left -= r.count as usize;
+                false
+            }
+        })
+    }
+
+    /// The configuration of team robot `k` as a one-robot configuration: `[robot]`, `[laser]`
+    /// and `[episode]` with its entry's fields put in (validated with the whole team).
+    pub fn team_robot(&self, k: usize) -> ValidConfig {
+        let mut c = self.0.clone();
+        c.robots = Vec::new();
+        if let Some(e) = self.team_entry(k) {
+            if let Some(v) = e.radius_px {
+                c.robot.radius_px = v;
+            }
+            if let Some(v) = e.move_speed_px {
+                c.robot.move_speed_px = v;
+            }
+            if let Some(v) = e.turn_speed_deg {
+                c.robot.turn_speed_deg = v;
+            }
+            if let Some(v) = e.laser_beams {
+                c.laser.beams = v;
+            }
+            if let Some(v) = e.laser_range_px {
+                c.laser.range_px = v;
+            }
+            if let Some(v) = e.laser_fov_deg {
+                c.laser.fov_deg = v;
+            }
+            c.episode.start = e.start;
+            c.episode.goal = e.goal;
+        }
+        ValidConfig(c)
     }
 
     /// The query distance scenes are indexed for: the laser range or a step plus the robot
@@ -715,6 +832,12 @@ impl SimConfig {
         non_negative("apf.repulsion_gain", a.repulsion_gain)?;
         length("apf.influence_px", a.influence_px, false)?;
         length("apf.lattice_px", a.lattice_px, false)?;
+        check(
+            e.deadlock_steps >= 1,
+            "episode.deadlock_steps",
+            e.deadlock_steps,
+            "must be at least 1",
+        )?;
         if let Some(v) = e.safety_radius_px {
             length("episode.safety_radius_px", v, true)?;
         }
@@ -882,6 +1005,73 @@ impl SimConfig {
             "moving",
             total,
             "at most 10000 moving obstacles in all",
+        )?;
+        let mut robots = 0u64;
+        for (i, r) in self.robots.iter().enumerate() {
+            let f = |name: &str| format!("robots[{i}].{name}");
+            check(
+                (1..=MAX_ROBOTS).contains(&r.count),
+                &f("count"),
+                r.count,
+                "must be between 1 and 10000",
+            )?;
+            robots += u64::from(r.count);
+            for (name, v) in [("start", r.start.map(|s| [s[0], s[1]])), ("goal", r.goal)] {
+                if let Some(p) = v {
+                    point(&f(name), p)?;
+                    check(
+                        r.count == 1,
+                        &f(name),
+                        format!("{p:?}"),
+                        "a fixed start or goal is for one robot (count = 1)",
+                    )?;
+                }
+            }
+            if let Some(s) = r.start {
+                finite(&f("start"), s[2])?;
+            }
+            for (name, v) in [
+                ("radius_px", r.radius_px),
+                ("move_speed_px", r.move_speed_px),
+                ("laser_range_px", r.laser_range_px),
+            ] {
+                if let Some(v) = v {
+                    length(&f(name), v, false)?;
+                }
+            }
+            if let Some(v) = r.turn_speed_deg {
+                finite(&f("turn_speed_deg"), v)?;
+            }
+            if let Some(v) = r.laser_beams {
+                check(
+                    (1..=MAX_BEAMS).contains(&v),
+                    &f("laser_beams"),
+                    v,
+                    "must be between 1 and 360",
+                )?;
+            }
+            if let Some(v) = r.laser_fov_deg {
+                check(
+                    v.is_finite() && (0.0..=360.0).contains(&v),
+                    &f("laser_fov_deg"),
+                    format!("{v:?}"),
+                    "must be between 0 and 360",
+                )?;
+            }
+            if let Some(p) = &r.policy {
+                check(
+                    !p.trim().is_empty(),
+                    &f("policy"),
+                    "\"\"",
+                    "must name a policy",
+                )?;
+            }
+        }
+        check(
+            robots <= u64::from(MAX_ROBOTS),
+            "robots",
+            robots,
+            "at most 10000 robots in all",
         )
     }
 }
@@ -957,6 +1147,7 @@ const FIELD_DOCS: &[(&str, &str, &str, Option<&str>)] = &[
     ("episode", "goal", "Fixed goal [x px, y px]. Unset: drawn from the seed.", Some("[850.0, 850.0]")),
     ("episode", "grid_px", "Cell side of the free-space grid for connected regions and planners, px.", None),
     ("episode", "safety_radius_px", "A step is near a moving obstacle when the gap to one is below this, px. Unset: two robot radii.", Some("10.0")),
+    ("episode", "deadlock_steps", "Several robots: the episode ends as a deadlock when no robot has moved for this many steps.", None),
     ("reward", "collision", "r_a: added on a step that collided.", None),
     ("reward", "progress_per_px", "r_b: per px of progress towards the goal (negative when moving away).", None),
     ("reward", "turn", "r_c: added on LEFT and RIGHT (scaled by |w| / w_max for continuous actions).", None),

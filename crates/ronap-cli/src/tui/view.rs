@@ -219,6 +219,7 @@ fn message(state: &ViewState) -> Option<(String, Color)> {
         Status::Success => Some(("TaskComplete".to_string(), Color::Green)),
         Status::TimeOut => Some((format!("time-out after {} steps", e.steps()), Color::Yellow)),
         Status::RewardMin => Some(("summed reward fell to R_min".to_string(), Color::Yellow)),
+        Status::Deadlock => Some(("deadlock: no robot moved".to_string(), Color::Yellow)),
         Status::Collision => Some(("CollisionWarning: episode over".to_string(), Color::Red)),
         Status::Running => match &state.ending {
             Some(Ending::GaveUp(why)) => Some((format!("stuck: {why}"), Color::Yellow)),

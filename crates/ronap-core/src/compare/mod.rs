@@ -515,7 +515,7 @@ fn read_run(
                 let (s, g) = (e.start(), e.goal());
                 [s.x, s.y, s.z_deg, g.x, g.y].map(|v| format!("{v:.3}"))
             });
-            (here.as_ref() != Some(recorded)).then(|| (r.seed, here))
+            (here.as_ref() != Some(recorded)).then_some((r.seed, here))
         });
     if let Some((seed, here)) = moved {
         return Err(mismatch(format!(

@@ -23,16 +23,19 @@ pub enum Outcome {
     Collision,
     /// The summed reward fell to `reward_min`.
     RewardMin,
+    /// A team's robots stood still for `episode.deadlock_steps` steps.
+    Deadlock,
 }
 
 impl Outcome {
     /// Every outcome, success first.
-    pub const ALL: [Outcome; 5] = [
+    pub const ALL: [Outcome; 6] = [
         Outcome::Success,
         Outcome::Timeout,
         Outcome::Stuck,
         Outcome::Collision,
         Outcome::RewardMin,
+        Outcome::Deadlock,
     ];
 
     /// The outcome named `name` (as [`Outcome::name`] writes it).
@@ -47,6 +50,7 @@ impl Outcome {
             Status::TimeOut => Outcome::Timeout,
             Status::Collision => Outcome::Collision,
             Status::RewardMin => Outcome::RewardMin,
+            Status::Deadlock => Outcome::Deadlock,
             Status::Running => Outcome::Stuck,
         }
     }
@@ -59,6 +63,7 @@ impl Outcome {
             Outcome::Stuck => "stuck",
             Outcome::Collision => "collision",
             Outcome::RewardMin => "reward_min",
+            Outcome::Deadlock => "deadlock",
         }
     }
 }

@@ -57,7 +57,7 @@ pub fn policy_colour(index: usize) -> Rgb<u8> {
 }
 
 /// The colour of an outcome in the outcome strip: success green, timeout amber, stuck grey,
-/// collision red, reward floor purple.
+/// collision red, reward floor purple, deadlock brown.
 pub fn outcome_colour(outcome: Outcome) -> Rgb<u8> {
     match outcome {
         Outcome::Success => Rgb([46, 160, 67]),
@@ -65,15 +65,17 @@ pub fn outcome_colour(outcome: Outcome) -> Rgb<u8> {
         Outcome::Stuck => Rgb([150, 150, 150]),
         Outcome::Collision => Rgb([215, 48, 39]),
         Outcome::RewardMin => Rgb([128, 64, 176]),
+        Outcome::Deadlock => Rgb([140, 86, 75]),
     }
 }
 
-const OUTCOMES: [Outcome; 5] = [
+const OUTCOMES: [Outcome; 6] = [
     Outcome::Success,
     Outcome::Timeout,
     Outcome::Stuck,
     Outcome::Collision,
     Outcome::RewardMin,
+    Outcome::Deadlock,
 ];
 
 // ---------------------------------------------------------------------------------------------

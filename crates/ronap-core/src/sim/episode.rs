@@ -8,10 +8,10 @@ use crate::geometry::{wrap_deg, Point};
 use crate::scene::freespace::FreeGrid;
 use crate::scene::Scene;
 use crate::sim::lidar::Laser;
-use crate::sim::moving::Movers;
+use crate::sim::moving::{Body, Disc, Movers};
 use crate::sim::placement::{sample_placement, EpisodeError, Placement, PLACEMENT_TRIES};
 use crate::sim::rng::{stream, Rng, Stream};
-use crate::sim::robot::{Action, DiscreteAction, Pose, Robot};
+use crate::sim::robot::{Action, DiscreteAction, Motion, Pose, Robot};
 use rand::Rng as _;
 use std::sync::Arc;
 
@@ -29,6 +29,8 @@ pub enum Status {
     RewardMin,
     /// Collided with `on_collision = terminate`.
     Collision,
+    /// A team's robots stood still for `episode.deadlock_steps` steps.
+    Deadlock,
 }
 
 impl Status {
@@ -50,7 +52,7 @@ impl Status {
     /// Gymnasium's `truncated`: a limit outside the task (the `max_steps` time-out) cut the
     /// episode short; the state still has a value.
     pub fn is_truncated(self) -> bool {
-        self == Status::TimeOut
+        matches!(self, Status::TimeOut | Status::Deadlock)
     }
 
     /// The name used in logs: `running`, `success`, `timeout`, `reward_min`, `collision`.
@@ -61,6 +63,7 @@ impl Status {
             Status::TimeOut => "timeout",
             Status::RewardMin => "reward_min",
             Status::Collision => "collision",
+            Status::Deadlock => "deadlock",
         }
     }
 }
@@ -115,6 +118,10 @@ pub struct Episode {
     /// The moving obstacles, when the configuration has some.
     movers: Option<Box<Movers>>,
     dynamic: DynamicMetrics,
+    /// Moving obstacles are about (this episode's own, or its team's).
+    among_movers: bool,
+    /// Steps another robot of a team blocked.
+    robot_collisions: u32,
 }
 
 /// How an episode went among moving obstacles (SPEC "Moving obstacles", metrics).
@@ -154,6 +161,18 @@ impl Episode {
         seed: u64,
         placement: Placement,
     ) -> Result<Self, EpisodeError> {
+        Self::placed(config, scene, seed, placement, true)
+    }
+
+    /// [`Episode::with_placement`]; `own_movers`: whether it holds the configuration's moving
+    /// obstacles itself (a team's robots share the team's).
+    pub(crate) fn placed(
+        config: &ValidConfig,
+        scene: Arc<Scene>,
+        seed: u64,
+        placement: Placement,
+        own_movers: bool,
+    ) -> Result<Self, EpisodeError> {
         let radius = config.robot.radius_px;
         let inside = |p: Point| scene.bounds().contains(p) && scene.disc_clear(p, radius);
         for (which, p) in [
@@ -169,15 +188,19 @@ impl Episode {
                 });
             }
         }
-        let movers = Movers::new(
-            config,
-            &scene,
-            placement.start.position(),
-            placement.goal,
-            seed,
-        )
-        .map_err(|e| EpisodeError::Moving(e.to_string()))?
-        .map(Box::new);
+        let movers = if own_movers {
+            Movers::new(
+                config,
+                &scene,
+                placement.start.position(),
+                placement.goal,
+                seed,
+            )
+            .map_err(|e| EpisodeError::Moving(e.to_string()))?
+            .map(Box::new)
+        } else {
+            None
+        };
         let laser = Laser::new(&config.laser);
         let beams = laser.beams();
         let mut episode = Self {
@@ -198,8 +221,10 @@ impl Episode {
             path_length_px: 0.0,
             status: Status::Running,
             scene,
+            among_movers: movers.is_some(),
             movers,
             dynamic: DynamicMetrics::default(),
+            robot_collisions: 0,
         };
         episode.sense();
         if episode.distance_px < config.episode.goal_tolerance_px {
@@ -210,12 +235,37 @@ impl Episode {
 
     /// Reads the laser and goal sensors at the current pose and refreshes the observation.
     fn sense(&mut self) {
+        let movers = self.movers.take();
+        self.sense_among(movers.as_deref(), &[]);
+        self.movers = movers;
+    }
+
+    /// Reads the sensors among `movers` (a team's, or this episode's own) and the other robots
+    /// `others` of a team, which the laser sees as discs.
+    pub(crate) fn sense_among(&mut self, movers: Option<&Movers>, others: &[Disc]) {
         let p = self.pose.position();
+        let radius = self.config.robot.radius_px;
         self.laser
             .scan(&self.scene, p, self.pose.z_deg, &mut self.readings);
-        if let Some(movers) = &self.movers {
-            let gap = movers.sense(&self.laser, p, self.pose.z_deg, &mut self.readings);
+        if let Some(movers) = movers {
+            let gap = movers.sense_as(&self.laser, p, radius, self.pose.z_deg, &mut self.readings);
             self.note_gap(gap);
+        }
+        let reach = self.laser.range_px() + radius;
+        let near = |d: &&Disc| (d.at - p).norm() - d.radius <= reach;
+        if others.iter().any(|d| near(&d)) {
+            self.laser.refine(
+                p,
+                self.pose.z_deg,
+                &mut self.readings,
+                |origin, dir, best| {
+                    others
+                        .iter()
+                        .filter(near)
+                        .filter_map(|d| Body::Disc(d.radius).ray(d.at, origin, dir, best))
+                        .fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.min(t))))
+                },
+            );
         }
         self.laser
             .add_noise(&mut self.readings, &mut self.noise_rng);
@@ -298,20 +348,54 @@ impl Episode {
                 .motion_clear_by(self.pose, &motion, |a, b, r| movers.sweep_clear(a, b, r)),
             None => false,
         };
-        let collided = wall || moving || touched;
+        let collided = self.apply(&motion, wall, moving, touched, false);
+        self.sense();
+        let reward = self.score(before, &motion, collided);
+        self.result(reward, collided)
+    }
+
+    /// The first half of a step: where `action` would take the robot (no collision check).
+    pub(crate) fn motion(&self, action: Action) -> Motion {
+        self.robot.motion(self.pose, action)
+    }
+
+    /// The robot.
+    pub(crate) fn robot(&self) -> &Robot {
+        &self.robot
+    }
+
+    /// Makes `motion` unless it is blocked (by a wall, a moving obstacle or another robot) and
+    /// counts the step's contacts; `touched`: a moving obstacle's own motion touched the robot.
+    /// Returns whether the step collided. The sensors are read next, then [`Episode::score`].
+    pub(crate) fn apply(
+        &mut self,
+        motion: &Motion,
+        wall: bool,
+        moving: bool,
+        touched: bool,
+        robot: bool,
+    ) -> bool {
+        let collided = wall || moving || touched || robot;
         if wall {
             self.collisions += 1;
         }
         if moving || touched {
             self.dynamic.collisions += 1;
         }
-        if !(wall || moving) {
+        if robot {
+            self.robot_collisions += 1;
+        }
+        if !(wall || moving || robot) {
             self.path_length_px += (motion.end.position() - self.pose.position()).norm();
             self.pose = motion.end;
         }
         self.steps += 1;
-        self.sense();
+        collided
+    }
 
+    /// The last part of a step, after the sensors are read: the reward (the goal distance was
+    /// `before`) and the new status.
+    pub(crate) fn score(&mut self, before: f64, motion: &Motion, collided: bool) -> f64 {
         let w = &self.config.reward;
         let success = self.distance_px < self.config.episode.goal_tolerance_px;
         let mut reward =
@@ -339,7 +423,7 @@ impl Episode {
         } else {
             Status::Running
         };
-        self.result(reward, collided)
+        reward
     }
 
     fn result(&self, reward: f64, collided: bool) -> StepResult<'_> {
@@ -452,7 +536,22 @@ impl Episode {
 
     /// How the episode has gone among moving obstacles so far; `None` without any.
     pub fn dynamic_metrics(&self) -> Option<DynamicMetrics> {
-        self.movers.as_ref().map(|_| self.dynamic)
+        self.among_movers.then_some(self.dynamic)
+    }
+
+    /// Steps another robot of a team blocked (0 alone).
+    pub fn robot_collisions(&self) -> u32 {
+        self.robot_collisions
+    }
+
+    /// Makes this a robot of a team among moving obstacles (the team holds them).
+    pub(crate) fn set_among_movers(&mut self, among: bool) {
+        self.among_movers = among;
+    }
+
+    /// Ends the episode with `status` (a team's deadlock or time-out).
+    pub(crate) fn end(&mut self, status: Status) {
+        self.status = status;
     }
 }
 

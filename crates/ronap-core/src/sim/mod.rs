@@ -1,6 +1,6 @@
 //! The simulation: the robot and its actions, the laser, the random streams, placement of start
-//! and goal, the episode that steps and scores them, and the worlds episodes run in. Uses
-//! `config`, `geometry` and `scene`.
+//! and goal, the episode that steps and scores them, a team of several robots, and the worlds
+//! episodes run in. Uses `config`, `geometry` and `scene`.
 
 pub mod episode;
 pub mod lidar;
@@ -8,4 +8,5 @@ pub mod moving;
 pub mod placement;
 pub mod rng;
 pub mod robot;
+pub mod team;
 pub mod world;

@@ -96,7 +96,7 @@ impl Body {
 
     /// Distance along the unit direction `dir` from `origin` to the body at `center`.
     #[inline]
-    fn ray(&self, center: Point, origin: Point, dir: Vector, max: f64) -> Option<f64> {
+    pub(crate) fn ray(&self, center: Point, origin: Point, dir: Vector, max: f64) -> Option<f64> {
         match *self {
             Body::Disc(r) => {
                 let oc = center - origin;
@@ -221,9 +221,9 @@ impl State {
 
     /// Turns every heading by this step's turn and moves it `speed` ahead into `ahead`, marking
     /// in `fits` those whose move stays in their free box; moves there, and marks `moved`, the
-    /// walks that fit and are not near the robot at `robot`. Plain arithmetic over the arrays,
+    /// walks that fit and are not near any robot at `robots`. Plain arithmetic over the arrays,
     /// so it vectorises; turns beyond 1 rad are applied one by one first.
-    fn turn_and_look_ahead(&mut self, robot: Point) {
+    fn turn_and_look_ahead(&mut self, robots: &[Point]) {
         for &(i, s, c) in &self.wide {
             let (dx, dy) = (self.dx[i], self.dy[i]);
             self.dx[i] = dx * c - dy * s;
@@ -262,8 +262,12 @@ impl State {
                 & (x[i] < hi_x[i])
                 & (y[i] > lo_y[i])
                 & (y[i] < hi_y[i]);
-            let (rx, ry) = (x[i] - robot.x, y[i] - robot.y);
-            moved[i] = walks[i] & fits[i] & (rx * rx + ry * ry >= near2[i]);
+            let mut far = true;
+            for robot in robots {
+                let (rx, ry) = (x[i] - robot.x, y[i] - robot.y);
+                far &= rx * rx + ry * ry >= near2[i];
+            }
+            moved[i] = walks[i] & fits[i] & far;
             x[i] = if moved[i] { ax[i] } else { x[i] };
             y[i] = if moved[i] { ay[i] } else { y[i] };
         }
@@ -415,7 +419,26 @@ pub struct Movers {
     rng: Rng,
     /// Largest bounding radius plus step, for the quick distance tests.
     reach: f64,
+    /// The (largest) robot radius obstacles keep clear of.
     robot_radius: f64,
+    /// The robots' centres this step (a buffer kept between steps).
+    centres: Vec<Point>,
+}
+
+/// A robot as moving obstacles see it: a disc.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Disc {
+    /// Its centre.
+    pub at: Point,
+    /// Its radius, px.
+    pub radius: f64,
+}
+
+impl Disc {
+    /// The disc of `radius` at `at`.
+    pub fn new(at: Point, radius: f64) -> Self {
+        Self { at, radius }
+    }
 }
 
 /// What moving the obstacles did in one step.
@@ -435,10 +458,27 @@ impl Movers {
         goal: Point,
         seed: u64,
     ) -> Result<Option<Self>, MovingError> {
+        let robot = [Disc::new(start, config.robot.radius_px)];
+        Self::among(config, scene, &robot, &[goal], seed)
+    }
+
+    /// The obstacles `config.moving` describes for episode `seed` in `scene`, among robots
+    /// starting as `robots` (discs; the largest radius is the one obstacles keep clear of)
+    /// and heading for `goals`. `None` when the configuration has none.
+    pub fn among(
+        config: &ValidConfig,
+        scene: &Scene,
+        robots: &[Disc],
+        goals: &[Point],
+        seed: u64,
+    ) -> Result<Option<Self>, MovingError> {
         if config.moving.is_empty() {
             return Ok(None);
         }
-        let robot_radius = config.robot.radius_px;
+        let robot_radius = robots
+            .iter()
+            .map(|r| r.radius)
+            .fold(config.robot.radius_px, f64::max);
         let mut rng = stream(seed, Stream::Moving);
         let mut entries = Vec::new();
         let mut state = State::default();
@@ -452,7 +492,7 @@ impl Movers {
             reach = reach.max(body.bounding_radius() + m.speed_px);
             for _ in 0..m.count {
                 let (e, position, dir) =
-                    Self::make(m, body, scene, start, goal, robot_radius, &mut rng).map_err(err)?;
+                    Self::make(m, body, scene, robots, goals, &mut rng).map_err(err)?;
                 let near = m.speed_px + body.bounding_radius() + robot_radius;
                 state.push(&e, position, dir, m.speed_px, near);
                 entries.push(e);
@@ -464,6 +504,7 @@ impl Movers {
             rng,
             reach,
             robot_radius,
+            centres: Vec::new(),
         }))
     }
 
@@ -472,9 +513,8 @@ impl Movers {
         m: &MovingConfig,
         body: Body,
         scene: &Scene,
-        start: Point,
-        goal: Point,
-        robot_radius: f64,
+        robots: &[Disc],
+        goals: &[Point],
         rng: &mut Rng,
     ) -> Result<(Entry, Point, Vector), String> {
         let kind = if m.motion == MotionKind::Appear {
@@ -490,8 +530,10 @@ impl Movers {
             (None, MotionKind::Waypoints) => Point::new(m.points[0][0], m.points[0][1]),
             (None, _) => {
                 let far = |p: Point| {
-                    body.gap(p, start, robot_radius) >= m.min_robot_distance_px
-                        && body.gap(p, goal, robot_radius) >= m.min_robot_distance_px
+                    robots.iter().zip(goals).all(|(r, &goal)| {
+                        body.gap(p, r.at, r.radius) >= m.min_robot_distance_px
+                            && body.gap(p, goal, r.radius) >= m.min_robot_distance_px
+                    })
                 };
                 free_spot(body, scene, rng, far).ok_or_else(|| {
                     format!(
@@ -502,7 +544,10 @@ impl Movers {
             }
         };
         // A fixed start on the robot's drawn start: held back until the robot has left it.
-        let held = appears_at.is_none() && body.gap(position, start, robot_radius) < 0.0;
+        let held = appears_at.is_none()
+            && robots
+                .iter()
+                .any(|r| body.gap(position, r.at, r.radius) < 0.0);
         let mut dir = Vector::new(1.0, 0.0);
         let motion = match kind {
             MotionKind::Still | MotionKind::Appear => Motion::Still,
@@ -567,20 +612,47 @@ impl Movers {
     /// free box per obstacle answering most clearance questions); what the free box cannot
     /// answer, waypoints and the contact with the robot are settled one by one.
     pub fn advance(&mut self, step: u32, scene: &Scene, robot: Point) -> Advance {
-        let radius = self.robot_radius;
+        let robot = [Disc::new(robot, self.robot_radius)];
+        let mut touched = Vec::new();
+        self.advance_among(step, scene, &robot, &mut touched);
+        Advance {
+            touched_robot: !touched.is_empty(),
+        }
+    }
+
+    /// [`Movers::advance`] among several robots (discs): `touched` is cleared, then gets the
+    /// index of every robot an obstacle's motion would have touched (once per such obstacle).
+    pub fn advance_among(
+        &mut self,
+        step: u32,
+        scene: &Scene,
+        robots: &[Disc],
+        touched: &mut Vec<usize>,
+    ) {
+        touched.clear();
+        self.centres.clear();
+        self.centres.extend(robots.iter().map(|r| r.at));
         let state = &mut self.state;
         for (i, e) in self.entries.iter_mut().enumerate() {
             if let Some(at) = e.appears_at {
                 if step >= at {
                     let (body, min_gap) = (e.body, e.min_gap);
-                    let far = |p: Point| body.gap(p, robot, radius) >= min_gap;
+                    let far = |p: Point| {
+                        robots
+                            .iter()
+                            .all(|r| body.gap(p, r.at, r.radius) >= min_gap)
+                    };
                     if let Some(p) = free_spot(body, scene, &mut self.rng, far) {
                         state.x[i] = p.x;
                         state.y[i] = p.y;
                         e.appears_at = None;
                     }
                 }
-            } else if e.held && e.body.gap(state.position(i), robot, radius) >= 0.0 {
+            } else if e.held
+                && robots
+                    .iter()
+                    .all(|r| e.body.gap(state.position(i), r.at, r.radius) >= 0.0)
+            {
                 e.held = false;
             }
         }
@@ -598,8 +670,7 @@ impl Movers {
                 state.turn[i] = 0.0;
             }
         }
-        state.turn_and_look_ahead(robot);
-        let mut out = Advance::default();
+        state.turn_and_look_ahead(&self.centres);
         for (i, e) in self.entries.iter_mut().enumerate() {
             if state.moved[i] || !e.present() {
                 continue;
@@ -645,16 +716,17 @@ impl Movers {
                 }
             };
             // Every motion moves at most `speed` a step.
-            if (from - robot).norm_squared() < state.near_robot2[i]
-                && e.body.sweep_touches(from, to, robot, radius)
-            {
-                out.touched_robot = true;
+            let hit = robots.iter().position(|r| {
+                (from - r.at).norm_squared() < state.near_robot2[i]
+                    && e.body.sweep_touches(from, to, r.at, r.radius)
+            });
+            if let Some(k) = hit {
+                touched.push(k);
                 continue;
             }
             state.x[i] = to.x;
             state.y[i] = to.y;
         }
-        out
     }
 
     /// Where heading obstacle `i` at `from` goes when its move ahead is not known clear: ahead
@@ -718,13 +790,25 @@ impl Movers {
         heading_deg: f64,
         out: &mut [f64],
     ) -> f64 {
+        self.sense_as(laser, position, self.robot_radius, heading_deg, out)
+    }
+
+    /// [`Movers::sense`] for a robot of `radius`.
+    pub fn sense_as(
+        &self,
+        laser: &crate::sim::lidar::Laser,
+        position: Point,
+        radius: f64,
+        heading_deg: f64,
+        out: &mut [f64],
+    ) -> f64 {
         let mut near = [0u32; 64];
         let mut count = 0;
         let mut overflow = false;
         let mut least_gap = f64::INFINITY;
         let range = laser.range_px();
         let st = &self.state;
-        let reach = range + self.robot_radius;
+        let reach = range + radius;
         for (i, e) in self.entries.iter().enumerate() {
             let (px, py) = (st.x[i] - position.x, st.y[i] - position.y);
             let d2 = px * px + py * py;
@@ -734,8 +818,8 @@ impl Movers {
             }
             let (p, bound) = (st.position(i), st.bound[i]);
             let d = d2.sqrt();
-            if d - bound <= range + self.robot_radius {
-                least_gap = least_gap.min(e.body.gap(p, position, self.robot_radius));
+            if d - bound <= range + radius {
+                least_gap = least_gap.min(e.body.gap(p, position, radius));
                 if d - bound <= range {
                     if count < near.len() {
                         near[count] = i as u32;

@@ -97,6 +97,20 @@ pub fn sample_placement(
     grid: Option<&FreeGrid>,
     seed: u64,
 ) -> Result<Placement, EpisodeError> {
+    let mut rng = stream(seed, Stream::Placement);
+    sample_placement_with(config, scene, grid, seed, &mut rng, |_, _| true)
+}
+
+/// [`sample_placement`] drawing from `rng` and keeping only a start and goal that `accept`
+/// takes (a team's robots keep clear of each other's).
+pub fn sample_placement_with(
+    config: &ValidConfig,
+    scene: &Scene,
+    grid: Option<&FreeGrid>,
+    seed: u64,
+    rng: &mut Rng,
+    accept: impl Fn(Point, Point) -> bool,
+) -> Result<Placement, EpisodeError> {
     let radius = config.robot.radius_px;
     let e = &config.episode;
     let fixed_start = e.start.map(|s| Pose::new(s[0], s[1], s[2]));
@@ -135,7 +149,6 @@ pub fn sample_placement(
     if grid.is_some() && cells.is_empty() {
         return Err(EpisodeError::NoFreeSpace { radius_px: radius });
     }
-    let mut rng = stream(seed, Stream::Placement);
     let draw = |rng: &mut Rng| -> Option<Point> {
         let p = match grid {
             Some(g) => {
@@ -157,7 +170,7 @@ pub fn sample_placement(
     for _ in 0..PLACEMENT_TRIES {
         let start = match fixed_start {
             Some(s) => s.position(),
-            None => match draw(&mut rng) {
+            None => match draw(rng) {
                 Some(p) => p,
                 None => continue,
             },
@@ -165,9 +178,9 @@ pub fn sample_placement(
         for _ in 0..PLACEMENT_TRIES {
             let goal = match fixed_goal {
                 Some(g) => Some(g),
-                None => draw(&mut rng),
+                None => draw(rng),
             };
-            if let Some(goal) = goal.filter(|g| (g - start).norm() >= min_d) {
+            if let Some(goal) = goal.filter(|g| (g - start).norm() >= min_d && accept(start, *g)) {
                 let start = fixed_start
                     .unwrap_or_else(|| Pose::new(start.x, start.y, rng.random_range(0.0..360.0)));
                 return Ok(Placement { start, goal });

@@ -26,6 +26,8 @@ pub enum Stream {
     Repose = 5,
     /// Moving obstacles: their starts, directions, turns and appearances.
     Moving = 6,
+    /// The starts and goals of a team's robots after the first.
+    Team = 7,
 }
 
 /// The generator for `purpose` in the episode with `seed`.

@@ -1,0 +1,499 @@
+//! Several robots in one episode (SPEC "Several robots"): each robot an [`Episode`] of its own
+//! configuration (radius, speeds, laser), all in one scene among one set of moving obstacles.
+//!
+//! Each step the moving obstacles move first, then every robot that is still going makes its
+//! action at once: each motion is swept against the walls and the moving obstacles, then against
+//! the other robots' motions (two moving discs are tested over their simultaneous straight
+//! sweeps, a standing one as a point), and robots whose motions would touch stay where they were
+//! and count a robot collision; that repeats until no motion touches, so no robot passes through
+//! another at any speed. Each laser sees the other robots as discs. A robot that reached its goal
+//! stops there and stays an obstacle, or leaves the scene with `on_arrival = "vanish"`. When no
+//! robot has moved for `episode.deadlock_steps` steps, the running ones end as a deadlock.
+//!
+//! The first robot's start and goal are drawn as a lone robot's are (the same stream), the
+//! others' from a stream of their own, each clear of the robots placed before it.
+
+use crate::config::{OnArrival, ValidConfig};
+use crate::geometry::{point_segment_distance_squared, Point};
+use crate::sim::episode::{Episode, Status};
+use crate::sim::moving::{Disc, Movers};
+use crate::sim::placement::{needs_region_grid, sample_placement_with, EpisodeError};
+use crate::sim::rng::{stream, Stream};
+use crate::sim::robot::{Action, Motion};
+use crate::sim::world::World;
+use std::sync::Arc;
+
+/// Space kept between two robots' starts (and two robots' goals), beyond their radii, px.
+pub const PLACEMENT_GAP_PX: f64 = 2.0;
+
+/// Several robots in one scene.
+#[derive(Clone, Debug)]
+pub struct Team {
+    robots: Vec<Episode>,
+    on_arrival: Vec<OnArrival>,
+    movers: Option<Box<Movers>>,
+    steps: u32,
+    /// Steps since a robot last moved.
+    still_for: u32,
+    deadlock_steps: u32,
+    /// Step at which each robot reached its goal.
+    arrived_at: Vec<Option<u32>>,
+    /// The previous step's reward of each robot.
+    rewards: Vec<f64>,
+    touched: Vec<usize>,
+}
+
+/// Whether discs of radii summing to `reach`, moving at once from `a0` to `a1` and from `b0` to
+/// `b1` in straight lines over the same step, come closer than `reach`.
+fn sweeps_touch(a0: Point, a1: Point, b0: Point, b1: Point, reach: f64) -> bool {
+    // In the frame of b, a moves from a0 - b0 to a1 - b1: the distance of that segment from
+    // the origin.
+    let from = Point::origin() + (a0 - b0);
+    let to = Point::origin() + (a1 - b1);
+    point_segment_distance_squared(Point::origin(), from, to) < reach * reach
+}
+
+impl Team {
+    /// The team `config.robots` describes for episode `seed`: robot `k` in `worlds[e]`, where
+    /// `e` is its `[[robots]]` entry (each world holds the entry's configuration and the shared
+    /// scene).
+    pub fn new(
+        config: &ValidConfig,
+        worlds: &[Arc<World>],
+        seed: u64,
+    ) -> Result<Self, EpisodeError> {
+        let n = config.team_size();
+        let mut robots: Vec<Episode> = Vec::with_capacity(n);
+        let mut on_arrival = Vec::with_capacity(n);
+        let mut others = stream(seed, Stream::Team);
+        let mut taken: Vec<(Point, Point, f64)> = Vec::new();
+        let mut k = 0;
+        for (e, entry) in config.robots.iter().enumerate() {
+            let world = &worlds[e];
+            let cfg = world.config();
+            let scene = world.scene();
+            let radius = cfg.robot.radius_px;
+            for _ in 0..entry.count {
+                let both_fixed = cfg.episode.start.is_some() && cfg.episode.goal.is_some();
+                let grid = (!both_fixed && needs_region_grid(cfg, scene)).then(|| world.grid());
+                let clear = |start: Point, goal: Point| {
+                    taken.iter().all(|&(s, g, r)| {
+                        let gap = radius + r + PLACEMENT_GAP_PX;
+                        (start - s).norm() >= gap && (goal - g).norm() >= gap
+                    })
+                };
+                let placement = if k == 0 {
+                    let mut first = stream(seed, Stream::Placement);
+                    sample_placement_with(cfg, scene, grid, seed, &mut first, clear)?
+                } else {
+                    sample_placement_with(cfg, scene, grid, seed, &mut others, clear)?
+                };
+                let robot = Episode::placed(cfg, scene.clone(), seed, placement, false)?;
+                taken.push((placement.start.position(), placement.goal, radius));
+                robots.push(robot);
+                on_arrival.push(entry.on_arrival);
+                k += 1;
+            }
+        }
+        let discs: Vec<Disc> = robots.iter().map(disc).collect();
+        let goals: Vec<Point> = robots.iter().map(|r| r.goal()).collect();
+        let scene = worlds
+            .first()
+            .map(|w| w.scene().clone())
+            .ok_or(EpisodeError::Moving(
+                "a team needs at least one robot".into(),
+            ))?;
+        let movers = Movers::among(config, &scene, &discs, &goals, seed)
+            .map_err(|e| EpisodeError::Moving(e.to_string()))?
+            .map(Box::new);
+        let mut team = Self {
+            arrived_at: robots
+                .iter()
+                .map(|r| (r.status() == Status::Success).then_some(0))
+                .collect(),
+            rewards: vec![0.0; robots.len()],
+            robots,
+            on_arrival,
+            movers,
+            steps: 0,
+            still_for: 0,
+            deadlock_steps: config.episode.deadlock_steps,
+            touched: Vec::new(),
+        };
+        let among = team.movers.is_some();
+        for r in &mut team.robots {
+            r.set_among_movers(among);
+        }
+        team.sense_all();
+        Ok(team)
+    }
+
+    /// The robots, in `[[robots]]` order.
+    pub fn robots(&self) -> &[Episode] {
+        &self.robots
+    }
+
+    /// Robot `k`.
+    pub fn robot(&self, k: usize) -> &Episode {
+        &self.robots[k]
+    }
+
+    /// The moving obstacles, when there are some.
+    pub fn movers(&self) -> Option<&Movers> {
+        self.movers.as_deref()
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u32 {
+        self.steps
+    }
+
+    /// Each robot's reward in the last step (0 for a robot that did not act).
+    pub fn rewards(&self) -> &[f64] {
+        &self.rewards
+    }
+
+    /// The step at which robot `k` reached its goal.
+    pub fn arrived_at(&self, k: usize) -> Option<u32> {
+        self.arrived_at[k]
+    }
+
+    /// Whether robot `k` is in the scene (a robot that vanished on arrival is not).
+    pub fn present(&self, k: usize) -> bool {
+        !(self.on_arrival[k] == OnArrival::Vanish && self.robots[k].status() == Status::Success)
+    }
+
+    /// Whether every robot's episode is over.
+    pub fn is_done(&self) -> bool {
+        self.robots.iter().all(|r| r.status().is_done())
+    }
+
+    /// Whether the team ended in a deadlock.
+    pub fn deadlocked(&self) -> bool {
+        self.robots.iter().any(|r| r.status() == Status::Deadlock)
+    }
+
+    /// Ends robot `k`'s episode now with `status` (its policy gave up, say): it stays where it
+    /// is, an obstacle to the others.
+    pub fn end_robot(&mut self, k: usize, status: Status) {
+        self.robots[k].end(status);
+    }
+
+    /// One step: `actions[k]` for each robot (`None`: it does nothing, as a robot whose episode
+    /// is over). Moving obstacles move first, then every running robot at once.
+    pub fn step(&mut self, actions: &[Option<Action>]) {
+        if self.is_done() {
+            return;
+        }
+        self.steps += 1;
+        let n = self.robots.len();
+        let present: Vec<usize> = (0..n).filter(|&k| self.present(k)).collect();
+        let discs: Vec<Disc> = present.iter().map(|&k| disc(&self.robots[k])).collect();
+        let mut touched = vec![false; n];
+        if let Some(movers) = &mut self.movers {
+            let scene = self.robots[0].scene().clone();
+            movers.advance_among(self.steps, &scene, &discs, &mut self.touched);
+            for &i in &self.touched {
+                touched[present[i]] = true;
+            }
+        }
+        // Each running robot's motion and what the still scene and the obstacles say of it.
+        let running: Vec<bool> = self
+            .robots
+            .iter()
+            .map(|r| r.status() == Status::Running)
+            .collect();
+        let mut motions: Vec<Option<Motion>> = vec![None; n];
+        let mut wall = vec![false; n];
+        let mut moving = vec![false; n];
+        for k in 0..n {
+            let Some(action) = actions.get(k).copied().flatten().filter(|_| running[k]) else {
+                continue;
+            };
+            let r = &self.robots[k];
+            let m = r.motion(action);
+            wall[k] = !r.robot().motion_clear(r.scene(), r.pose(), &m);
+            moving[k] = match &self.movers {
+                Some(movers) => !r
+                    .robot()
+                    .motion_clear_by(r.pose(), &m, |a, b, rad| movers.sweep_clear(a, b, rad)),
+                None => false,
+            };
+            motions[k] = Some(m);
+        }
+        // Robots against robots, until no remaining motion touches another robot.
+        let ends: Vec<Point> = (0..n)
+            .map(|k| match &motions[k] {
+                Some(m) if !wall[k] && !moving[k] => m.end.position(),
+                _ => self.robots[k].pose().position(),
+            })
+            .collect();
+        let starts: Vec<Point> = self.robots.iter().map(|r| r.pose().position()).collect();
+        let radii: Vec<f64> = self
+            .robots
+            .iter()
+            .map(|r| r.config().robot.radius_px)
+            .collect();
+        let mut blocked = vec![false; n];
+        let moves = |k: usize, blocked: &[bool]| !blocked[k] && ends[k] != starts[k];
+        loop {
+            let mut changed = false;
+            for &i in &present {
+                if !moves(i, &blocked) {
+                    continue;
+                }
+                for &j in &present {
+                    if i == j {
+                        continue;
+                    }
+                    let reach = radii[i] + radii[j];
+                    let (j0, j1) = if moves(j, &blocked) {
+                        (starts[j], ends[j])
+                    } else {
+                        (starts[j], starts[j])
+                    };
+                    // Far apart: neither sweep can reach the other.
+                    let span = (ends[i] - starts[i]).norm() + (j1 - j0).norm() + reach;
+                    if (starts[i] - starts[j]).norm() > span {
+                        continue;
+                    }
+                    if sweeps_touch(starts[i], ends[i], j0, j1, reach) {
+                        blocked[i] = true;
+                        if moves(j, &blocked) {
+                            blocked[j] = true;
+                        }
+                        changed = true;
+                        break;
+                    }
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        // Make the motions, then read every sensor among everyone's new poses.
+        let mut collided = vec![false; n];
+        let before: Vec<f64> = self.robots.iter().map(|r| r.distance_px()).collect();
+        let mut moved_any = false;
+        for k in 0..n {
+            if let Some(m) = &motions[k] {
+                collided[k] = self.robots[k].apply(m, wall[k], moving[k], touched[k], blocked[k]);
+                moved_any |= self.robots[k].pose().position() != starts[k];
+            }
+        }
+        self.sense_all();
+        for k in 0..n {
+            self.rewards[k] = 0.0;
+            if let Some(m) = &motions[k] {
+                self.rewards[k] = self.robots[k].score(before[k], m, collided[k]);
+                if self.robots[k].status() == Status::Success {
+                    self.arrived_at[k].get_or_insert(self.steps);
+                }
+            }
+        }
+        self.still_for = if moved_any { 0 } else { self.still_for + 1 };
+        if self.still_for >= self.deadlock_steps {
+            for r in &mut self.robots {
+                if r.status() == Status::Running {
+                    r.end(Status::Deadlock);
+                }
+            }
+        }
+    }
+
+    /// Every running robot reads its sensors among the others (discs) and the obstacles.
+    fn sense_all(&mut self) {
+        let n = self.robots.len();
+        let discs: Vec<(usize, Disc)> = (0..n)
+            .filter(|&k| self.present(k))
+            .map(|k| (k, disc(&self.robots[k])))
+            .collect();
+        let movers = self.movers.take();
+        let mut others = Vec::with_capacity(discs.len());
+        for k in 0..n {
+            if self.robots[k].status().is_done() && self.steps > 0 {
+                continue;
+            }
+            others.clear();
+            others.extend(discs.iter().filter(|(j, _)| *j != k).map(|(_, d)| *d));
+            self.robots[k].sense_among(movers.as_deref(), &others);
+        }
+        self.movers = movers;
+    }
+}
+
+/// Robot `r` as a disc.
+fn disc(r: &Episode) -> Disc {
+    Disc::new(r.pose().position(), r.config().robot.radius_px)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::TeamRobotConfig;
+    use crate::geometry::Vector;
+    use crate::sim::robot::DiscreteAction;
+
+    /// The unit vector `v` scaled to `len`.
+    fn along(v: Vector, len: f64) -> Vector {
+        v.normalize() * len
+    }
+
+    #[test]
+    fn head_on_sweeps_touch_and_parallel_ones_do_not() {
+        let o = Point::origin();
+        // Two discs of radius 5 swapping places 8 px apart pass through each other mid-step.
+        assert!(sweeps_touch(
+            o,
+            Point::new(8.0, 0.0),
+            Point::new(8.0, 0.0),
+            o,
+            10.0
+        ));
+        // Side by side, 12 px apart, moving the same way: never closer than 12.
+        let up = along(Vector::new(0.0, 1.0), 50.0);
+        assert!(!sweeps_touch(
+            o,
+            o + up,
+            Point::new(12.0, 0.0),
+            Point::new(12.0, 0.0) + up,
+            10.0
+        ));
+        // At any speed: 1000 px steps crossing still touch.
+        assert!(sweeps_touch(
+            Point::new(-500.0, 0.0),
+            Point::new(500.0, 0.0),
+            Point::new(0.0, -500.0),
+            Point::new(0.0, 500.0),
+            10.0
+        ));
+    }
+
+    fn team_config(count: u32) -> ValidConfig {
+        let c = crate::SimConfig {
+            robots: vec![TeamRobotConfig {
+                count,
+                ..Default::default()
+            }],
+            ..Default::default()
+        };
+        c.validate().expect("valid")
+    }
+
+    fn worlds(config: &ValidConfig, seed: u64) -> Vec<Arc<World>> {
+        let scene = Arc::new(crate::sim::world::maze_scene(config, seed));
+        (0..config.robots.len())
+            .map(|e| {
+                let k: usize = config.robots[..e].iter().map(|r| r.count as usize).sum();
+                Arc::new(World::new(config.team_robot(k), scene.clone()))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn robots_start_apart_and_never_overlap() {
+        let config = team_config(8);
+        for seed in 0..6 {
+            let mut team = Team::new(&config, &worlds(&config, seed), seed).expect("placed");
+            let ahead = Some(Action::from(DiscreteAction::Ahead));
+            let left = Some(Action::from(DiscreteAction::Left));
+            for step in 0..300 {
+                let actions: Vec<Option<Action>> = (0..8)
+                    .map(|k| if (step + k) % 5 == 0 { left } else { ahead })
+                    .collect();
+                team.step(&actions);
+                let r = team.robots();
+                for i in 0..r.len() {
+                    for j in i + 1..r.len() {
+                        if !(team.present(i) && team.present(j)) {
+                            continue;
+                        }
+                        let d = (r[i].pose().position() - r[j].pose().position()).norm();
+                        assert!(d >= 10.0 - 1e-9, "seed {seed} step {step}: {i} {j} at {d}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_first_robot_is_placed_as_a_lone_one() {
+        let config = team_config(3);
+        let team = Team::new(&config, &worlds(&config, 4), 4).expect("placed");
+        let alone = World::maze(ValidConfig::default(), 4)
+            .episode(4)
+            .expect("placed");
+        assert_eq!(team.robot(0).start(), alone.start());
+        assert_eq!(team.robot(0).goal(), alone.goal());
+    }
+
+    /// Two robots facing each other down an open corridor, driving ahead.
+    fn corridor(speed: f64) -> (ValidConfig, Vec<Arc<World>>) {
+        let mut c = crate::SimConfig::default();
+        let robot = |start: [f64; 3], goal: [f64; 2]| TeamRobotConfig {
+            start: Some(start),
+            goal: Some(goal),
+            move_speed_px: Some(speed),
+            ..Default::default()
+        };
+        c.robots = vec![
+            robot([50.0, 50.0, 0.0], [350.0, 50.0]),
+            robot([350.0, 50.0, 180.0], [50.0, 50.0]),
+        ];
+        c.episode.deadlock_steps = 10;
+        let config = c.validate().expect("valid");
+        let scene = Arc::new(crate::Scene::from_boxes(400.0, 100.0, Vec::new(), 50.0));
+        let worlds = (0..2)
+            .map(|k| Arc::new(World::new(config.team_robot(k), scene.clone())))
+            .collect();
+        (config, worlds)
+    }
+
+    #[test]
+    fn head_on_robots_block_each_other_at_any_speed_and_deadlock() {
+        for speed in [5.0, 37.0, 1000.0] {
+            let (config, worlds) = corridor(speed);
+            let mut team = Team::new(&config, &worlds, 0).expect("placed");
+            let ahead = Some(Action::from(DiscreteAction::Ahead));
+            while !team.is_done() {
+                let before = [0, 1].map(|k| team.robot(k).pose().position().x);
+                team.step(&[ahead, ahead]);
+                let after = [0, 1].map(|k| team.robot(k).pose().position().x);
+                // Never through each other: the first stays left of the second.
+                assert!(after[0] + 10.0 <= after[1] + 1e-9, "{speed}: {after:?}");
+                assert!(before[0] <= after[0] && after[1] <= before[1]);
+            }
+            assert!(team.deadlocked(), "{speed}");
+            assert!(team.robot(0).robot_collisions() > 0);
+            if speed == 5.0 {
+                // Face to face: each one's middle beam reads the other's disc.
+                let gap = (team.robot(1).pose().position() - team.robot(0).pose().position())
+                    .norm()
+                    - 5.0;
+                assert!((team.robot(0).readings()[8] - gap).abs() < 1e-9);
+                assert!((team.robot(1).readings()[8] - gap).abs() < 1e-9);
+            }
+            assert_eq!(team.robot(0).status(), Status::Deadlock);
+        }
+    }
+
+    #[test]
+    fn robots_that_never_move_end_in_a_deadlock() {
+        let mut c = crate::SimConfig {
+            robots: vec![TeamRobotConfig {
+                count: 2,
+                ..Default::default()
+            }],
+            ..Default::default()
+        };
+        c.episode.deadlock_steps = 7;
+        let config = c.validate().expect("valid");
+        let mut team = Team::new(&config, &worlds(&config, 1), 1).expect("placed");
+        let turn = Some(Action::from(DiscreteAction::Left));
+        for _ in 0..20 {
+            team.step(&[turn, turn]);
+        }
+        assert!(team.deadlocked() && team.is_done());
+        assert_eq!(team.steps(), 7);
+    }
+}
