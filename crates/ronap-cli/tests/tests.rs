@@ -9,5 +9,6 @@ mod compare;
 mod learn;
 mod replay;
 mod run;
+mod team;
 mod tui;
 mod util;

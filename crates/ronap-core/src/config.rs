@@ -1202,6 +1202,42 @@ const MOVING_DOCS: &[(&str, &str)] = &[
     ),
 ];
 
+/// Every field of a `[[robots]]` entry and what it means.
+const ROBOTS_DOCS: &[(&str, &str)] = &[
+    ("count", "How many robots this entry makes."),
+    (
+        "start",
+        "Fixed start pose [x px, y px, heading deg] (count 1). Unset: drawn from the seed.",
+    ),
+    (
+        "goal",
+        "Fixed goal [x, y], px (count 1). Unset: drawn from the seed.",
+    ),
+    (
+        "policy",
+        "The policy that drives them (any --policy name). Unset: the run's.",
+    ),
+    ("radius_px", "Disc radius, px. Unset: robot.radius_px."),
+    (
+        "move_speed_px",
+        "Distance of one AHEAD step, px. Unset: robot.move_speed_px.",
+    ),
+    (
+        "turn_speed_deg",
+        "Heading change of LEFT / RIGHT, degrees. Unset: robot.turn_speed_deg.",
+    ),
+    ("laser_beams", "Laser beams. Unset: laser.beams."),
+    ("laser_range_px", "Laser range, px. Unset: laser.range_px."),
+    (
+        "laser_fov_deg",
+        "Laser field of view, degrees. Unset: laser.fov_deg.",
+    ),
+    (
+        "on_arrival",
+        "On reaching the goal: \"stay\" (an obstacle there) or \"vanish\" (leave the scene).",
+    ),
+];
+
 fn commented(block: &str) -> String {
     block.lines().map(|l| format!("# {l}\n")).collect()
 }
@@ -1266,6 +1302,29 @@ impl SimConfig {
             }
             None => out.push_str(&commented(
                 "[[moving]]\ncount = 5\nshape = \"disc\"\nradius_px = 8.0\nmotion = \"random_walk\"\nspeed_px = 2.0\n",
+            )),
+        }
+        out.push_str(
+            "\n# Several robots, any number of entries; each makes `count` robots alike, and a field\n\
+             # left out takes [robot]'s, [laser]'s or [episode]'s value. All robots act at once;\n\
+             # robots whose motions would touch stay where they were (a robot collision).\n",
+        );
+        let robots = value.get("robots").and_then(|v| v.as_array());
+        match robots.filter(|a| !a.is_empty()) {
+            Some(list) => {
+                for r in list {
+                    out.push_str("[[robots]]\n");
+                    for &(field, doc) in ROBOTS_DOCS {
+                        out.push_str(&format!("# {doc}\n"));
+                        match r.get(field) {
+                            Some(v) => out.push_str(&format!("{field} = {v}\n")),
+                            None => out.push_str(&format!("# {field} = ...\n")),
+                        }
+                    }
+                }
+            }
+            None => out.push_str(&commented(
+                "[[robots]]\ncount = 4\npolicy = \"geodesic\"\non_arrival = \"stay\"\n",
             )),
         }
         out

@@ -53,6 +53,9 @@ pub struct RunArgs {
 pub fn run(args: RunArgs) -> Result<ExitCode> {
     // Everything that can be wrong with the input is checked before anything is written.
     let (config, scenes, map_source) = args.episodes.resolve()?;
+    if config.team_size() > 0 {
+        return run_team(args, config, scenes, map_source);
+    }
     let factory = policy_factory(&args.policy, &config)?;
     let evaluator = Evaluator::new(config.clone(), scenes);
     let first = args.seed_start;
@@ -157,6 +160,128 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// `ronap run` of a scenario with `[[robots]]`: team episodes, each robot driven by its entry's
+/// policy (or `--policy`); `episodes.csv` holds a row per team episode, `robots.csv` a row per
+/// robot.
+fn run_team(
+    args: RunArgs,
+    config: ronap_core::ValidConfig,
+    scenes: ronap_core::Scenes,
+    map_source: Option<ronap_core::scene::map::MapSource>,
+) -> Result<ExitCode> {
+    if args.png.is_some() || !args.gif.is_empty() || args.log_steps {
+        bail!(
+            "--png, --gif and --log-steps do not draw or log team runs yet; run without them \
+             (robots.csv holds every robot's figures)"
+        );
+    }
+    let mut names = Vec::new();
+    let mut factories: Vec<Box<dyn ronap_core::policy::PolicyFactory>> = Vec::new();
+    let mut of_robot = Vec::new();
+    let mut k = 0;
+    for entry in &config.robots {
+        let name = entry.policy.clone().unwrap_or_else(|| args.policy.clone());
+        let factory = policy_factory(&name, &config.team_robot(k))
+            .with_context(|| format!("[[robots]] entry with robot {k}"))?;
+        factories.push(factory);
+        for _ in 0..entry.count {
+            names.push(name.clone());
+            of_robot.push(factories.len() - 1);
+            k += 1;
+        }
+    }
+    let factories_per_robot: Vec<&dyn ronap_core::policy::PolicyFactory> =
+        of_robot.iter().map(|&i| factories[i].as_ref()).collect();
+    let first = args.seed_start;
+    let seeds = seed_range(first, args.seeds)?;
+    let evaluator = Evaluator::new(config.clone(), scenes);
+    let threads = args.threads.count();
+    let out_dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| default_out_dir(&args.policy));
+    std::fs::create_dir_all(&out_dir)
+        .with_context(|| format!("cannot prepare output directory {}", out_dir.display()))?;
+    let cancel = cancel_on_ctrl_c("finishing running episodes and writing what is done");
+    let bar = crate::output::progress_bar(
+        args.seeds,
+        "{prefix} {wide_bar} {pos}/{len} team episodes, {per_sec}, eta {eta}",
+        format!("ronap run {} robots", names.len()),
+    );
+    let options = EvalOptions {
+        seeds,
+        threads,
+        recording: Recording::default(),
+    };
+    let info = RunInfo {
+        policy: args.policy.clone(),
+        scenes: args.episodes.scenes.spec(&config),
+        map: map_source,
+    };
+    let evaluation = ronap_core::io::run_dir::evaluate_team_into(
+        &evaluator,
+        &factories_per_robot,
+        &names,
+        &options,
+        &info,
+        Some(&out_dir),
+        &cancel,
+        &|_| bar.inc(1),
+    )?;
+    bar.finish_and_clear();
+    let mut stdout = std::io::stdout().lock();
+    writeln!(
+        stdout,
+        "ronap run: {} robots ({}), seeds {first}..{}, {threads} threads",
+        names.len(),
+        summary_of_names(&names),
+        first + args.seeds - 1
+    )?;
+    write!(stdout, "{}", evaluation.team.table())?;
+    writeln!(stdout, "per robot:")?;
+    write!(stdout, "{}", evaluation.summary.table())?;
+    writeln!(stdout, "outputs in {}", out_dir.display())?;
+    if let Some(e) = evaluation.write_error {
+        return Err(e.into());
+    }
+    if let Some(e) = &evaluation.result.error {
+        bail!(
+            "run stopped: {e} (the {} finished episodes are saved)",
+            evaluation.result.records.len()
+        );
+    }
+    if evaluation.result.cancelled {
+        return Ok(ExitCode::from(130));
+    }
+    if let Some(min) = args.min_success {
+        if evaluation.team.team_success_rate < min {
+            eprintln!(
+                "ronap run: team success rate {:.1}% is below --min-success {:.1}%",
+                100.0 * evaluation.team.team_success_rate,
+                100.0 * min
+            );
+            return Ok(ExitCode::from(1));
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `8 x geodesic` or `4 x apf, 4 x geodesic`: the policies of a team, counted.
+fn summary_of_names(names: &[String]) -> String {
+    let mut counted: Vec<(&str, usize)> = Vec::new();
+    for n in names {
+        match counted.iter_mut().find(|(m, _)| *m == n.as_str()) {
+            Some((_, c)) => *c += 1,
+            None => counted.push((n, 1)),
+        }
+    }
+    counted
+        .iter()
+        .map(|(n, c)| format!("{c} x {n}"))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Runs the episode of `record` again with a fresh policy, recording its steps, and writes its

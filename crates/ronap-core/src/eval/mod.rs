@@ -7,9 +7,11 @@
 
 pub mod record;
 pub mod summary;
+pub mod team;
 
 pub use record::{EpisodeRecord, Outcome, Recording, StepLog};
 pub use summary::Summary;
+pub use team::{RobotRecord, TeamRecord, TeamRunResult, TeamSummary};
 
 use crate::config::ValidConfig;
 use crate::plan::shortest_path_px;

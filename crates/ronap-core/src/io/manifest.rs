@@ -36,8 +36,11 @@ pub struct RunManifest {
     pub interrupted: bool,
     /// The error that stopped the run, if one did.
     pub error: Option<String>,
-    /// The figures.
+    /// The figures (of every robot, for a team run).
     pub summary: Summary,
+    /// The team figures, for a run of several robots.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub team: Option<crate::eval::TeamSummary>,
     /// The whole configuration.
     pub config: SimConfig,
 }

@@ -7,7 +7,10 @@
 //! times, so `episodes.csv` is byte-identical whatever the thread count.
 
 use crate::config::ValidConfig;
-use crate::eval::{EpisodeRecord, EvalOptions, Evaluator, Outcome, Recording, RunResult, Summary};
+use crate::eval::{
+    EpisodeRecord, EvalOptions, Evaluator, Outcome, Recording, RunResult, Summary, TeamRecord,
+    TeamRunResult, TeamSummary,
+};
 use crate::io::atomic::{save_image, write_atomic, OutputError};
 use crate::io::manifest::{RunManifest, SCHEMA_VERSION};
 use crate::io::steplog::write_steps;
@@ -361,6 +364,175 @@ fn manifest(
         interrupted: result.cancelled,
         error: result.error.as_ref().map(|e| e.to_string()),
         summary: summary.clone(),
+        team: None,
         config: config.as_sim_config().clone(),
     }
+}
+
+/// Columns of a team run's `episodes.csv` (one row per team episode).
+pub const TEAM_COLUMNS: [&str; 10] = [
+    "seed",
+    "outcome",
+    "robots",
+    "arrived",
+    "steps",
+    "makespan",
+    "path_length_px",
+    "collisions",
+    "robot_collisions",
+    "deadlock",
+];
+
+/// Writes a team run's `episodes.csv`: one row per team episode.
+pub fn write_team_episodes(records: &[TeamRecord], out: &mut dyn Write) -> std::io::Result<()> {
+    let mut w = csv::Writer::from_writer(out);
+    w.write_record(TEAM_COLUMNS)?;
+    for r in records {
+        w.write_record([
+            r.seed.to_string(),
+            r.outcome.name().to_string(),
+            r.robots.len().to_string(),
+            r.robots
+                .iter()
+                .filter(|x| x.outcome == Outcome::Success)
+                .count()
+                .to_string(),
+            r.steps.to_string(),
+            r.makespan.map_or(String::new(), |m| m.to_string()),
+            format!("{:.3}", r.path_length_px),
+            r.collisions.to_string(),
+            r.robot_collisions.to_string(),
+            r.deadlock.to_string(),
+        ])?;
+    }
+    w.flush()
+}
+
+/// Columns of a team run's `robots.csv` (one row per robot per episode).
+pub const ROBOT_COLUMNS: [&str; 18] = [
+    "seed",
+    "robot",
+    "policy",
+    "outcome",
+    "steps",
+    "arrived_at",
+    "collisions",
+    "robot_collisions",
+    "dynamic_collisions",
+    "path_length_px",
+    "shortest_px",
+    "spl",
+    "start_x",
+    "start_y",
+    "start_heading_deg",
+    "goal_x",
+    "goal_y",
+    "reason",
+];
+
+/// Writes a team run's `robots.csv`: one row per robot of every episode.
+pub fn write_robots(records: &[TeamRecord], out: &mut dyn Write) -> std::io::Result<()> {
+    let mut w = csv::Writer::from_writer(out);
+    w.write_record(ROBOT_COLUMNS)?;
+    for r in records {
+        for x in &r.robots {
+            w.write_record([
+                r.seed.to_string(),
+                x.robot.to_string(),
+                x.policy.clone(),
+                x.outcome.name().to_string(),
+                x.steps.to_string(),
+                x.arrived_at.map_or(String::new(), |a| a.to_string()),
+                x.collisions.to_string(),
+                x.robot_collisions.to_string(),
+                x.dynamic_collisions
+                    .map_or(String::new(), |d| d.to_string()),
+                format!("{:.3}", x.path_length_px),
+                x.shortest_px.map_or(String::new(), |l| format!("{l:.3}")),
+                format!("{:.4}", x.spl),
+                format!("{:.3}", x.start.x),
+                format!("{:.3}", x.start.y),
+                format!("{:.3}", x.start.z_deg),
+                format!("{:.3}", x.goal.x),
+                format!("{:.3}", x.goal.y),
+                x.reason.clone().unwrap_or_default(),
+            ])?;
+        }
+    }
+    w.flush()
+}
+
+/// A finished team evaluation.
+#[derive(Debug)]
+pub struct TeamEvaluation {
+    /// The records and how the run stopped.
+    pub result: TeamRunResult,
+    /// The team figures.
+    pub team: TeamSummary,
+    /// The figures of every robot.
+    pub summary: Summary,
+    /// The run directory's files could not all be written.
+    pub write_error: Option<OutputError>,
+}
+
+/// Runs a team evaluation (robot `k` driven by `factories[k]`, named `names[k]`) and, given
+/// `dir`, writes `episodes.csv` (team rows), `robots.csv`, `timing.csv` and `summary.json` into
+/// it at the end, also after an interruption or a failing episode.
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate_team_into(
+    evaluator: &Evaluator,
+    factories: &[&dyn PolicyFactory],
+    names: &[String],
+    options: &EvalOptions,
+    info: &RunInfo,
+    dir: Option<&Path>,
+    cancel: &AtomicBool,
+    on_record: &(dyn Fn(&TeamRecord) + Sync),
+) -> Result<TeamEvaluation, PolicyError> {
+    let result = evaluator.run_team(factories, names, options, cancel, on_record)?;
+    let team = TeamSummary::new(&result.records, result.wall_time_s);
+    let robots: Vec<EpisodeRecord> = result
+        .records
+        .iter()
+        .flat_map(|r| r.robots.iter().map(|x| x.as_episode(r.seed)))
+        .collect();
+    let summary = Summary::new(&robots, result.wall_time_s);
+    let write_error = dir.and_then(|dir| {
+        let write = || -> Result<(), OutputError> {
+            std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
+                path: dir.to_path_buf(),
+                source,
+            })?;
+            write_atomic(&dir.join("episodes.csv"), |out| {
+                write_team_episodes(&result.records, out)
+            })?;
+            write_atomic(&dir.join("robots.csv"), |out| {
+                write_robots(&result.records, out)
+            })?;
+            write_atomic(&dir.join("timing.csv"), |out| {
+                let mut w = csv::Writer::from_writer(out);
+                w.write_record(["seed", "wall_time_ms"])?;
+                for r in &result.records {
+                    w.write_record([r.seed.to_string(), format!("{:.3}", r.wall_time_s * 1e3)])?;
+                }
+                w.flush()
+            })?;
+            let run = RunResult {
+                records: Vec::new(),
+                cancelled: result.cancelled,
+                error: result.error.clone(),
+                wall_time_s: result.wall_time_s,
+            };
+            let mut m = manifest(evaluator.config(), options, info, &run, &summary);
+            m.team = Some(team.clone());
+            m.write(&dir.join("summary.json"))
+        };
+        write().err()
+    });
+    Ok(TeamEvaluation {
+        result,
+        team,
+        summary,
+        write_error,
+    })
 }

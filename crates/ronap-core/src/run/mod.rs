@@ -1,9 +1,11 @@
 //! Running policies, above `policy`: one episode driven by one policy ([`rollout`]), and many
 //! episodes stepped side by side with automatic resets ([`batch`]), the engine of the vectorised
-//! Python environment and of DQN. Uses every layer up to `policy`.
+//! Python environment and of DQN, and a team of robots each with its own policy ([`team`]). Uses
+//! every layer up to `policy`.
 
 pub mod batch;
 pub mod rollout;
+pub mod team;
 
 use crate::policy::PolicyError;
 use crate::sim::placement::EpisodeError;

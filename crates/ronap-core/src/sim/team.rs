@@ -41,6 +41,8 @@ pub struct Team {
     /// The previous step's reward of each robot.
     rewards: Vec<f64>,
     touched: Vec<usize>,
+    /// Robots whose policies gave up.
+    retired: Vec<bool>,
 }
 
 /// Whether discs of radii summing to `reach`, moving at once from `a0` to `a1` and from `b0` to
@@ -112,6 +114,7 @@ impl Team {
                 .map(|r| (r.status() == Status::Success).then_some(0))
                 .collect(),
             rewards: vec![0.0; robots.len()],
+            retired: vec![false; robots.len()],
             robots,
             on_arrival,
             movers,
@@ -163,9 +166,9 @@ impl Team {
         !(self.on_arrival[k] == OnArrival::Vanish && self.robots[k].status() == Status::Success)
     }
 
-    /// Whether every robot's episode is over.
+    /// Whether every robot's episode is over (or its policy gave up).
     pub fn is_done(&self) -> bool {
-        self.robots.iter().all(|r| r.status().is_done())
+        (0..self.robots.len()).all(|k| !self.running(k))
     }
 
     /// Whether the team ended in a deadlock.
@@ -173,10 +176,20 @@ impl Team {
         self.robots.iter().any(|r| r.status() == Status::Deadlock)
     }
 
-    /// Ends robot `k`'s episode now with `status` (its policy gave up, say): it stays where it
-    /// is, an obstacle to the others.
-    pub fn end_robot(&mut self, k: usize, status: Status) {
-        self.robots[k].end(status);
+    /// Takes robot `k` out of the running (its policy gave up): it acts no more and stays where
+    /// it is, an obstacle to the others; its episode keeps its `Running` status.
+    pub fn retire(&mut self, k: usize) {
+        self.retired[k] = true;
+    }
+
+    /// Whether robot `k` was taken out of the running.
+    pub fn retired(&self, k: usize) -> bool {
+        self.retired[k]
+    }
+
+    /// Whether robot `k` still acts.
+    pub fn running(&self, k: usize) -> bool {
+        !self.retired[k] && self.robots[k].status() == Status::Running
     }
 
     /// One step: `actions[k]` for each robot (`None`: it does nothing, as a robot whose episode
@@ -198,11 +211,7 @@ impl Team {
             }
         }
         // Each running robot's motion and what the still scene and the obstacles say of it.
-        let running: Vec<bool> = self
-            .robots
-            .iter()
-            .map(|r| r.status() == Status::Running)
-            .collect();
+        let running: Vec<bool> = (0..n).map(|k| self.running(k)).collect();
         let mut motions: Vec<Option<Motion>> = vec![None; n];
         let mut wall = vec![false; n];
         let mut moving = vec![false; n];
@@ -293,9 +302,9 @@ impl Team {
         }
         self.still_for = if moved_any { 0 } else { self.still_for + 1 };
         if self.still_for >= self.deadlock_steps {
-            for r in &mut self.robots {
-                if r.status() == Status::Running {
-                    r.end(Status::Deadlock);
+            for k in 0..n {
+                if self.running(k) {
+                    self.robots[k].end(Status::Deadlock);
                 }
             }
         }
@@ -311,7 +320,7 @@ impl Team {
         let movers = self.movers.take();
         let mut others = Vec::with_capacity(discs.len());
         for k in 0..n {
-            if self.robots[k].status().is_done() && self.steps > 0 {
+            if !self.running(k) && self.steps > 0 {
                 continue;
             }
             others.clear();

@@ -211,6 +211,8 @@ pub struct Worlds {
     config: ValidConfig,
     scenes: Scenes,
     shared: Option<Arc<World>>,
+    /// A team's worlds (one per `[[robots]]` entry) in the shared scene, made on first use.
+    team_shared: std::sync::OnceLock<Vec<Arc<World>>>,
 }
 
 impl Worlds {
@@ -226,6 +228,7 @@ impl Worlds {
             config,
             scenes,
             shared,
+            team_shared: std::sync::OnceLock::new(),
         }
     }
 
@@ -247,6 +250,28 @@ impl Worlds {
                 Arc::new(World::warehouse(self.config.clone(), seed))
             }
             None => Arc::new(World::maze(self.config.clone(), seed)),
+        }
+    }
+
+    /// A team's worlds for episode `seed`: one per `[[robots]]` entry, each with the entry's
+    /// configuration ([`ValidConfig::team_robot`]) in the seed's scene (made once for a scene
+    /// every seed shares, so each entry's free-space grid is built once).
+    pub fn team(&self, seed: u64) -> Vec<Arc<World>> {
+        let make = |scene: &Arc<Scene>| {
+            let mut first = 0;
+            self.config
+                .robots
+                .iter()
+                .map(|entry| {
+                    let world = Arc::new(World::new(self.config.team_robot(first), scene.clone()));
+                    first += entry.count as usize;
+                    world
+                })
+                .collect::<Vec<_>>()
+        };
+        match &self.shared {
+            Some(w) => self.team_shared.get_or_init(|| make(w.scene())).clone(),
+            None => make(self.world(seed).scene()),
         }
     }
 

@@ -1,0 +1,116 @@
+//! End-to-end tests of team runs (`ronap run --scenario` with `[[robots]]`): the shipped corridor
+//! swap deadlocks and says so, robots.csv beside team rows, the same bytes on one and two
+//! threads, and bad entries named.
+
+use crate::util::{assert_rejected, col, ok, repo_root, ronap, rows};
+use std::path::Path;
+
+fn run_team(scenario: &Path, out: &Path, extra: &[&str]) -> String {
+    let mut args = vec![
+        "run",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--policy",
+        "geodesic",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    ok(&ronap(&args))
+}
+
+#[test]
+fn the_corridor_swap_deadlocks_and_is_reported_as_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("swap");
+    let table = run_team(
+        &repo_root().join("scenarios/corridor-swap.toml"),
+        &out,
+        &["--seeds", "3"],
+    );
+    assert!(table.contains("2 robots (2 x geodesic)"), "{table}");
+    assert!(table.contains("deadlocks               3"), "{table}");
+    let episodes = rows(&out.join("episodes.csv"));
+    assert_eq!(episodes.len(), 4);
+    let (outcome, deadlock) = (col(&episodes, "outcome"), col(&episodes, "deadlock"));
+    for r in &episodes[1..] {
+        assert_eq!(
+            (r[outcome].as_str(), r[deadlock].as_str()),
+            ("deadlock", "true")
+        );
+    }
+    let robots = rows(&out.join("robots.csv"));
+    assert_eq!(robots.len(), 1 + 3 * 2);
+    let rc = col(&robots, "robot_collisions");
+    assert!(robots[1..]
+        .iter()
+        .all(|r| r[rc].parse::<u32>().unwrap() > 0));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["team"]["deadlocks"], 3);
+}
+
+#[test]
+fn team_runs_are_the_same_on_one_and_two_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = dir.path().join("team.toml");
+    std::fs::write(
+        &scenario,
+        "[scene]\nkind = \"maze\"\n\n[[robots]]\ncount = 6\n\n[[robots]]\ncount = 2\npolicy = \"apf\"\non_arrival = \"vanish\"\n",
+    )
+    .unwrap();
+    let (a, b) = (dir.path().join("a"), dir.path().join("b"));
+    run_team(&scenario, &a, &["--seeds", "6", "--threads", "1"]);
+    run_team(&scenario, &b, &["--seeds", "6", "--threads", "2"]);
+    for f in ["episodes.csv", "robots.csv"] {
+        assert_eq!(
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(b.join(f)).unwrap(),
+            "{f}"
+        );
+    }
+    let robots = rows(&a.join("robots.csv"));
+    let policy = col(&robots, "policy");
+    assert_eq!(
+        robots[1..].iter().filter(|r| r[policy] == "apf").count(),
+        6 * 2
+    );
+}
+
+#[test]
+fn bad_robot_entries_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    for (text, names) in [
+        ("[[robots]]\ncount = 0\n", vec!["robots[0].count", "0"]),
+        (
+            "[[robots]]\ncount = 2\nstart = [50.0, 50.0, 0.0]\n",
+            vec!["robots[0].start", "count = 1"],
+        ),
+        (
+            "[[robots]]\nradius_px = -3.0\n",
+            vec!["robots[0].radius_px", "-3"],
+        ),
+        ("[[robots]]\nspeed = 3.0\n", vec!["speed"]),
+        (
+            "[[robots]]\non_arrival = \"fly\"\n",
+            vec!["on_arrival", "fly"],
+        ),
+    ] {
+        let f = dir.path().join("bad.toml");
+        std::fs::write(&f, text).unwrap();
+        let out = dir.path().join("never");
+        assert_rejected(
+            &[
+                "run",
+                "--policy",
+                "geodesic",
+                "--scenario",
+                f.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            &names,
+        );
+        assert!(!out.exists());
+    }
+}
