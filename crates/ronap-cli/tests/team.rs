@@ -26,8 +26,9 @@ fn the_corridor_swap_deadlocks_and_is_reported_as_one() {
     let table = run_team(
         &repo_root().join("scenarios/corridor-swap.toml"),
         &out,
-        &["--seeds", "3"],
+        &["--seeds", "3", "--png", "1"],
     );
+    image::open(out.join("png/seed-000000-deadlock.png")).unwrap();
     assert!(table.contains("2 robots (2 x geodesic)"), "{table}");
     assert!(table.contains("deadlocks               3"), "{table}");
     let episodes = rows(&out.join("episodes.csv"));

@@ -171,10 +171,10 @@ fn run_team(
     scenes: ronap_core::Scenes,
     map_source: Option<ronap_core::scene::map::MapSource>,
 ) -> Result<ExitCode> {
-    if args.png.is_some() || !args.gif.is_empty() || args.log_steps {
+    if !args.gif.is_empty() || args.log_steps {
         bail!(
-            "--png, --gif and --log-steps do not draw or log team runs yet; run without them \
-             (robots.csv holds every robot's figures)"
+            "--gif and --log-steps do not animate or log team runs yet; run without them \
+             (--png draws them; robots.csv holds every robot's figures)"
         );
     }
     let mut names = Vec::new();
@@ -227,6 +227,7 @@ fn run_team(
         &options,
         &info,
         Some(&out_dir),
+        args.png,
         &cancel,
         &|_| bar.inc(1),
     )?;

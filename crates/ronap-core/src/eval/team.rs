@@ -13,7 +13,7 @@ use crate::sim::robot::Pose;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 /// One robot of a finished team episode.
@@ -82,7 +82,7 @@ impl RobotRecord {
 }
 
 /// One finished team episode.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub struct TeamRecord {
     /// The seed.
     pub seed: u64,
@@ -105,6 +105,10 @@ pub struct TeamRecord {
     pub robots: Vec<RobotRecord>,
     /// Wall time, seconds.
     pub wall_time_s: f64,
+    /// Each robot's centre at every step from the start (while present), when recorded.
+    pub paths: Vec<Vec<Point>>,
+    /// The scene, when paths were recorded (for pictures).
+    pub scene: Option<Arc<crate::Scene>>,
 }
 
 /// The figures of a set of team episodes.
@@ -266,16 +270,30 @@ pub struct TeamRunResult {
 
 impl Evaluator {
     /// Runs the team episode of `seed` with `policies` (one per robot).
+    /// With `paths`, keeps every robot's path and the scene (for a picture).
     pub fn run_team_episode(
         &self,
         policies: &mut [Box<dyn crate::policy::Policy>],
         names: &[String],
         seed: u64,
+        paths: bool,
     ) -> Result<TeamRecord, RunError> {
         let clock = Instant::now();
         let worlds = self.worlds().team(seed);
         let mut rollout = TeamRollout::start(self.config(), worlds, seed, policies)?;
-        while rollout.advance(policies)? {}
+        let n = rollout.team().robots().len();
+        let mut tracks: Vec<Vec<Point>> = vec![Vec::new(); if paths { n } else { 0 }];
+        let note = |team: &crate::sim::team::Team, tracks: &mut Vec<Vec<Point>>| {
+            for (k, t) in tracks.iter_mut().enumerate() {
+                if team.present(k) {
+                    t.push(team.robot(k).pose().position());
+                }
+            }
+        };
+        note(rollout.team(), &mut tracks);
+        while rollout.advance(policies)? {
+            note(rollout.team(), &mut tracks);
+        }
         let team = rollout.team();
         let mut robots = Vec::new();
         for (k, r) in team.robots().iter().enumerate() {
@@ -346,6 +364,8 @@ impl Evaluator {
             deadlock,
             robots,
             wall_time_s: clock.elapsed().as_secs_f64(),
+            scene: paths.then(|| team.robot(0).scene().clone()),
+            paths: tracks,
         })
     }
 
@@ -386,10 +406,17 @@ impl Evaluator {
                             return None;
                         }
                     };
-                    let result = self.run_team_episode(&mut policies, names, seed);
-                    match &result {
-                        Ok(r) => on_record(r),
-                        Err(_) => cancel.store(true, Ordering::Relaxed),
+                    let paths = options.recording.trajectory;
+                    let result = self
+                        .run_team_episode(&mut policies, names, seed, paths)
+                        .map(|mut r| {
+                            on_record(&r);
+                            r.paths = Vec::new();
+                            r.scene = None;
+                            r
+                        });
+                    if result.is_err() {
+                        cancel.store(true, Ordering::Relaxed);
                     }
                     Some(result)
                 })
@@ -461,26 +488,34 @@ mod tests {
             .expect("runs")
             .records
             .into_iter()
-            .map(|mut r| {
-                r.wall_time_s = 0.0;
-                r
-            })
+            .map(|r| (r.seed, r.outcome, r.steps, r.makespan, r.robots))
             .collect::<Vec<_>>()
         };
         let one = run(1);
         assert_eq!(one, run(2));
         assert_eq!(one.len(), 8);
-        for r in &one {
-            assert_eq!(r.robots.len(), 4);
-            if r.outcome == Outcome::Success {
-                assert_eq!(
-                    r.makespan,
-                    r.robots.iter().filter_map(|x| x.arrived_at).max()
-                );
+        for (_, outcome, _, makespan, robots) in &one {
+            assert_eq!(robots.len(), 4);
+            if *outcome == Outcome::Success {
+                assert_eq!(*makespan, robots.iter().filter_map(|x| x.arrived_at).max());
             }
         }
         // Four geodesic robots in a maze mostly all arrive.
-        let summary = TeamSummary::new(&one, 1.0);
+        let options = EvalOptions {
+            seeds: (0..8).collect(),
+            ..Default::default()
+        };
+        let records = ev
+            .run_team(
+                &factories,
+                &names,
+                &options,
+                &AtomicBool::new(false),
+                &|_| {},
+            )
+            .expect("runs")
+            .records;
+        let summary = TeamSummary::new(&records, 1.0);
         assert!(summary.robot_success_rate > 0.5, "{summary:?}");
     }
 }

@@ -51,10 +51,15 @@ impl std::str::FromStr for Pictures {
 impl Pictures {
     /// Whether `record` gets a picture, in a run whose seeds start at `first_seed`.
     pub fn wants(self, record: &EpisodeRecord, first_seed: u64) -> bool {
+        self.wants_seed(record.seed, record.outcome, first_seed)
+    }
+
+    /// Whether the episode of `seed`, which ended as `outcome`, gets a picture.
+    pub fn wants_seed(self, seed: u64, outcome: Outcome, first_seed: u64) -> bool {
         match self {
             Pictures::All => true,
-            Pictures::Failures => record.outcome != Outcome::Success,
-            Pictures::First(n) => record.seed.wrapping_sub(first_seed) < n,
+            Pictures::Failures => outcome != Outcome::Success,
+            Pictures::First(n) => seed.wrapping_sub(first_seed) < n,
         }
     }
 }
@@ -486,10 +491,46 @@ pub fn evaluate_team_into(
     options: &EvalOptions,
     info: &RunInfo,
     dir: Option<&Path>,
+    pictures: Option<Pictures>,
     cancel: &AtomicBool,
     on_record: &(dyn Fn(&TeamRecord) + Sync),
 ) -> Result<TeamEvaluation, PolicyError> {
-    let result = evaluator.run_team(factories, names, options, cancel, on_record)?;
+    let mut options = options.clone();
+    options.recording.trajectory = pictures.is_some() && dir.is_some();
+    let first = options.seeds.first().copied().unwrap_or(0);
+    let picture_errors: Mutex<Vec<String>> = Mutex::new(Vec::new());
+    if let (Some(dir), Some(_)) = (dir, pictures) {
+        let png = dir.join("png");
+        if let Err(e) = std::fs::create_dir_all(&png) {
+            return Err(PolicyError::Failed(format!(
+                "cannot make {}: {e}",
+                png.display()
+            )));
+        }
+        if let Err(e) = remove_stale_files(dir) {
+            return Err(PolicyError::Failed(e.to_string()));
+        }
+    }
+    let result = evaluator.run_team(factories, names, &options, cancel, &|r: &TeamRecord| {
+        if let (Some(dir), Some(p)) = (dir, pictures) {
+            if p.wants_seed(r.seed, r.outcome, first) {
+                if let Some(img) = crate::render::team::team_image(r, 1.0) {
+                    let path = dir.join("png").join(format!(
+                        "seed-{:06}-{}.png",
+                        r.seed,
+                        r.outcome.name()
+                    ));
+                    if let Err(e) = save_image(&path, &img) {
+                        if let Ok(mut all) = picture_errors.lock() {
+                            all.push(e.to_string());
+                        }
+                    }
+                }
+            }
+        }
+        on_record(r);
+    })?;
+    let options = &options;
     let team = TeamSummary::new(&result.records, result.wall_time_s);
     let robots: Vec<EpisodeRecord> = result
         .records
@@ -525,7 +566,15 @@ pub fn evaluate_team_into(
             };
             let mut m = manifest(evaluator.config(), options, info, &run, &summary);
             m.team = Some(team.clone());
-            m.write(&dir.join("summary.json"))
+            m.write(&dir.join("summary.json"))?;
+            let errors = picture_errors.into_inner().unwrap_or_default();
+            match errors.first() {
+                Some(first) => Err(OutputError::Episodes {
+                    count: errors.len(),
+                    first: first.clone(),
+                }),
+                None => Ok(()),
+            }
         };
         write().err()
     });

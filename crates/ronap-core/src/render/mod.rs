@@ -10,6 +10,7 @@
 pub mod chart;
 pub mod first_person;
 pub mod gif;
+pub mod team;
 pub mod trajectory;
 
 pub use first_person::{first_person, HeadingUp, FIRST_PERSON_HALF_SPAN};
