@@ -79,6 +79,33 @@ fn team_runs_are_the_same_on_one_and_two_threads() {
 }
 
 #[test]
+fn goal_lists_report_every_order_s_tour() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("wh");
+    run_team(
+        &repo_root().join("scenarios/warehouse-team.toml"),
+        &out,
+        &["--seeds", "2"],
+    );
+    let robots = rows(&out.join("robots.csv"));
+    assert_eq!(robots.len(), 1 + 2 * 8);
+    let [goals, chosen, given, nearest, optimal] = [
+        "goals",
+        "tour_px",
+        "given_tour_px",
+        "nearest_tour_px",
+        "optimal_tour_px",
+    ]
+    .map(|c| col(&robots, c));
+    for r in &robots[1..] {
+        assert_eq!(r[goals], "3");
+        let px = |i: usize| r[i].parse::<f64>().unwrap();
+        assert_eq!(px(chosen), px(optimal));
+        assert!(px(optimal) <= px(given) + 1e-6 && px(optimal) <= px(nearest) + 1e-6);
+    }
+}
+
+#[test]
 fn bad_robot_entries_are_named() {
     let dir = tempfile::tempdir().unwrap();
     for (text, names) in [

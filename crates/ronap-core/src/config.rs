@@ -507,6 +507,21 @@ pub struct SimConfig {
     pub robots: Vec<TeamRobotConfig>,
 }
 
+/// In which order a robot visits its goals (SPEC "Multi-destination tasks").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Order {
+    /// As listed.
+    #[default]
+    Given,
+    /// Greedily: each time the unvisited goal nearest by geodesic distance, the first listed on a
+    /// tie.
+    Nearest,
+    /// The order minimising the summed geodesic distance: exact for up to
+    /// `plan::tour::HELD_KARP_MAX_GOALS` (12) goals, never longer than [`Order::Nearest`]'s beyond.
+    Optimal,
+}
+
 /// What a robot of a team does on reaching its goal.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -544,8 +559,16 @@ pub struct TeamRobotConfig {
     pub laser_range_px: Option<f64>,
     /// Laser field of view, degrees. Default: `laser.fov_deg`.
     pub laser_fov_deg: Option<f64>,
-    /// On reaching its goal: `stay` (default; it stays an obstacle there) or `vanish`.
+    /// On reaching its (last) goal: `stay` (default; it stays an obstacle there) or `vanish`.
     pub on_arrival: OnArrival,
+    /// Fixed goals `[[x, y], ...]` visited one after the other (count 1 only; instead of `goal`).
+    /// Default: `goal_count` goals drawn from the seed.
+    pub goals: Vec<[f64; 2]>,
+    /// Goals drawn from the seed when `goals` is unset. Default 1.
+    pub goal_count: u32,
+    /// The order the goals are visited in: `given` (default), `nearest` (greedily by geodesic
+    /// distance) or `optimal` (the shortest tour).
+    pub order: Order,
 }
 
 impl Default for TeamRobotConfig {
@@ -562,9 +585,15 @@ impl Default for TeamRobotConfig {
             laser_range_px: None,
             laser_fov_deg: None,
             on_arrival: OnArrival::Stay,
+            goals: Vec::new(),
+            goal_count: 1,
+            order: Order::Given,
         }
     }
 }
+
+/// Most goals one robot visits.
+pub const MAX_GOALS: u32 = 64;
 
 /// Largest number of robots in a team.
 pub const MAX_ROBOTS: u32 = 10_000;
@@ -636,7 +665,7 @@ impl ValidConfig {
                 c.laser.fov_deg = v;
             }
             c.episode.start = e.start;
-            c.episode.goal = e.goal;
+            c.episode.goal = e.goal.or(e.goals.first().copied());
         }
         ValidConfig(c)
     }
@@ -1058,6 +1087,21 @@ impl SimConfig {
                     "must be between 0 and 360",
                 )?;
             }
+            for p in &r.goals {
+                point(&f("goals"), *p)?;
+            }
+            check(
+                r.goals.is_empty() || (r.count == 1 && r.goal.is_none()),
+                &f("goals"),
+                format!("{:?}", r.goals),
+                "a goal list is for one robot (count = 1) without `goal`",
+            )?;
+            check(
+                (1..=MAX_GOALS).contains(&r.goal_count),
+                &f("goal_count"),
+                r.goal_count,
+                "must be between 1 and 64",
+            )?;
             if let Some(p) = &r.policy {
                 check(
                     !p.trim().is_empty(),
@@ -1234,7 +1278,16 @@ const ROBOTS_DOCS: &[(&str, &str)] = &[
     ),
     (
         "on_arrival",
-        "On reaching the goal: \"stay\" (an obstacle there) or \"vanish\" (leave the scene).",
+        "On reaching the (last) goal: \"stay\" (an obstacle there) or \"vanish\" (leave the scene).",
+    ),
+    (
+        "goals",
+        "Fixed goals [[x, y], ...] visited one after the other (count 1). Unset: goal_count drawn.",
+    ),
+    ("goal_count", "Goals drawn from the seed, visited one after the other."),
+    (
+        "order",
+        "Visiting order: \"given\", \"nearest\" (greedy, geodesic) or \"optimal\" (shortest tour).",
     ),
 ];
 

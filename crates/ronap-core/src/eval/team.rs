@@ -39,7 +39,14 @@ pub struct RobotRecord {
     pub dynamic_collisions: Option<u32>,
     /// Distance driven, px.
     pub path_length_px: f64,
-    /// Its shortest path from start to within epsilon of the goal (on success), px.
+    /// Goals it had (1, or a goal list's length).
+    pub goals: u32,
+    /// Goals it reached.
+    pub goals_reached: u32,
+    /// A goal list's tour lengths (the driven order's and the optimal one), px.
+    pub tour: Option<crate::run::team::TourLengths>,
+    /// Its shortest path from start to within epsilon of the goal (on success; through every
+    /// goal of a list, the optimal tour less the tolerance at each end of each leg), px.
     pub shortest_px: Option<f64>,
     /// SPL.
     pub spl: f64,
@@ -303,10 +310,17 @@ impl Evaluator {
                 Outcome::of(r.status())
             };
             let tolerance = r.config().episode.goal_tolerance_px;
+            let tour = rollout.tour(k);
+            // Each goal counts as reached within the tolerance: a tour of n goals can be cut by
+            // up to the tolerance on arriving at each and on leaving each but the last.
+            let goals = team.goals(k).len().max(1) as f64;
             let shortest_px = (outcome == Outcome::Success)
-                .then(|| shortest_path_px(rollout.world(k), r.start().position(), r.goal()))
+                .then(|| match tour {
+                    Some(t) => Some(t.optimal).filter(|l| l.is_finite()),
+                    None => shortest_path_px(rollout.world(k), r.start().position(), r.goal()),
+                })
                 .flatten()
-                .map(|l| (l - tolerance).max(0.0));
+                .map(|l| (l - tolerance * (2.0 * goals - 1.0)).max(0.0));
             let spl = match shortest_px {
                 Some(l) if r.path_length_px() > 0.0 => l / l.max(r.path_length_px()),
                 Some(_) => 1.0,
@@ -322,6 +336,9 @@ impl Evaluator {
                 collisions: r.collisions(),
                 robot_collisions: r.robot_collisions(),
                 dynamic_collisions: r.dynamic_metrics().map(|d| d.collisions),
+                goals: team.goals(k).len() as u32,
+                goals_reached: r.goals_reached(),
+                tour,
                 path_length_px: r.path_length_px(),
                 shortest_px,
                 spl,
@@ -516,6 +533,65 @@ mod tests {
             .expect("runs")
             .records;
         let summary = TeamSummary::new(&records, 1.0);
+        assert!(records
+            .iter()
+            .all(|r| r.robots.iter().all(|x| x.goals == 1 && x.tour.is_none())));
         assert!(summary.robot_success_rate > 0.5, "{summary:?}");
+    }
+
+    #[test]
+    fn goal_lists_are_visited_in_the_optimal_order() {
+        let config = crate::SimConfig {
+            robots: vec![TeamRobotConfig {
+                count: 3,
+                goal_count: 4,
+                order: crate::config::Order::Optimal,
+                ..Default::default()
+            }],
+            ..Default::default()
+        }
+        .validate()
+        .expect("valid");
+        let ev = Evaluator::new(config, Scenes::MazePerSeed);
+        let f = factory("geodesic", ev.config().observation_size()).expect("geodesic");
+        let factories: Vec<&dyn PolicyFactory> = (0..3).map(|_| f.as_ref()).collect();
+        let names = vec!["geodesic".to_string(); 3];
+        let options = EvalOptions {
+            seeds: (0..6).collect(),
+            ..Default::default()
+        };
+        let records = ev
+            .run_team(
+                &factories,
+                &names,
+                &options,
+                &AtomicBool::new(false),
+                &|_| {},
+            )
+            .expect("runs")
+            .records;
+        let mut arrived = 0;
+        for r in &records {
+            for x in &r.robots {
+                let t = x.tour.expect("a goal list");
+                assert!(
+                    t.optimal <= t.nearest + 1e-9 && t.optimal <= t.given + 1e-9,
+                    "{t:?}"
+                );
+                assert_eq!(t.chosen_px(), t.optimal);
+                assert_eq!(x.goals, 4);
+                assert!(x.goals_reached <= 4);
+                if x.outcome == Outcome::Success {
+                    arrived += 1;
+                    assert_eq!(x.goals_reached, 4);
+                    // Never shorter than the optimal tour (less the goals' tolerances).
+                    let shortest = x.shortest_px.expect("success");
+                    assert!(x.path_length_px >= shortest - 1e-6, "{x:?}");
+                } else {
+                    assert!(x.goals_reached < 4);
+                }
+            }
+        }
+        assert!(arrived > 0);
     }
 }

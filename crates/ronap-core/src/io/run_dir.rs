@@ -414,7 +414,7 @@ pub fn write_team_episodes(records: &[TeamRecord], out: &mut dyn Write) -> std::
 }
 
 /// Columns of a team run's `robots.csv` (one row per robot per episode).
-pub const ROBOT_COLUMNS: [&str; 18] = [
+pub const ROBOT_COLUMNS: [&str; 24] = [
     "seed",
     "robot",
     "policy",
@@ -424,6 +424,12 @@ pub const ROBOT_COLUMNS: [&str; 18] = [
     "collisions",
     "robot_collisions",
     "dynamic_collisions",
+    "goals",
+    "goals_reached",
+    "tour_px",
+    "given_tour_px",
+    "nearest_tour_px",
+    "optimal_tour_px",
     "path_length_px",
     "shortest_px",
     "spl",
@@ -452,6 +458,15 @@ pub fn write_robots(records: &[TeamRecord], out: &mut dyn Write) -> std::io::Res
                 x.robot_collisions.to_string(),
                 x.dynamic_collisions
                     .map_or(String::new(), |d| d.to_string()),
+                x.goals.to_string(),
+                x.goals_reached.to_string(),
+                x.tour
+                    .map_or(String::new(), |t| format!("{:.3}", t.chosen_px())),
+                x.tour.map_or(String::new(), |t| format!("{:.3}", t.given)),
+                x.tour
+                    .map_or(String::new(), |t| format!("{:.3}", t.nearest)),
+                x.tour
+                    .map_or(String::new(), |t| format!("{:.3}", t.optimal)),
                 format!("{:.3}", x.path_length_px),
                 x.shortest_px.map_or(String::new(), |l| format!("{l:.3}")),
                 format!("{:.4}", x.spl),

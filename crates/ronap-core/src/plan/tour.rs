@@ -7,8 +7,6 @@
 //! unvisited goal; [`Order::Optimal`] minimises the tour length, exactly by Held-Karp for up to
 //! [`HELD_KARP_MAX_GOALS`] goals and by 2-opt and or-opt from the nearest-neighbour tour beyond.
 
-use serde::{Deserialize, Serialize};
-
 /// Most goals [`Order::Optimal`] orders exactly (Held-Karp, O(2^n n^2) time, O(2^n n) memory);
 /// beyond, it improves the nearest-neighbour tour by local search.
 pub const HELD_KARP_MAX_GOALS: usize = 12;
@@ -20,20 +18,7 @@ const OR_OPT_MAX_SEGMENT: usize = 3;
 /// above the rounding error of summing them, so rounding can never make local search cycle.
 const MIN_IMPROVEMENT: f64 = 1e-9;
 
-/// In which order a robot visits its goals (SPEC "Multi-destination tasks").
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Order {
-    /// As listed.
-    #[default]
-    Given,
-    /// Greedily: each time the unvisited goal nearest by geodesic distance, the first listed on a
-    /// tie.
-    Nearest,
-    /// The order minimising the summed geodesic distance: exact for up to
-    /// [`HELD_KARP_MAX_GOALS`] goals, never longer than [`Order::Nearest`]'s beyond.
-    Optimal,
-}
+pub use crate::config::Order;
 
 /// Why a [`CostMatrix`] could not be built.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -659,7 +644,7 @@ mod tests {
 
     #[test]
     fn order_reads_lower_case_names() {
-        #[derive(Deserialize, Serialize)]
+        #[derive(serde::Deserialize, serde::Serialize)]
         struct Task {
             order: Order,
         }

@@ -3,6 +3,9 @@
 //! the other robots in it, goal), then the team moves at once. A policy that gives up takes its
 //! robot out of the running; it stays where it is, an obstacle to the others.
 
+use crate::geometry::Point;
+use crate::plan::tour::{self, CostMatrix, Order};
+use crate::plan::{path_length, smooth, DistanceField};
 use crate::policy::{Decision, Policy};
 use crate::run::RunError;
 use crate::sim::robot::Action;
@@ -16,6 +19,92 @@ pub struct TeamRollout {
     team: Team,
     worlds: Vec<Arc<World>>,
     gave_up: Vec<Option<String>>,
+    /// The tour lengths of each robot with a goal list.
+    tours: Vec<Option<TourLengths>>,
+}
+
+/// A goal list's tour lengths under each order (geodesic, px; infinite where a leg cannot be
+/// driven), and the one the robot drives.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TourLengths {
+    /// In the order listed or drawn.
+    pub given: f64,
+    /// Greedily to the nearest goal.
+    pub nearest: f64,
+    /// The shortest tour (exact up to 12 goals).
+    pub optimal: f64,
+    /// The order the robot drives.
+    pub chosen: Order,
+}
+
+impl TourLengths {
+    /// The length of the tour the robot drives.
+    pub fn chosen_px(&self) -> f64 {
+        match self.chosen {
+            Order::Given => self.given,
+            Order::Nearest => self.nearest,
+            Order::Optimal => self.optimal,
+        }
+    }
+}
+
+/// The tour lengths from `start` through `goals` in `world` under every order, and the visiting
+/// order `order` gives (indices into `goals`). Costs are shortest-path lengths for the world's
+/// robot (a distance field per goal, each leg's path smoothed).
+fn plan_tour(
+    world: &World,
+    start: Point,
+    goals: &[Point],
+    order: Order,
+) -> (TourLengths, Vec<usize>) {
+    let radius = world.config().robot.radius_px;
+    let nodes: Vec<Point> = std::iter::once(start)
+        .chain(goals.iter().copied())
+        .collect();
+    let fields: Vec<DistanceField> = goals
+        .iter()
+        .map(|&g| DistanceField::new(world.scene(), world.grid(), g, radius, 1.0))
+        .collect();
+    let leg = |from: usize, to: usize| -> f64 {
+        if to == 0 || from == to {
+            return 0.0;
+        }
+        fields[to - 1]
+            .path(world.scene(), world.grid(), nodes[from], radius)
+            .map_or(f64::INFINITY, |p| {
+                path_length(&smooth(world.scene(), &p, radius))
+            })
+    };
+    let tours = CostMatrix::from_fn(nodes.len(), leg).map(|costs| {
+        [Order::Given, Order::Nearest, Order::Optimal].map(|o| tour::order(&costs, o))
+    });
+    match tours {
+        Ok([given, nearest, optimal]) => {
+            let visit = match order {
+                Order::Given => given.goals.clone(),
+                Order::Nearest => nearest.goals.clone(),
+                Order::Optimal => optimal.goals.clone(),
+            };
+            (
+                TourLengths {
+                    given: given.length,
+                    nearest: nearest.length,
+                    optimal: optimal.length,
+                    chosen: order,
+                },
+                visit,
+            )
+        }
+        Err(_) => (
+            TourLengths {
+                given: f64::INFINITY,
+                nearest: f64::INFINITY,
+                optimal: f64::INFINITY,
+                chosen: order,
+            },
+            (0..goals.len()).collect(),
+        ),
+    }
 }
 
 impl TeamRollout {
@@ -38,6 +127,22 @@ impl TeamRollout {
             });
         }
         let per_robot = robot_worlds(config, &worlds);
+        let mut team = team;
+        let mut tours = vec![None; n];
+        for (k, tour) in tours.iter_mut().enumerate() {
+            if team.goals(k).len() < 2 {
+                continue;
+            }
+            let order = config.team_entry(k).map(|e| e.order).unwrap_or_default();
+            let (lengths, visit) = plan_tour(
+                &per_robot[k],
+                team.robot(k).start().position(),
+                team.goals(k),
+                order,
+            );
+            team.order_goals(k, &visit);
+            *tour = Some(lengths);
+        }
         for (k, policy) in policies.iter_mut().enumerate() {
             policy
                 .reset(&per_robot[k], team.robot(k))
@@ -51,6 +156,7 @@ impl TeamRollout {
             gave_up: vec![None; n],
             team,
             worlds: per_robot,
+            tours,
         })
     }
 
@@ -62,6 +168,11 @@ impl TeamRollout {
     /// Robot `k`'s world.
     pub fn world(&self, k: usize) -> &Arc<World> {
         &self.worlds[k]
+    }
+
+    /// Robot `k`'s tour lengths, when it has a goal list.
+    pub fn tour(&self, k: usize) -> Option<TourLengths> {
+        self.tours[k]
     }
 
     /// Why robot `k`'s policy gave up, if it did.
@@ -110,7 +221,23 @@ impl TeamRollout {
         if self.finished() {
             return Ok(false);
         }
+        let reached: Vec<u32> = self
+            .team
+            .robots()
+            .iter()
+            .map(|r| r.goals_reached())
+            .collect();
         self.team.step(&actions);
+        // A robot on to the next goal of its list starts a new leg: its policy plans afresh.
+        for (k, policy) in policies.iter_mut().enumerate() {
+            let r = self.team.robot(k);
+            if self.team.running(k) && r.goals_reached() > reached[k] {
+                let seed = r.seed();
+                policy
+                    .reset(&self.worlds[k], r)
+                    .map_err(|source| RunError::Policy { seed, step, source })?;
+            }
+        }
         Ok(true)
     }
 

@@ -122,6 +122,10 @@ pub struct Episode {
     among_movers: bool,
     /// Steps another robot of a team blocked.
     robot_collisions: u32,
+    /// The goals after the first of a goal list, and how many of them are behind.
+    later_goals: Vec<Point>,
+    next_goal: usize,
+    goals_reached: u32,
 }
 
 /// How an episode went among moving obstacles (SPEC "Moving obstacles", metrics).
@@ -225,6 +229,9 @@ impl Episode {
             movers,
             dynamic: DynamicMetrics::default(),
             robot_collisions: 0,
+            later_goals: Vec::new(),
+            next_goal: 0,
+            goals_reached: 0,
         };
         episode.sense();
         if episode.distance_px < config.episode.goal_tolerance_px {
@@ -354,6 +361,34 @@ impl Episode {
         self.result(reward, collided)
     }
 
+    /// Makes `goals` the robot's goals, visited one after the other from the first (a goal
+    /// list, SPEC "Multi-destination tasks"); the observation follows the current one.
+    pub(crate) fn set_goals(&mut self, goals: &[Point]) {
+        if let Some((&first, rest)) = goals.split_first() {
+            self.goal = first;
+            self.later_goals = rest.to_vec();
+            self.next_goal = 0;
+            self.refresh_goal();
+        }
+    }
+
+    /// The goals still to visit after the current one.
+    pub fn later_goals(&self) -> &[Point] {
+        &self.later_goals[self.next_goal..]
+    }
+
+    /// Goals reached so far.
+    pub fn goals_reached(&self) -> u32 {
+        self.goals_reached
+    }
+
+    /// Recomputes the goal distance and the observation's goal direction for a new goal.
+    fn refresh_goal(&mut self) {
+        self.distance_px = (self.goal - self.pose.position()).norm();
+        let last = self.readings.len();
+        self.observation[last] = (self.direction_deg() / 360.0) as f32;
+    }
+
     /// The first half of a step: where `action` would take the robot (no collision check).
     pub(crate) fn motion(&self, action: Action) -> Motion {
         self.robot.motion(self.pose, action)
@@ -407,7 +442,18 @@ impl Episode {
             reward += w.success;
         }
         self.total_reward += reward;
-        self.status = if success {
+        let mut last = success;
+        if success {
+            self.goals_reached += 1;
+            if let Some(&next) = self.later_goals.get(self.next_goal) {
+                // On to the next goal of the list.
+                self.next_goal += 1;
+                self.goal = next;
+                self.refresh_goal();
+                last = false;
+            }
+        }
+        self.status = if last {
             Status::Success
         } else if collided && self.config.robot.on_collision == OnCollision::Terminate {
             Status::Collision

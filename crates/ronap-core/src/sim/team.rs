@@ -43,6 +43,8 @@ pub struct Team {
     touched: Vec<usize>,
     /// Robots whose policies gave up.
     retired: Vec<bool>,
+    /// Each robot's goals as drawn or listed (before any reordering).
+    goal_lists: Vec<Vec<Point>>,
 }
 
 /// Whether discs of radii summing to `reach`, moving at once from `a0` to `a1` and from `b0` to
@@ -69,6 +71,7 @@ impl Team {
         let mut on_arrival = Vec::with_capacity(n);
         let mut others = stream(seed, Stream::Team);
         let mut taken: Vec<(Point, Point, f64)> = Vec::new();
+        let mut goal_lists: Vec<Vec<Point>> = Vec::with_capacity(n);
         let mut k = 0;
         for (e, entry) in config.robots.iter().enumerate() {
             let world = &worlds[e];
@@ -90,8 +93,37 @@ impl Team {
                 } else {
                     sample_placement_with(cfg, scene, grid, seed, &mut others, clear)?
                 };
-                let robot = Episode::placed(cfg, scene.clone(), seed, placement, false)?;
+                let mut robot = Episode::placed(cfg, scene.clone(), seed, placement, false)?;
+                let goals: Vec<Point> = if !entry.goals.is_empty() {
+                    entry.goals.iter().map(|g| Point::new(g[0], g[1])).collect()
+                } else {
+                    let mut goals = vec![placement.goal];
+                    let tolerance = cfg.episode.goal_tolerance_px;
+                    let mut fixed = cfg.as_sim_config().clone();
+                    let s = placement.start;
+                    fixed.episode.start = Some([s.x, s.y, s.z_deg]);
+                    fixed.episode.goal = None;
+                    let fixed = fixed
+                        .validate()
+                        .map_err(|e| EpisodeError::Moving(e.to_string()))?;
+                    for _ in 1..entry.goal_count {
+                        let apart = |_: Point, g: Point| {
+                            goals.iter().all(|q| (g - q).norm() >= 2.0 * tolerance)
+                                && taken.iter().all(|&(_, q, r)| {
+                                    (g - q).norm() >= radius + r + PLACEMENT_GAP_PX
+                                })
+                        };
+                        let p =
+                            sample_placement_with(&fixed, scene, grid, seed, &mut others, apart)?;
+                        goals.push(p.goal);
+                    }
+                    goals
+                };
+                if goals.len() > 1 {
+                    robot.set_goals(&goals);
+                }
                 taken.push((placement.start.position(), placement.goal, radius));
+                goal_lists.push(goals);
                 robots.push(robot);
                 on_arrival.push(entry.on_arrival);
                 k += 1;
@@ -115,6 +147,7 @@ impl Team {
                 .collect(),
             rewards: vec![0.0; robots.len()],
             retired: vec![false; robots.len()],
+            goal_lists,
             robots,
             on_arrival,
             movers,
@@ -174,6 +207,23 @@ impl Team {
     /// Whether the team ended in a deadlock.
     pub fn deadlocked(&self) -> bool {
         self.robots.iter().any(|r| r.status() == Status::Deadlock)
+    }
+
+    /// Robot `k`'s goals as drawn or listed (one, or a goal list).
+    pub fn goals(&self, k: usize) -> &[Point] {
+        &self.goal_lists[k]
+    }
+
+    /// Makes robot `k` visit its goals in `order` (indices into [`Team::goals`]); before the
+    /// first step only.
+    pub fn order_goals(&mut self, k: usize, order: &[usize]) {
+        let goals: Vec<Point> = order
+            .iter()
+            .filter_map(|&i| self.goal_lists[k].get(i).copied())
+            .collect();
+        if self.steps == 0 && goals.len() == self.goal_lists[k].len() {
+            self.robots[k].set_goals(&goals);
+        }
     }
 
     /// Takes robot `k` out of the running (its policy gave up): it acts no more and stays where
