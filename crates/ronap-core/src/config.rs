@@ -505,7 +505,52 @@ pub struct SimConfig {
     /// Several robots (SPEC "Several robots"); none: the one robot of `[robot]`.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub robots: Vec<TeamRobotConfig>,
+    /// How the robots of a team talk (SPEC "Several robots", communication).
+    #[serde(skip_serializing_if = "TeamConfig::is_default")]
+    pub team: TeamConfig,
 }
+
+/// Communication between the robots of a team: each broadcasts its pose, goal and a message of
+/// `message_size` floats its policy chooses; a robot receives what the robots within
+/// `comm_range_px` sent at the previous step, and its observation carries the `neighbours`
+/// nearest of them after the paper's values.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TeamConfig {
+    /// Range of a broadcast, px. Default 200.
+    pub comm_range_px: f64,
+    /// Floats in a policy's message. Default 0 (pose and goal only).
+    pub message_size: u32,
+    /// Nearest senders in the observation: each `[dx, dy]` in the robot's frame over
+    /// `comm_range_px`, the heading difference over 360, 1 (present), then its message;
+    /// zeros for missing ones. Default 0 (the paper's observation).
+    pub neighbours: u32,
+}
+
+impl Default for TeamConfig {
+    fn default() -> Self {
+        Self {
+            comm_range_px: 200.0,
+            message_size: 0,
+            neighbours: 0,
+        }
+    }
+}
+
+impl TeamConfig {
+    /// Whether every field has its default (then written configurations leave it out).
+    pub fn is_default(&self) -> bool {
+        *self == Self::default()
+    }
+
+    /// Values per neighbour in the observation.
+    pub fn slot_size(&self) -> usize {
+        4 + self.message_size as usize
+    }
+}
+
+/// Most neighbours, and most floats in a message.
+pub const MAX_NEIGHBOURS: u32 = 64;
 
 /// In which order a robot visits its goals (SPEC "Multi-destination tasks").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -619,7 +664,7 @@ impl ValidConfig {
     /// Length of the observation a policy sees: one value per laser beam, then the goal
     /// direction (SPEC "Observation and reward").
     pub fn observation_size(&self) -> usize {
-        self.laser.beams as usize + 1
+        self.laser.beams as usize + 1 + self.team.neighbours as usize * self.team.slot_size()
     }
 
     /// Robots in a team (0: no `[[robots]]`, the one robot of `[robot]`).
@@ -1116,6 +1161,20 @@ impl SimConfig {
             "robots",
             robots,
             "at most 10000 robots in all",
+        )?;
+        let t = &self.team;
+        length("team.comm_range_px", t.comm_range_px, true)?;
+        check(
+            t.message_size <= MAX_NEIGHBOURS,
+            "team.message_size",
+            t.message_size,
+            "must be between 0 and 64",
+        )?;
+        check(
+            t.neighbours <= MAX_NEIGHBOURS,
+            "team.neighbours",
+            t.neighbours,
+            "must be between 0 and 64",
         )
     }
 }
@@ -1192,6 +1251,9 @@ const FIELD_DOCS: &[(&str, &str, &str, Option<&str>)] = &[
     ("episode", "grid_px", "Cell side of the free-space grid for connected regions and planners, px.", None),
     ("episode", "safety_radius_px", "A step is near a moving obstacle when the gap to one is below this, px. Unset: two robot radii.", Some("10.0")),
     ("episode", "deadlock_steps", "Several robots: the episode ends as a deadlock when no robot has moved for this many steps.", None),
+    ("team", "comm_range_px", "Several robots: range of each robot's broadcast (pose, goal, message), px.", None),
+    ("team", "message_size", "Several robots: floats in the message a policy broadcasts each step (0: pose and goal only).", None),
+    ("team", "neighbours", "Several robots: nearest senders in the observation, after the paper's values (0: the paper's observation).", None),
     ("reward", "collision", "r_a: added on a step that collided.", None),
     ("reward", "progress_per_px", "r_b: per px of progress towards the goal (negative when moving away).", None),
     ("reward", "turn", "r_c: added on LEFT and RIGHT (scaled by |w| / w_max for continuous actions).", None),
@@ -1306,7 +1368,12 @@ impl SimConfig {
              # ronap.NavEnv(scenario=...). Units: px (scene pixels, x right, y up) and degrees\n\
              # (counter-clockwise from +x).\n",
         );
-        let value = toml::Value::try_from(self).unwrap_or(toml::Value::Table(Default::default()));
+        let mut value =
+            toml::Value::try_from(self).unwrap_or(toml::Value::Table(Default::default()));
+        // [team] is left out of written configurations when it has its defaults: show them here.
+        if let (Some(table), Ok(team)) = (value.as_table_mut(), toml::Value::try_from(&self.team)) {
+            table.entry("team").or_insert(team);
+        }
         let mut section = "";
         for &(sec, field, doc, example) in FIELD_DOCS {
             if sec != section {
@@ -1588,6 +1655,7 @@ mod documented_tests {
         c.episode.safety_radius_px = Some(3.0);
         c.scene.seed = Some(1);
         c.scene.file = Some("m.png".into());
+        c.team.neighbours = 1;
         let full = toml::Value::try_from(&c).unwrap();
         let mut count = 0;
         for (sec, table) in full.as_table().unwrap() {

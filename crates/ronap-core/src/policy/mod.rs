@@ -41,6 +41,12 @@ pub trait Policy: Send {
 
     /// The decision for the episode's current state.
     fn act(&mut self, episode: &Episode) -> Result<Decision, PolicyError>;
+
+    /// The message a robot of a team broadcasts with its last decision (`team.message_size`
+    /// floats, zeros already in `out`); the built-in policies send none.
+    fn message(&mut self, out: &mut [f32]) {
+        let _ = out;
+    }
 }
 
 /// Makes policies: one per worker thread of an evaluation.

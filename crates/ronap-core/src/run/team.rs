@@ -21,6 +21,8 @@ pub struct TeamRollout {
     gave_up: Vec<Option<String>>,
     /// The tour lengths of each robot with a goal list.
     tours: Vec<Option<TourLengths>>,
+    /// Floats in a policy's message.
+    message_size: usize,
 }
 
 /// A goal list's tour lengths under each order (geodesic, px; infinite where a leg cannot be
@@ -157,6 +159,7 @@ impl TeamRollout {
             team,
             worlds: per_robot,
             tours,
+            message_size: config.team.message_size as usize,
         })
     }
 
@@ -194,6 +197,7 @@ impl TeamRollout {
         let n = self.team.robots().len();
         let step = self.team.steps() + 1;
         let mut actions: Vec<Option<Action>> = vec![None; n];
+        let mut message = vec![0.0f32; self.message_size];
         for k in 0..n {
             if !self.team.running(k) {
                 continue;
@@ -211,6 +215,11 @@ impl TeamRollout {
                         }
                     }
                     actions[k] = Some(action);
+                    if !message.is_empty() {
+                        message.fill(0.0);
+                        policies[k].message(&mut message);
+                        self.team.set_message(k, &message);
+                    }
                 }
                 Decision::GiveUp(why) => {
                     self.gave_up[k] = Some(why);

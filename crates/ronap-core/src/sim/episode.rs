@@ -217,7 +217,7 @@ impl Episode {
             goal: placement.goal,
             noise_rng: stream(seed, Stream::Noise),
             readings: vec![0.0; beams],
-            observation: vec![0.0; beams + 1],
+            observation: vec![0.0; config.observation_size()],
             distance_px: 0.0,
             steps: 0,
             collisions: 0,
@@ -359,6 +359,12 @@ impl Episode {
         self.sense();
         let reward = self.score(before, &motion, collided);
         self.result(reward, collided)
+    }
+
+    /// The observation's values after the paper's (a team's neighbour slots), to fill in.
+    pub(crate) fn neighbour_slots_mut(&mut self) -> &mut [f32] {
+        let paper = self.readings.len() + 1;
+        &mut self.observation[paper..]
     }
 
     /// Makes `goals` the robot's goals, visited one after the other from the first (a goal

@@ -13,18 +13,32 @@
 //! The first robot's start and goal are drawn as a lone robot's are (the same stream), the
 //! others' from a stream of their own, each clear of the robots placed before it.
 
-use crate::config::{OnArrival, ValidConfig};
+use crate::config::{OnArrival, TeamConfig, ValidConfig};
 use crate::geometry::{point_segment_distance_squared, Point};
 use crate::sim::episode::{Episode, Status};
 use crate::sim::moving::{Disc, Movers};
 use crate::sim::placement::{needs_region_grid, sample_placement_with, EpisodeError};
 use crate::sim::rng::{stream, Stream};
-use crate::sim::robot::{Action, Motion};
+use crate::sim::robot::{Action, Motion, Pose};
 use crate::sim::world::World;
 use std::sync::Arc;
 
 /// Space kept between two robots' starts (and two robots' goals), beyond their radii, px.
 pub const PLACEMENT_GAP_PX: f64 = 2.0;
+
+/// What a robot broadcast at a step: received the step after by the robots within
+/// `team.comm_range_px`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Broadcast {
+    /// The sender.
+    pub from: usize,
+    /// Its pose when it sent.
+    pub pose: Pose,
+    /// Its (current) goal.
+    pub goal: Point,
+    /// Its policy's message (`team.message_size` floats).
+    pub message: Vec<f32>,
+}
 
 /// Several robots in one scene.
 #[derive(Clone, Debug)]
@@ -45,6 +59,12 @@ pub struct Team {
     retired: Vec<bool>,
     /// Each robot's goals as drawn or listed (before any reordering).
     goal_lists: Vec<Vec<Point>>,
+    /// How the robots talk.
+    comm: TeamConfig,
+    /// Each robot's message for the next broadcast.
+    outbox: Vec<Vec<f32>>,
+    /// What each robot received at the last step, nearest sender first.
+    inbox: Vec<Vec<Broadcast>>,
 }
 
 /// Whether discs of radii summing to `reach`, moving at once from `a0` to `a1` and from `b0` to
@@ -148,6 +168,9 @@ impl Team {
             rewards: vec![0.0; robots.len()],
             retired: vec![false; robots.len()],
             goal_lists,
+            comm: config.team.clone(),
+            outbox: vec![vec![0.0; config.team.message_size as usize]; robots.len()],
+            inbox: vec![Vec::new(); robots.len()],
             robots,
             on_arrival,
             movers,
@@ -209,6 +232,22 @@ impl Team {
         self.robots.iter().any(|r| r.status() == Status::Deadlock)
     }
 
+    /// Sets robot `k`'s message for the next broadcast (the first `team.message_size` floats of
+    /// `message`; the rest zeros).
+    pub fn set_message(&mut self, k: usize, message: &[f32]) {
+        let out = &mut self.outbox[k];
+        out.fill(0.0);
+        for (o, m) in out.iter_mut().zip(message) {
+            *o = *m;
+        }
+    }
+
+    /// What robot `k` received at the last step: the broadcasts of the robots that were within
+    /// `team.comm_range_px` of it when they sent, nearest first.
+    pub fn inbox(&self, k: usize) -> &[Broadcast] {
+        &self.inbox[k]
+    }
+
     /// Robot `k`'s goals as drawn or listed (one, or a goal list).
     pub fn goals(&self, k: usize) -> &[Point] {
         &self.goal_lists[k]
@@ -251,6 +290,19 @@ impl Team {
         self.steps += 1;
         let n = self.robots.len();
         let present: Vec<usize> = (0..n).filter(|&k| self.present(k)).collect();
+        // What every robot in the scene broadcasts now, received after the step.
+        let sent: Vec<Broadcast> = present
+            .iter()
+            .map(|&k| Broadcast {
+                from: k,
+                pose: self.robots[k].pose(),
+                goal: self.robots[k].goal(),
+                message: std::mem::replace(
+                    &mut self.outbox[k],
+                    vec![0.0; self.comm.message_size as usize],
+                ),
+            })
+            .collect();
         let discs: Vec<Disc> = present.iter().map(|&k| disc(&self.robots[k])).collect();
         let mut touched = vec![false; n];
         if let Some(movers) = &mut self.movers {
@@ -341,6 +393,7 @@ impl Team {
             }
         }
         self.sense_all();
+        self.deliver(&sent);
         for k in 0..n {
             self.rewards[k] = 0.0;
             if let Some(m) = &motions[k] {
@@ -355,6 +408,47 @@ impl Team {
             for k in 0..n {
                 if self.running(k) {
                     self.robots[k].end(Status::Deadlock);
+                }
+            }
+        }
+    }
+
+    /// Hands each robot in the scene the broadcasts `sent` from within range of where it was,
+    /// nearest first, and writes the nearest `team.neighbours` into its observation.
+    fn deliver(&mut self, sent: &[Broadcast]) {
+        let range = self.comm.comm_range_px;
+        let scale = range.max(1.0);
+        let slot = self.comm.slot_size();
+        let k_near = self.comm.neighbours as usize;
+        for (i, inbox) in self.inbox.iter_mut().enumerate() {
+            inbox.clear();
+            let Some(me) = sent.iter().find(|b| b.from == i) else {
+                continue;
+            };
+            let at = me.pose.position();
+            let mut near: Vec<(f64, &Broadcast)> = sent
+                .iter()
+                .filter(|b| b.from != i)
+                .map(|b| ((b.pose.position() - at).norm(), b))
+                .filter(|(d, _)| *d <= range)
+                .collect();
+            near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.from.cmp(&b.1.from)));
+            inbox.extend(near.iter().map(|(_, b)| (*b).clone()));
+            if k_near == 0 {
+                continue;
+            }
+            let pose = self.robots[i].pose();
+            let (sin, cos) = pose.z_deg.to_radians().sin_cos();
+            let slots = self.robots[i].neighbour_slots_mut();
+            slots.fill(0.0);
+            for (b, out) in inbox.iter().zip(slots.chunks_mut(slot)).take(k_near) {
+                let d = b.pose.position() - pose.position();
+                out[0] = ((d.x * cos + d.y * sin) / scale) as f32;
+                out[1] = ((-d.x * sin + d.y * cos) / scale) as f32;
+                out[2] = (crate::geometry::wrap_deg(b.pose.z_deg - pose.z_deg) / 360.0) as f32;
+                out[3] = 1.0;
+                for (o, m) in out[4..].iter_mut().zip(&b.message) {
+                    *o = *m;
                 }
             }
         }
@@ -389,7 +483,7 @@ fn disc(r: &Episode) -> Disc {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::TeamRobotConfig;
+    use crate::config::{TeamConfig, TeamRobotConfig};
     use crate::geometry::Vector;
     use crate::sim::robot::DiscreteAction;
 
@@ -534,6 +628,56 @@ mod tests {
             }
             assert_eq!(team.robot(0).status(), Status::Deadlock);
         }
+    }
+
+    #[test]
+    fn messages_arrive_one_step_late_and_only_within_range() {
+        let mut c = crate::SimConfig::default();
+        let at = |x: f64| TeamRobotConfig {
+            start: Some([x, 50.0, 0.0]),
+            goal: Some([x, 80.0]),
+            ..Default::default()
+        };
+        c.robots = vec![at(50.0), at(150.0), at(450.0)];
+        c.team = TeamConfig {
+            comm_range_px: 150.0,
+            message_size: 1,
+            neighbours: 2,
+        };
+        c.episode.min_goal_distance_px = 10.0;
+        let config = c.validate().expect("valid");
+        assert_eq!(config.observation_size(), 18 + 2 * 5);
+        let scene = Arc::new(crate::Scene::from_boxes(500.0, 100.0, Vec::new(), 50.0));
+        let worlds: Vec<_> = (0..3)
+            .map(|k| Arc::new(World::new(config.team_robot(k), scene.clone())))
+            .collect();
+        let mut team = Team::new(&config, &worlds, 0).expect("placed");
+        assert!((0..3).all(|k| team.inbox(k).is_empty()));
+        let turn = Some(Action::from(DiscreteAction::Left));
+        team.set_message(0, &[7.0]);
+        // Sent with this step's decisions, received after it.
+        team.step(&[turn, turn, turn]);
+        let b = team.inbox(1);
+        assert_eq!(b.len(), 1);
+        assert_eq!((b[0].from, b[0].message.as_slice()), (0, &[7.0f32][..]));
+        assert_eq!(team.inbox(0).len(), 1);
+        assert_eq!(team.inbox(0)[0].message, vec![0.0]);
+        assert!(team.inbox(2).is_empty(), "300 px from the nearest");
+        // Robot 1, turned 15 degrees left since, sees robot 0 as it sent: 100 px behind where
+        // robot 1 stands, heading 15 degrees to the right of it.
+        let slots = &team.robot(1).observation()[18..];
+        let z = 15f64.to_radians();
+        assert!((f64::from(slots[0]) - (-100.0 * z.cos() / 150.0)).abs() < 1e-6);
+        assert!((f64::from(slots[1]) - (100.0 * z.sin() / 150.0)).abs() < 1e-6);
+        assert!((f64::from(slots[2]) - 345.0 / 360.0).abs() < 1e-6);
+        assert_eq!(&slots[3..5], &[1.0, 7.0]);
+        assert_eq!(&slots[5..], &[0.0; 5]);
+        // A message is sent once: the next step's is zeros unless set again.
+        team.step(&[turn, turn, turn]);
+        assert_eq!(team.inbox(1)[0].message, vec![0.0]);
+        team.set_message(0, &[8.0]);
+        team.step(&[turn, turn, turn]);
+        assert_eq!(team.inbox(1)[0].message, vec![8.0]);
     }
 
     #[test]
