@@ -123,6 +123,18 @@ fn bad_robot_entries_are_named() {
             "[[robots]]\non_arrival = \"fly\"\n",
             vec!["on_arrival", "fly"],
         ),
+        (
+            "[[robots]]\ngoal_count = 0\n",
+            vec!["robots[0].goal_count", "0"],
+        ),
+        (
+            "[[robots]]\norder = \"shortest\"\n",
+            vec!["order", "shortest"],
+        ),
+        (
+            "[[robots]]\nstart = [150.0, 150.0, 0.0]\n\n[[robots]]\nstart = [155.0, 150.0, 0.0]\n",
+            vec!["robot 1's start", "overlapping robots cannot start"],
+        ),
     ] {
         let f = dir.path().join("bad.toml");
         std::fs::write(&f, text).unwrap();

@@ -198,6 +198,9 @@ fn run_team(
     let seeds = seed_range(first, args.seeds)?;
     let evaluator = Evaluator::new(config.clone(), scenes);
     let threads = args.threads.count();
+    // A team that cannot be placed fails the same way for every seed: say so before writing.
+    ronap_core::sim::team::Team::new(&config, &evaluator.worlds().team(first), first)
+        .with_context(|| format!("cannot start team episodes in this scene (seed {first})"))?;
     let out_dir = args
         .out
         .clone()

@@ -101,6 +101,19 @@ impl Team {
             for _ in 0..entry.count {
                 let both_fixed = cfg.episode.start.is_some() && cfg.episode.goal.is_some();
                 let grid = (!both_fixed && needs_region_grid(cfg, scene)).then(|| world.grid());
+                // A fixed start is not drawn, so nothing else keeps it apart from the others.
+                if let Some([x, y, _]) = cfg.episode.start {
+                    let p = Point::new(x, y);
+                    let hit = taken
+                        .iter()
+                        .position(|&(q, _, r)| (p - q).norm() < radius + r + PLACEMENT_GAP_PX);
+                    if let Some(j) = hit {
+                        return Err(EpisodeError::Moving(format!(
+                            "robot {k}'s start ({x}, {y}) is within {PLACEMENT_GAP_PX} px of robot \
+                             {j}'s: overlapping robots cannot start"
+                        )));
+                    }
+                }
                 let clear = |start: Point, goal: Point| {
                     taken.iter().all(|&(s, g, r)| {
                         let gap = radius + r + PLACEMENT_GAP_PX;
