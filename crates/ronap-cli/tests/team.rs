@@ -106,6 +106,24 @@ fn goal_lists_report_every_order_s_tour() {
 }
 
 #[test]
+fn one_robot_commands_refuse_a_team_by_name() {
+    let swap = repo_root().join("scenarios/corridor-swap.toml");
+    let s = swap.to_str().unwrap();
+    assert_rejected(
+        &[
+            "compare",
+            "--policy",
+            "apf",
+            "--policy",
+            "geodesic",
+            "--scenario",
+            s,
+        ],
+        &["2 robots", "ronap run --scenario"],
+    );
+}
+
+#[test]
 fn bad_robot_entries_are_named() {
     let dir = tempfile::tempdir().unwrap();
     for (text, names) in [

@@ -38,6 +38,15 @@ pub enum EpisodeError {
     /// The moving obstacles could not be placed.
     #[error("{0}")]
     Moving(String),
+    /// The configuration describes a team (`[[robots]]`) where one robot was asked for.
+    #[error(
+        "the scenario has {robots} robots ([[robots]]): run teams with `ronap run --scenario`; \
+         this drives one robot (remove [[robots]] for the one robot of [robot])"
+    )]
+    Team {
+        /// Robots in the team.
+        robots: usize,
+    },
     /// A fixed start or goal touches an obstacle or lies outside the scene.
     #[error("episode.{which} = ({x}, {y}) is not free: a robot of radius {radius_px} px there touches an obstacle or leaves the scene")]
     Blocked {

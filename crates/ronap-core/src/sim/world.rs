@@ -108,6 +108,11 @@ impl World {
 
     /// The episode of `seed`: start and goal as the configuration fixes them or drawn from the seed.
     pub fn episode(&self, seed: u64) -> Result<Episode, EpisodeError> {
+        if self.config.team_size() > 0 {
+            return Err(EpisodeError::Team {
+                robots: self.config.team_size(),
+            });
+        }
         let both_fixed = self.config.episode.start.is_some() && self.config.episode.goal.is_some();
         let grid =
             (!both_fixed && needs_region_grid(&self.config, &self.scene)).then(|| self.grid());
