@@ -18,6 +18,21 @@ pub struct Maze {
     horizontal: Vec<bool>,
 }
 
+/// A grid line of a maze: the horizontal line `y = row * cell` or the vertical `x = col * cell`.
+#[derive(Clone, Copy, Debug)]
+enum Line {
+    Horizontal(usize),
+    Vertical(usize),
+}
+
+/// Walls on consecutive edges of one line: `edges` counts columns along a horizontal line, rows
+/// along a vertical one.
+#[derive(Clone, Debug)]
+struct WallRun {
+    line: Line,
+    edges: std::ops::Range<usize>,
+}
+
 /// An interior edge between two cells.
 #[derive(Clone, Copy, Debug)]
 enum Edge {
@@ -201,45 +216,82 @@ impl Maze {
         count
     }
 
+    /// The walls as runs of collinear neighbours, horizontal lines bottom to top and then vertical
+    /// lines left to right, each run from its first edge to its last: the order of
+    /// [`Maze::wall_boxes`].
+    fn wall_runs(&self) -> Vec<WallRun> {
+        let mut runs = Vec::new();
+        let mut push_runs = |count: usize, present: &dyn Fn(usize) -> bool, line: Line| {
+            let mut i = 0;
+            while i < count {
+                if present(i) {
+                    let start = i;
+                    while i < count && present(i) {
+                        i += 1;
+                    }
+                    runs.push(WallRun {
+                        line,
+                        edges: start..i,
+                    });
+                } else {
+                    i += 1;
+                }
+            }
+        };
+        for row in 0..=self.rows {
+            push_runs(
+                self.cols,
+                &|c| self.horizontal_wall(c, row),
+                Line::Horizontal(row),
+            );
+        }
+        for col in 0..=self.cols {
+            push_runs(
+                self.rows,
+                &|r| self.vertical_wall(col, r),
+                Line::Vertical(col),
+            );
+        }
+        runs
+    }
+
     /// The walls as boxes of `thickness` px centred on their cell edges, collinear neighbours
     /// merged into one box. Each box runs `thickness / 2` past its end cells so corners close.
     pub fn wall_boxes(&self, cell: f64, thickness: f64) -> Vec<Aabb> {
         let h = thickness / 2.0;
-        let mut boxes = Vec::new();
-        let push_runs =
-            |count: usize, present: &dyn Fn(usize) -> bool, make: &mut dyn FnMut(usize, usize)| {
-                let mut i = 0;
-                while i < count {
-                    if present(i) {
-                        let start = i;
-                        while i < count && present(i) {
-                            i += 1;
-                        }
-                        make(start, i);
-                    } else {
-                        i += 1;
+        self.wall_runs()
+            .iter()
+            .map(|run| {
+                let (from, to) = (run.edges.start as f64 * cell, run.edges.end as f64 * cell);
+                match run.line {
+                    Line::Horizontal(row) => {
+                        let y = row as f64 * cell;
+                        Aabb::from_corners(Point::new(from - h, y - h), Point::new(to + h, y + h))
+                    }
+                    Line::Vertical(col) => {
+                        let x = col as f64 * cell;
+                        Aabb::from_corners(Point::new(x - h, from - h), Point::new(x + h, to + h))
                     }
                 }
-            };
-        for row in 0..=self.rows {
-            let y = row as f64 * cell;
-            push_runs(self.cols, &|c| self.horizontal_wall(c, row), &mut |a, b| {
-                boxes.push(Aabb::from_corners(
-                    Point::new(a as f64 * cell - h, y - h),
-                    Point::new(b as f64 * cell + h, y + h),
-                ))
-            });
+            })
+            .collect()
+    }
+
+    /// Which of [`Maze::wall_boxes`] covers each edge, laid out like the wall bits: `vertical[row
+    /// * (cols + 1) + col]` for the edge at `x = col * cell`, `horizontal[row * cols + col]` for
+    /// the edge at `y = row * cell`, and `None` where the edge is open.
+    pub fn wall_box_of_edges(&self) -> (Vec<Option<u32>>, Vec<Option<u32>>) {
+        let mut vertical = vec![None; (self.cols + 1) * self.rows];
+        let mut horizontal = vec![None; self.cols * (self.rows + 1)];
+        for (i, run) in self.wall_runs().into_iter().enumerate() {
+            for e in run.edges {
+                match run.line {
+                    Line::Horizontal(row) => horizontal[row * self.cols + e] = Some(i as u32),
+                    Line::Vertical(col) => vertical[e * (self.cols + 1) + col] = Some(i as u32),
+                }
+            }
         }
-        for col in 0..=self.cols {
-            let x = col as f64 * cell;
-            push_runs(self.rows, &|r| self.vertical_wall(col, r), &mut |a, b| {
-                boxes.push(Aabb::from_corners(
-                    Point::new(x - h, a as f64 * cell - h),
-                    Point::new(x + h, b as f64 * cell + h),
-                ))
-            });
-        }
-        boxes
+        (vertical, horizontal)
     }
 
     /// The maze as text, top row first: `+--+` for walls, `S` and `G` in the marked cells.
