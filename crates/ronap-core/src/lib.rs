@@ -11,7 +11,7 @@
 //! | layer | holds |
 //! | --- | --- |
 //! | [`config`] | every model field with its default, and their validation (uses nothing) |
-//! | [`geometry`] | points, boxes, the bin index, parry2d as the reference geometry |
+//! | [`geometry`] | points, boxes, the bin index, the ray grid, parry2d as the reference geometry |
 //! | [`scene`] | the scene's obstacles, mazes, image and ROS maps, the free-space grid |
 //! | [`sim`] | robot and actions, laser, random streams, placement, the episode, worlds and scenes |
 //! | [`plan`] | geodesic distance fields and shortest paths |

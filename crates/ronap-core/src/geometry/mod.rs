@@ -1,5 +1,5 @@
-//! Geometry, the bottom layer: points, boxes and the exact queries on them, the bin index, and
-//! parry2d as the reference geometry. Uses nothing of the crate.
+//! Geometry, the bottom layer: points, boxes and the exact queries on them, the bin index, the ray
+//! grid, and parry2d as the reference geometry. Uses nothing of the crate.
 //!
 //! Plane geometry on axis-aligned boxes, in scene px (x right, y up).
 //!
@@ -8,6 +8,7 @@
 //! sensors and the collision check need, written for boxes so they cost a few nanoseconds each.
 
 pub mod index;
+pub mod ray_grid;
 pub mod reference;
 pub mod shape;
 

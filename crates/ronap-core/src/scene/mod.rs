@@ -5,19 +5,24 @@
 //!
 //! A scene covers `[0, width] x [0, height]` px. It comes from a generated maze (walls on cell
 //! edges), an image (occupied pixels merged into boxes, everything outside the image an obstacle)
-//! or boxes given by hand. Queries run through a [`BinIndex`] so one costs a single bin lookup.
+//! or boxes given by hand. Queries near a point run through a [`BinIndex`] so one costs a single
+//! bin lookup; rays walk a coarse [`RayGrid`] so one costs per cell it crosses, whatever its range.
 
 pub mod freespace;
 pub mod map;
 pub mod maze;
+pub mod maze_rays;
 pub mod warehouse;
 
 use crate::config::{MapConfig, MazeConfig};
 use crate::geometry::index::BinIndex;
+use crate::geometry::ray_grid::{self, RayGrid};
 use crate::geometry::shape::Shape;
 use crate::geometry::{Aabb, Point, Vector};
 use crate::scene::maze::Maze;
+use crate::scene::maze_rays::MazeRays;
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 /// Bin side of the query index, px: small enough that a bin's list is close to the boxes really
 /// within reach, large enough that building it per episode stays well under a millisecond.
@@ -91,6 +96,43 @@ pub fn read_image(path: &Path) -> Result<image::DynamicImage, SceneError> {
     Ok(image)
 }
 
+/// How a scene's long rays find the boxes they cross.
+#[derive(Clone, Debug)]
+enum RayIndex {
+    /// A maze's own walls: the cells and the wall on each edge.
+    Maze(MazeRays),
+    /// Any boxes: a uniform grid listing the boxes touching each cell.
+    Grid(RayGrid),
+}
+
+/// Rays from one point of a scene ([`Scene::rays_from`]).
+#[derive(Clone, Copy, Debug)]
+pub struct RaysFrom<'a> {
+    start: RayStart<'a>,
+}
+
+/// Where rays from one point start, in the scene's [`RayIndex`].
+#[derive(Clone, Copy, Debug)]
+enum RayStart<'a> {
+    Maze(&'a MazeRays, maze_rays::Start),
+    Grid(&'a RayGrid, ray_grid::GridStart),
+}
+
+impl RaysFrom<'_> {
+    /// The nearest [`Aabb::ray_hit`] among the scene's boxes (not its shapes) of the ray along the
+    /// unit direction `dir`, within `max_px`, with `1 / dir` per component as the inverse
+    /// direction: exactly the least over every box. Costs per coarse cell the ray crosses before
+    /// its first hit, whatever `max_px`.
+    #[inline]
+    pub fn first_box_hit(&self, dir: Vector, max_px: f64) -> Option<f64> {
+        let inv = Vector::new(1.0 / dir.x, 1.0 / dir.y);
+        match &self.start {
+            RayStart::Maze(walls, start) => walls.cast(start, dir, inv, max_px),
+            RayStart::Grid(grid, start) => grid.cast(start, dir, inv, max_px),
+        }
+    }
+}
+
 /// Obstacles and the queries the sensors and collision checks need.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -98,6 +140,8 @@ pub struct Scene {
     height: f64,
     boxes: Vec<Aabb>,
     index: BinIndex,
+    /// How long rays find the boxes they cross, built on the first ray that needs it.
+    rays: OnceLock<RayIndex>,
     source: SceneSource,
     /// Discs and convex polygons, checked one by one (a scene has few).
     shapes: Vec<Shape>,
@@ -127,6 +171,7 @@ impl Scene {
             height,
             boxes,
             index,
+            rays: OnceLock::new(),
             source,
             shapes: Vec::new(),
             added: false,
@@ -323,46 +368,54 @@ impl Scene {
         (piece >= 1.0).then_some(piece)
     }
 
+    /// What long rays walk: a maze's own cells and walls, or for other scenes (and mazes with
+    /// added boxes) a uniform grid sized to their boxes.
+    fn ray_index(&self) -> &RayIndex {
+        self.rays.get_or_init(|| {
+            if let SceneSource::Maze {
+                maze,
+                cell_px,
+                wall_thickness_px,
+            } = &self.source
+            {
+                let walls = MazeRays::new(maze, *cell_px, *wall_thickness_px);
+                if let Some(walls) = walls.filter(|w| w.boxes() == self.boxes.as_slice()) {
+                    return RayIndex::Maze(walls);
+                }
+            }
+            RayIndex::Grid(RayGrid::fitted(&self.boxes, self.bounds()))
+        })
+    }
+
+    /// Rays from `origin`, which share the work of finding where they start (a scan's beams).
+    #[inline]
+    pub fn rays_from(&self, origin: Point) -> RaysFrom<'_> {
+        let start = match self.ray_index() {
+            RayIndex::Maze(walls) => RayStart::Maze(walls, walls.start(origin)),
+            RayIndex::Grid(grid) => RayStart::Grid(grid, grid.start(origin)),
+        };
+        RaysFrom { start }
+    }
+
+    /// The nearest [`Aabb::ray_hit`] among the boxes (not the shapes) of the ray from `origin`
+    /// along the unit direction `dir`, within `max_px` ([`RaysFrom::first_box_hit`]).
+    pub fn first_box_hit(&self, origin: Point, dir: Vector, max_px: f64) -> Option<f64> {
+        self.rays_from(origin).first_box_hit(dir, max_px)
+    }
+
     /// Distance from `origin` along the unit direction `dir` to the first obstacle, if one lies
     /// within `max_px`. `Some(0.0)` when `origin` is inside an obstacle.
     pub fn cast_ray(&self, origin: Point, dir: Vector, max_px: f64) -> Option<f64> {
-        let inv = Vector::new(1.0 / dir.x, 1.0 / dir.y);
-        let first_hit = |from: Point, reach: f64, limit: f64| -> Option<f64> {
-            let mut best = limit;
-            let mut hit = false;
-            for &i in self.index.near(from, reach) {
-                if let Some(t) = self.boxes[i as usize].ray_hit(origin, inv, best) {
-                    best = t;
-                    hit = true;
-                }
-            }
-            hit.then_some(best)
-        };
-        if !self.shapes.is_empty() {
-            // Few shapes: the nearest hit among them and the boxes, read whole.
-            let boxes = first_hit(origin, max_px, max_px).unwrap_or(f64::INFINITY);
-            let shapes = self
-                .shapes
-                .iter()
-                .filter_map(|s| s.cast_ray(origin, dir, max_px))
-                .fold(f64::INFINITY, f64::min);
-            let best = boxes.min(shapes);
-            return best.is_finite().then_some(best);
+        let boxes = self.first_box_hit(origin, dir, max_px);
+        if self.shapes.is_empty() {
+            return boxes;
         }
-        let Some(piece) = self.piece_px(0.0).filter(|&p| max_px > p) else {
-            return first_hit(origin, max_px, max_px);
-        };
-        // A hit at distance t lies within `piece` of the start of the piece holding t, so the
-        // first piece with a hit inside it has the first hit.
-        let mut start = 0.0;
-        while start < max_px {
-            let end = (start + piece).min(max_px);
-            if let Some(t) = first_hit(origin + dir * start, end - start, end) {
-                return Some(t);
-            }
-            start = end;
-        }
-        None
+        let best = self
+            .shapes
+            .iter()
+            .filter_map(|s| s.cast_ray(origin, dir, max_px))
+            .fold(boxes.unwrap_or(f64::INFINITY), f64::min);
+        best.is_finite().then_some(best)
     }
 
     /// Whether a disc of `radius` at `p` touches no obstacle (a tangent disc does not touch).

@@ -8,9 +8,14 @@ use crate::geometry::{unit, Aabb, Point, Vector};
 use crate::scene::Scene;
 use rand_distr::{Distribution, Normal};
 
-/// Above this many candidate boxes a scan tests the bin's list as it is instead of copying the
-/// boxes in range to the stack.
+/// A scan copies the boxes within range to the stack when the index's bin lists at most this many.
 const MAX_LOCAL_BOXES: usize = 48;
+
+/// Up to this many boxes within range, every beam tests each of them (the tests run side by side,
+/// a few ns each); beyond, each beam walks the scene's ray grid, which costs about as much as
+/// this many tests whatever the range (measured with `examples`-style scans of the default maze
+/// and its image at 50-300 px).
+const LOCAL_BOXES_BEFORE_WALK: usize = 16;
 
 /// `offset` (a beam's unit vector in the robot frame) turned to the scene frame of `heading`.
 #[inline]
@@ -100,42 +105,42 @@ impl Laser {
         debug_assert_eq!(out.len(), self.offsets.len());
         let range = self.range_px;
         let heading = unit(heading_deg);
-        let near = scene.boxes_near(position, range);
-        let boxes = scene.boxes();
-        // Copy the boxes that are really in range next to each other: every beam reads them all.
-        let mut local = [Aabb::from_corners(Point::origin(), Point::origin()); MAX_LOCAL_BOXES];
-        let mut count = 0;
         let r2 = range * range;
-        let mut overflow = false;
-        for &i in near {
-            let b = boxes[i as usize];
-            if b.distance_squared(position) <= r2 {
-                if count == MAX_LOCAL_BOXES {
-                    overflow = true;
-                    break;
+        let near = scene.boxes_near(position, range);
+        // The boxes within range, when the bin lists few enough to copy.
+        let mut local = [Aabb::from_corners(Point::origin(), Point::origin()); MAX_LOCAL_BOXES];
+        let mut count = usize::MAX;
+        if near.len() <= MAX_LOCAL_BOXES {
+            let boxes = scene.boxes();
+            count = 0;
+            for &i in near {
+                let b = boxes[i as usize];
+                if b.distance_squared(position) <= r2 {
+                    local[count] = b;
+                    count += 1;
                 }
-                local[count] = b;
-                count += 1;
             }
         }
-        for (reading, offset) in out.iter_mut().zip(&self.offsets) {
-            let dir = turn(heading, *offset);
-            let inv = Vector::new(1.0 / dir.x, 1.0 / dir.y);
-            let mut best = range;
-            if overflow {
-                for &i in near {
-                    if let Some(t) = boxes[i as usize].ray_hit(position, inv, best) {
-                        best = t;
-                    }
-                }
-            } else {
+        if count <= LOCAL_BOXES_BEFORE_WALK {
+            for (reading, offset) in out.iter_mut().zip(&self.offsets) {
+                let dir = turn(heading, *offset);
+                let inv = Vector::new(1.0 / dir.x, 1.0 / dir.y);
+                // Each box against the whole beam, so the tests do not wait on each other: the
+                // least hit is the same as shortening the beam box by box.
+                let mut best = range;
                 for b in &local[..count] {
-                    if let Some(t) = b.ray_hit(position, inv, best) {
-                        best = t;
+                    if let Some(t) = b.ray_hit(position, inv, range) {
+                        best = if t < best { t } else { best };
                     }
                 }
+                *reading = best;
             }
-            *reading = best;
+        } else {
+            let rays = scene.rays_from(position);
+            for (reading, offset) in out.iter_mut().zip(&self.offsets) {
+                let dir = turn(heading, *offset);
+                *reading = rays.first_box_hit(dir, range).unwrap_or(range);
+            }
         }
         if !scene.shapes().is_empty() {
             let near: Vec<_> = scene

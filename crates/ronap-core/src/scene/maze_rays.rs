@@ -1,0 +1,387 @@
+//! Rays through a maze, paying per cell crossed: the maze's own cells and wall bits as the grid.
+//!
+//! A maze's walls are boxes centred on cell edges, `wall_thickness_px / 2` deep either side
+//! ([`Maze::wall_boxes`]). A ray walks the cells it crosses (Amanatides and Woo, "A fast voxel
+//! traversal algorithm for ray tracing", 1987) and, where it leaves a cell, looks up the wall on
+//! the edge it crosses: a wall there ends the walk. Lengths in px.
+//!
+//! Which boxes the walk tests, and why that finds the nearest: inside one cell the ray is a
+//! segment, and its distance to any line is least at one of its two ends. So a wall box can meet
+//! the segment inside the cell only (a) on the edge the ray leaves by, (b) near an end of the
+//! segment that lies within the walls' half thickness of another edge, or (c) in a corner of the
+//! cell that the segment cuts, which needs an end within twice the half thickness of that corner.
+//! The walk tests the wall of each edge it crosses, every wall meeting at a grid corner within
+//! twice the half thickness of a crossing, and at the start the walls of each side the origin is
+//! within reach of; it stops at the first cell whose tests gave a hit no further than where the ray
+//! leaves it. Every hit is [`Aabb::ray_hit`] of the same ray, so the answer is exactly the least
+//! over all the walls. The closed outer boundary keeps a ray from inside from leaving the maze
+//! before its first wall.
+
+use crate::geometry::{Aabb, Point, Vector};
+use crate::scene::maze::Maze;
+
+/// A maze's walls by the edges they stand on, for ray casts.
+#[derive(Clone, Debug)]
+pub struct MazeRays {
+    cols: usize,
+    rows: usize,
+    cell_px: f64,
+    inv_cell_px: f64,
+    /// How far a wall box reaches from its edge (half its thickness and a rounding margin), px.
+    reach_px: f64,
+    /// `vertical[row * (cols + 1) + col]`: the box on the edge at `x = col * cell_px` beside
+    /// cell `(col, row)`, [`NO_WALL`] where there is none.
+    vertical: Vec<u32>,
+    /// `horizontal[row * cols + col]`: the box on the edge at `y = row * cell_px` below cell
+    /// `(col, row)`, [`NO_WALL`] where there is none.
+    horizontal: Vec<u32>,
+    boxes: Vec<Aabb>,
+}
+
+/// What every ray from one origin shares ([`MazeRays::start`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Start {
+    origin: Point,
+    /// Whether the origin lies in the maze (else rays test every wall).
+    inside: bool,
+    col: isize,
+    row: isize,
+    /// Lower-left corner of the origin's cell.
+    corner: Point,
+    /// Whether the origin is within a wall's reach of a side of its cell.
+    near_wall: bool,
+}
+
+/// An open edge.
+const NO_WALL: u32 = u32::MAX;
+
+impl MazeRays {
+    /// The walls of `maze` with cells of `cell_px` and walls `wall_thickness_px` thick, as
+    /// [`Maze::wall_boxes`] gives them. `None` when the walls are a quarter cell thick or more, or
+    /// the outer boundary is open: the walk's reasoning needs thin walls and a closed maze.
+    pub fn new(maze: &Maze, cell_px: f64, wall_thickness_px: f64) -> Option<Self> {
+        let (cols, rows) = (maze.cols(), maze.rows());
+        // Rounding in the walk moves a crossing by far less than this margin.
+        let reach_px = wall_thickness_px / 2.0 + cell_px * 1e-6;
+        if cols == 0 || rows == 0 || 4.0 * reach_px >= cell_px || !maze.boundary_closed() {
+            return None;
+        }
+        let (vertical, horizontal) = maze.wall_box_of_edges();
+        let edge = |b: Option<u32>| b.unwrap_or(NO_WALL);
+        Some(Self {
+            cols,
+            rows,
+            cell_px,
+            inv_cell_px: 1.0 / cell_px,
+            reach_px,
+            vertical: vertical.into_iter().map(edge).collect(),
+            horizontal: horizontal.into_iter().map(edge).collect(),
+            boxes: maze.wall_boxes(cell_px, wall_thickness_px),
+        })
+    }
+
+    /// The boxes of the walls, in the order of [`Maze::wall_boxes`].
+    pub fn boxes(&self) -> &[Aabb] {
+        &self.boxes
+    }
+
+    /// What every ray from `origin` shares: its cell, and the walls it is within reach of.
+    #[inline]
+    pub fn start(&self, origin: Point) -> Start {
+        let c = self.cell_px;
+        let inside = origin.x >= 0.0
+            && origin.y >= 0.0
+            && origin.x <= self.cols as f64 * c
+            && origin.y <= self.rows as f64 * c;
+        // A float cast truncates, which is the floor here.
+        let col = ((origin.x * self.inv_cell_px) as isize).min(self.cols as isize - 1);
+        let row = ((origin.y * self.inv_cell_px) as isize).min(self.rows as isize - 1);
+        let corner = Point::new(col as f64 * c, row as f64 * c);
+        let gaps = [
+            origin.x - corner.x,
+            corner.x + c - origin.x,
+            origin.y - corner.y,
+            corner.y + c - origin.y,
+        ];
+        Start {
+            origin,
+            inside,
+            col,
+            row,
+            corner,
+            near_wall: gaps.iter().any(|&g| g <= self.reach_px),
+        }
+    }
+
+    /// The nearest [`Aabb::ray_hit`] over every wall of the ray `start.origin + t * dir`, `t` in
+    /// `[0, max_t]`, with `inv_dir = 1 / dir` per component: `Some(0.0)` when the origin is in a
+    /// wall, `None` when no wall lies within `max_t`. From outside the maze, every wall is tested.
+    #[inline]
+    pub fn cast(&self, start: &Start, dir: Vector, inv_dir: Vector, max_t: f64) -> Option<f64> {
+        let o = start.origin;
+        if !start.inside {
+            return self.every_box(o, inv_dir, max_t);
+        }
+        let c = self.cell_px;
+        let mut best = f64::INFINITY;
+        if start.near_wall {
+            self.near_origin(start, inv_dir, max_t, &mut best);
+        }
+        // Per axis: the step between cells, the `t` of the next cell line ahead and the `t`
+        // between lines. An axis the ray runs parallel to never steps: its next line is further
+        // than any other (and finite, so that the blends below stay exact).
+        let ahead_x = isize::from(inv_dir.x > 0.0);
+        let ahead_y = isize::from(inv_dir.y > 0.0);
+        let (step_x, step_y) = (2 * ahead_x - 1, 2 * ahead_y - 1);
+        let axis = |corner: f64, ahead: isize, o: f64, inv: f64| -> (f64, f64) {
+            if inv.is_finite() {
+                ((corner + ahead as f64 * c - o) * inv, c * inv.abs())
+            } else {
+                (f64::MAX, 0.0)
+            }
+        };
+        let (mut next_x, delta_x) = axis(start.corner.x, ahead_x, o.x, inv_dir.x);
+        let (mut next_y, delta_y) = axis(start.corner.y, ahead_y, o.y, inv_dir.y);
+        let (cols, rows) = (self.cols as isize, self.rows as isize);
+        let (mut col, mut row) = (start.col, start.row);
+        let mut corner = start.corner;
+        let (corner_step_x, corner_step_y) = (step_x as f64 * c, step_y as f64 * c);
+        // The edges ahead on either axis, and how they move with a step along x or along y.
+        let mut vertical = row * (cols + 1) + col + ahead_x;
+        let mut horizontal = (row + ahead_y) * cols + col;
+        let (vertical_by_y, horizontal_by_y) = (step_y * (cols + 1), step_y * cols);
+        let reach = 2.0 * self.reach_px;
+        let mut limit = max_t;
+        let wall = loop {
+            // Which line the ray crosses first, as 1.0/0.0 weights: a step is blended from both
+            // axes rather than chosen by a branch the processor would guess wrong half the time.
+            // `x * 1.0 + y * 0.0` is exactly `x` for the finite values here.
+            let along_x = next_x < next_y;
+            let wx = f64::from(u8::from(along_x));
+            let wy = 1.0 - wx;
+            let t = next_x.min(next_y);
+            // Where along the crossed edge the ray crosses it, from the edge's lower or left end.
+            let along = (o.y + t * dir.y - corner.y) * wx + (o.x + t * dir.x - corner.x) * wy;
+            let pick_x = 0u32.wrapping_sub(u32::from(along_x));
+            let wall = (self.vertical[vertical as usize] & pick_x)
+                | (self.horizontal[horizontal as usize] & !pick_x);
+            if along < reach || along > c - reach {
+                let vertex = if along_x {
+                    (col + ahead_x, row, 0, 1)
+                } else {
+                    (col, row + ahead_y, 1, 0)
+                };
+                self.crossing_corners(vertex, along, inv_dir, o, max_t, &mut best);
+                limit = best.min(max_t);
+            }
+            if wall != NO_WALL || limit <= t {
+                break wall;
+            }
+            let (kx, ky) = (isize::from(along_x), isize::from(!along_x));
+            col += step_x * kx;
+            row += step_y * ky;
+            corner.x += corner_step_x * wx;
+            corner.y += corner_step_y * wy;
+            next_x += delta_x * wx;
+            next_y += delta_y * wy;
+            vertical += step_x * kx + vertical_by_y * ky;
+            horizontal += step_x * kx + horizontal_by_y * ky;
+            if (col as usize) >= cols as usize || (row as usize) >= rows as usize {
+                break NO_WALL;
+            }
+        };
+        // The ray leaves its last cell through a wall (which it meets by then), or it ends.
+        if wall != NO_WALL {
+            self.test(wall, o, inv_dir, max_t, &mut best);
+        }
+        (best <= max_t).then_some(best)
+    }
+
+    /// Tests the walls meeting at the ends of a crossed edge that `along` (from the edge's lower
+    /// or left end) comes within reach of: `vertex` is the lower or left end `(i, j)` and the step
+    /// `(di, dj)` to the other.
+    #[cold]
+    fn crossing_corners(
+        &self,
+        vertex: (isize, isize, isize, isize),
+        along: f64,
+        inv: Vector,
+        origin: Point,
+        max_t: f64,
+        best: &mut f64,
+    ) {
+        let reach = 2.0 * self.reach_px;
+        let (i, j, di, dj) = vertex;
+        if along < reach {
+            self.corner(i as usize, j as usize, origin, inv, max_t, best);
+        }
+        if along > self.cell_px - reach {
+            self.corner(
+                (i + di) as usize,
+                (j + dj) as usize,
+                origin,
+                inv,
+                max_t,
+                best,
+            );
+        }
+    }
+
+    /// Lowers `best` to the hit on box `b`, if any.
+    #[inline]
+    fn test(&self, b: u32, origin: Point, inv_dir: Vector, max_t: f64, best: &mut f64) {
+        if let Some(t) = self.boxes[b as usize].ray_hit(origin, inv_dir, max_t) {
+            if t < *best {
+                *best = t;
+            }
+        }
+    }
+
+    /// Tests the walls on the (up to four) edges meeting at grid corner `(i, j)`.
+    #[cold]
+    fn corner(&self, i: usize, j: usize, origin: Point, inv: Vector, max_t: f64, best: &mut f64) {
+        let (cols, rows) = (self.cols, self.rows);
+        let mut walls = [NO_WALL; 4];
+        if j > 0 && i <= cols {
+            walls[0] = self.vertical[(j - 1) * (cols + 1) + i];
+        }
+        if j < rows && i <= cols {
+            walls[1] = self.vertical[j * (cols + 1) + i];
+        }
+        if i > 0 && j <= rows {
+            walls[2] = self.horizontal[j * cols + i - 1];
+        }
+        if i < cols && j <= rows {
+            walls[3] = self.horizontal[j * cols + i];
+        }
+        for w in walls {
+            if w != NO_WALL {
+                self.test(w, origin, inv, max_t, best);
+            }
+        }
+    }
+
+    /// Tests the walls the start of a ray may meet before it reaches an edge: those of each side
+    /// of the origin's cell within reach of the origin, with the corners at its ends.
+    #[cold]
+    fn near_origin(&self, start: &Start, inv: Vector, max_t: f64, best: &mut f64) {
+        let (o, c) = (start.origin, self.cell_px);
+        let (col, row) = (start.col as usize, start.row as usize);
+        let gaps = [
+            o.x - start.corner.x,
+            start.corner.x + c - o.x,
+            o.y - start.corner.y,
+            start.corner.y + c - o.y,
+        ];
+        // Each side by the corners at its two ends (whose walls include the side's own).
+        let sides = [
+            ((col, row), (col, row + 1)),
+            ((col + 1, row), (col + 1, row + 1)),
+            ((col, row), (col + 1, row)),
+            ((col, row + 1), (col + 1, row + 1)),
+        ];
+        for (gap, (a, b)) in gaps.into_iter().zip(sides) {
+            if gap <= self.reach_px {
+                self.corner(a.0, a.1, o, inv, max_t, best);
+                self.corner(b.0, b.1, o, inv, max_t, best);
+            }
+        }
+    }
+
+    /// The nearest hit testing every box.
+    #[cold]
+    fn every_box(&self, origin: Point, inv_dir: Vector, max_t: f64) -> Option<f64> {
+        let mut best = f64::INFINITY;
+        for b in 0..self.boxes.len() {
+            self.test(b as u32, origin, inv_dir, max_t, &mut best);
+        }
+        (best <= max_t).then_some(best)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::unit;
+    use crate::sim::rng::{stream, Stream};
+    use rand::{Rng, SeedableRng};
+
+    /// The nearest hit testing every box, the way a scan without an index does.
+    fn every_box(boxes: &[Aabb], origin: Point, inv: Vector, max_t: f64) -> Option<f64> {
+        let mut best = max_t;
+        let mut hit = false;
+        for b in boxes {
+            if let Some(t) = b.ray_hit(origin, inv, best) {
+                best = t;
+                hit = true;
+            }
+        }
+        hit.then_some(best)
+    }
+
+    #[test]
+    fn a_walk_gives_the_bits_every_wall_gives() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(23);
+        let mut hits = 0;
+        for (seed, (cols, rows, cell, thickness, loops)) in [
+            (10, 10, 100.0, 2.0, 0.4),
+            (7, 3, 30.0, 7.0, 0.0),
+            (12, 9, 17.3, 0.5, 1.0),
+            (1, 1, 50.0, 12.0, 0.0),
+            (40, 25, 25.0, 2.0, 0.7),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let maze = Maze::generate(cols, rows, loops, &mut stream(seed as u64, Stream::Scene));
+            let walls = MazeRays::new(&maze, cell, thickness).expect("thin walls");
+            let boxes = maze.wall_boxes(cell, thickness);
+            let (w, h) = (cols as f64 * cell, rows as f64 * cell);
+            for k in 0..20_000 {
+                // Origins on grid lines and corners, at wall faces, anywhere, and outside.
+                let grid_point = |rng: &mut rand_chacha::ChaCha8Rng, n: usize| {
+                    rng.random_range(0..=n) as f64 * cell
+                };
+                let origin = match k % 6 {
+                    0 => Point::new(grid_point(&mut rng, cols), grid_point(&mut rng, rows)),
+                    1 => Point::new(grid_point(&mut rng, cols), rng.random_range(0.0..h)),
+                    2 => Point::new(
+                        grid_point(&mut rng, cols) + thickness / 2.0,
+                        rng.random_range(0.0..h),
+                    ),
+                    3 => Point::new(
+                        rng.random_range(-0.5 * w..1.5 * w),
+                        rng.random_range(-0.5 * h..1.5 * h),
+                    ),
+                    _ => Point::new(rng.random_range(0.0..w), rng.random_range(0.0..h)),
+                };
+                let deg = if k % 3 == 0 {
+                    rng.random_range(0..8) as f64 * 45.0
+                } else {
+                    rng.random_range(0.0..360.0)
+                };
+                let dir = unit(deg);
+                let inv = Vector::new(1.0 / dir.x, 1.0 / dir.y);
+                let max_t = [0.0, 1.0, cell / 2.0, 3.0 * cell, 2.0 * (w + h)][k % 5];
+                let ours = walls.cast(&walls.start(origin), dir, inv, max_t);
+                let all = every_box(&boxes, origin, inv, max_t);
+                assert_eq!(
+                    ours.map(f64::to_bits),
+                    all.map(f64::to_bits),
+                    "maze {seed} from {origin:?} at {deg} deg up to {max_t}: {ours:?} vs {all:?}"
+                );
+                hits += usize::from(all.is_some());
+            }
+        }
+        assert!(hits > 50_000, "only {hits} rays hit a wall");
+    }
+
+    #[test]
+    fn thick_walls_and_open_mazes_are_refused() {
+        let maze = Maze::closed(3, 3);
+        assert!(MazeRays::new(&maze, 100.0, 2.0).is_some());
+        assert!(MazeRays::new(&maze, 100.0, 50.0).is_none());
+        let empty = Maze::closed(0, 4);
+        assert!(MazeRays::new(&empty, 100.0, 2.0).is_none());
+    }
+}
