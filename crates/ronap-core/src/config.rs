@@ -787,7 +787,7 @@ fn fraction(field: &str, v: f64) -> Result<(), ConfigError> {
 }
 
 /// Largest number of laser beams.
-pub const MAX_BEAMS: u32 = 360;
+pub const MAX_BEAMS: u32 = 4096;
 
 impl SimConfig {
     /// Reads a configuration from TOML text; missing fields keep their defaults and an unknown
@@ -854,7 +854,7 @@ impl SimConfig {
             (1..=MAX_BEAMS).contains(&l.beams),
             "laser.beams",
             l.beams,
-            "must be between 1 and 360",
+            "must be between 1 and 4096",
         )?;
         check(
             l.fov_deg.is_finite() && (0.0..=360.0).contains(&l.fov_deg),
