@@ -93,6 +93,133 @@ fn long_rays_and_sweeps_match_parry2d() {
     }
 }
 
+/// The default configuration with a laser of `beams` over `fov_deg` reaching `range_px`.
+fn laser_config(beams: u32, fov_deg: f64, range_px: f64) -> ValidConfig {
+    let mut sim = SimConfig::default();
+    sim.laser.beams = beams;
+    sim.laser.fov_deg = fov_deg;
+    sim.laser.range_px = range_px;
+    sim.validate().unwrap()
+}
+
+/// The maze of `seed` drawn with `Canvas` and loaded back as an image scene.
+fn image_of_maze(config: &ValidConfig, seed: u64) -> Scene {
+    let maze = maze_scene(config, seed);
+    let picture = image::DynamicImage::ImageRgb8(Canvas::new(&maze, 1.0).into_image());
+    Scene::from_image(&picture, &config.map, config.reach_px())
+}
+
+#[test]
+fn laser_matches_parry2d_at_long_range_and_many_beams() {
+    // Out to the scene's size and past its diagonal, up to the beam cap; mazes (walked by their
+    // own cells) and image scenes (walked by a uniform grid).
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(29);
+    let mut compared = 0;
+    for (range, beams, fov) in [
+        (200.0, 64, 180.0),
+        (500.0, 17, 180.0),
+        (1000.0, 360, 360.0),
+        (1000.0, 1080, 270.0),
+        (1500.0, 4096, 360.0),
+    ] {
+        let config = laser_config(beams, fov, range);
+        let laser = Laser::new(&config.laser);
+        let mut readings = vec![0.0; laser.beams()];
+        for seed in 0..3 {
+            for scene in [maze_scene(&config, seed), image_of_maze(&config, seed)] {
+                let parry = ParryScene::new(scene.boxes()).expect("walls");
+                for _ in 0..4 {
+                    let p = free_point(&scene, 0.5, &mut rng);
+                    let z = rng.random_range(0.0..360.0);
+                    laser.scan(&scene, p, z, &mut readings);
+                    for (i, &d) in readings.iter().enumerate() {
+                        let dir = unit(laser.beam_angle_deg(i, z));
+                        let expected = parry.cast_ray(p, dir, range).unwrap_or(range);
+                        assert!(
+                            (d - expected).abs() < 1e-4,
+                            "{range} px, {beams} beams, seed {seed}, p {p:?} z {z} beam {i}: \
+                             {d} vs parry {expected}"
+                        );
+                        compared += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(compared, 3 * 2 * 4 * (64 + 17 + 360 + 1080 + 4096));
+}
+
+#[test]
+fn laser_readings_are_the_least_box_hit_to_the_bit() {
+    // Whichever way a scan finds its boxes (the boxes in range, a maze's cells, a uniform grid),
+    // each reading is bit for bit the least `Aabb::ray_hit` over every box of the scene.
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(31);
+    let mut compared = 0;
+    for range in [50.0, 150.0, 500.0, 1000.0, 5000.0] {
+        let config = laser_config(90, 360.0, range);
+        let laser = Laser::new(&config.laser);
+        let mut readings = vec![0.0; laser.beams()];
+        let with_box = maze_scene(&config, 4).with_obstacles(
+            vec![ronap_core::Aabb::from_corners(
+                Point::new(430.0, 440.0),
+                Point::new(470.0, 455.0),
+            )],
+            vec![],
+        );
+        let scenes = [
+            maze_scene(&config, 2),
+            image_of_maze(&config, 3),
+            with_box,
+            ronap_core::sim::world::warehouse_scene(&config, 5),
+        ];
+        for scene in &scenes {
+            for k in 0..25 {
+                // Some poses hug a wall, where a beam can run along a face.
+                let p = free_point(scene, if k % 5 == 0 { 1e-3 } else { 1.0 }, &mut rng);
+                let z = if k % 3 == 0 {
+                    0.0
+                } else {
+                    rng.random_range(0.0..360.0)
+                };
+                laser.scan(scene, p, z, &mut readings);
+                // Every box against each beam, in turn, as the scan did before it had an index;
+                // `refine` hands over each beam's direction exactly as the scan computes it.
+                let mut every_box = vec![range; laser.beams()];
+                laser.refine(p, z, &mut every_box, |origin, dir, _| {
+                    let inv = ronap_core::Vector::new(1.0 / dir.x, 1.0 / dir.y);
+                    let mut best = range;
+                    for b in scene.boxes() {
+                        if let Some(t) = b.ray_hit(origin, inv, best) {
+                            best = t;
+                        }
+                    }
+                    Some(best)
+                });
+                for (i, (d, e)) in readings.iter().zip(&every_box).enumerate() {
+                    assert_eq!(
+                        d.to_bits(),
+                        e.to_bits(),
+                        "{range} px, p {p:?} z {z} beam {i}"
+                    );
+                    compared += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(compared, 5 * 4 * 25 * 90);
+}
+
+#[test]
+fn a_laser_may_have_up_to_4096_beams() {
+    assert!(SimConfig::default().validate().is_ok());
+    let mut sim = SimConfig::default();
+    sim.laser.beams = 4096;
+    assert!(sim.clone().validate().is_ok());
+    sim.laser.beams = 4097;
+    let e = sim.validate().unwrap_err().to_string();
+    assert!(e.contains("laser.beams") && e.contains("4096"), "{e}");
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
 

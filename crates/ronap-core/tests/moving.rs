@@ -8,7 +8,7 @@ use parry2d_f64::math::{Isometry, Point as PPoint, Vector as PVector};
 use parry2d_f64::query::{Ray, RayCast};
 use parry2d_f64::shape::{Ball, Compound, ConvexPolygon, Cuboid, SharedShape};
 use proptest::prelude::*;
-use ronap_core::config::{MotionKind, MovingConfig, MovingShape, ObstacleConfig};
+use ronap_core::config::{LaserConfig, MotionKind, MovingConfig, MovingShape, ObstacleConfig};
 use ronap_core::geometry::unit;
 use ronap_core::sim::moving::Body;
 use ronap_core::sim::world::maze_scene;
@@ -101,30 +101,36 @@ fn episode(config: &ValidConfig, seed: u64) -> Episode {
     Episode::new(config, scene, seed).unwrap()
 }
 
-#[test]
-fn the_laser_sees_discs_polygons_and_moving_obstacles_as_parry2d_does() {
-    let config = config_with(
-        vec![
+/// Scans of episodes among discs, a polygon, an added box and moving discs and boxes, with `laser`,
+/// each reading against parry2d's ray cast into all of them; how many readings were compared.
+fn laser_against_parry2d(laser: LaserConfig, seeds: u64, steps: usize) -> usize {
+    let range = laser.range_px;
+    let config = SimConfig {
+        moving: vec![
             crowd(60, MotionKind::RandomWalk, MovingShape::Disc, 3.0),
             crowd(20, MotionKind::Linear, MovingShape::Box, 4.0),
         ],
-        shapes(),
-    );
+        obstacles: shapes(),
+        laser,
+        ..SimConfig::default()
+    }
+    .validate()
+    .unwrap();
     let mut compared = 0;
-    for seed in 0..10 {
+    for seed in 0..seeds {
         let mut e = episode(&config, seed);
-        for step in 0..150 {
+        for step in 0..steps {
             let compound = parry_of(&e);
             let p = e.pose().position();
             for (i, &d) in e.readings().iter().enumerate() {
                 let dir = unit(e.laser().beam_angle_deg(i, e.pose().z_deg));
                 let ray = Ray::new(PPoint::new(p.x, p.y), PVector::new(dir.x, dir.y));
                 let expected = compound
-                    .cast_ray(&Isometry::identity(), &ray, 50.0, true)
-                    .unwrap_or(50.0);
+                    .cast_ray(&Isometry::identity(), &ray, range, true)
+                    .unwrap_or(range);
                 assert!(
                     (d - expected).abs() < 1e-4,
-                    "seed {seed} step {step} beam {i}: {d} vs parry {expected}"
+                    "{range} px, seed {seed} step {step} beam {i}: {d} vs parry {expected}"
                 );
                 compared += 1;
             }
@@ -133,7 +139,25 @@ fn the_laser_sees_discs_polygons_and_moving_obstacles_as_parry2d_does() {
             ));
         }
     }
+    compared
+}
+
+#[test]
+fn the_laser_sees_discs_polygons_and_moving_obstacles_as_parry2d_does() {
+    let compared = laser_against_parry2d(LaserConfig::default(), 10, 150);
     assert_eq!(compared, 10 * 150 * 17);
+}
+
+#[test]
+fn a_long_laser_of_many_beams_sees_them_as_parry2d_does() {
+    // The added box takes the maze off its own cells onto the uniform ray grid.
+    let laser = LaserConfig {
+        beams: 720,
+        fov_deg: 360.0,
+        range_px: 1000.0,
+        ..LaserConfig::default()
+    };
+    assert_eq!(laser_against_parry2d(laser, 3, 10), 3 * 10 * 720);
 }
 
 #[test]
