@@ -48,7 +48,7 @@ enum Command {
     /// Render a logged episode (`ronap run --log-steps`) as an animated GIF, from above or
     /// first-person.
     Replay(replay::ReplayArgs),
-    /// Measure how fast this machine steps the default scene.
+    /// Measure how fast this machine steps a scene and what its laser costs per ray.
     Bench(bench::BenchArgs),
     /// Train a policy network (behaviour cloning or DQN) and write its weights file.
     Train(train::TrainArgs),

@@ -1,6 +1,8 @@
 //! End-to-end tests of the `ronap` binary: outputs read back and checked, bad input rejected.
 
-use crate::util::{assert_rejected_in_empty_dir, ronap, stderr, stdout};
+use crate::util::{
+    assert_rejected, assert_rejected_in_empty_dir, ok, repo_root, ronap, stderr, stdout,
+};
 
 #[test]
 fn maze_prints_text_by_default() {
@@ -216,6 +218,114 @@ fn bench_reports_steps_per_second_and_scan_time() {
 }
 
 #[test]
+fn bench_takes_its_laser_and_scene_from_the_flags() {
+    let o = ronap(&[
+        "bench",
+        "--seconds",
+        "0.01",
+        "--threads",
+        "1",
+        "--beams",
+        "360",
+        "--range",
+        "300",
+        "--fov",
+        "360",
+        "--cols",
+        "5",
+        "--rows",
+        "3",
+    ]);
+    let text = ok(&o);
+    let header = text.lines().next().unwrap();
+    assert!(
+        header.contains("maze of seed 0 of 500 x 300 px"),
+        "{header}"
+    );
+    assert!(
+        header.contains("360 beams over 360 deg to 300 px"),
+        "{header}"
+    );
+    let scan = text.lines().find(|l| l.contains("laser scan")).unwrap();
+    assert!(
+        scan.contains("(360 beams, ") && scan.contains("ns per ray"),
+        "{scan}"
+    );
+
+    let office = repo_root().join("scenarios/office.png");
+    let o = ronap(&[
+        "bench",
+        "--seconds",
+        "0.01",
+        "--threads",
+        "1",
+        "--map",
+        office.to_str().unwrap(),
+    ]);
+    let header = ok(&o).lines().next().unwrap().to_string();
+    assert!(header.contains("office.png of 720 x 480 px"), "{header}");
+
+    assert_rejected(&["bench", "--beams", "4097"], &["--beams", "4096"]);
+    assert_rejected(&["bench", "--fov", "400"], &["--fov", "360"]);
+    assert_rejected(&["bench", "--range", "0"], &["--range"]);
+    assert_rejected(
+        &["bench", "--sweep", "--beams", "9"],
+        &["--sweep", "--beams"],
+    );
+}
+
+#[test]
+fn bench_sweep_tabulates_every_beam_count_and_range() {
+    let o = ronap(&[
+        "bench",
+        "--sweep",
+        "--seconds",
+        "0.01",
+        "--cols",
+        "4",
+        "--rows",
+        "4",
+    ]);
+    let text = ok(&o);
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    assert!(
+        header.contains("maze of seed 0 of 400 x 400 px"),
+        "{header}"
+    );
+    assert_eq!(
+        lines.next().unwrap().split_whitespace().collect::<Vec<_>>(),
+        ["beams", "range", "px", "ns", "per", "ray", "steps/s"]
+    );
+    let rows: Vec<(u32, f64, f64, f64)> = lines
+        .map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            assert_eq!(f.len(), 4, "{l}");
+            (
+                f[0].parse().unwrap(),
+                f[1].parse().unwrap(),
+                f[2].parse().unwrap(),
+                f[3].replace(',', "").parse().unwrap(),
+            )
+        })
+        .collect();
+    let cells: Vec<(u32, f64)> = rows.iter().map(|r| (r.0, r.1)).collect();
+    let mut expected = Vec::new();
+    for beams in [17, 64, 360, 1080] {
+        for range in [50.0, 200.0, 1000.0] {
+            expected.push((beams, range));
+        }
+    }
+    assert_eq!(cells, expected);
+    for (beams, range, ns, steps) in rows {
+        assert!(
+            ns > 0.0 && steps > 0.0,
+            "{beams} beams at {range} px: {ns} ns, {steps} steps/s"
+        );
+    }
+}
+
+#[test]
 fn help_explains_every_flag_with_its_default() {
     let o = ronap(&["maze", "--help"]);
     assert!(o.status.success());
@@ -229,6 +339,7 @@ fn help_explains_every_flag_with_its_default() {
         (&["train", "dqn", "--help"][..], "train_dqn_help"),
         (&["view", "--help"][..], "view_help"),
         (&["replay", "--help"][..], "replay_help"),
+        (&["bench", "--help"][..], "bench_help"),
     ] {
         let o = ronap(args);
         assert!(o.status.success());

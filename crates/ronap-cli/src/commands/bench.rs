@@ -1,150 +1,266 @@
-//! `ronap bench`: how fast this machine steps the default scene (or a scenario's, moving obstacles
-//! and all), on one thread and on all.
+//! `ronap bench`: how fast this machine steps the default scene (or a scenario's or a map's, moving
+//! obstacles and all), on one thread and on all, and what a laser scan costs; `--sweep` tabulates
+//! the laser's cost over beam counts and ranges.
 
 use crate::args::{positive, SimArgs};
 use anyhow::{Context, Result};
 use clap::Args;
+use ronap_core::config::MAX_BEAMS;
 use ronap_core::scene::freespace::FreeGrid;
 use ronap_core::sim::placement::{free_grid, needs_region_grid, sample_placement};
 use ronap_core::sim::world::{SceneSpec, Worlds};
 use ronap_core::{Episode, Laser, Scene, ValidConfig};
 use std::io::Write;
+use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// The action pattern stepped: AHEAD x3, LEFT, AHEAD x2, RIGHT, AHEAD.
 const PATTERN: [usize; 8] = [1, 1, 1, 0, 1, 1, 2, 1];
 
+/// Beam counts `--sweep` measures.
+const SWEEP_BEAMS: [u32; 4] = [17, 64, 360, 1080];
+/// Laser ranges `--sweep` measures, px.
+const SWEEP_RANGES_PX: [f64; 3] = [50.0, 200.0, 1000.0];
+/// Seconds per figure: without and with `--sweep`.
+const SECONDS: f64 = 2.0;
+const SWEEP_SECONDS: f64 = 0.2;
+
 /// Arguments of `ronap bench`.
 #[derive(Args, Debug)]
 pub struct BenchArgs {
-    /// Seconds to step for, in each of the two measurements.
-    #[arg(long, allow_negative_numbers = true, value_name = "S", default_value_t = 2.0, value_parser = positive)]
-    seconds: f64,
+    /// Seconds to measure each figure for [default: 2, or 0.2 with --sweep].
+    #[arg(long, allow_negative_numbers = true, value_name = "S", value_parser = positive)]
+    seconds: Option<f64>,
     /// Threads for the all-threads figure [default: all cores].
     #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1024))]
     threads: Option<u32>,
+    /// Laser beams, 1 to 4096 [default: 17].
+    #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_BEAMS)))]
+    beams: Option<u32>,
+    /// Laser range, px [default: 50].
+    #[arg(long, allow_negative_numbers = true, value_name = "PX", value_parser = positive)]
+    range: Option<f64>,
+    /// Angle the beams cover, centred on the heading, 0 to 360 degrees [default: 180].
+    #[arg(long, allow_negative_numbers = true, value_name = "DEG", value_parser = field_of_view)]
+    fov: Option<f64>,
+    /// Bench on an image scene (PNG/PGM: dark pixels are obstacles) or a ROS map_server YAML file
+    /// instead of the maze.
+    #[arg(long, value_name = "FILE")]
+    map: Option<PathBuf>,
+    /// Print ns per ray and steps/s (one thread) for every beam count of 17, 64, 360 and 1080 and
+    /// range of 50, 200 and 1000 px, instead of the usual figures.
+    #[arg(long, conflicts_with_all = ["beams", "range", "threads"])]
+    sweep: bool,
     #[command(flatten)]
     sim: SimArgs,
 }
 
-/// Steps episodes in `scene` for `duration`, starting a new placement whenever one ends; returns
-/// the number of steps. Placements come from the free grid computed once, so the figure is the
-/// stepping and not scene setup.
-fn step_for(
-    config: &ValidConfig,
-    scene: &Arc<Scene>,
-    grid: Option<&FreeGrid>,
-    first_seed: u64,
-    duration: Duration,
-) -> Result<u64> {
-    let mut seed = first_seed;
-    let new_episode = |seed: u64| -> Result<Episode> {
-        let placement = sample_placement(config, scene, grid, seed)?;
-        Ok(Episode::with_placement(
+/// Parses a field of view: 0 to 360 degrees.
+fn field_of_view(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
+    if (0.0..=360.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err("must be between 0 and 360 degrees".into())
+    }
+}
+
+/// What is benched: a configuration, the scene of seed 0 under it, and the free grid placements
+/// are drawn from (when the scene needs one).
+struct Bench {
+    config: ValidConfig,
+    spec: SceneSpec,
+    scene: Arc<Scene>,
+    grid: Option<FreeGrid>,
+}
+
+impl Bench {
+    /// The flags' configuration with the laser of `beams` and `range_px` (when given), and its
+    /// scene: the scenario's (the maze by default) or the map, of seed 0, moving obstacles and all.
+    fn new(args: &BenchArgs, beams: Option<u32>, range_px: Option<f64>) -> Result<Self> {
+        let config = args.sim.config_with(|sim| {
+            let laser = &mut sim.laser;
+            laser.beams = beams.unwrap_or(laser.beams);
+            laser.range_px = range_px.unwrap_or(laser.range_px);
+            laser.fov_deg = args.fov.unwrap_or(laser.fov_deg);
+        })?;
+        let spec = SceneSpec::resolve(&config.scene, Some(0), args.map.as_deref());
+        let (scenes, _) = spec
+            .load(&config)
+            .with_context(|| format!("loading the {spec}"))?;
+        let scene = Worlds::new(config.clone(), scenes).world(0).scene().clone();
+        let grid = needs_region_grid(&config, &scene).then(|| free_grid(&config, &scene));
+        Ok(Self {
             config,
-            scene.clone(),
-            seed,
-            placement,
-        )?)
-    };
-    let mut episode = new_episode(seed)?;
-    let start = Instant::now();
-    let mut steps = 0u64;
-    loop {
-        for k in 0..4096 {
-            let r = episode
-                .step_index(PATTERN[k % PATTERN.len()])
-                .context("pattern action")?;
-            if r.status.is_done() {
-                seed += 1;
-                episode = new_episode(seed)?;
+            spec,
+            scene,
+            grid,
+        })
+    }
+
+    /// Steps episodes for `duration` on `threads` threads, starting a new placement whenever one
+    /// ends; returns steps per second.
+    fn steps_per_second(&self, threads: usize, duration: Duration) -> Result<f64> {
+        let start = Instant::now();
+        let total: u64 = std::thread::scope(|s| {
+            let handles: Vec<_> = (0..threads)
+                .map(|t| s.spawn(move || self.step_for(t as u64 * 1_000_000, duration)))
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| {
+                    h.join()
+                        .unwrap_or_else(|_| Err(anyhow::anyhow!("a bench thread panicked")))
+                })
+                .sum::<Result<u64>>()
+        })?;
+        Ok(total as f64 / start.elapsed().as_secs_f64())
+    }
+
+    /// Steps episodes for `duration`, from `first_seed` on; returns the number of steps.
+    /// Placements come from the free grid computed once, so the figure is the stepping and not
+    /// scene setup.
+    fn step_for(&self, first_seed: u64, duration: Duration) -> Result<u64> {
+        let (config, scene) = (&self.config, &self.scene);
+        let new_episode = |seed: u64| -> Result<Episode> {
+            let placement = sample_placement(config, scene, self.grid.as_ref(), seed)?;
+            Ok(Episode::with_placement(
+                config,
+                scene.clone(),
+                seed,
+                placement,
+            )?)
+        };
+        let mut seed = first_seed;
+        let mut episode = new_episode(seed)?;
+        let start = Instant::now();
+        let mut steps = 0u64;
+        loop {
+            for k in 0..4096 {
+                let r = episode
+                    .step_index(PATTERN[k % PATTERN.len()])
+                    .context("pattern action")?;
+                if r.status.is_done() {
+                    seed += 1;
+                    episode = new_episode(seed)?;
+                }
+            }
+            steps += 4096;
+            if start.elapsed() >= duration {
+                return Ok(steps);
             }
         }
-        steps += 4096;
-        if start.elapsed() >= duration {
-            return Ok(steps);
+    }
+
+    /// Nanoseconds per laser scan, over scans from 1000 placements spread over the scene (so the
+    /// figure is not one lucky pose) repeated for about `duration`.
+    fn scan_ns(&self, duration: Duration) -> Result<f64> {
+        let laser = Laser::new(&self.config.laser);
+        let poses: Vec<_> = (0..1000)
+            .map(|seed| {
+                sample_placement(&self.config, &self.scene, self.grid.as_ref(), seed)
+                    .map(|p| p.start)
+            })
+            .collect::<Result<_, _>>()?;
+        let mut readings = vec![0.0; laser.beams()];
+        let (mut scans, start) = (0u64, Instant::now());
+        while scans == 0 || start.elapsed() < duration {
+            for pose in &poses {
+                laser.scan(&self.scene, pose.position(), pose.z_deg, &mut readings);
+            }
+            scans += poses.len() as u64;
         }
+        Ok(start.elapsed().as_secs_f64() * 1e9 / scans as f64)
     }
 }
 
 /// Runs `ronap bench`.
 pub fn run(args: BenchArgs) -> Result<std::process::ExitCode> {
-    let config = args.sim.config()?;
+    // Written, not printed: `ronap bench | head` ends quietly instead of panicking.
+    let mut out = std::io::stdout().lock();
+    if args.sweep {
+        sweep(&args, &mut out)?;
+        return Ok(std::process::ExitCode::SUCCESS);
+    }
+    let bench = Bench::new(&args, args.beams, args.range)?;
     let threads = args.threads.map_or_else(
         || std::thread::available_parallelism().map_or(1, |n| n.get()),
         |n| n as usize,
     );
-    let duration = Duration::from_secs_f64(args.seconds);
-    // The scenario's scene (the maze by default) of seed 0, moving obstacles and all.
-    let spec = SceneSpec::resolve(&config.scene, Some(0), None);
-    let (scenes, _) = spec.load(&config)?;
-    let scene = Worlds::new(config.clone(), scenes).world(0).scene().clone();
-    let grid = needs_region_grid(&config, &scene).then(|| free_grid(&config, &scene));
-    let movers: u32 = config.moving.iter().map(|m| m.count).sum();
-    // Written, not printed: `ronap bench | head` ends quietly instead of panicking.
-    let mut out = std::io::stdout().lock();
+    let seconds = args.seconds.unwrap_or(SECONDS);
+    let duration = Duration::from_secs_f64(seconds);
+    let laser = &bench.config.laser;
+    let movers: u32 = bench.config.moving.iter().map(|m| m.count).sum();
     writeln!(
         out,
-        "ronap bench: {} of {:.0} x {:.0} px, {} moving obstacles, {} beams, {} s per figure",
-        spec,
-        scene.width(),
-        scene.height(),
+        "ronap bench: {} of {:.0} x {:.0} px, {} moving obstacles, {} beams over {} deg to {} px, \
+         {} s per figure",
+        bench.spec,
+        bench.scene.width(),
+        bench.scene.height(),
         movers,
-        config.laser.beams,
-        args.seconds
+        laser.beams,
+        laser.fov_deg,
+        laser.range_px,
+        seconds
     )?;
-
-    let start = Instant::now();
-    let steps = step_for(&config, &scene, grid.as_ref(), 0, duration)?;
-    let single = steps as f64 / start.elapsed().as_secs_f64();
+    let single = bench.steps_per_second(1, duration)?;
     writeln!(out, "  one thread       {:>14} steps/s", group(single))?;
-
-    let start = Instant::now();
-    let total: u64 = std::thread::scope(|s| {
-        let handles: Vec<_> = (0..threads)
-            .map(|t| {
-                let (config, scene, grid) = (&config, &scene, grid.as_ref());
-                s.spawn(move || step_for(config, scene, grid, t as u64 * 1_000_000, duration))
-            })
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| {
-                h.join()
-                    .unwrap_or_else(|_| Err(anyhow::anyhow!("a bench thread panicked")))
-            })
-            .sum::<Result<u64>>()
-    })?;
-    let all = total as f64 / start.elapsed().as_secs_f64();
+    let all = bench.steps_per_second(threads, duration)?;
     writeln!(
         out,
         "  {threads} thread{}        {:>14} steps/s",
         if threads == 1 { " " } else { "s" },
         group(all)
     )?;
-
-    // Scans from 1000 placements spread over the scene, so the figure is not one lucky pose.
-    let laser = Laser::new(&config.laser);
-    let poses: Vec<_> = (0..1000)
-        .map(|seed| sample_placement(&config, &scene, grid.as_ref(), seed).map(|p| p.start))
-        .collect::<Result<_, _>>()?;
-    let mut readings = vec![0.0; laser.beams()];
-    let rounds = 200;
-    let start = Instant::now();
-    for _ in 0..rounds {
-        for pose in &poses {
-            laser.scan(&scene, pose.position(), pose.z_deg, &mut readings);
-        }
-    }
-    let ns = start.elapsed().as_secs_f64() * 1e9 / (rounds * poses.len()) as f64;
+    let ns = bench.scan_ns(duration)?;
     writeln!(
         out,
-        "  one laser scan   {:>14.0} ns ({} beams)",
+        "  one laser scan   {:>14.0} ns ({} beams, {:.1} ns per ray)",
         ns,
-        laser.beams()
+        laser.beams,
+        ns / f64::from(laser.beams)
     )?;
     Ok(std::process::ExitCode::SUCCESS)
+}
+
+/// `ronap bench --sweep`: one row per beam count and range.
+fn sweep(args: &BenchArgs, out: &mut impl Write) -> Result<()> {
+    let seconds = args.seconds.unwrap_or(SWEEP_SECONDS);
+    let duration = Duration::from_secs_f64(seconds);
+    let mut header = false;
+    for beams in SWEEP_BEAMS {
+        for range_px in SWEEP_RANGES_PX {
+            let bench = Bench::new(args, Some(beams), Some(range_px))?;
+            if !header {
+                writeln!(
+                    out,
+                    "ronap bench --sweep: {} of {:.0} x {:.0} px, beams over {} deg, one thread, \
+                     {} s per figure",
+                    bench.spec,
+                    bench.scene.width(),
+                    bench.scene.height(),
+                    bench.config.laser.fov_deg,
+                    seconds
+                )?;
+                writeln!(
+                    out,
+                    "  {:>6}  {:>8}  {:>10}  {:>12}",
+                    "beams", "range px", "ns per ray", "steps/s"
+                )?;
+                header = true;
+            }
+            let ns = bench.scan_ns(duration)? / f64::from(beams);
+            let steps = bench.steps_per_second(1, duration)?;
+            writeln!(
+                out,
+                "  {beams:>6}  {range_px:>8}  {ns:>10.1}  {:>12}",
+                group(steps)
+            )?;
+        }
+    }
+    Ok(())
 }
 
 /// `1234567.8` as `1,234,568`.
