@@ -14,6 +14,14 @@
 
 use crate::geometry::{Aabb, Point, Vector};
 
+/// 1 when a walk between cell lines crosses a vertical line next (`next_x < next_y`, the `t` of
+/// the next line across x and across y), else 0: read from the sign of the difference, because a
+/// comparison would be compiled into a branch the processor guesses wrong half the time.
+#[inline(always)]
+pub fn crosses_x_first(next_x: f64, next_y: f64) -> u64 {
+    (next_x - next_y).to_bits() >> 63
+}
+
 /// Most cells a grid has; its cells grow to keep under it.
 pub const MAX_CELLS: usize = 1 << 20;
 
@@ -24,6 +32,31 @@ struct Listed {
     aabb: Aabb,
     center: Point,
     half: Vector,
+}
+
+impl Listed {
+    /// An empty slot: its negative half extents fail every quick test.
+    const NONE: Listed = Listed {
+        aabb: Aabb {
+            min: Point::new(0.0, 0.0),
+            max: Point::new(0.0, 0.0),
+        },
+        center: Point::new(0.0, 0.0),
+        half: Vector::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+    };
+}
+
+/// Boxes a cell holds in place: most cells list no more, so a walk reads a cell without a loop
+/// whose length the processor would have to guess.
+const SLOTS: usize = 2;
+
+/// A cell: its first boxes in place (the rest padded with [`Listed::NONE`]), and where the others
+/// are in [`RayGrid::more`].
+#[derive(Clone, Copy, Debug)]
+struct Cell {
+    slots: [Listed; SLOTS],
+    more: u32,
+    more_len: u32,
 }
 
 /// Boxes listed per square cell, for ray casts.
@@ -37,10 +70,10 @@ pub struct RayGrid {
     inv_cell_px: f64,
     cols: usize,
     rows: usize,
-    /// `starts[c]..starts[c + 1]` is cell `c`'s slice of `listed` (cells row by row from the
-    /// bottom).
-    starts: Vec<u32>,
-    listed: Vec<Listed>,
+    /// Cells row by row from the bottom.
+    cells: Vec<Cell>,
+    /// The boxes of cells that list more than [`SLOTS`].
+    more: Vec<Listed>,
     /// More than rounding can move a box's distance from a ray's line, px.
     slack_px: f64,
 }
@@ -134,6 +167,26 @@ impl RayGrid {
                 }
             }
         }
+        // The first boxes of each cell in place, the rest after one another.
+        let mut more = Vec::new();
+        let cells = starts
+            .windows(2)
+            .map(|w| {
+                let all = &listed[w[0] as usize..w[1] as usize];
+                let mut slots = [Listed::NONE; SLOTS];
+                for (slot, b) in slots.iter_mut().zip(all) {
+                    *slot = *b;
+                }
+                let extra = all.get(SLOTS..).unwrap_or(&[]);
+                let cell = Cell {
+                    slots,
+                    more: more.len() as u32,
+                    more_len: extra.len() as u32,
+                };
+                more.extend_from_slice(extra);
+                cell
+            })
+            .collect();
         let largest = [area.min.x, area.min.y, area.max.x, area.max.y]
             .iter()
             .fold(1.0f64, |m, v| m.max(v.abs()));
@@ -144,8 +197,8 @@ impl RayGrid {
             inv_cell_px: 1.0 / cell_px,
             cols,
             rows,
-            starts,
-            listed,
+            cells,
+            more,
             slack_px: largest * 1e-9,
         }
     }
@@ -230,36 +283,38 @@ impl RayGrid {
         let (mut next_y, delta_y) = axis(line_y, o.y, inv_dir.y);
         let (cols, rows) = (self.cols as isize, self.rows as isize);
         let mut cell = row * cols + col;
-        let (abs_x, abs_y) = (dir.x.abs(), dir.y.abs());
+        let abs = dir.abs();
         let mut best = f64::INFINITY;
         loop {
-            let listed = &self.listed
-                [self.starts[cell as usize] as usize..self.starts[cell as usize + 1] as usize];
-            for b in listed {
-                // Whether the ray's line comes within the half width across it (the perpendicular
-                // of `dir`) of the box's part in this cell, give or take rounding: the line
-                // within the cell is the ray's piece there, so a box it misses is met, if at all,
-                // in another cell that lists it.
-                let rel = b.center - o;
-                let across = rel.x * dir.y - rel.y * dir.x;
-                let reach = b.half.x * abs_y + b.half.y * abs_x + self.slack_px;
-                if across.abs() <= reach {
-                    if let Some(t) = b.aabb.ray_hit(o, inv_dir, max_t) {
-                        best = if t < best { t } else { best };
+            let here = &self.cells[cell as usize];
+            let meets = here.slots.map(|b| self.meets(&b, o, dir, abs));
+            // Not `any`, which stops at the first and so branches on each.
+            if meets.iter().fold(false, |any, &m| any | m) {
+                for (b, m) in here.slots.iter().zip(meets) {
+                    if m {
+                        Self::test(b, o, inv_dir, max_t, &mut best);
+                    }
+                }
+            }
+            if here.more_len > 0 {
+                let more = here.more as usize..(here.more + here.more_len) as usize;
+                for b in &self.more[more] {
+                    if self.meets(b, o, dir, abs) {
+                        Self::test(b, o, inv_dir, max_t, &mut best);
                     }
                 }
             }
             // `x * 1.0 + y * 0.0` is exactly `x` for the finite values here: a step is blended
             // from both axes rather than chosen by a branch the processor would guess wrong half
             // the time.
-            let along_x = next_x < next_y;
-            let wx = f64::from(u8::from(along_x));
+            let x_first = crosses_x_first(next_x, next_y);
+            let wx = x_first as f64;
             let wy = 1.0 - wx;
             let exit = next_x.min(next_y);
             if best.min(max_t) <= exit {
                 break;
             }
-            let (kx, ky) = (isize::from(along_x), isize::from(!along_x));
+            let (kx, ky) = (x_first as isize, 1 - x_first as isize);
             col += step_x * kx;
             row += step_y * ky;
             cell += step_x * kx + step_y * cols * ky;
@@ -270,6 +325,24 @@ impl RayGrid {
             }
         }
         (best <= max_t).then_some(best)
+    }
+
+    /// Whether the ray's line comes within the half width across it (the perpendicular of `dir`)
+    /// of the box's part in the cell, give or take rounding: the line within the cell is the
+    /// ray's piece there, so a box it misses is met, if at all, in another cell that lists it.
+    #[inline(always)]
+    fn meets(&self, b: &Listed, o: Point, dir: Vector, abs: Vector) -> bool {
+        let rel = b.center - o;
+        let across = rel.x * dir.y - rel.y * dir.x;
+        across.abs() <= b.half.x * abs.y + b.half.y * abs.x + self.slack_px
+    }
+
+    /// Lowers `best` to the ray's hit on `b`, if any.
+    #[inline(always)]
+    fn test(b: &Listed, o: Point, inv_dir: Vector, max_t: f64, best: &mut f64) {
+        if let Some(t) = b.aabb.ray_hit(o, inv_dir, max_t) {
+            *best = if t < *best { t } else { *best };
+        }
     }
 }
 

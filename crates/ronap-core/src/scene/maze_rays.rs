@@ -17,6 +17,7 @@
 //! over all the walls. The closed outer boundary keeps a ray from inside from leaving the maze
 //! before its first wall.
 
+use crate::geometry::ray_grid::crosses_x_first;
 use crate::geometry::{Aabb, Point, Vector};
 use crate::scene::maze::Maze;
 
@@ -44,12 +45,17 @@ pub struct Start {
     origin: Point,
     /// Whether the origin lies in the maze (else rays test every wall).
     inside: bool,
-    col: isize,
-    row: isize,
-    /// Lower-left corner of the origin's cell.
-    corner: Point,
-    /// Whether the origin is within a wall's reach of a side of its cell.
-    near_wall: bool,
+    /// The origin less the lower-left corner of its cell.
+    offset: Vector,
+    /// The vertical edge left of the origin's cell and the horizontal edge below it, as indices
+    /// into [`MazeRays::vertical`] and [`MazeRays::horizontal`].
+    vertical: isize,
+    horizontal: isize,
+    /// The walls a ray may meet before it reaches an edge of the origin's cell: those of each side
+    /// the origin is within reach of, and of the corners at the side's ends (`NO_WALL` beyond
+    /// `near_count`; a wall may repeat).
+    near: [u32; 16],
+    near_count: usize,
 }
 
 /// An open edge.
@@ -85,7 +91,7 @@ impl MazeRays {
         &self.boxes
     }
 
-    /// What every ray from `origin` shares: its cell, and the walls it is within reach of.
+    /// What every ray from `origin` shares: its cell and the walls it is within reach of.
     #[inline]
     pub fn start(&self, origin: Point) -> Start {
         let c = self.cell_px;
@@ -96,27 +102,47 @@ impl MazeRays {
         // A float cast truncates, which is the floor here.
         let col = ((origin.x * self.inv_cell_px) as isize).min(self.cols as isize - 1);
         let row = ((origin.y * self.inv_cell_px) as isize).min(self.rows as isize - 1);
-        let corner = Point::new(col as f64 * c, row as f64 * c);
-        let gaps = [
-            origin.x - corner.x,
-            corner.x + c - origin.x,
-            origin.y - corner.y,
-            corner.y + c - origin.y,
-        ];
-        Start {
+        let offset = origin - Point::new(col as f64 * c, row as f64 * c);
+        let cols = self.cols as isize;
+        let mut start = Start {
             origin,
             inside,
-            col,
-            row,
-            corner,
-            near_wall: gaps.iter().any(|&g| g <= self.reach_px),
+            offset,
+            vertical: row * (cols + 1) + col,
+            horizontal: row * cols + col,
+            near: [NO_WALL; 16],
+            near_count: 0,
+        };
+        let gaps = [offset.x, c - offset.x, offset.y, c - offset.y];
+        if inside && gaps.iter().any(|&g| g <= self.reach_px) {
+            let (col, row) = (col as usize, row as usize);
+            // Each side by the corners at its two ends (whose walls include the side's own).
+            let sides = [
+                [(col, row), (col, row + 1)],
+                [(col + 1, row), (col + 1, row + 1)],
+                [(col, row), (col + 1, row)],
+                [(col, row + 1), (col + 1, row + 1)],
+            ];
+            for (gap, ends) in gaps.into_iter().zip(sides) {
+                if gap <= self.reach_px {
+                    for (i, j) in ends {
+                        for wall in self.corner_walls(i, j) {
+                            if wall != NO_WALL && start.near_count < start.near.len() {
+                                start.near[start.near_count] = wall;
+                                start.near_count += 1;
+                            }
+                        }
+                    }
+                }
+            }
         }
+        start
     }
 
     /// The nearest [`Aabb::ray_hit`] over every wall of the ray `start.origin + t * dir`, `t` in
     /// `[0, max_t]`, with `inv_dir = 1 / dir` per component: `Some(0.0)` when the origin is in a
     /// wall, `None` when no wall lies within `max_t`. From outside the maze, every wall is tested.
-    #[inline]
+    #[inline(always)]
     pub fn cast(&self, start: &Start, dir: Vector, inv_dir: Vector, max_t: f64) -> Option<f64> {
         let o = start.origin;
         if !start.inside {
@@ -124,71 +150,75 @@ impl MazeRays {
         }
         let c = self.cell_px;
         let mut best = f64::INFINITY;
-        if start.near_wall {
-            self.near_origin(start, inv_dir, max_t, &mut best);
+        for &wall in &start.near[..start.near_count] {
+            self.test(wall, o, inv_dir, max_t, &mut best);
         }
-        // Per axis: the step between cells, the `t` of the next cell line ahead and the `t`
-        // between lines. An axis the ray runs parallel to never steps: its next line is further
-        // than any other (and finite, so that the blends below stay exact).
-        let ahead_x = isize::from(inv_dir.x > 0.0);
-        let ahead_y = isize::from(inv_dir.y > 0.0);
+        // Per axis, the step between cells, and the `t` of the next cell line ahead and between
+        // lines. An axis the ray runs parallel to never steps: its next line is further than any
+        // other (and finite, so that the blends below stay exact).
+        let (ahead_x, ahead_y) = (isize::from(inv_dir.x > 0.0), isize::from(inv_dir.y > 0.0));
         let (step_x, step_y) = (2 * ahead_x - 1, 2 * ahead_y - 1);
-        let axis = |corner: f64, ahead: isize, o: f64, inv: f64| -> (f64, f64) {
+        let axis = |gap: f64, inv: f64| {
             if inv.is_finite() {
-                ((corner + ahead as f64 * c - o) * inv, c * inv.abs())
+                (gap * inv.abs(), c * inv.abs())
             } else {
                 (f64::MAX, 0.0)
             }
         };
-        let (mut next_x, delta_x) = axis(start.corner.x, ahead_x, o.x, inv_dir.x);
-        let (mut next_y, delta_y) = axis(start.corner.y, ahead_y, o.y, inv_dir.y);
-        let (cols, rows) = (self.cols as isize, self.rows as isize);
-        let (mut col, mut row) = (start.col, start.row);
-        let mut corner = start.corner;
-        let (corner_step_x, corner_step_y) = (step_x as f64 * c, step_y as f64 * c);
-        // The edges ahead on either axis, and how they move with a step along x or along y.
-        let mut vertical = row * (cols + 1) + col + ahead_x;
-        let mut horizontal = (row + ahead_y) * cols + col;
-        let (vertical_by_y, horizontal_by_y) = (step_y * (cols + 1), step_y * cols);
+        let mut offset = start.offset;
+        let gap_x = if ahead_x == 1 { c - offset.x } else { offset.x };
+        let gap_y = if ahead_y == 1 { c - offset.y } else { offset.y };
+        let (mut next_x, delta_x) = axis(gap_x, inv_dir.x);
+        let (mut next_y, delta_y) = axis(gap_y, inv_dir.y);
+        let (offset_by_x, offset_by_y) = (step_x as f64 * c, step_y as f64 * c);
+        // The edges ahead on either axis, and how a step across x or across y moves them.
+        let cols = self.cols as isize;
+        let mut vertical = start.vertical + ahead_x;
+        let mut horizontal = start.horizontal + ahead_y * cols;
+        let vertical_by = [step_x, step_y * (cols + 1)];
+        let horizontal_by = [step_x, step_y * cols];
         let reach = 2.0 * self.reach_px;
         let mut limit = max_t;
         let wall = loop {
-            // Which line the ray crosses first, as 1.0/0.0 weights: a step is blended from both
+            // Which line the ray crosses next, as 1.0/0.0 weights: a step is blended from both
             // axes rather than chosen by a branch the processor would guess wrong half the time.
             // `x * 1.0 + y * 0.0` is exactly `x` for the finite values here.
-            let along_x = next_x < next_y;
-            let wx = f64::from(u8::from(along_x));
-            let wy = 1.0 - wx;
-            let t = next_x.min(next_y);
+            let x_first = crosses_x_first(next_x, next_y);
+            let (wx, wy) = (x_first as f64, 1.0 - x_first as f64);
+            let t = next_x * wx + next_y * wy;
             // Where along the crossed edge the ray crosses it, from the edge's lower or left end.
-            let along = (o.y + t * dir.y - corner.y) * wx + (o.x + t * dir.x - corner.x) * wy;
-            let pick_x = 0u32.wrapping_sub(u32::from(along_x));
-            let wall = (self.vertical[vertical as usize] & pick_x)
-                | (self.horizontal[horizontal as usize] & !pick_x);
+            let along = (offset.y + t * dir.y) * wx + (offset.x + t * dir.x) * wy;
+            let (edges, edge) = if x_first == 1 {
+                (&self.vertical, vertical)
+            } else {
+                (&self.horizontal, horizontal)
+            };
+            // The closed boundary ends every walk inside the maze.
+            let Some(&wall) = edges.get(edge as usize) else {
+                break NO_WALL;
+            };
             if along < reach || along > c - reach {
-                let vertex = if along_x {
-                    (col + ahead_x, row, 0, 1)
-                } else {
-                    (col, row + ahead_y, 1, 0)
-                };
-                self.crossing_corners(vertex, along, inv_dir, o, max_t, &mut best);
+                self.crossing_corners(
+                    x_first == 1,
+                    edge as usize,
+                    along,
+                    inv_dir,
+                    o,
+                    max_t,
+                    &mut best,
+                );
                 limit = best.min(max_t);
             }
             if wall != NO_WALL || limit <= t {
                 break wall;
             }
-            let (kx, ky) = (isize::from(along_x), isize::from(!along_x));
-            col += step_x * kx;
-            row += step_y * ky;
-            corner.x += corner_step_x * wx;
-            corner.y += corner_step_y * wy;
             next_x += delta_x * wx;
             next_y += delta_y * wy;
-            vertical += step_x * kx + vertical_by_y * ky;
-            horizontal += step_x * kx + horizontal_by_y * ky;
-            if (col as usize) >= cols as usize || (row as usize) >= rows as usize {
-                break NO_WALL;
-            }
+            offset.x -= offset_by_x * wx;
+            offset.y -= offset_by_y * wy;
+            let k = 1 - x_first as usize;
+            vertical += vertical_by[k];
+            horizontal += horizontal_by[k];
         };
         // The ray leaves its last cell through a wall (which it meets by then), or it ends.
         if wall != NO_WALL {
@@ -197,13 +227,15 @@ impl MazeRays {
         (best <= max_t).then_some(best)
     }
 
-    /// Tests the walls meeting at the ends of a crossed edge that `along` (from the edge's lower
-    /// or left end) comes within reach of: `vertex` is the lower or left end `(i, j)` and the step
-    /// `(di, dj)` to the other.
+    /// Tests the walls meeting at each end of the crossed edge (the vertical edge `edge` when
+    /// `vertical`, else the horizontal one) that `along` (from the edge's lower or left end) comes
+    /// within reach of.
     #[cold]
+    #[allow(clippy::too_many_arguments)]
     fn crossing_corners(
         &self,
-        vertex: (isize, isize, isize, isize),
+        vertical: bool,
+        edge: usize,
         along: f64,
         inv: Vector,
         origin: Point,
@@ -211,19 +243,17 @@ impl MazeRays {
         best: &mut f64,
     ) {
         let reach = 2.0 * self.reach_px;
-        let (i, j, di, dj) = vertex;
+        // The edge's lower or left end `(i, j)`, and the step to its other end.
+        let (i, j, di, dj) = if vertical {
+            (edge % (self.cols + 1), edge / (self.cols + 1), 0, 1)
+        } else {
+            (edge % self.cols, edge / self.cols, 1, 0)
+        };
         if along < reach {
-            self.corner(i as usize, j as usize, origin, inv, max_t, best);
+            self.corner(i, j, origin, inv, max_t, best);
         }
         if along > self.cell_px - reach {
-            self.corner(
-                (i + di) as usize,
-                (j + dj) as usize,
-                origin,
-                inv,
-                max_t,
-                best,
-            );
+            self.corner(i + di, j + dj, origin, inv, max_t, best);
         }
     }
 
@@ -237,9 +267,9 @@ impl MazeRays {
         }
     }
 
-    /// Tests the walls on the (up to four) edges meeting at grid corner `(i, j)`.
-    #[cold]
-    fn corner(&self, i: usize, j: usize, origin: Point, inv: Vector, max_t: f64, best: &mut f64) {
+    /// The walls on the (up to four) edges meeting at grid corner `(i, j)`, [`NO_WALL`] for the
+    /// open ones.
+    fn corner_walls(&self, i: usize, j: usize) -> [u32; 4] {
         let (cols, rows) = (self.cols, self.rows);
         let mut walls = [NO_WALL; 4];
         if j > 0 && i <= cols {
@@ -254,36 +284,14 @@ impl MazeRays {
         if i < cols && j <= rows {
             walls[3] = self.horizontal[j * cols + i];
         }
-        for w in walls {
-            if w != NO_WALL {
-                self.test(w, origin, inv, max_t, best);
-            }
-        }
+        walls
     }
 
-    /// Tests the walls the start of a ray may meet before it reaches an edge: those of each side
-    /// of the origin's cell within reach of the origin, with the corners at its ends.
-    #[cold]
-    fn near_origin(&self, start: &Start, inv: Vector, max_t: f64, best: &mut f64) {
-        let (o, c) = (start.origin, self.cell_px);
-        let (col, row) = (start.col as usize, start.row as usize);
-        let gaps = [
-            o.x - start.corner.x,
-            start.corner.x + c - o.x,
-            o.y - start.corner.y,
-            start.corner.y + c - o.y,
-        ];
-        // Each side by the corners at its two ends (whose walls include the side's own).
-        let sides = [
-            ((col, row), (col, row + 1)),
-            ((col + 1, row), (col + 1, row + 1)),
-            ((col, row), (col + 1, row)),
-            ((col, row + 1), (col + 1, row + 1)),
-        ];
-        for (gap, (a, b)) in gaps.into_iter().zip(sides) {
-            if gap <= self.reach_px {
-                self.corner(a.0, a.1, o, inv, max_t, best);
-                self.corner(b.0, b.1, o, inv, max_t, best);
+    /// Tests the walls on the edges meeting at grid corner `(i, j)`.
+    fn corner(&self, i: usize, j: usize, origin: Point, inv: Vector, max_t: f64, best: &mut f64) {
+        for w in self.corner_walls(i, j) {
+            if w != NO_WALL {
+                self.test(w, origin, inv, max_t, best);
             }
         }
     }

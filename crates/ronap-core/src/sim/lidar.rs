@@ -2,20 +2,25 @@
 //!
 //! Beam `i` points at `z - fov/2 + i * fov/(m-1)` degrees (beam 0 on the right). A reading is the
 //! distance in px from the robot centre to the first obstacle, `range_px` when none is in range.
+//!
+//! A reading is the least [`Aabb::ray_hit`] over the scene's boxes. When few boxes lie within
+//! range, every beam tests each of them; otherwise each beam walks the scene's ray index
+//! ([`Scene::rays_from`]), which costs per cell crossed rather than per box in range. Both give
+//! the same reading to the bit.
 
 use crate::config::LaserConfig;
 use crate::geometry::{unit, Aabb, Point, Vector};
 use crate::scene::Scene;
 use rand_distr::{Distribution, Normal};
 
-/// A scan copies the boxes within range to the stack when the index's bin lists at most this many.
-const MAX_LOCAL_BOXES: usize = 48;
+/// A scan looks for the boxes within range among those the index's bin lists when it lists at
+/// most this many (a bin listing more is a long range, and looking would cost more than it saves).
+const MAX_LISTED_BOXES: usize = 32;
 
 /// Up to this many boxes within range, every beam tests each of them (the tests run side by side,
 /// a few ns each); beyond, each beam walks the scene's ray grid, which costs about as much as
-/// this many tests whatever the range (measured with `examples`-style scans of the default maze
-/// and its image at 50-300 px).
-const LOCAL_BOXES_BEFORE_WALK: usize = 16;
+/// this many tests whatever the range (measured on the default maze and its image at 50-300 px).
+const MAX_LOCAL_BOXES: usize = 10;
 
 /// `offset` (a beam's unit vector in the robot frame) turned to the scene frame of `heading`.
 #[inline]
@@ -107,21 +112,26 @@ impl Laser {
         let heading = unit(heading_deg);
         let r2 = range * range;
         let near = scene.boxes_near(position, range);
-        // The boxes within range, when the bin lists few enough to copy.
+        // The boxes within range, when the bin lists few enough to look through and there are
+        // few enough of them.
         let mut local = [Aabb::from_corners(Point::origin(), Point::origin()); MAX_LOCAL_BOXES];
         let mut count = usize::MAX;
-        if near.len() <= MAX_LOCAL_BOXES {
+        if near.len() <= MAX_LISTED_BOXES {
             let boxes = scene.boxes();
             count = 0;
             for &i in near {
                 let b = boxes[i as usize];
                 if b.distance_squared(position) <= r2 {
+                    if count == MAX_LOCAL_BOXES {
+                        count = usize::MAX;
+                        break;
+                    }
                     local[count] = b;
                     count += 1;
                 }
             }
         }
-        if count <= LOCAL_BOXES_BEFORE_WALK {
+        if count <= MAX_LOCAL_BOXES {
             for (reading, offset) in out.iter_mut().zip(&self.offsets) {
                 let dir = turn(heading, *offset);
                 let inv = Vector::new(1.0 / dir.x, 1.0 / dir.y);
@@ -136,11 +146,10 @@ impl Laser {
                 *reading = best;
             }
         } else {
-            let rays = scene.rays_from(position);
-            for (reading, offset) in out.iter_mut().zip(&self.offsets) {
-                let dir = turn(heading, *offset);
-                *reading = rays.first_box_hit(dir, range).unwrap_or(range);
-            }
+            let beams = self.offsets.iter().map(|offset| turn(heading, *offset));
+            scene
+                .rays_from(position)
+                .first_box_hits(range, beams.zip(out.iter_mut()));
         }
         if !scene.shapes().is_empty() {
             let near: Vec<_> = scene
