@@ -18,7 +18,7 @@ use crate::geometry::{Aabb, Point, Vector};
 /// the next line across x and across y), else 0: read from the sign of the difference, because a
 /// comparison would be compiled into a branch the processor guesses wrong half the time.
 #[inline(always)]
-pub fn crosses_x_first(next_x: f64, next_y: f64) -> u64 {
+fn crosses_x_first(next_x: f64, next_y: f64) -> u64 {
     (next_x - next_y).to_bits() >> 63
 }
 

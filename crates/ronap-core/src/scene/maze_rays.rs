@@ -17,7 +17,6 @@
 //! over all the walls. The closed outer boundary keeps a ray from inside from leaving the maze
 //! before its first wall.
 
-use crate::geometry::ray_grid::crosses_x_first;
 use crate::geometry::{Aabb, Point, Vector};
 use crate::scene::maze::Maze;
 
@@ -165,30 +164,28 @@ impl MazeRays {
                 (f64::MAX, 0.0)
             }
         };
-        let mut offset = start.offset;
+        let offset = start.offset;
         let gap_x = if ahead_x == 1 { c - offset.x } else { offset.x };
         let gap_y = if ahead_y == 1 { c - offset.y } else { offset.y };
         let (mut next_x, delta_x) = axis(gap_x, inv_dir.x);
         let (mut next_y, delta_y) = axis(gap_y, inv_dir.y);
-        let (offset_by_x, offset_by_y) = (step_x as f64 * c, step_y as f64 * c);
+        let across = Vector::new(dir.y.abs(), dir.x.abs());
         // The edges ahead on either axis, and how a step across x or across y moves them.
         let cols = self.cols as isize;
         let mut vertical = start.vertical + ahead_x;
         let mut horizontal = start.horizontal + ahead_y * cols;
-        let vertical_by = [step_x, step_y * (cols + 1)];
-        let horizontal_by = [step_x, step_y * cols];
+        let (vertical_by_y, horizontal_by_y) = (step_y * (cols + 1), step_y * cols);
         let reach = 2.0 * self.reach_px;
         let mut limit = max_t;
         let wall = loop {
-            // Which line the ray crosses next, as 1.0/0.0 weights: a step is blended from both
-            // axes rather than chosen by a branch the processor would guess wrong half the time.
-            // `x * 1.0 + y * 0.0` is exactly `x` for the finite values here.
-            let x_first = crosses_x_first(next_x, next_y);
-            let (wx, wy) = (x_first as f64, 1.0 - x_first as f64);
-            let t = next_x * wx + next_y * wy;
-            // Where along the crossed edge the ray crosses it, from the edge's lower or left end.
-            let along = (offset.y + t * dir.y) * wx + (offset.x + t * dir.x) * wy;
-            let (edges, edge) = if x_first == 1 {
+            // Selects rather than branches on the axis crossed next, which the processor would
+            // guess wrong about every other step.
+            let x_first = next_x < next_y;
+            let t = if x_first { next_x } else { next_y };
+            // How far along the crossed edge, from its end ahead on the other axis, the ray
+            // crosses it: the `t` to the next line across, times the speed across.
+            let ahead = (next_x - next_y).abs() * if x_first { across.x } else { across.y };
+            let (edges, edge) = if x_first {
                 (&self.vertical, vertical)
             } else {
                 (&self.horizontal, horizontal)
@@ -197,28 +194,17 @@ impl MazeRays {
             let Some(&wall) = edges.get(edge as usize) else {
                 break NO_WALL;
             };
-            if along < reach || along > c - reach {
-                self.crossing_corners(
-                    x_first == 1,
-                    edge as usize,
-                    along,
-                    inv_dir,
-                    o,
-                    max_t,
-                    &mut best,
-                );
+            if ahead < reach || ahead > c - reach {
+                self.crossing_corners(x_first, edge as usize, t, dir, inv_dir, o, max_t, &mut best);
                 limit = best.min(max_t);
             }
             if wall != NO_WALL || limit <= t {
                 break wall;
             }
-            next_x += delta_x * wx;
-            next_y += delta_y * wy;
-            offset.x -= offset_by_x * wx;
-            offset.y -= offset_by_y * wy;
-            let k = 1 - x_first as usize;
-            vertical += vertical_by[k];
-            horizontal += horizontal_by[k];
+            next_x += if x_first { delta_x } else { 0.0 };
+            next_y += if x_first { 0.0 } else { delta_y };
+            vertical += if x_first { step_x } else { vertical_by_y };
+            horizontal += if x_first { step_x } else { horizontal_by_y };
         };
         // The ray leaves its last cell through a wall (which it meets by then), or it ends.
         if wall != NO_WALL {
@@ -228,31 +214,35 @@ impl MazeRays {
     }
 
     /// Tests the walls meeting at each end of the crossed edge (the vertical edge `edge` when
-    /// `vertical`, else the horizontal one) that `along` (from the edge's lower or left end) comes
-    /// within reach of.
+    /// `vertical`, else the horizontal one, crossed at `t`) that the crossing comes within reach
+    /// of.
     #[cold]
     #[allow(clippy::too_many_arguments)]
     fn crossing_corners(
         &self,
         vertical: bool,
         edge: usize,
-        along: f64,
+        t: f64,
+        dir: Vector,
         inv: Vector,
         origin: Point,
         max_t: f64,
         best: &mut f64,
     ) {
-        let reach = 2.0 * self.reach_px;
-        // The edge's lower or left end `(i, j)`, and the step to its other end.
-        let (i, j, di, dj) = if vertical {
-            (edge % (self.cols + 1), edge / (self.cols + 1), 0, 1)
+        let (c, reach) = (self.cell_px, 2.0 * self.reach_px);
+        // The edge's lower or left end `(i, j)`, the step to its other end, and where along it
+        // the ray crosses.
+        let (i, j, di, dj, along) = if vertical {
+            let (i, j) = (edge % (self.cols + 1), edge / (self.cols + 1));
+            (i, j, 0, 1, origin.y + t * dir.y - j as f64 * c)
         } else {
-            (edge % self.cols, edge / self.cols, 1, 0)
+            let (i, j) = (edge % self.cols, edge / self.cols);
+            (i, j, 1, 0, origin.x + t * dir.x - i as f64 * c)
         };
         if along < reach {
             self.corner(i, j, origin, inv, max_t, best);
         }
-        if along > self.cell_px - reach {
+        if along > c - reach {
             self.corner(i + di, j + dj, origin, inv, max_t, best);
         }
     }
