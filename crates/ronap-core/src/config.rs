@@ -1121,7 +1121,7 @@ impl SimConfig {
                     (1..=MAX_BEAMS).contains(&v),
                     &f("laser_beams"),
                     v,
-                    "must be between 1 and 360",
+                    "must be between 1 and 4096",
                 )?;
             }
             if let Some(v) = r.laser_fov_deg {
