@@ -9,6 +9,7 @@ mod conv;
 mod env;
 mod errors;
 mod evaluate;
+mod multi_env;
 mod vec_env;
 
 use conv::{Config, Scenario};
@@ -81,6 +82,8 @@ fn _ronap(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scenario>()?;
     m.add_class::<env::Env>()?;
     m.add_class::<vec_env::VecEnv>()?;
+    m.add_class::<multi_env::MultiEnv>()?;
+    m.add_class::<multi_env::VecMultiEnv>()?;
     m.add_function(wrap_pyfunction!(default_config_json, m)?)?;
     m.add_function(wrap_pyfunction!(maze_occupancy, m)?)?;
     m.add_function(wrap_pyfunction!(maze_image, m)?)?;

@@ -36,3 +36,36 @@ pub fn team_image(record: &TeamRecord, scale: f64) -> Option<RgbImage> {
     }
     Some(canvas.into_image())
 }
+
+/// The picture of a team episode as it stands: each robot's goal as a faded disc of the goal
+/// tolerance, its path so far (`paths[k]`) and, while it is in the scene, the robot with its
+/// heading, all in its own colour; moving obstacles as they are now.
+pub fn team_frame(
+    team: &crate::sim::team::Team,
+    paths: &[Vec<crate::geometry::Point>],
+    scale: f64,
+) -> RgbImage {
+    let first = team.robot(0);
+    let mut canvas = Canvas::new(first.scene(), scale);
+    let least = 3.0 / scale;
+    for (k, r) in team.robots().iter().enumerate() {
+        if !team.present(k) && r.status() == crate::sim::episode::Status::Success {
+            continue;
+        }
+        let tolerance = r.config().episode.goal_tolerance_px;
+        canvas.fill_disc(r.goal(), tolerance.max(least), faded(policy_colour(k)));
+    }
+    for (k, path) in paths.iter().enumerate() {
+        canvas.path(path, 2.0, policy_colour(k));
+    }
+    if let Some(movers) = team.movers() {
+        canvas.movers(movers);
+    }
+    for (k, r) in team.robots().iter().enumerate() {
+        if team.present(k) {
+            let radius = r.config().robot.radius_px.max(least);
+            canvas.robot(r.pose(), radius, policy_colour(k));
+        }
+    }
+    canvas.into_image()
+}

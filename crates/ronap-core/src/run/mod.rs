@@ -6,6 +6,7 @@
 pub mod batch;
 pub mod rollout;
 pub mod team;
+pub mod team_batch;
 
 use crate::policy::PolicyError;
 use crate::sim::placement::EpisodeError;

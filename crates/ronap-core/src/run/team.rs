@@ -119,15 +119,36 @@ impl TeamRollout {
         seed: u64,
         policies: &mut [Box<dyn Policy>],
     ) -> Result<Self, RunError> {
-        let team = Team::new(config, &worlds, seed)
-            .map_err(|source| RunError::Episode { seed, source })?;
-        let n = team.robots().len();
+        let n = config.team_size();
         if policies.len() != n {
             return Err(RunError::ActionCount {
                 given: policies.len(),
                 envs: n,
             });
         }
+        let rollout = Self::placed(config, worlds, seed)?;
+        for (k, policy) in policies.iter_mut().enumerate() {
+            policy
+                .reset(&rollout.worlds[k], rollout.team.robot(k))
+                .map_err(|source| RunError::Policy {
+                    seed,
+                    step: 0,
+                    source,
+                })?;
+        }
+        Ok(rollout)
+    }
+
+    /// The team episode of `seed` with every goal list put in its order, for actions chosen
+    /// outside (an environment stepped from Python): [`TeamRollout::step`] moves it.
+    pub fn placed(
+        config: &crate::ValidConfig,
+        worlds: Vec<Arc<World>>,
+        seed: u64,
+    ) -> Result<Self, RunError> {
+        let team = Team::new(config, &worlds, seed)
+            .map_err(|source| RunError::Episode { seed, source })?;
+        let n = team.robots().len();
         let per_robot = robot_worlds(config, &worlds);
         let mut team = team;
         let mut tours = vec![None; n];
@@ -144,15 +165,6 @@ impl TeamRollout {
             );
             team.order_goals(k, &visit);
             *tour = Some(lengths);
-        }
-        for (k, policy) in policies.iter_mut().enumerate() {
-            policy
-                .reset(&per_robot[k], team.robot(k))
-                .map_err(|source| RunError::Policy {
-                    seed,
-                    step: 0,
-                    source,
-                })?;
         }
         Ok(Self {
             gave_up: vec![None; n],
@@ -181,6 +193,18 @@ impl TeamRollout {
     /// Why robot `k`'s policy gave up, if it did.
     pub fn gave_up(&self, k: usize) -> Option<&str> {
         self.gave_up[k].as_deref()
+    }
+
+    /// Sets robot `k`'s message for the next broadcast (`team.message_size` floats; shorter is
+    /// padded with zeros, longer cut).
+    pub fn set_message(&mut self, k: usize, message: &[f32]) {
+        self.team.set_message(k, message);
+    }
+
+    /// One step of actions chosen outside: `actions[k]` for robot `k` (`None`: it stands).
+    /// Robots whose episodes are over ignore theirs.
+    pub fn step(&mut self, actions: &[Option<Action>]) {
+        self.team.step(actions);
     }
 
     /// Whether every robot is done.

@@ -54,6 +54,8 @@ pub struct Team {
     arrived_at: Vec<Option<u32>>,
     /// The previous step's reward of each robot.
     rewards: Vec<f64>,
+    /// Whether each robot collided in the previous step.
+    collided: Vec<bool>,
     touched: Vec<usize>,
     /// Robots whose policies gave up.
     retired: Vec<bool>,
@@ -179,6 +181,7 @@ impl Team {
                 .map(|r| (r.status() == Status::Success).then_some(0))
                 .collect(),
             rewards: vec![0.0; robots.len()],
+            collided: vec![false; robots.len()],
             retired: vec![false; robots.len()],
             goal_lists,
             comm: config.team.clone(),
@@ -223,6 +226,11 @@ impl Team {
     /// Each robot's reward in the last step (0 for a robot that did not act).
     pub fn rewards(&self) -> &[f64] {
         &self.rewards
+    }
+
+    /// Whether robot `k` collided (with a wall, an obstacle or a robot) in the last step.
+    pub fn collided(&self, k: usize) -> bool {
+        self.collided.get(k).copied().unwrap_or(false)
     }
 
     /// The step at which robot `k` reached its goal.
@@ -396,7 +404,9 @@ impl Team {
             }
         }
         // Make the motions, then read every sensor among everyone's new poses.
-        let mut collided = vec![false; n];
+        let mut collided = std::mem::take(&mut self.collided);
+        collided.clear();
+        collided.resize(n, false);
         let before: Vec<f64> = self.robots.iter().map(|r| r.distance_px()).collect();
         let mut moved_any = false;
         for k in 0..n {
@@ -416,6 +426,7 @@ impl Team {
                 }
             }
         }
+        self.collided = collided;
         self.still_for = if moved_any { 0 } else { self.still_for + 1 };
         if self.still_for >= self.deadlock_steps {
             for k in 0..n {

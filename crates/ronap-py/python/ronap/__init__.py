@@ -2,6 +2,8 @@
 
 - ``NavEnv`` / ``gymnasium.make("ronap/Nav-v0")``: one environment, Gymnasium API.
 - ``VecNavEnv(num_envs)``: a ``gymnasium.vector.VectorEnv`` stepped in Rust across cores.
+- ``MultiNavEnv``: several robots of a scenario's ``[[robots]]`` as a PettingZoo ``ParallelEnv``;
+  ``VecMultiNavEnv(num_envs)``: many such episodes stepped in Rust, as ``[env, robot]`` arrays.
 - ``evaluate(policy, seeds)``: the batch evaluator of ``ronap run`` with a Python callable or a
   built-in policy.
 - ``compare(policies, seeds)``: several policies on the same seeds with paired statistics, as
@@ -30,16 +32,19 @@ from .compare import compare
 from .config import default_config, make_config
 from .env import NavEnv, VecNavEnv
 from .evaluate import evaluate
+from .multi import MultiNavEnv, VecMultiNavEnv
 from .scenes import maze_image, maze_occupancy, policies
 
 __all__ = [
     "ActionError",
     "ConfigError",
+    "MultiNavEnv",
     "NavEnv",
     "OutputError",
     "PolicyError",
     "RonapError",
     "SceneError",
+    "VecMultiNavEnv",
     "VecNavEnv",
     "__version__",
     "compare",

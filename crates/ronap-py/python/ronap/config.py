@@ -15,7 +15,9 @@ ScenarioLike = Union[str, os.PathLike, Mapping[str, Any]]
 nested like it (``{"scene": {"kind": "warehouse"}, "moving": [{"count": 5}]}``)."""
 
 # Top-level entries of a configuration that are arrays of tables, not sections.
-_ARRAYS = ("obstacles", "moving")
+_ARRAYS = ("obstacles", "moving", "robots")
+# Sections the configuration's JSON leaves out while they hold their defaults.
+_OPTIONAL = ("team",)
 
 
 def default_config() -> dict[str, Any]:
@@ -24,6 +26,8 @@ def default_config() -> dict[str, Any]:
 
 
 def _merge(into: dict, section: str, field: str, value: Any) -> None:
+    if section not in into and section in _OPTIONAL:
+        into[section] = {}
     if section not in into:
         raise ConfigError(f"unknown configuration section {section!r} (in {section}.{field})")
     if section in _ARRAYS:

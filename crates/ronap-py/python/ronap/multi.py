@@ -1,0 +1,266 @@
+"""Several robots in one episode: a PettingZoo ``ParallelEnv`` over the Rust team model."""
+
+from __future__ import annotations
+
+import json
+from typing import Any, Mapping
+
+import numpy as np
+from gymnasium import spaces
+
+from . import _ronap
+from .config import ScenarioLike, checked_config
+
+try:  # PettingZoo is optional: without it MultiNavEnv still works, as a plain class.
+    from pettingzoo import ParallelEnv as _Base
+except ImportError:  # pragma: no cover - exercised only without pettingzoo
+    _Base = object  # type: ignore[assignment,misc]
+
+_SEED_LIMIT = 2**63
+
+
+class MultiNavEnv(_Base):  # type: ignore[misc,valid-type]
+    """The robots of a scenario's ``[[robots]]`` entries in one scene, as a PettingZoo
+    ``ParallelEnv``: agents ``robot_0``, ``robot_1``, ... in entry order.
+
+    Each agent observes its own robot as a lone robot would (its laser, which sees the other
+    robots, and its goal direction: ``float32[beams + 1]``), then ``team.neighbours`` slots of
+    the nearest robots heard last step (position in its frame over ``comm_range_px``, heading
+    difference over 360, 1, and the sender's message). Actions: ``Discrete(3)`` (0 LEFT, 1 AHEAD,
+    2 RIGHT), or ``Box(-1, 1, (2,))`` with ``continuous=True`` (``v / v_max, w / w_max`` of that
+    robot). With ``team.message_size = m > 0`` an action is a dict ``{"action": a, "message":
+    float32[m]}``: the message goes out with the robot's pose and goal to every robot within
+    ``comm_range_px`` and arrives the next step (in their observations and in ``infos[agent]
+    ["inbox"]``).
+
+    All robots move at once; robots whose motions would touch stay put and count a collision.
+    An agent leaves ``agents`` after the step that ends its episode: ``terminated`` on success
+    (or a collision under ``robot_on_collision="terminate"``), ``truncated`` at the time-out or
+    a deadlock (no robot moved for ``episode.deadlock_steps`` steps). A robot that arrived stays
+    in the scene as an obstacle, or leaves it with ``on_arrival = "vanish"``.
+
+    Configure it as ``NavEnv``: ``scenario`` (a TOML file or a nested dict with ``robots``
+    entries), ``config`` and keyword overrides. ``reset(seed=s)`` plays team episode ``s``,
+    the same as ``ronap run --scenario ... `` seed ``s``.
+    """
+
+    metadata = {"name": "ronap_multi_nav_v0", "render_modes": ["rgb_array"], "render_fps": 30}
+
+    def __init__(
+        self,
+        render_mode: str | None = None,
+        *,
+        scenario: ScenarioLike | None = None,
+        config: Mapping[str, Any] | None = None,
+        continuous: bool = False,
+        maze_seed: int | None = None,
+        map: str | None = None,
+        render_scale: float = 0.5,
+        **fields: Any,
+    ) -> None:
+        if render_mode not in (None, "rgb_array"):
+            raise _ronap.ConfigError(f"render_mode {render_mode!r}: expected None or 'rgb_array'")
+        checked = checked_config(config, fields, scenario)
+        self._env = _ronap.MultiEnv(checked, maze_seed, None if map is None else str(map), continuous)
+        self.config = json.loads(checked.json)
+        self.render_mode = render_mode
+        self.render_scale = render_scale
+        self.continuous = continuous
+        self.message_size = self._env.message_size
+        n = self._env.robots
+        self.possible_agents: list[str] = [f"robot_{k}" for k in range(n)]
+        self.agents: list[str] = []
+        self._index = {a: k for k, a in enumerate(self.possible_agents)}
+        slots = self._env.slots_size
+        self._observation_spaces = {
+            a: _observation_space(size - slots, slots)
+            for a, size in zip(self.possible_agents, self._env.observation_sizes)
+        }
+        self._action_spaces = {a: self._make_action_space() for a in self.possible_agents}
+        self._scales = [np.array(limits, np.float64) for limits in self._env.speed_limits]
+        self._rng = np.random.default_rng()
+        self.seed_used: int | None = None
+
+    def _make_action_space(self) -> spaces.Space[Any]:
+        base: spaces.Space[Any]
+        if self.continuous:
+            base = spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
+        else:
+            base = spaces.Discrete(3)
+        if self.message_size == 0:
+            return base
+        message = spaces.Box(-np.inf, np.inf, (self.message_size,), dtype=np.float32)
+        return spaces.Dict({"action": base, "message": message})
+
+    def observation_space(self, agent: str) -> spaces.Space[Any]:
+        return self._observation_spaces[agent]
+
+    def action_space(self, agent: str) -> spaces.Space[Any]:
+        return self._action_spaces[agent]
+
+    def reset(
+        self, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, dict[str, Any]]]:
+        if seed is not None:
+            self._rng = np.random.default_rng(seed)
+            episode_seed = int(seed)
+        else:
+            episode_seed = int(self._rng.integers(0, _SEED_LIMIT))
+        if not 0 <= episode_seed < 2**64:
+            raise _ronap.ConfigError(f"seed = {seed}: must be between 0 and 2^64 - 1")
+        self.seed_used = episode_seed
+        obs, infos = self._env.reset(episode_seed)
+        self.agents = list(self.possible_agents)
+        return (
+            {a: obs[k] for k, a in enumerate(self.possible_agents)},
+            {a: infos[k] for k, a in enumerate(self.possible_agents)},
+        )
+
+    def step(
+        self, actions: Mapping[str, Any]
+    ) -> tuple[
+        dict[str, np.ndarray],
+        dict[str, float],
+        dict[str, bool],
+        dict[str, bool],
+        dict[str, dict[str, Any]],
+    ]:
+        if not self.agents:
+            raise _ronap.RonapError("step() with no agents left: call reset()")
+        unknown = [a for a in actions if a not in self._index]
+        if unknown:
+            raise _ronap.ActionError(f"unknown agent {unknown[0]!r}: expected one of {self.possible_agents}")
+        n = len(self.possible_agents)
+        moves: list[Any] = [None] * n
+        messages: list[np.ndarray | None] | None = [None] * n if self.message_size else None
+        for agent, action in actions.items():
+            if agent not in self.agents:
+                continue  # a robot whose episode is over does nothing
+            k = self._index[agent]
+            if self.message_size and isinstance(action, Mapping):
+                if "message" in action and messages is not None:
+                    messages[k] = np.ascontiguousarray(action["message"], dtype=np.float32).reshape(-1)
+                action = action.get("action")
+            moves[k] = self._scale(k, action) if self.continuous else _discrete(agent, action)
+        obs, rewards, terminated, truncated, infos = self._env.step(moves, messages)
+        live = self.agents
+        self.agents = [a for a in live if not (terminated[self._index[a]] or truncated[self._index[a]])]
+        return (
+            {a: obs[self._index[a]] for a in live},
+            {a: float(rewards[self._index[a]]) for a in live},
+            {a: bool(terminated[self._index[a]]) for a in live},
+            {a: bool(truncated[self._index[a]]) for a in live},
+            {a: infos[self._index[a]] for a in live},
+        )
+
+    def _scale(self, k: int, action: Any) -> list[float] | None:
+        if action is None:
+            return None
+        scaled = np.asarray(action, dtype=np.float64)
+        if scaled.shape != (2,):
+            raise _ronap.ActionError(f"robot_{k}'s action {action!r}: expected two numbers in [-1, 1]")
+        return (scaled * self._scales[k]).tolist()
+
+    def render(self) -> np.ndarray | None:
+        if self.render_mode != "rgb_array":
+            return None
+        return self._env.render(self.render_scale)
+
+    def close(self) -> None:
+        pass
+
+
+def _discrete(agent: str, action: Any) -> Any:
+    if action is None:
+        return None
+    if isinstance(action, (bool, np.bool_)):
+        raise _ronap.ActionError(f"{agent}'s action {action!r}: expected 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)")
+    if isinstance(action, (float, np.floating)) and not float(action).is_integer():
+        raise _ronap.ActionError(f"{agent}'s action {action!r}: expected 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)")
+    if isinstance(action, np.ndarray) and action.shape == ():
+        action = action.item()
+    return int(action) if isinstance(action, (float, np.floating, np.integer)) else action
+
+
+def _observation_space(beams_plus_goal: int, slots: int) -> spaces.Box:
+    low = np.concatenate([np.zeros(beams_plus_goal, np.float32), np.full(slots, -np.inf, np.float32)])
+    high = np.concatenate([np.ones(beams_plus_goal, np.float32), np.full(slots, np.inf, np.float32)])
+    return spaces.Box(low, high, dtype=np.float32)
+
+
+class VecMultiNavEnv:
+    """``num_envs`` team episodes stepped together in Rust, across cores, with the GIL released:
+    the vectorised form of ``MultiNavEnv`` for learning with shared-parameter policies.
+
+    Arrays are indexed ``[env, robot]``: ``reset(seed)`` and ``step(actions)`` return
+    observations ``float32[num_envs, num_agents, obs_size]`` (each robot's ``MultiNavEnv``
+    observation, zeros past its length when robots differ), and ``step`` rewards, terminated and
+    truncated ``[num_envs, num_agents]``. ``actions`` is ``int[num_envs, num_agents]`` (0 LEFT,
+    1 AHEAD, 2 RIGHT; ignored for robots that are done); with ``team.message_size = m > 0``,
+    ``messages=float32[num_envs, num_agents, m]`` sends messages. ``infos["active"]`` says which
+    robots are still going after the step (mask the others out of a loss), ``infos["acted"]``
+    whose action counted, ``infos["reset"]`` which environments started a new episode,
+    ``infos["seed"]`` and ``infos["steps"]`` each environment's episode.
+
+    Next-step autoreset: the step after every robot of an environment is done starts its next
+    episode (its actions are ignored, rewards 0). Environment ``i``'s episodes have seeds
+    ``seed + i``, ``seed + i + num_envs``, ...: the same episodes ``MultiNavEnv`` plays with those
+    seeds, on any number of threads.
+    """
+
+    def __init__(
+        self,
+        num_envs: int,
+        *,
+        scenario: ScenarioLike | None = None,
+        config: Mapping[str, Any] | None = None,
+        maze_seed: int | None = None,
+        map: str | None = None,
+        threads: int = 0,
+        **fields: Any,
+    ) -> None:
+        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
+            raise _ronap.ConfigError(f"num_envs = {num_envs!r}: must be an integer of at least 1")
+        if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 0:
+            raise _ronap.ConfigError(f"threads = {threads!r}: must be an integer of at least 0")
+        checked = checked_config(config, fields, scenario)
+        self._vec = _ronap.VecMultiEnv(int(num_envs), checked, maze_seed, None if map is None else str(map), int(threads))
+        self.config = json.loads(checked.json)
+        self.num_envs: int = self._vec.num_envs
+        self.num_agents: int = self._vec.robots
+        self.possible_agents = [f"robot_{k}" for k in range(self.num_agents)]
+        self.message_size: int = self._vec.message_size
+        d = self._vec.observation_size
+        self.single_observation_space = spaces.Box(-np.inf, np.inf, (d,), np.float32)
+        self.single_action_space = spaces.Discrete(3)
+        self._started = False
+
+    def reset(self, seed: int = 0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= seed < 2**64:
+            raise _ronap.ConfigError(f"seed = {seed!r}: must be an integer between 0 and 2^64 - 1")
+        self._started = True
+        return self._vec.reset(int(seed))
+
+    def step(
+        self, actions: Any, messages: Any = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, np.ndarray]]:
+        if not self._started:
+            raise _ronap.RonapError("step() before reset()")
+        a = np.asarray(actions)
+        shape = (self.num_envs, self.num_agents)
+        if a.shape != shape:
+            raise _ronap.ActionError(f"actions of shape {a.shape}: expected {shape}")
+        if a.dtype.kind == "f" and not np.all(np.isfinite(a) & (a == np.round(a))):
+            raise _ronap.ActionError("actions: expected whole numbers 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)")
+        if a.dtype.kind not in "iuf":
+            raise _ronap.ActionError(f"actions of dtype {a.dtype}: expected integers 0, 1 or 2")
+        flat_messages = None
+        if messages is not None:
+            m = np.ascontiguousarray(messages, dtype=np.float32)
+            if m.shape != (*shape, self.message_size):
+                raise _ronap.ActionError(f"messages of shape {m.shape}: expected {(*shape, self.message_size)}")
+            flat_messages = m.reshape(-1)
+        return self._vec.step(np.ascontiguousarray(a, dtype=np.int64).reshape(-1), flat_messages)
+
+    def close(self) -> None:
+        pass

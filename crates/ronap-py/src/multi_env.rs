@@ -1,0 +1,450 @@
+//! Several robots in one episode, stepped from Python: the core's [`TeamRollout`] with actions
+//! (and messages) chosen outside. The PettingZoo class `ronap.MultiNavEnv` is built on it.
+
+use crate::conv::{self, Config};
+use crate::errors::{self, ActionError};
+use numpy::{PyArray1, PyArray3, PyArrayMethods, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use ronap_core::run::team::TeamRollout;
+use ronap_core::run::team_batch::{RobotStep, TeamBatch};
+use ronap_core::sim::robot::{Action, DiscreteAction};
+use ronap_core::sim::team::Team;
+use ronap_core::sim::world::Worlds;
+use ronap_core::Point;
+
+/// Several robots in one scene, an episode at a time.
+#[pyclass(module = "ronap._ronap")]
+pub struct MultiEnv {
+    worlds: Worlds,
+    rollout: Option<TeamRollout>,
+    paths: Vec<Vec<Point>>,
+    continuous: bool,
+}
+
+/// Robot `k`'s info dictionary: its episode's figures, plus what it received at the last step.
+fn robot_info<'py>(py: Python<'py>, team: &Team, k: usize) -> PyResult<Bound<'py, PyDict>> {
+    let r = team.robot(k);
+    let d = conv::info(py, r, team.collided(k))?;
+    d.set_item("robot", k)?;
+    d.set_item("present", team.present(k))?;
+    d.set_item("goals_reached", r.goals_reached())?;
+    d.set_item("goals", team.goals(k).len())?;
+    let inbox = PyList::empty(py);
+    for b in team.inbox(k) {
+        let m = PyDict::new(py);
+        m.set_item("from", b.from)?;
+        m.set_item("pose", (b.pose.x, b.pose.y, b.pose.z_deg))?;
+        m.set_item("goal", (b.goal.x, b.goal.y))?;
+        m.set_item("message", PyArray1::from_slice(py, &b.message))?;
+        inbox.append(m)?;
+    }
+    d.set_item("inbox", inbox)?;
+    Ok(d)
+}
+
+impl MultiEnv {
+    fn rollout(&self, what: &str) -> PyResult<&TeamRollout> {
+        self.rollout
+            .as_ref()
+            .ok_or_else(|| errors::RonapError::new_err(format!("{what}() before reset()")))
+    }
+}
+
+/// Every robot's observation and info.
+#[allow(clippy::type_complexity)]
+fn observe<'py>(
+    py: Python<'py>,
+    team: &Team,
+) -> PyResult<(Vec<Bound<'py, PyArray1<f32>>>, Vec<Bound<'py, PyDict>>)> {
+    let n = team.robots().len();
+    let obs = (0..n)
+        .map(|k| PyArray1::from_slice(py, team.robot(k).observation()))
+        .collect();
+    let infos = (0..n)
+        .map(|k| robot_info(py, team, k))
+        .collect::<PyResult<_>>()?;
+    Ok((obs, infos))
+}
+
+#[pymethods]
+impl MultiEnv {
+    /// The team of `config`'s `[[robots]]`; `maze_seed` fixes one maze for every episode and
+    /// `map_path` uses an image or ROS map instead of mazes.
+    #[new]
+    #[pyo3(signature = (config, maze_seed = None, map_path = None, continuous = false))]
+    fn new(
+        config: &Config,
+        maze_seed: Option<u64>,
+        map_path: Option<&str>,
+        continuous: bool,
+    ) -> PyResult<Self> {
+        let valid = config.valid();
+        if valid.team_size() == 0 {
+            return Err(errors::ConfigError::new_err(
+                "MultiNavEnv needs a team: a scenario with [[robots]] entries \
+                 (or robots=[{\"count\": N}])",
+            ));
+        }
+        let (_, scenes, _) = conv::scenes(valid, maze_seed, map_path)?;
+        Ok(Self {
+            worlds: Worlds::new(valid.clone(), scenes),
+            rollout: None,
+            paths: Vec::new(),
+            continuous,
+        })
+    }
+
+    /// Starts the team episode of `seed` (the same as `ronap run` seed `seed`); returns
+    /// (observations, infos), one per robot.
+    #[allow(clippy::type_complexity)]
+    fn reset<'py>(
+        &mut self,
+        py: Python<'py>,
+        seed: u64,
+    ) -> PyResult<(Vec<Bound<'py, PyArray1<f32>>>, Vec<Bound<'py, PyDict>>)> {
+        let worlds = self.worlds.team(seed);
+        let config = self.worlds.config().clone();
+        let rollout = py
+            .allow_threads(|| TeamRollout::placed(&config, worlds, seed))
+            .map_err(|e| errors::run(&e))?;
+        let team = rollout.team();
+        self.paths = team
+            .robots()
+            .iter()
+            .map(|r| vec![r.pose().position()])
+            .collect();
+        let out = observe(py, team)?;
+        self.rollout = Some(rollout);
+        Ok(out)
+    }
+
+    /// One step of the team: `actions[k]` for robot `k` (None: it stands still, as robots
+    /// whose episodes are over do anyway), `messages[k]` its message for the next broadcast
+    /// (None or a shorter array: zeros). Returns (observations, rewards, terminated, truncated,
+    /// infos), one each per robot.
+    #[allow(clippy::type_complexity)]
+    #[pyo3(signature = (actions, messages = None))]
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        actions: Vec<Option<Bound<'py, PyAny>>>,
+        messages: Option<Vec<Option<PyReadonlyArray1<'py, f32>>>>,
+    ) -> PyResult<(
+        Vec<Bound<'py, PyArray1<f32>>>,
+        Vec<f64>,
+        Vec<bool>,
+        Vec<bool>,
+        Vec<Bound<'py, PyDict>>,
+    )> {
+        let continuous = self.continuous;
+        let n = self.rollout("step")?.team().robots().len();
+        if actions.len() != n {
+            return Err(ActionError::new_err(format!(
+                "{} actions for {n} robots",
+                actions.len()
+            )));
+        }
+        let mut chosen: Vec<Option<Action>> = Vec::with_capacity(n);
+        for (k, a) in actions.iter().enumerate() {
+            chosen.push(match a {
+                None => None,
+                Some(a) => Some(conv::action(a, continuous).map_err(|why| {
+                    ActionError::new_err(format!("robot_{k}'s action {a}: {why}"))
+                })?),
+            });
+        }
+        let rollout = self
+            .rollout
+            .as_mut()
+            .ok_or_else(|| errors::RonapError::new_err("step() before reset()"))?;
+        if let Some(messages) = &messages {
+            if messages.len() != n {
+                return Err(ActionError::new_err(format!(
+                    "{} messages for {n} robots",
+                    messages.len()
+                )));
+            }
+            for (k, m) in messages.iter().enumerate() {
+                if let Some(m) = m {
+                    let m = m.as_slice().map_err(|_| {
+                        ActionError::new_err(format!("robot_{k}'s message: not contiguous"))
+                    })?;
+                    if m.iter().any(|x| !x.is_finite()) {
+                        return Err(ActionError::new_err(format!(
+                            "robot_{k}'s message: NaN or infinite values"
+                        )));
+                    }
+                    rollout.set_message(k, m);
+                }
+            }
+        }
+        py.allow_threads(|| rollout.step(&chosen));
+        let team = rollout.team();
+        for (path, r) in self.paths.iter_mut().zip(team.robots()) {
+            let p = r.pose().position();
+            if path.last() != Some(&p) {
+                path.push(p);
+            }
+        }
+        let rewards = team.rewards().to_vec();
+        let terminated = team
+            .robots()
+            .iter()
+            .map(|r| conv::ends(r.status()).0)
+            .collect();
+        let truncated = team
+            .robots()
+            .iter()
+            .map(|r| conv::ends(r.status()).1)
+            .collect();
+        let (obs, infos) = observe(py, team)?;
+        Ok((obs, rewards, terminated, truncated, infos))
+    }
+
+    /// The whole scene as it stands, every robot in its own colour with its path so far,
+    /// `scale` pixels per px.
+    fn render<'py>(&self, py: Python<'py>, scale: f64) -> PyResult<Bound<'py, PyArray3<u8>>> {
+        if !(scale.is_finite() && scale > 0.0 && scale <= 16.0) {
+            return Err(errors::ConfigError::new_err(format!(
+                "render scale = {scale}: must be between 0 and 16"
+            )));
+        }
+        let team = self.rollout("render")?.team();
+        conv::image(
+            py,
+            ronap_core::render::team::team_frame(team, &self.paths, scale),
+        )
+    }
+
+    /// Robots in the team.
+    #[getter]
+    fn robots(&self) -> usize {
+        self.worlds.config().team_size()
+    }
+
+    /// Each robot's observation length (its beams + 1 + the neighbour slots).
+    #[getter]
+    fn observation_sizes(&self) -> Vec<usize> {
+        let config = self.worlds.config();
+        (0..config.team_size())
+            .map(|k| config.team_robot(k).observation_size())
+            .collect()
+    }
+
+    /// Each robot's (max linear speed px/step, max angular speed deg/step), for continuous
+    /// actions.
+    #[getter]
+    fn speed_limits(&self) -> Vec<(f64, f64)> {
+        let config = self.worlds.config();
+        (0..config.team_size())
+            .map(|k| {
+                let r = config.team_robot(k).robot.clone();
+                (r.max_linear_speed_px, r.max_angular_speed_deg)
+            })
+            .collect()
+    }
+
+    /// The floats of the neighbour slots at the end of each observation.
+    #[getter]
+    fn slots_size(&self) -> usize {
+        let team = &self.worlds.config().team;
+        team.neighbours as usize * team.slot_size()
+    }
+
+    /// Floats in a robot's message.
+    #[getter]
+    fn message_size(&self) -> usize {
+        self.worlds.config().team.message_size as usize
+    }
+
+    /// Steps so far in this episode.
+    #[getter]
+    fn steps(&self) -> u32 {
+        self.rollout.as_ref().map_or(0, |r| r.team().steps())
+    }
+}
+
+/// Several team environments stepped together in Rust, across cores, with the GIL released.
+#[pyclass(module = "ronap._ronap")]
+pub struct VecMultiEnv {
+    batch: TeamBatch,
+}
+
+impl VecMultiEnv {
+    /// (observations `N x R x D`, infos of `N x R` or `N` arrays).
+    fn arrays<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyDict>)> {
+        let b = &self.batch;
+        let (n, r, d) = (b.len(), b.robots(), b.observation_size());
+        let obs = PyArray1::from_slice(py, b.observations()).reshape([n, r, d])?;
+        let steps = b.steps();
+        let grid = |f: &dyn Fn(&RobotStep) -> bool| {
+            PyArray1::from_iter(py, steps.iter().map(f)).reshape([n, r])
+        };
+        let infos = PyDict::new(py);
+        infos.set_item("active", grid(&|s| s.running)?)?;
+        infos.set_item("acted", grid(&|s| s.acted)?)?;
+        infos.set_item("collided", grid(&|s| s.collided)?)?;
+        let rollouts = (0..n).map(|i| b.rollout(i));
+        let seeds: Vec<u64> = rollouts
+            .clone()
+            .map(|t| t.map_or(0, |t| t.team().robot(0).seed()))
+            .collect();
+        infos.set_item("seed", PyArray1::from_vec(py, seeds))?;
+        let team_steps: Vec<u32> = rollouts
+            .map(|t| t.map_or(0, |t| t.team().steps()))
+            .collect();
+        infos.set_item("steps", PyArray1::from_vec(py, team_steps))?;
+        let reset: Vec<bool> = (0..n).map(|i| b.was_reset(i)).collect();
+        infos.set_item("reset", PyArray1::from_vec(py, reset))?;
+        Ok((obs.into_any(), infos))
+    }
+}
+
+#[pymethods]
+impl VecMultiEnv {
+    /// `num_envs` team environments under `config`, stepped on `threads` threads (0: all cores).
+    #[new]
+    #[pyo3(signature = (num_envs, config, maze_seed = None, map_path = None, threads = 0))]
+    fn new(
+        num_envs: usize,
+        config: &Config,
+        maze_seed: Option<u64>,
+        map_path: Option<&str>,
+        threads: usize,
+    ) -> PyResult<Self> {
+        if num_envs == 0 {
+            return Err(errors::ConfigError::new_err(
+                "num_envs = 0: must be at least 1",
+            ));
+        }
+        let valid = config.valid();
+        if valid.team_size() == 0 {
+            return Err(errors::ConfigError::new_err(
+                "VecMultiNavEnv needs a team: a scenario with [[robots]] entries",
+            ));
+        }
+        let (_, scenes, _) = conv::scenes(valid, maze_seed, map_path)?;
+        let batch = TeamBatch::new(Worlds::new(valid.clone(), scenes), num_envs, threads)
+            .map_err(|e| errors::run(&e))?;
+        Ok(Self { batch })
+    }
+
+    /// Starts every environment: environment `i` gets seed `seed + i`. Returns (observations,
+    /// infos).
+    fn reset<'py>(
+        &mut self,
+        py: Python<'py>,
+        seed: u64,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyDict>)> {
+        py.allow_threads(|| self.batch.reset(seed))
+            .map_err(|e| errors::run(&e))?;
+        self.arrays(py)
+    }
+
+    /// Steps every environment with `actions` (`N x R` indices: 0 LEFT, 1 AHEAD, 2 RIGHT) and
+    /// optionally `messages` (`N x R x message_size` floats). Returns (observations, rewards,
+    /// terminations, truncations, infos), the middle three `N x R`.
+    #[allow(clippy::type_complexity)]
+    #[pyo3(signature = (actions, messages = None))]
+    fn step<'py>(
+        &mut self,
+        py: Python<'py>,
+        actions: PyReadonlyArray1<'py, i64>,
+        messages: Option<PyReadonlyArray1<'py, f32>>,
+    ) -> PyResult<(
+        Bound<'py, PyAny>,
+        Bound<'py, PyAny>,
+        Bound<'py, PyAny>,
+        Bound<'py, PyAny>,
+        Bound<'py, PyDict>,
+    )> {
+        let (n, r, m) = (
+            self.batch.len(),
+            self.batch.robots(),
+            self.batch.message_size(),
+        );
+        let actions = actions.as_slice()?;
+        if actions.len() != n * r {
+            return Err(ActionError::new_err(format!(
+                "{} actions for {n} environments of {r} robots",
+                actions.len()
+            )));
+        }
+        let actions = actions
+            .iter()
+            .enumerate()
+            .map(|(j, &a)| {
+                usize::try_from(a)
+                    .ok()
+                    .and_then(DiscreteAction::from_index)
+                    .map(Action::from)
+                    .ok_or_else(|| {
+                        ActionError::new_err(format!(
+                            "action {a} for environment {}, robot_{}: expected 0 (LEFT), \
+                             1 (AHEAD) or 2 (RIGHT)",
+                            j / r,
+                            j % r
+                        ))
+                    })
+            })
+            .collect::<PyResult<Vec<Action>>>()?;
+        let messages = match &messages {
+            Some(a) => {
+                let s = a.as_slice()?;
+                if s.len() != n * r * m {
+                    return Err(ActionError::new_err(format!(
+                        "{} message floats for {n} environments of {r} robots with \
+                         message_size {m}",
+                        s.len()
+                    )));
+                }
+                if s.iter().any(|x| !x.is_finite()) {
+                    return Err(ActionError::new_err("messages: NaN or infinite values"));
+                }
+                Some(s)
+            }
+            None => None,
+        };
+        py.allow_threads(|| self.batch.step(&actions, messages))
+            .map_err(|e| errors::run(&e))?;
+        let steps = self.batch.steps();
+        let rewards = PyArray1::from_iter(py, steps.iter().map(|s| s.reward)).reshape([n, r])?;
+        let terminated =
+            PyArray1::from_iter(py, steps.iter().map(|s| s.terminated)).reshape([n, r])?;
+        let truncated =
+            PyArray1::from_iter(py, steps.iter().map(|s| s.truncated)).reshape([n, r])?;
+        let (obs, infos) = self.arrays(py)?;
+        Ok((
+            obs,
+            rewards.into_any(),
+            terminated.into_any(),
+            truncated.into_any(),
+            infos,
+        ))
+    }
+
+    /// Number of environments.
+    #[getter]
+    fn num_envs(&self) -> usize {
+        self.batch.len()
+    }
+
+    /// Robots per environment.
+    #[getter]
+    fn robots(&self) -> usize {
+        self.batch.robots()
+    }
+
+    /// Length of an observation row (the longest robot's; shorter ones padded with zeros).
+    #[getter]
+    fn observation_size(&self) -> usize {
+        self.batch.observation_size()
+    }
+
+    /// Floats in a robot's message.
+    #[getter]
+    fn message_size(&self) -> usize {
+        self.batch.message_size()
+    }
+}

@@ -1,0 +1,185 @@
+"""Several robots from Python: MultiNavEnv (PettingZoo ParallelEnv) and VecMultiNavEnv."""
+
+import csv
+import pathlib
+import subprocess
+
+import numpy as np
+import pytest
+from pettingzoo.test import parallel_api_test, parallel_seed_test
+
+import ronap
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
+WAREHOUSE = ROOT / "scenarios" / "warehouse-team.toml"
+CORRIDOR = ROOT / "scenarios" / "corridor-swap.toml"
+
+
+def corridor(x0: float, x1: float, **fields):
+    """Two robots in an 18 px corridor at x0 and x1, each heading for a point past the other."""
+    scenario = {
+        "scene": {"kind": "maze", "seed": 0},
+        "maze": {"cols": 30, "rows": 1, "cell_px": 18.0},
+        "episode": {"min_goal_distance_px": 10.0},
+        "robots": [
+            {"start": [x0, 9.0, 0.0], "goal": [525.0, 9.0]},
+            {"start": [x1, 9.0, 180.0], "goal": [15.0, 9.0]},
+        ],
+    }
+    return ronap.MultiNavEnv(scenario=scenario, **fields)
+
+
+def test_parallel_api_test_passes():
+    for path in (WAREHOUSE, CORRIDOR):
+        env = ronap.MultiNavEnv(scenario=path)
+        parallel_api_test(env, num_cycles=200)
+    parallel_api_test(ronap.MultiNavEnv(scenario=WAREHOUSE, continuous=True), num_cycles=50)
+    parallel_api_test(corridor(15.0, 100.0, team_message_size=2, team_neighbours=1), num_cycles=50)
+
+
+def test_seed_test_passes():
+    parallel_seed_test(lambda: ronap.MultiNavEnv(scenario=WAREHOUSE), num_cycles=50)
+
+
+def play(env, seed, steps=60):
+    """Obs, rewards and flags of `steps` steps of a fixed action pattern from episode `seed`."""
+    obs, _ = env.reset(seed=seed)
+    trace = [np.concatenate([obs[a] for a in env.possible_agents])]
+    t = 0
+    while env.agents and t < steps:
+        actions = {a: (t + k) % 3 for k, a in enumerate(env.agents)}
+        obs, rew, term, trunc, _ = env.step(actions)
+        trace.append(np.concatenate([obs[a] for a in sorted(obs)]))
+        trace.append(np.array([rew[a] for a in sorted(rew)] + [term[a] for a in sorted(term)] + [trunc[a] for a in sorted(trunc)]))
+        t += 1
+    return trace
+
+
+def test_same_seed_same_bits_and_other_seeds_differ():
+    a = play(ronap.MultiNavEnv(scenario=WAREHOUSE), 4)
+    b = play(ronap.MultiNavEnv(scenario=WAREHOUSE), 4)
+    c = play(ronap.MultiNavEnv(scenario=WAREHOUSE), 5)
+    assert len(a) == len(b) and all(np.array_equal(x, y) for x, y in zip(a, b))
+    assert not np.array_equal(a[0], c[0])
+
+
+def test_starts_are_those_of_ronap_run(ronap_bin, tmp_path):
+    out = tmp_path / "run"
+    subprocess.run(
+        [ronap_bin, "run", "--scenario", str(WAREHOUSE), "--policy", "apf", "--seeds", "3", "--seed-start", "7", "--out", str(out)],
+        check=True,
+        capture_output=True,
+    )
+    rows = list(csv.DictReader(open(out / "robots.csv")))
+    env = ronap.MultiNavEnv(scenario=WAREHOUSE)
+    for seed in (7, 8, 9):
+        _, infos = env.reset(seed=seed)
+        for row in (r for r in rows if int(r["seed"]) == seed):
+            x, y, heading = infos[f"robot_{row['robot']}"]["pose"]
+            assert f"{x:.3f}" == row["start_x"] and f"{y:.3f}" == row["start_y"]
+            assert f"{heading:.3f}" == row["start_heading_deg"]
+
+
+def test_messages_arrive_a_step_late_and_only_within_range():
+    env = corridor(15.0, 100.0, team_message_size=2, team_neighbours=1, team_comm_range_px=200.0)
+    space = env.action_space("robot_0")
+    assert set(space.spaces) == {"action", "message"}
+    obs, infos = env.reset(seed=0)
+    assert obs["robot_1"].shape == (18 + 4 + 2,)
+    stand = {"action": None}
+    obs, _, _, _, infos = env.step({"robot_0": {"action": 0, "message": np.array([7.0, 8.0], np.float32)}, "robot_1": stand})
+    # Sent this step, heard after it: robot_1 sees robot_0's message, robot_0 hears robot_1's zeros.
+    assert [m["from"] for m in infos["robot_1"]["inbox"]] == [0]
+    np.testing.assert_array_equal(infos["robot_1"]["inbox"][0]["message"], [7.0, 8.0])
+    np.testing.assert_array_equal(obs["robot_1"][-2:], [7.0, 8.0])
+    assert obs["robot_1"][-3] == 1.0  # the slot is filled
+    # Robot 0 is 85 px behind robot 1, which faces it: straight ahead in its frame, 85 / 200.
+    assert obs["robot_1"][18] == pytest.approx(85.0 / 200.0, abs=1e-4)
+    np.testing.assert_array_equal(obs["robot_0"][-2:], [0.0, 0.0])
+    # Next step nothing new was sent by robot_0: robot_1 hears zeros.
+    obs, _, _, _, infos = env.step({"robot_0": 1, "robot_1": 1})
+    np.testing.assert_array_equal(obs["robot_1"][-2:], [0.0, 0.0])
+
+    far = corridor(15.0, 100.0, team_message_size=2, team_neighbours=1, team_comm_range_px=50.0)
+    far.reset(seed=0)
+    obs, _, _, _, infos = far.step({"robot_0": {"action": 1, "message": np.array([7.0, 8.0], np.float32)}, "robot_1": 1})
+    assert infos["robot_1"]["inbox"] == []
+    np.testing.assert_array_equal(obs["robot_1"][18:], np.zeros(6, np.float32))
+
+
+def test_corridor_swap_ends_as_a_deadlock_and_agents_leave():
+    env = ronap.MultiNavEnv(scenario=CORRIDOR)
+    env.reset(seed=0)
+    steps = 0
+    while env.agents:
+        obs, rew, term, trunc, infos = env.step({a: 1 for a in env.agents})
+        steps += 1
+        assert steps < 1000
+    assert all(trunc.values()) and not any(term.values())
+    assert {i["status"] for i in infos.values()} == {"deadlock"}
+    with pytest.raises(ronap.RonapError, match="no agents left"):
+        env.step({})
+
+
+def test_render_draws_the_scene():
+    env = ronap.MultiNavEnv(render_mode="rgb_array", scenario=WAREHOUSE, render_scale=0.5)
+    env.reset(seed=1)
+    img = env.render()
+    assert img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3
+    assert len(np.unique(img.reshape(-1, 3), axis=0)) > 8  # walls, floor and eight robot colours
+
+
+def test_errors_name_what_was_wrong():
+    with pytest.raises(ronap.ConfigError, match=r"\[\[robots\]\]"):
+        ronap.MultiNavEnv()
+    env = ronap.MultiNavEnv(scenario=WAREHOUSE)
+    with pytest.raises(ronap.RonapError, match="before reset"):
+        env._env.step([None] * 8)
+    env.reset(seed=0)
+    with pytest.raises(ronap.ActionError, match="robot_9"):
+        env.step({"robot_9": 1})
+    with pytest.raises(ronap.ActionError, match="robot_0"):
+        env.step({"robot_0": 7})
+    with pytest.raises(ronap.ActionError, match="robot_0"):
+        env.step({"robot_0": 1.5})
+    with pytest.raises(ronap.ConfigError, match="num_envs"):
+        ronap.VecMultiNavEnv(0, scenario=WAREHOUSE)
+    vec = ronap.VecMultiNavEnv(2, scenario=WAREHOUSE)
+    with pytest.raises(ronap.RonapError, match="before reset"):
+        vec.step(np.ones((2, 8), np.int64))
+    vec.reset(0)
+    with pytest.raises(ronap.ActionError, match="shape"):
+        vec.step(np.ones((2, 7), np.int64))
+    with pytest.raises(ronap.ActionError, match="environment 1, robot_3"):
+        a = np.ones((2, 8), np.int64)
+        a[1, 3] = 5
+        vec.step(a)
+
+
+def test_vector_form_plays_the_same_episodes_on_any_thread_count():
+    n, steps = 3, 120
+    runs = []
+    for threads in (1, 2):
+        vec = ronap.VecMultiNavEnv(n, scenario=CORRIDOR, threads=threads, episode_max_steps=50)
+        obs, infos = vec.reset(seed=10)
+        trace = [obs.copy()]
+        for t in range(steps):
+            actions = (np.arange(n * vec.num_agents).reshape(n, vec.num_agents) + t) % 3
+            obs, rew, term, trunc, infos = vec.step(actions)
+            trace += [obs.copy(), rew.copy(), term.copy(), trunc.copy(), infos["active"].copy(), infos["seed"].copy()]
+        runs.append(trace)
+    assert all(np.array_equal(x, y) for x, y in zip(*runs))
+    assert obs.shape == (n, 2, 18) and rew.shape == (n, 2)
+    # Episodes of 50 steps at most, restarted on the next step with seed + n.
+    assert set(runs[0][-1]) <= {10, 11, 12, 13, 14, 15, 16, 17, 18}
+    assert max(runs[0][-1]) >= 13
+
+    # Environment 1's first episode is MultiNavEnv's seed 11, step for step.
+    single = ronap.MultiNavEnv(scenario=CORRIDOR, episode_max_steps=50)
+    obs1, _ = single.reset(seed=11)
+    np.testing.assert_array_equal(runs[0][0][1], np.stack([obs1["robot_0"], obs1["robot_1"]]))
+    for t in range(10):
+        actions = (np.arange(n * 2).reshape(n, 2) + t) % 3
+        o, r, _, _, _ = single.step({f"robot_{k}": int(actions[1, k]) for k in range(2)})
+        np.testing.assert_array_equal(runs[0][1 + 6 * t][1], np.stack([o["robot_0"], o["robot_1"]]))
+        np.testing.assert_array_equal(runs[0][2 + 6 * t][1], [r["robot_0"], r["robot_1"]])
