@@ -8,6 +8,7 @@
 //! sensors and the collision check need, written for boxes so they cost a few nanoseconds each.
 
 pub mod index;
+pub mod point_grid;
 pub mod ray_grid;
 pub mod reference;
 pub mod shape;

@@ -108,6 +108,8 @@ pub struct Episode {
     goal: Point,
     noise_rng: Rng,
     readings: Vec<f64>,
+    /// The other robots near enough to see, gathered afresh each sensing (a kept buffer).
+    near_discs: Vec<(Point, f64)>,
     observation: Vec<f32>,
     distance_px: f64,
     steps: u32,
@@ -217,6 +219,7 @@ impl Episode {
             goal: placement.goal,
             noise_rng: stream(seed, Stream::Noise),
             readings: vec![0.0; beams],
+            near_discs: Vec::new(),
             observation: vec![0.0; config.observation_size()],
             distance_px: 0.0,
             steps: 0,
@@ -259,21 +262,24 @@ impl Episode {
             self.note_gap(gap);
         }
         let reach = self.laser.range_px() + radius;
-        let near = |d: &&Disc| (d.at - p).norm() - d.radius <= reach;
-        if others.iter().any(|d| near(&d)) {
-            self.laser.refine(
+        let mut near = std::mem::take(&mut self.near_discs);
+        near.clear();
+        near.extend(
+            others
+                .iter()
+                .filter(|d| (d.at - p).norm() - d.radius <= reach)
+                .map(|d| (d.at, d.radius)),
+        );
+        if !near.is_empty() {
+            self.laser.refine_round(
                 p,
                 self.pose.z_deg,
                 &mut self.readings,
-                |origin, dir, best| {
-                    others
-                        .iter()
-                        .filter(near)
-                        .filter_map(|d| Body::Disc(d.radius).ray(d.at, origin, dir, best))
-                        .fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.min(t))))
-                },
+                &near,
+                |j, origin, dir, best| Body::Disc(near[j].1).ray(near[j].0, origin, dir, best),
             );
         }
+        self.near_discs = near;
         self.laser
             .add_noise(&mut self.readings, &mut self.noise_rng);
         self.distance_px = (self.goal - p).norm();

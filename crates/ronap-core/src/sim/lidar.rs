@@ -189,6 +189,59 @@ impl Laser {
         }
     }
 
+    /// Like [`Laser::refine`] for a few round targets (`(centre, radius)`): `hit(j, origin,
+    /// unit direction, reading)` is asked only for the beams whose direction passes within
+    /// target `j`'s angular reach (plus a margin far above rounding), so a scan among many
+    /// small targets costs per beam that can touch one, not per beam and target. The readings
+    /// are those [`Laser::refine`] gives with a `hit` that reports the nearest target: the same
+    /// directions, the same least hit.
+    pub fn refine_round(
+        &self,
+        position: Point,
+        heading_deg: f64,
+        out: &mut [f64],
+        targets: &[(Point, f64)],
+        mut hit: impl FnMut(usize, Point, Vector, f64) -> Option<f64>,
+    ) {
+        let heading = unit(heading_deg);
+        let m = self.offsets.len();
+        let mut beam = |i: usize, j: usize, out: &mut [f64]| {
+            let dir = turn(heading, self.offsets[i]);
+            if let Some(t) = hit(j, position, dir, out[i]) {
+                if t < out[i] {
+                    out[i] = t;
+                }
+            }
+        };
+        for (j, &(centre, radius)) in targets.iter().enumerate() {
+            let oc = centre - position;
+            let d = oc.norm();
+            if d <= radius * (1.0 + 1e-9) || self.step_deg == 0.0 || !d.is_finite() {
+                // Overlapping the laser (or one beam): every beam may touch it.
+                for i in 0..m {
+                    beam(i, j, out);
+                }
+                continue;
+            }
+            // Half the angle the target covers, with a margin of a micro-degree.
+            let half = (radius / d).asin().to_degrees() + 1e-6;
+            let from_first = crate::geometry::wrap_deg(
+                oc.y.atan2(oc.x).to_degrees() - heading_deg - self.first_offset_deg,
+            );
+            let last = (m - 1) as f64;
+            for shift in [-360.0, 0.0, 360.0] {
+                let c = from_first + shift;
+                let lo = ((c - half) / self.step_deg).ceil().max(0.0);
+                let hi = ((c + half) / self.step_deg).floor().min(last);
+                if lo <= hi {
+                    for i in lo as usize..=hi as usize {
+                        beam(i, j, out);
+                    }
+                }
+            }
+        }
+    }
+
     /// Adds Gaussian noise (if configured) to readings, keeping each in `[0, range]`.
     pub fn add_noise(&self, readings: &mut [f64], rng: &mut impl rand::Rng) {
         if let Some(noise) = &self.noise {
@@ -318,5 +371,66 @@ mod tests {
         assert_eq!(l.class(31.0), RayClass::Green);
         assert_eq!(l.class(30.0), RayClass::Yellow);
         assert_eq!(l.class(15.0), RayClass::Red);
+    }
+
+    /// The exact distance along `dir` from `origin` to a disc, as the moving model computes it.
+    fn disc_ray(c: Point, r: f64, origin: Point, dir: Vector, max: f64) -> Option<f64> {
+        let oc = c - origin;
+        let along = oc.dot(&dir);
+        let d2 = oc.norm_squared() - along * along;
+        if d2 > r * r {
+            return None;
+        }
+        let t = if oc.norm_squared() <= r * r {
+            0.0
+        } else {
+            along - (r * r - d2).sqrt()
+        };
+        (t >= 0.0 && t <= max).then_some(t)
+    }
+
+    #[test]
+    fn refine_round_reads_what_refine_reads_to_the_bit() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        for case in 0..400 {
+            let beams = [1, 2, 17, 64, 360, 1081][case % 6];
+            let fov = [180.0, 360.0, 90.0, 270.0][case % 4];
+            let l = Laser::new(&LaserConfig {
+                beams,
+                fov_deg: fov,
+                range_px: 200.0,
+                ..LaserConfig::default()
+            });
+            let p = Point::new(rng.random_range(0.0..500.0), rng.random_range(0.0..500.0));
+            let heading = rng.random_range(-720.0..720.0);
+            let discs: Vec<(Point, f64)> = (0..rng.random_range(0..12))
+                .map(|_| {
+                    let at = p + Vector::new(
+                        rng.random_range(-220.0..220.0),
+                        rng.random_range(-220.0..220.0),
+                    );
+                    (at, rng.random_range(0.5..12.0))
+                })
+                .collect();
+            let walls: Vec<f64> = (0..beams).map(|_| rng.random_range(0.0..200.0)).collect();
+            let mut want = walls.clone();
+            l.refine(p, heading, &mut want, |o, dir, best| {
+                discs
+                    .iter()
+                    .filter_map(|&(c, r)| disc_ray(c, r, o, dir, best))
+                    .fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.min(t))))
+            });
+            let mut got = walls.clone();
+            l.refine_round(p, heading, &mut got, &discs, |j, o, dir, best| {
+                disc_ray(discs[j].0, discs[j].1, o, dir, best)
+            });
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(
+                bits(&got),
+                bits(&want),
+                "case {case}: {beams} beams over {fov} deg"
+            );
+        }
     }
 }

@@ -14,6 +14,7 @@
 //! others' from a stream of their own, each clear of the robots placed before it.
 
 use crate::config::{OnArrival, TeamConfig, ValidConfig};
+use crate::geometry::point_grid::PointGrid;
 use crate::geometry::{point_segment_distance_squared, Point};
 use crate::sim::episode::{Episode, Status};
 use crate::sim::moving::{Disc, Movers};
@@ -25,6 +26,9 @@ use std::sync::Arc;
 
 /// Space kept between two robots' starts (and two robots' goals), beyond their radii, px.
 pub const PLACEMENT_GAP_PX: f64 = 2.0;
+
+/// Side of the cells of the grids that find the robots near a robot, px.
+const NEAR_CELL_PX: f64 = 64.0;
 
 /// What a robot broadcast at a step: received the step after by the robots within
 /// `team.comm_range_px`.
@@ -67,6 +71,12 @@ pub struct Team {
     outbox: Vec<Vec<f32>>,
     /// What each robot received at the last step, nearest sender first.
     inbox: Vec<Vec<Broadcast>>,
+    /// The robots in the scene by where they were before the step (motions, messages)...
+    grid_before: PointGrid,
+    /// ... and where they are after it (sensing).
+    grid_after: PointGrid,
+    /// The largest robot radius, px.
+    max_radius: f64,
 }
 
 /// Whether discs of radii summing to `reach`, moving at once from `a0` to `a1` and from `b0` to
@@ -194,7 +204,15 @@ impl Team {
             still_for: 0,
             deadlock_steps: config.episode.deadlock_steps,
             touched: Vec::new(),
+            grid_before: PointGrid::new(scene.width(), scene.height(), NEAR_CELL_PX),
+            grid_after: PointGrid::new(scene.width(), scene.height(), NEAR_CELL_PX),
+            max_radius: 0.0,
         };
+        team.max_radius = team
+            .robots
+            .iter()
+            .map(|r| r.config().robot.radius_px)
+            .fold(0.0, f64::max);
         let among = team.movers.is_some();
         for r in &mut team.robots {
             r.set_among_movers(among);
@@ -368,16 +386,34 @@ impl Team {
             .collect();
         let mut blocked = vec![false; n];
         let moves = |k: usize, blocked: &[bool]| !blocked[k] && ends[k] != starts[k];
+        // Each moving robot's candidates: the robots within its reach of its start, in index
+        // order (the exact test below decides).
+        self.grid_before
+            .fill(present.iter().map(|&k| (k, starts[k])));
+        let max_move = present
+            .iter()
+            .map(|&k| (ends[k] - starts[k]).norm())
+            .fold(0.0, f64::max);
+        let mut near_start = vec![0usize; n + 1];
+        let mut near: Vec<u32> = Vec::new();
+        let mut found = Vec::new();
+        for k in 0..n {
+            near_start[k] = near.len();
+            if present.binary_search(&k).is_ok() && moves(k, &blocked) {
+                let reach = (ends[k] - starts[k]).norm() + max_move + radii[k] + self.max_radius;
+                self.grid_before.near(starts[k], reach, &mut found);
+                near.extend(found.iter().filter(|&&j| j as usize != k));
+            }
+        }
+        near_start[n] = near.len();
         loop {
             let mut changed = false;
             for &i in &present {
                 if !moves(i, &blocked) {
                     continue;
                 }
-                for &j in &present {
-                    if i == j {
-                        continue;
-                    }
+                for &j in &near[near_start[i]..near_start[i + 1]] {
+                    let j = j as usize;
                     let reach = radii[i] + radii[j];
                     let (j0, j1) = if moves(j, &blocked) {
                         (starts[j], ends[j])
@@ -444,14 +480,19 @@ impl Team {
         let scale = range.max(1.0);
         let slot = self.comm.slot_size();
         let k_near = self.comm.neighbours as usize;
+        // `sent` is in robot order, and the grid holds where the senders were.
+        let of = |k: usize| sent.binary_search_by_key(&k, |b| b.from).ok();
+        let mut found = Vec::new();
         for (i, inbox) in self.inbox.iter_mut().enumerate() {
             inbox.clear();
-            let Some(me) = sent.iter().find(|b| b.from == i) else {
+            let Some(me) = of(i).map(|m| &sent[m]) else {
                 continue;
             };
             let at = me.pose.position();
-            let mut near: Vec<(f64, &Broadcast)> = sent
+            self.grid_before.near(at, range, &mut found);
+            let mut near: Vec<(f64, &Broadcast)> = found
                 .iter()
+                .filter_map(|&j| of(j as usize).map(|m| &sent[m]))
                 .filter(|b| b.from != i)
                 .map(|b| ((b.pose.position() - at).norm(), b))
                 .filter(|(d, _)| *d <= range)
@@ -486,13 +527,24 @@ impl Team {
             .map(|k| (k, disc(&self.robots[k])))
             .collect();
         let movers = self.movers.take();
+        self.grid_after.fill(discs.iter().map(|(k, d)| (*k, d.at)));
         let mut others = Vec::with_capacity(discs.len());
+        let mut found = Vec::new();
         for k in 0..n {
             if !self.running(k) && self.steps > 0 {
                 continue;
             }
+            // The robots the laser can reach, in robot order (sense_among keeps its exact test).
+            let r = &self.robots[k];
+            let reach = r.laser().range_px() + r.config().robot.radius_px + self.max_radius;
+            self.grid_after.near(r.pose().position(), reach, &mut found);
             others.clear();
-            others.extend(discs.iter().filter(|(j, _)| *j != k).map(|(_, d)| *d));
+            others.extend(found.iter().filter(|&&j| j as usize != k).filter_map(|&j| {
+                discs
+                    .binary_search_by_key(&(j as usize), |(i, _)| *i)
+                    .ok()
+                    .map(|m| discs[m].1)
+            }));
             self.robots[k].sense_among(movers.as_deref(), &others);
         }
         self.movers = movers;

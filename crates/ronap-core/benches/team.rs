@@ -1,0 +1,63 @@
+//! Criterion benchmark of a big team: 1000 robots, each with a 64-beam 360-degree laser of range
+//! 200 px, in a 40 x 40 maze of 100 px cells (issue target: one step of all robots in at most
+//! 2 ms on one core). Robots drive the `ronap bench` action pattern, each at its own phase, and
+//! stay in the scene; the episode never ends (no time-out, no deadlock).
+//!
+//! `cargo bench -p ronap-core --bench team`.
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use ronap_core::config::{SimConfig, TeamRobotConfig};
+use ronap_core::run::team::TeamRollout;
+use ronap_core::sim::robot::{Action, DiscreteAction};
+use ronap_core::sim::world::{Scenes, Worlds};
+use std::time::Duration;
+
+/// The action pattern `ronap bench` uses: mostly ahead, some turns.
+const PATTERN: [usize; 8] = [1, 1, 1, 0, 1, 1, 2, 1];
+
+/// `robots` robots with 64-beam 360-degree lasers of range 200 px in a 40 x 40 maze.
+pub fn big_team(robots: u32) -> SimConfig {
+    let mut c = SimConfig::default();
+    c.maze.cols = 40;
+    c.maze.rows = 40;
+    c.laser.beams = 64;
+    c.laser.fov_deg = 360.0;
+    c.laser.range_px = 200.0;
+    c.episode.max_steps = u32::MAX;
+    c.episode.deadlock_steps = u32::MAX;
+    c.robots = vec![TeamRobotConfig {
+        count: robots,
+        ..TeamRobotConfig::default()
+    }];
+    c
+}
+
+fn team(c: &mut Criterion) {
+    let mut group = c.benchmark_group("team");
+    group
+        .sample_size(20)
+        .measurement_time(Duration::from_secs(10));
+    for robots in [100u32, 1000] {
+        let config = big_team(robots).validate().expect("valid");
+        let worlds = Worlds::new(config.clone(), Scenes::Maze(0));
+        let mut rollout = TeamRollout::placed(&config, worlds.team(0), 0).expect("room for all");
+        let n = robots as usize;
+        let mut t = 0usize;
+        let mut actions: Vec<Option<Action>> = vec![None; n];
+        group.throughput(Throughput::Elements(u64::from(robots)));
+        group.bench_function(format!("step_{robots}_robots_64_beams_200px"), |b| {
+            b.iter(|| {
+                t += 1;
+                for (k, a) in actions.iter_mut().enumerate() {
+                    let i = PATTERN[(t + k) % PATTERN.len()];
+                    *a = DiscreteAction::from_index(i).map(Action::from);
+                }
+                rollout.step(&actions);
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, team);
+criterion_main!(benches);
