@@ -16,7 +16,7 @@ use std::time::Duration;
 const PATTERN: [usize; 8] = [1, 1, 1, 0, 1, 1, 2, 1];
 
 /// `robots` robots with 64-beam 360-degree lasers of range 200 px in a 40 x 40 maze.
-pub fn big_team(robots: u32) -> SimConfig {
+fn big_team(robots: u32) -> SimConfig {
     let mut c = SimConfig::default();
     c.maze.cols = 40;
     c.maze.rows = 40;
@@ -59,5 +59,11 @@ fn team(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, team);
+// The macro defines an undocumented `benches` function.
+#[allow(missing_docs)]
+mod group {
+    use super::*;
+    criterion_group!(benches, team);
+}
+use group::benches;
 criterion_main!(benches);
