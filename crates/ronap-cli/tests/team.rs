@@ -172,3 +172,62 @@ fn bad_robot_entries_are_named() {
         assert!(!out.exists());
     }
 }
+
+#[test]
+fn gif_animates_a_team_episode_with_every_robot_in_its_colour() {
+    use image::AnimationDecoder;
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("swap");
+    run_team(
+        &repo_root().join("scenarios/corridor-swap.toml"),
+        &out,
+        &["--seeds", "2", "--gif", "1"],
+    );
+    let gif = out.join("gif/seed-000001-deadlock.gif");
+    let file = std::io::BufReader::new(std::fs::File::open(&gif).unwrap());
+    let frames: Vec<image::RgbaImage> = image::codecs::gif::GifDecoder::new(file)
+        .unwrap()
+        .into_frames()
+        .map(|f| f.unwrap().into_buffer())
+        .collect();
+    let episodes = rows(&out.join("episodes.csv"));
+    let steps: usize = episodes[2][col(&episodes, "steps")].parse().unwrap();
+    // The start and a frame after every step.
+    assert_eq!(frames.len(), steps + 1);
+    // Robot 0 (blue) starts at the left end, robot 1 (orange) at the right.
+    let xs = |img: &image::RgbaImage, colour: [u8; 3]| -> Vec<u32> {
+        img.enumerate_pixels()
+            .filter(|(_, _, p)| p.0[..3] == colour)
+            .map(|(x, _, _)| x)
+            .collect()
+    };
+    let (blue, orange) = ([31, 119, 180], [255, 127, 14]);
+    let first = &frames[0];
+    let (b, o) = (xs(first, blue), xs(first, orange));
+    assert!(!b.is_empty() && !o.is_empty());
+    assert!(b.iter().max() < o.iter().min(), "{b:?} {o:?}");
+    // They drove towards each other.
+    let last = frames.last().unwrap();
+    assert!(xs(last, blue).iter().max() > b.iter().max());
+    assert!(xs(last, orange).iter().min() < o.iter().min());
+    // A seed outside the run is refused before anything runs.
+    let swap = repo_root().join("scenarios/corridor-swap.toml");
+    let no = dir.path().join("no");
+    assert_rejected(
+        &[
+            "run",
+            "--scenario",
+            swap.to_str().unwrap(),
+            "--policy",
+            "geodesic",
+            "--seeds",
+            "2",
+            "--gif",
+            "5",
+            "--out",
+            no.to_str().unwrap(),
+        ],
+        &["--gif 5: not one of this run's seeds (0..=1)"],
+    );
+    assert!(!dir.path().join("no").exists());
+}

@@ -60,13 +60,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     let evaluator = Evaluator::new(config.clone(), scenes);
     let first = args.seed_start;
     let seeds = seed_range(first, args.seeds)?;
-    let end = first + args.seeds;
-    if let Some(s) = args.gif.iter().find(|&&s| s < first || s >= end) {
-        bail!(
-            "--gif {s}: not one of this run's seeds ({first}..={})",
-            end - 1
-        );
-    }
+    check_gif_seeds(&args.gif, first, args.seeds)?;
     // A scene with no room for a start and goal fails the same way for every seed: say so now.
     evaluator
         .worlds()
@@ -124,7 +118,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         stdout,
         "ronap run: policy {}, seeds {first}..{}, {threads} threads",
         args.policy,
-        end - 1
+        first + args.seeds - 1
     )?;
     write!(stdout, "{}", summary.table())?;
     writeln!(stdout, "outputs in {}", out_dir.display())?;
@@ -171,10 +165,10 @@ fn run_team(
     scenes: ronap_core::Scenes,
     map_source: Option<ronap_core::scene::map::MapSource>,
 ) -> Result<ExitCode> {
-    if !args.gif.is_empty() || args.log_steps {
+    if args.log_steps {
         bail!(
-            "--gif and --log-steps do not animate or log team runs yet; run without them \
-             (--png draws them; robots.csv holds every robot's figures)"
+            "--log-steps does not log team runs yet; run without it (robots.csv holds every \
+             robot's figures, --gif SEED animates an episode)"
         );
     }
     let mut names = Vec::new();
@@ -196,6 +190,7 @@ fn run_team(
         of_robot.iter().map(|&i| factories[i].as_ref()).collect();
     let first = args.seed_start;
     let seeds = seed_range(first, args.seeds)?;
+    check_gif_seeds(&args.gif, first, args.seeds)?;
     let evaluator = Evaluator::new(config.clone(), scenes);
     let threads = args.threads.count();
     // A team that cannot be placed fails the same way for every seed: say so before writing.
@@ -246,7 +241,22 @@ fn run_team(
     write!(stdout, "{}", evaluation.team.table())?;
     writeln!(stdout, "per robot:")?;
     write!(stdout, "{}", evaluation.summary.table())?;
+    let mut gif_notes = Vec::new();
+    for &seed in &args.gif {
+        if let Some(record) = evaluation.result.records.iter().find(|r| r.seed == seed) {
+            gif_notes.extend(write_team_gif(
+                &evaluator,
+                &factories_per_robot,
+                &names,
+                record,
+                &out_dir,
+            )?);
+        }
+    }
     writeln!(stdout, "outputs in {}", out_dir.display())?;
+    for note in gif_notes {
+        eprintln!("ronap run: {note}");
+    }
     if let Some(e) = evaluation.write_error {
         return Err(e.into());
     }
@@ -319,6 +329,62 @@ fn write_gif(
         (rerun.steps != record.steps || rerun.outcome != record.outcome).then(|| {
             format!(
                 "--gif {seed}: the policy is not deterministic; the GIF shows a re-run ({} steps, \
+                 {}), episodes.csv the run ({} steps, {})",
+                rerun.steps,
+                rerun.outcome.name(),
+                record.steps,
+                record.outcome.name()
+            )
+        }),
+    )
+}
+
+/// Refuses a `--gif` seed outside the run's `count` seeds from `first` (a range already
+/// checked not to pass 2^64).
+fn check_gif_seeds(gif: &[u64], first: u64, count: u64) -> Result<()> {
+    let last = first.saturating_add(count.saturating_sub(1));
+    if let Some(s) = gif.iter().find(|&&s| s < first || s > last || count == 0) {
+        bail!("--gif {s}: not one of this run's seeds ({first}..={last})");
+    }
+    Ok(())
+}
+
+/// Runs team episode `record.seed` again with fresh policies and writes its animation to
+/// `gif/`. Returns a note when the re-run differs from `record` (a policy that is not
+/// deterministic), since the GIF then shows the re-run.
+fn write_team_gif(
+    evaluator: &Evaluator,
+    factories: &[&dyn ronap_core::policy::PolicyFactory],
+    names: &[String],
+    record: &ronap_core::eval::TeamRecord,
+    out_dir: &std::path::Path,
+) -> Result<Option<String>> {
+    let seed = record.seed;
+    let mut policies = factories
+        .iter()
+        .map(|f| f.make())
+        .collect::<Result<Vec<_>, _>>()?;
+    // About 500 pixels along the scene's longer side.
+    let scene_side = evaluator
+        .worlds()
+        .team(seed)
+        .first()
+        .map_or(1000.0, |w| w.scene().width().max(w.scene().height()));
+    let options = ronap_core::render::gif::GifOptions {
+        scale: (500.0 / scene_side).clamp(0.1, 4.0),
+        ..Default::default()
+    };
+    let (animation, rerun) =
+        ronap_core::render::team::animate_team(evaluator, &mut policies, names, seed, &options)
+            .with_context(|| format!("--gif {seed}"))?;
+    let dir = out_dir.join("gif");
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot make {}", dir.display()))?;
+    let path = dir.join(format!("seed-{seed:06}-{}.gif", rerun.outcome.name()));
+    ronap_core::io::atomic::write_atomic(&path, |w| w.write_all(&animation.bytes))?;
+    Ok(
+        (rerun.steps != record.steps || rerun.outcome != record.outcome).then(|| {
+            format!(
+                "--gif {seed}: a policy is not deterministic; the GIF shows a re-run ({} steps, \
                  {}), episodes.csv the run ({} steps, {})",
                 rerun.steps,
                 rerun.outcome.name(),

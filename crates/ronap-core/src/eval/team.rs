@@ -285,9 +285,23 @@ impl Evaluator {
         seed: u64,
         paths: bool,
     ) -> Result<TeamRecord, RunError> {
+        self.watch_team_episode(policies, names, seed, paths, &mut |_| {})
+    }
+
+    /// [`Evaluator::run_team_episode`], showing `watch` the team at its start and after every
+    /// step (for an animation).
+    pub fn watch_team_episode(
+        &self,
+        policies: &mut [Box<dyn crate::policy::Policy>],
+        names: &[String],
+        seed: u64,
+        paths: bool,
+        watch: &mut dyn FnMut(&crate::sim::team::Team),
+    ) -> Result<TeamRecord, RunError> {
         let clock = Instant::now();
         let worlds = self.worlds().team(seed);
         let mut rollout = TeamRollout::start(self.config(), worlds, seed, policies)?;
+        watch(rollout.team());
         let n = rollout.team().robots().len();
         let mut tracks: Vec<Vec<Point>> = vec![Vec::new(); if paths { n } else { 0 }];
         let note = |team: &crate::sim::team::Team, tracks: &mut Vec<Vec<Point>>| {
@@ -300,6 +314,7 @@ impl Evaluator {
         note(rollout.team(), &mut tracks);
         while rollout.advance(policies)? {
             note(rollout.team(), &mut tracks);
+            watch(rollout.team());
         }
         let team = rollout.team();
         let mut robots = Vec::new();

@@ -38,7 +38,10 @@ pub const NO_DATA: Rgb<u8> = Rgb([236, 236, 236]);
 pub const DISAGREE: Rgb<u8> = Rgb([40, 40, 40]);
 
 /// Policy colours: matplotlib's "tab10", ten hues that stay apart on screen and in print.
-const POLICY_COLOURS: [Rgb<u8>; 10] = [
+/// How many distinct colours [`policy_colour`] gives before repeating.
+pub const POLICY_COUNT: usize = 10;
+
+const POLICY_COLOURS: [Rgb<u8>; POLICY_COUNT] = [
     Rgb([31, 119, 180]),
     Rgb([255, 127, 14]),
     Rgb([44, 160, 44]),

@@ -224,6 +224,7 @@ fn same_pose(a: Pose, b: Pose) -> bool {
 /// nearest of them). Each frame after the first stores only the rectangle that changed.
 pub struct GifWriter<W: Write> {
     encoder: gif::Encoder<W>,
+    palette: Vec<image::Rgb<u8>>,
     width: u16,
     height: u16,
     previous: Option<Vec<u8>>,
@@ -233,11 +234,24 @@ pub struct GifWriter<W: Write> {
 impl<W: Write> GifWriter<W> {
     /// An animation of `width` x `height` frames, looping forever.
     pub fn new(out: W, width: u16, height: u16) -> Result<Self, gif::EncodingError> {
-        let palette: Vec<u8> = render::PALETTE.iter().flat_map(|c| c.0).collect();
-        let mut encoder = gif::Encoder::new(out, width, height, &palette)?;
+        Self::with_palette(out, width, height, &render::PALETTE)
+    }
+
+    /// An animation whose pictures use the colours of `palette` (at most 256; any other colour
+    /// becomes the nearest of them).
+    pub fn with_palette(
+        out: W,
+        width: u16,
+        height: u16,
+        palette: &[image::Rgb<u8>],
+    ) -> Result<Self, gif::EncodingError> {
+        let palette = palette[..palette.len().min(256)].to_vec();
+        let bytes: Vec<u8> = palette.iter().flat_map(|c| c.0).collect();
+        let mut encoder = gif::Encoder::new(out, width, height, &bytes)?;
         encoder.set_repeat(gif::Repeat::Infinite)?;
         Ok(Self {
             encoder,
+            palette,
             width,
             height,
             previous: None,
@@ -259,15 +273,13 @@ impl<W: Write> GifWriter<W> {
             )));
         }
         // Pictures come in long runs of one colour: look each new colour up once.
-        let mut last = (
-            image::Rgb([255, 255, 255]).0,
-            palette_index([255, 255, 255]),
-        );
+        let palette = &self.palette;
+        let mut last = ([255, 255, 255], palette_index(palette, [255, 255, 255]));
         let indices: Vec<u8> = image
             .pixels()
             .map(|p| {
                 if p.0 != last.0 {
-                    last = (p.0, palette_index(p.0));
+                    last = (p.0, palette_index(palette, p.0));
                 }
                 last.1
             })
@@ -310,15 +322,15 @@ impl<W: Write> GifWriter<W> {
     }
 }
 
-/// The index in [`render::PALETTE`] of `rgb`, or of the nearest colour there.
-fn palette_index(rgb: [u8; 3]) -> u8 {
+/// The index in `palette` of `rgb`, or of the nearest colour there.
+fn palette_index(palette: &[image::Rgb<u8>], rgb: [u8; 3]) -> u8 {
     let distance = |c: &image::Rgb<u8>| {
         c.0.iter()
             .zip(rgb)
             .map(|(&a, b)| (i32::from(a) - i32::from(b)).pow(2))
             .sum::<i32>()
     };
-    render::PALETTE
+    palette
         .iter()
         .enumerate()
         .min_by_key(|(_, c)| distance(c))

@@ -1,9 +1,14 @@
 //! Pictures of team episodes: the whole scene with every robot's path, start and goal in its own
 //! colour (the colours of [`crate::render::chart::policy_colour`], repeating after ten).
 
-use crate::eval::TeamRecord;
-use crate::render::chart::policy_colour;
+use crate::eval::{Evaluator, TeamRecord};
+use crate::geometry::Point;
+use crate::policy::Policy;
+use crate::render::chart::{policy_colour, POLICY_COUNT};
+use crate::render::gif::{Animation, AnimationError, GifOptions, GifWriter};
 use crate::render::Canvas;
+use crate::run::RunError;
+use crate::sim::team::Team;
 use image::{Rgb, RgbImage};
 
 /// `colour` mixed half-way with white, for goals.
@@ -40,11 +45,7 @@ pub fn team_image(record: &TeamRecord, scale: f64) -> Option<RgbImage> {
 /// The picture of a team episode as it stands: each robot's goal as a faded disc of the goal
 /// tolerance, its path so far (`paths[k]`) and, while it is in the scene, the robot with its
 /// heading, all in its own colour; moving obstacles as they are now.
-pub fn team_frame(
-    team: &crate::sim::team::Team,
-    paths: &[Vec<crate::geometry::Point>],
-    scale: f64,
-) -> RgbImage {
+pub fn team_frame(team: &Team, paths: &[Vec<Point>], scale: f64) -> RgbImage {
     let first = team.robot(0);
     let mut canvas = Canvas::new(first.scene(), scale);
     let least = 3.0 / scale;
@@ -68,4 +69,99 @@ pub fn team_frame(
         }
     }
     canvas.into_image()
+}
+
+/// Every colour of team pictures: the scene's and moving obstacles' ([`crate::render::PALETTE`]),
+/// each robot colour and its faded goal colour.
+pub fn team_palette() -> Vec<Rgb<u8>> {
+    let mut palette = crate::render::PALETTE.to_vec();
+    palette.extend((0..POLICY_COUNT).map(policy_colour));
+    palette.extend((0..POLICY_COUNT).map(|k| faded(policy_colour(k))));
+    palette
+}
+
+/// A team episode that could not be animated.
+#[derive(Debug, thiserror::Error)]
+pub enum TeamAnimationError {
+    /// The episode could not be run again.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// The frames could not be encoded.
+    #[error(transparent)]
+    Animation(#[from] AnimationError),
+}
+
+/// Runs team episode `seed` again with `policies` (one per robot, fresh from their factories)
+/// and draws it from above ([`team_frame`] at `options.scale`) every `options.stride` steps.
+/// Returns the animation and the re-run's record (a policy that is not deterministic may play
+/// the episode otherwise than the run did).
+pub fn animate_team(
+    evaluator: &Evaluator,
+    policies: &mut [Box<dyn Policy>],
+    names: &[String],
+    seed: u64,
+    options: &GifOptions,
+) -> Result<(Animation, TeamRecord), TeamAnimationError> {
+    let stride = options.stride.max(1);
+    let worlds = evaluator.worlds().team(seed);
+    let Some(world) = worlds.first() else {
+        let source =
+            crate::sim::placement::EpisodeError::Moving("a team needs at least one robot".into());
+        return Err(RunError::Episode { seed, source }.into());
+    };
+    let (width, height) = Canvas::new(world.scene(), options.scale)
+        .into_image()
+        .dimensions();
+    let too_large = || AnimationError::TooLarge { width, height };
+    let mut writer = GifWriter::with_palette(
+        Vec::new(),
+        u16::try_from(width).map_err(|_| too_large())?,
+        u16::try_from(height).map_err(|_| too_large())?,
+        &team_palette(),
+    )
+    .map_err(AnimationError::from)?;
+    let mut paths: Vec<Vec<Point>> = Vec::new();
+    let mut pending: Option<RgbImage> = None;
+    let mut failed: Option<gif::EncodingError> = None;
+    let mut watch = |team: &Team| {
+        if paths.is_empty() {
+            paths = vec![Vec::new(); team.robots().len()];
+        }
+        for (k, path) in paths.iter_mut().enumerate() {
+            let p = team.robot(k).pose().position();
+            if team.present(k) && path.last() != Some(&p) {
+                path.push(p);
+            }
+        }
+        if failed.is_some() || (team.steps() % stride != 0 && !team.is_done()) {
+            return;
+        }
+        if let Some(before) = pending.take() {
+            if let Err(e) = writer.add(&before, options.frame_delay_cs) {
+                failed = Some(e);
+                return;
+            }
+        }
+        pending = Some(team_frame(team, &paths, options.scale));
+    };
+    let record = evaluator.watch_team_episode(policies, names, seed, false, &mut watch)?;
+    if let Some(e) = failed {
+        return Err(AnimationError::from(e).into());
+    }
+    if let Some(last) = pending {
+        writer
+            .add(&last, options.last_frame_delay_cs)
+            .map_err(AnimationError::from)?;
+    }
+    let frames = writer.frames();
+    let bytes = writer.finish().map_err(AnimationError::from)?;
+    Ok((
+        Animation {
+            bytes,
+            frames,
+            steps: record.steps as usize,
+            size: (width, height),
+        },
+        record,
+    ))
 }
