@@ -1,10 +1,16 @@
 //! `--policy py:FILE.py:FUNCTION`: a Python function as a policy, run in a Python process per
 //! worker thread and spoken to over pipes, so the `ronap` binary needs no Python to build.
 //!
-//! Each step sends the observation as one line of numbers; the process answers `A <index>` for an
-//! action, `BAD <repr>` for a value that is not one, or `ERR <message>` when the function raised.
-//! The interpreter is `$RONAP_PYTHON`, else `python3`; the observation reaches the function as a
-//! float32 numpy array when numpy is installed, else as a list.
+//! Each step sends the observation as one line of numbers, then ` | ` and what a team robot
+//! received (`<count>` broadcasts of `<from> <x> <y> <heading> <goal x> <goal y> <message...>`);
+//! the process answers `A <index>` for an action (with ` M <floats>` for a message), `BAD <repr>`
+//! for a value that is not one, or `ERR <message>` when the function raised. The interpreter is
+//! `$RONAP_PYTHON`, else `python3`; the observation reaches the function as a float32 numpy array
+//! when numpy is installed, else as a list.
+//!
+//! A function of one argument gets the observation and returns an action. A function of two gets
+//! the observation and the team's inbox (a list of dicts: `from`, `pose`, `goal`, `message`,
+//! nearest sender first; empty for a lone robot) and returns an action or `(action, message)`.
 
 use ronap_core::policy::{Decision, Policy, PolicyError, PolicyFactory};
 use ronap_core::{Action, DiscreteAction, Episode, World};
@@ -34,20 +40,49 @@ try:
     import numpy as np
 except ImportError:
     np = None
+import inspect
+try:
+    params = [p for p in inspect.signature(fn).parameters.values()
+              if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD, p.VAR_POSITIONAL)]
+    listens = len(params) >= 2 or any(p.kind == p.VAR_POSITIONAL for p in params)
+except (TypeError, ValueError):
+    listens = False
+def arr(values):
+    return np.asarray(values, dtype=np.float32) if np is not None else values
 say("READY")
 for line in sys.stdin:
-    obs = [float(x) for x in line.split()]
-    if np is not None:
-        obs = np.asarray(obs, dtype=np.float32)
+    head, _, tail = line.partition("|")
+    obs = arr([float(x) for x in head.split()])
     try:
-        a = fn(obs)
+        if listens:
+            words = tail.split()
+            count, size, at, inbox = int(words[0]), int(words[1]), 2, []
+            for _ in range(count):
+                v = [float(x) for x in words[at:at + 6 + size]]
+                at += 6 + size
+                inbox.append({"from": int(v[0]), "pose": (v[1], v[2], v[3]), "goal": (v[4], v[5]),
+                              "message": arr(v[6:])})
+            a = fn(obs, inbox)
+        else:
+            a = fn(obs)
     except Exception as e:
         say(f"ERR {e!r}")
         continue
+    message = None
+    if listens and isinstance(a, (tuple, list)) and len(a) == 2:
+        a, message = a
     if isinstance(a, bool) or not hasattr(a, "__index__"):
         say(f"BAD {a!r}")
-    else:
+        continue
+    if message is None:
         say(f"A {a.__index__()}")
+        continue
+    try:
+        floats = [float(x) for x in (message.tolist() if hasattr(message, "tolist") else message)]
+    except Exception:
+        say(f"BADM {message!r}")
+        continue
+    say(f"A {a.__index__()} M " + " ".join(repr(x) for x in floats))
 "#;
 
 /// Makes Python policies from `py:FILE:FUNCTION`.
@@ -105,6 +140,8 @@ impl PyPolicyFactory {
             stdin,
             stdout,
             line: String::new(),
+            inbox: "0 0".into(),
+            message: Vec::new(),
         };
         match process.read()?.as_str() {
             "READY" => Ok(process),
@@ -129,6 +166,10 @@ struct PyProcess {
     stdin: ChildStdin,
     stdout: BufReader<ChildStdout>,
     line: String,
+    /// What the robot received, as the next request sends it.
+    inbox: String,
+    /// The message of the last answer.
+    message: Vec<f32>,
 }
 
 impl PyProcess {
@@ -151,7 +192,30 @@ impl Drop for PyProcess {
 
 impl Policy for PyProcess {
     fn reset(&mut self, _world: &World, _episode: &Episode) -> Result<(), PolicyError> {
+        self.inbox = "0 0".into();
+        self.message.clear();
         Ok(())
+    }
+
+    fn hear(&mut self, inbox: &[ronap_core::sim::team::Broadcast]) {
+        let size = inbox.first().map_or(0, |b| b.message.len());
+        let mut text = format!("{} {size}", inbox.len());
+        for b in inbox {
+            text.push_str(&format!(
+                " {} {:?} {:?} {:?} {:?} {:?}",
+                b.from, b.pose.x, b.pose.y, b.pose.z_deg, b.goal.x, b.goal.y
+            ));
+            for m in &b.message {
+                text.push_str(&format!(" {m:?}"));
+            }
+        }
+        self.inbox = text;
+    }
+
+    fn message(&mut self, out: &mut [f32]) {
+        for (o, m) in out.iter_mut().zip(&self.message) {
+            *o = *m;
+        }
     }
 
     fn act(&mut self, episode: &Episode) -> Result<Decision, PolicyError> {
@@ -159,19 +223,37 @@ impl Policy for PyProcess {
         for v in episode.observation() {
             line.push_str(&format!("{v:?} "));
         }
+        line.push_str("| ");
+        line.push_str(&self.inbox);
         line.push('\n');
         self.stdin
             .write_all(line.as_bytes())
             .map_err(|e| PolicyError::Failed(format!("cannot write to the Python process: {e}")))?;
         let answer = self.read().map_err(PolicyError::Failed)?;
         let expected = "expected 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)";
-        if let Some(index) = answer.strip_prefix("A ") {
+        if let Some(rest) = answer.strip_prefix("A ") {
+            let (index, message) = rest.split_once(" M ").unwrap_or((rest, ""));
+            self.message.clear();
+            for x in message.split_whitespace() {
+                match x.parse::<f32>() {
+                    Ok(v) if v.is_finite() => self.message.push(v),
+                    _ => {
+                        return Err(PolicyError::Failed(format!(
+                            "returned the message value {x}, expected finite numbers"
+                        )))
+                    }
+                }
+            }
             let action = index
                 .parse::<usize>()
                 .ok()
                 .and_then(DiscreteAction::from_index)
                 .ok_or_else(|| PolicyError::Failed(format!("returned {index}, {expected}")))?;
             Ok(Decision::Act(Action::Discrete(action)))
+        } else if let Some(repr) = answer.strip_prefix("BADM ") {
+            Err(PolicyError::Failed(format!(
+                "returned the message {repr}, expected numbers"
+            )))
         } else if let Some(repr) = answer.strip_prefix("BAD ") {
             Err(PolicyError::Failed(format!("returned {repr}, {expected}")))
         } else if let Some(message) = answer.strip_prefix("ERR ") {

@@ -47,6 +47,13 @@ pub trait Policy: Send {
     fn message(&mut self, out: &mut [f32]) {
         let _ = out;
     }
+
+    /// What a robot of a team received at the last step (the broadcasts of the robots within
+    /// `team.comm_range_px`, nearest first), told before each [`Policy::act`]; the built-in
+    /// policies do not listen.
+    fn hear(&mut self, inbox: &[crate::sim::team::Broadcast]) {
+        let _ = inbox;
+    }
 }
 
 /// Makes policies: one per worker thread of an evaluation.

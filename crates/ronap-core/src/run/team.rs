@@ -226,6 +226,7 @@ impl TeamRollout {
             if !self.team.running(k) {
                 continue;
             }
+            policies[k].hear(self.team.inbox(k));
             let episode = self.team.robot(k);
             let seed = episode.seed();
             match policies[k]
