@@ -231,3 +231,33 @@ fn gif_animates_a_team_episode_with_every_robot_in_its_colour() {
     );
     assert!(!dir.path().join("no").exists());
 }
+
+#[test]
+fn bench_times_a_team_step_of_every_robot() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = dir.path().join("team.toml");
+    std::fs::write(
+        &scenario,
+        "[scene]\nkind = \"maze\"\n\n[laser]\nbeams = 64\nfov_deg = 360.0\nrange_px = 200.0\n\n[[robots]]\ncount = 12\n",
+    )
+    .unwrap();
+    let text = ok(&ronap(&[
+        "bench",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--seconds",
+        "0.1",
+        "--threads",
+        "2",
+    ]));
+    assert!(text.contains("64 beams over 360 deg to 200 px"), "{text}");
+    let one = text.lines().find(|l| l.contains("one thread")).unwrap();
+    assert!(one.contains("ms per step of all 12 robots"), "{one}");
+    let ms: f64 = one.split_whitespace().nth(2).unwrap().parse().unwrap();
+    assert!(ms > 0.0, "{one}");
+    let two = text.lines().find(|l| l.contains("2 threads")).unwrap();
+    assert!(
+        two.contains("team steps/s") && two.contains("robot-steps/s"),
+        "{two}"
+    );
+}

@@ -1,15 +1,17 @@
 //! `ronap bench`: how fast this machine steps the default scene (or a scenario's or a map's, moving
 //! obstacles and all), on one thread and on all, and what a laser scan costs; `--sweep` tabulates
-//! the laser's cost over beam counts and ranges.
+//! the laser's cost over beam counts and ranges. A scenario with `[[robots]]` is timed as a team:
+//! the time of one step of all its robots, and team steps per second on all threads.
 
 use crate::args::{positive, SimArgs};
 use anyhow::{Context, Result};
 use clap::Args;
 use ronap_core::config::MAX_BEAMS;
+use ronap_core::run::team::TeamRollout;
 use ronap_core::scene::freespace::FreeGrid;
 use ronap_core::sim::placement::{free_grid, needs_region_grid, sample_placement};
 use ronap_core::sim::world::{SceneSpec, Worlds};
-use ronap_core::{Episode, Laser, Scene, ValidConfig};
+use ronap_core::{Action, DiscreteAction, Episode, Laser, Scene, ValidConfig};
 use std::io::Write;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -153,6 +155,92 @@ impl Bench {
         }
     }
 
+    /// The figures of a team scenario: time per team step (every robot moving at once) on one
+    /// thread, and team steps per second with a team per thread on `threads`.
+    fn team(
+        &self,
+        threads: usize,
+        duration: Duration,
+        out: &mut impl Write,
+    ) -> Result<std::process::ExitCode> {
+        let robots = self.config.team_size();
+        let (steps, seconds) = self.team_steps_for(0, duration)?;
+        let per_step = seconds / steps as f64;
+        writeln!(
+            out,
+            "  one thread       {:>14.3} ms per step of all {robots} robots ({} robot-steps/s)",
+            per_step * 1e3,
+            group(robots as f64 / per_step)
+        )?;
+        let start = Instant::now();
+        let total: u64 = std::thread::scope(|s| {
+            let handles: Vec<_> = (0..threads)
+                .map(|t| {
+                    s.spawn(move || {
+                        self.team_steps_for(t as u64 * 1_000_000, duration)
+                            .map(|r| r.0)
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| {
+                    h.join()
+                        .unwrap_or_else(|_| Err(anyhow::anyhow!("a bench thread panicked")))
+                })
+                .sum::<Result<u64>>()
+        })?;
+        let rate = total as f64 / start.elapsed().as_secs_f64();
+        writeln!(
+            out,
+            "  {threads} thread{}        {:>14} team steps/s ({} robot-steps/s)",
+            if threads == 1 { " " } else { "s" },
+            group(rate),
+            group(rate * robots as f64)
+        )?;
+        Ok(std::process::ExitCode::SUCCESS)
+    }
+
+    /// Steps team episodes from `first_seed` on for about `duration`, each robot driving the
+    /// action pattern at its own phase; returns the team steps and the seconds they took
+    /// (placing a new team when one ends is not counted).
+    fn team_steps_for(&self, first_seed: u64, duration: Duration) -> Result<(u64, f64)> {
+        let worlds = Worlds::new(
+            self.config.clone(),
+            ronap_core::Scenes::Fixed(self.scene.clone()),
+        );
+        let place = |seed: u64| {
+            TeamRollout::placed(&self.config, worlds.team(seed), seed)
+                .with_context(|| format!("placing the team of seed {seed}"))
+        };
+        let mut seed = first_seed;
+        let mut rollout = place(seed)?;
+        let n = self.config.team_size();
+        let mut actions: Vec<Option<Action>> = vec![None; n];
+        let (mut steps, mut seconds) = (0u64, 0.0);
+        let begin = Instant::now();
+        while steps == 0 || begin.elapsed() < duration {
+            let clock = Instant::now();
+            for t in 0..16usize {
+                for (k, a) in actions.iter_mut().enumerate() {
+                    *a = DiscreteAction::from_index(PATTERN[(t + k) % PATTERN.len()])
+                        .map(Action::from);
+                }
+                rollout.step(&actions);
+                steps += 1;
+                if rollout.finished() {
+                    break;
+                }
+            }
+            seconds += clock.elapsed().as_secs_f64();
+            if rollout.finished() {
+                seed += 1;
+                rollout = place(seed)?;
+            }
+        }
+        Ok((steps, seconds))
+    }
+
     /// Nanoseconds per laser scan, over scans from 1000 placements spread over the scene (so the
     /// figure is not one lucky pose) repeated for about `duration`.
     fn scan_ns(&self, duration: Duration) -> Result<f64> {
@@ -205,6 +293,9 @@ pub fn run(args: BenchArgs) -> Result<std::process::ExitCode> {
         laser.range_px,
         seconds
     )?;
+    if bench.config.team_size() > 0 {
+        return bench.team(threads, duration, &mut out);
+    }
     let single = bench.steps_per_second(1, duration)?;
     writeln!(out, "  one thread       {:>14} steps/s", group(single))?;
     let all = bench.steps_per_second(threads, duration)?;
