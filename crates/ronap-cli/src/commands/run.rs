@@ -291,13 +291,7 @@ fn run_lone(
         eprintln!("ronap run: {note}");
     }
     if let Some(e) = evaluation.write_error {
-        return Err(anyhow::Error::new(e).context(format!(
-            "run stopped: {} episodes are saved in {} (as *.partial); free some space, then \
-             ronap run --resume {}",
-            summary.episodes,
-            job.out_dir.display(),
-            job.out_dir.display()
-        )));
+        return Err(stopped_writing(e, &job.out_dir));
     }
     if let Some(e) = &result.error {
         bail!(
@@ -416,13 +410,7 @@ fn run_team(
     write!(stdout, "{}", evaluation.summary.table())?;
     writeln!(stdout, "outputs in {}", job.out_dir.display())?;
     if let Some(e) = evaluation.write_error {
-        return Err(anyhow::Error::new(e).context(format!(
-            "run stopped: {} episodes are saved in {} (as *.partial); free some space, then \
-             ronap run --resume {}",
-            evaluation.team.episodes,
-            job.out_dir.display(),
-            job.out_dir.display()
-        )));
+        return Err(stopped_writing(e, &job.out_dir));
     }
     if let Some(e) = &evaluation.result.error {
         bail!(
@@ -444,6 +432,17 @@ fn run_team(
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The error of a run whose files could not be written (a full disk): what is kept, and how to
+/// go on.
+fn stopped_writing(e: ronap_core::io::atomic::OutputError, dir: &Path) -> anyhow::Error {
+    anyhow::Error::new(e).context(format!(
+        "run stopped: the episodes written so far are kept in {} (as *.partial); free some \
+         space, then ronap run --resume {}",
+        dir.display(),
+        dir.display()
+    ))
 }
 
 /// `8 x geodesic` or `4 x apf, 4 x geodesic`: the policies of a team, counted.

@@ -97,6 +97,8 @@ struct Claims {
     handed: usize,
     /// No more claims: a job failed or the sink refused.
     stop: bool,
+    /// Workers waiting for the window to move (so the sink wakes them only then).
+    waiting: usize,
 }
 
 /// Runs jobs `0..count` on the workers of `pool`, handing each result to `sink` in number order
@@ -127,7 +129,9 @@ pub fn run_in_order<S, T: Send, E: Send>(
                 c.claimed += 1;
                 return Some(c.claimed - 1);
             }
+            c.waiting += 1;
             c = moved.wait(c).unwrap_or_else(|e| e.into_inner());
+            c.waiting -= 1;
         }
     };
     let stop = || {
@@ -168,8 +172,11 @@ pub fn run_in_order<S, T: Send, E: Send>(
                     Ok(item) => {
                         if sink(item) {
                             ended.handed += 1;
-                            lock().handed = ended.handed;
-                            moved.notify_all();
+                            let mut c = lock();
+                            c.handed = ended.handed;
+                            if c.waiting > 0 {
+                                moved.notify_all();
+                            }
                         } else {
                             ended.refused = true;
                             stop();

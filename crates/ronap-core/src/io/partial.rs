@@ -163,7 +163,13 @@ fn scan(path: &Path, limit: usize) -> Result<(usize, u64), OutputError> {
             Err(_) => break,
         }
         let at = reader.position().byte();
-        let whole = (at < len || ends_whole) && *width.get_or_insert(record.len()) == record.len();
+        let mut whole =
+            (at < len || ends_whole) && *width.get_or_insert(record.len()) == record.len();
+        // A last row cut inside a quoted field that held a line break ends with one, but leaves
+        // its quotes unbalanced.
+        if whole && at >= len {
+            whole = quotes_balanced(path, end, len)?;
+        }
         if !whole {
             break;
         }
@@ -171,6 +177,19 @@ fn scan(path: &Path, limit: usize) -> Result<(usize, u64), OutputError> {
         end = at;
     }
     Ok((rows, end))
+}
+
+/// Whether the bytes `from..to` of `path` hold an even number of double quotes.
+fn quotes_balanced(path: &Path, from: u64, to: u64) -> Result<bool, OutputError> {
+    let io = |source| OutputError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let mut file = File::open(path).map_err(io)?;
+    file.seek(SeekFrom::Start(from)).map_err(io)?;
+    let mut bytes = Vec::new();
+    file.take(to - from).read_to_end(&mut bytes).map_err(io)?;
+    Ok(bytes.iter().filter(|&&b| b == b'"').count() % 2 == 0)
 }
 
 #[cfg(test)]
