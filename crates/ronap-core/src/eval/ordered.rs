@@ -101,6 +101,9 @@ struct Claims {
     waiting: usize,
 }
 
+/// A job: its number and the worker's state in, its result out.
+pub type Job<'a, S, T, E> = dyn Fn(&mut Option<S>, usize) -> Result<T, E> + Sync + 'a;
+
 /// Runs jobs `0..count` on the workers of `pool`, handing each result to `sink` in number order
 /// on the calling thread. `work(state, i)` runs job `i` with the worker's own `state` (made by
 /// `work` itself when `None`, e.g. a policy). Stops claiming when `cancel` is set, when a job
@@ -111,7 +114,7 @@ pub fn run_in_order<S, T: Send, E: Send>(
     count: usize,
     window: Window,
     cancel: &AtomicBool,
-    work: &(dyn Fn(&mut Option<S>, usize) -> Result<T, E> + Sync),
+    work: &Job<'_, S, T, E>,
     sink: &mut dyn FnMut(T) -> bool,
 ) -> Ordered<E> {
     let window = window.0.max(1);
