@@ -35,6 +35,9 @@ enum Command {
     /// Draw a scene: a PNG (white floor, black walls) with --out, else the maze as text.
     Maze(maze::MazeArgs),
     /// Evaluate a policy over many seeded episodes: summary table, CSV logs, PNG trajectories.
+    #[command(
+        override_usage = "ronap run [OPTIONS] --policy <NAME>\n       ronap run --resume <DIR>"
+    )]
     Run(run::RunArgs),
     /// Compare policies on the same seeds: success with 95% intervals, paired tests (McNemar,
     /// bootstrap), pictures and a report (report.html, report.md).

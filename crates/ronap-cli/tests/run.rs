@@ -181,6 +181,8 @@ fn bad_input_is_named_and_leaves_no_output() {
             "run",
             "--policy",
             "random",
+            "--seed-start",
+            "1",
             "--seeds",
             "18446744073709551615",
             "--out",

@@ -9,6 +9,7 @@ mod compare;
 mod learn;
 mod replay;
 mod run;
+mod stream;
 mod team;
 mod tui;
 mod util;

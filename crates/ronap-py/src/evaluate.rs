@@ -194,7 +194,7 @@ pub fn evaluate<'py>(
         .transpose()?;
     let evaluator = Evaluator::new(config.clone(), scenes);
     let options = EvalOptions {
-        seeds,
+        seeds: seeds.into(),
         threads,
         ..EvalOptions::default()
     };
@@ -214,6 +214,7 @@ pub fn evaluate<'py>(
                 writer,
                 &cancel,
                 &|_| {},
+                &|_| true,
             )
         })
         .map_err(|e| errors::PolicyError::new_err(e.to_string()))?;

@@ -1,13 +1,20 @@
-//! `ronap run`: evaluate a policy over many seeded episodes and write what happened.
+//! `ronap run`: evaluate a policy over many seeded episodes and write what happened, as it
+//! happens; `--resume` finishes a run stopped short.
 
-use crate::args::{count, fraction, policy_factory, seed, seed_range, EpisodeArgs, ThreadArgs};
+use crate::args::{count, fraction, policy_factory, seed, EpisodeArgs, ThreadArgs};
 use crate::output::cancel_on_ctrl_c;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use ronap_core::eval::{EpisodeRecord, EvalOptions, Evaluator, Recording};
-use ronap_core::io::run_dir::{evaluate_into, Pictures, RunFiles, RunInfo, RunWriter};
+use ronap_core::eval::{EpisodeRecord, EvalOptions, Evaluator, Recording, Seeds};
+use ronap_core::io::manifest::PLAN_FILE;
+use ronap_core::io::run_dir::{
+    evaluate_into, evaluate_team_into, Pictures, ResumeError, RunFiles, RunInfo, RunWriter,
+};
+use ronap_core::scene::map::MapSource;
+use ronap_core::sim::world::SceneSpec;
+use ronap_core::{Scenes, ValidConfig};
 use std::io::Write as _;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Arguments of `ronap run`.
@@ -18,8 +25,8 @@ pub struct RunArgs {
     /// mlp:policies/bc.safetensors; append @argmax or @sample:T to override its decision rule), or
     /// py:FILE.py:FUNCTION (a Python function: observation in, action 0/1/2 out; run with
     /// $RONAP_PYTHON or python3).
-    #[arg(long, value_name = "NAME")]
-    policy: String,
+    #[arg(long, value_name = "NAME", required_unless_present = "resume")]
+    policy: Option<String>,
     /// Number of episodes; episode i has seed seed-start + i.
     #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 1000, value_parser = count)]
     seeds: u64,
@@ -30,9 +37,17 @@ pub struct RunArgs {
     threads: ThreadArgs,
     #[command(flatten)]
     episodes: EpisodeArgs,
-    /// Output directory [default: runs/<policy>-<UTC time>].
+    /// Output directory [default: runs/<policy>-<UTC time>]. episodes.csv and timing.csv are
+    /// written as episodes finish (as *.partial until the run ends), so memory stays flat and a
+    /// killed run keeps its finished episodes; one run at a time per directory.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+    /// Finish the run in DIR that was stopped short (killed, Ctrl-C, disk full) with the settings
+    /// it was started with (DIR/run.json), running only the seeds it had not finished; the
+    /// results are the same as an uninterrupted run's. Run it from the directory the run was
+    /// started in (policy and map paths are read from there). Takes no other flag.
+    #[arg(long, value_name = "DIR", exclusive = true)]
+    resume: Option<PathBuf>,
     /// Also write each episode's steps to steps/seed-<seed>.csv (the data-log format).
     #[arg(long)]
     log_steps: bool,
@@ -51,49 +66,190 @@ pub struct RunArgs {
 
 /// Runs `ronap run`.
 pub fn run(args: RunArgs) -> Result<ExitCode> {
-    // Everything that can be wrong with the input is checked before anything is written.
-    let (config, scenes, map_source) = args.episodes.resolve()?;
-    if config.team_size() > 0 {
-        return run_team(args, config, scenes, map_source);
+    if let Some(dir) = &args.resume {
+        return resume(dir);
     }
-    let factory = policy_factory(&args.policy, &config)?;
-    let evaluator = Evaluator::new(config.clone(), scenes);
+    // Everything that can be wrong with the input is checked before anything is written.
+    let (config, scenes, map) = args.episodes.resolve()?;
+    let policy = args.policy.clone().unwrap_or_default();
     let first = args.seed_start;
-    let seeds = seed_range(first, args.seeds)?;
-    check_gif_seeds(&args.gif, first, args.seeds)?;
+    first.checked_add(args.seeds).ok_or_else(|| {
+        anyhow::anyhow!(
+            "--seed-start {first} --seeds {}: the seed range passes 2^64",
+            args.seeds
+        )
+    })?;
+    let job = Job {
+        out_dir: match &args.out {
+            Some(d) => d.clone(),
+            None => default_out_dir(&policy),
+        },
+        policy,
+        seeds: Seeds::Range {
+            start: first,
+            count: args.seeds,
+        },
+        threads: args.threads.count(),
+        info_scenes: args.episodes.scenes.spec(&config),
+        map,
+        png: args.png,
+        log_steps: args.log_steps,
+        gif: args.gif,
+        min_success: args.min_success,
+    };
+    if config.team_size() > 0 {
+        run_team(job, config, scenes, None)
+    } else {
+        run_lone(job, config, scenes, None)
+    }
+}
+
+/// A run as asked for, by flags or by a resumed run's plan.
+struct Job {
+    policy: String,
+    seeds: Seeds,
+    threads: usize,
+    info_scenes: SceneSpec,
+    map: Option<MapSource>,
+    out_dir: PathBuf,
+    png: Option<Pictures>,
+    log_steps: bool,
+    gif: Vec<u64>,
+    min_success: Option<f64>,
+}
+
+impl Job {
+    /// The first and last seeds, for messages.
+    fn span(&self) -> (u64, u64) {
+        let first = self.seeds.first().unwrap_or(0);
+        let last = self
+            .seeds
+            .get(self.seeds.len().saturating_sub(1))
+            .unwrap_or(first);
+        (first, last)
+    }
+
+    /// What `ronap run` keeps in the plan beyond the core's fields, for `--resume`.
+    fn front_end(&self) -> serde_json::Value {
+        serde_json::json!({ "gif": self.gif, "min_success": self.min_success })
+    }
+
+    /// The writer of a new run into `out_dir`.
+    fn writer(&self, files: RunFiles) -> Result<RunWriter> {
+        Ok(
+            RunWriter::create(&self.out_dir, files, self.seeds.first().unwrap_or(0))
+                .with_context(|| {
+                    format!("cannot prepare output directory {}", self.out_dir.display())
+                })?
+                .with_front_end(self.front_end()),
+        )
+    }
+}
+
+/// `ronap run --resume DIR`: the run in `dir`, rebuilt from its plan, finished.
+fn resume(dir: &Path) -> Result<ExitCode> {
+    let (writer, plan) = match RunWriter::resume(dir) {
+        Ok(w) => w,
+        Err(e @ ResumeError::Complete { .. }) => {
+            println!("ronap run: {e}");
+            return Ok(ExitCode::SUCCESS);
+        }
+        Err(e) => return Err(e.into()),
+    };
+    let plan_path = dir.join(PLAN_FILE);
+    let (config, scenes) = plan.setting(&plan_path)?;
+    let bad = |field: &str, value: &serde_json::Value| {
+        anyhow::anyhow!(
+            "cannot resume: {}: `front_end.{field}` = {value} is not what ronap run writes",
+            plan_path.display()
+        )
+    };
+    let front = &plan.front_end;
+    let gif = match front.get("gif") {
+        None | Some(serde_json::Value::Null) => Vec::new(),
+        Some(v) => serde_json::from_value(v.clone()).map_err(|_| bad("gif", v))?,
+    };
+    let min_success = match front.get("min_success") {
+        None | Some(serde_json::Value::Null) => None,
+        Some(v) => Some(v.as_f64().ok_or_else(|| bad("min_success", v))?),
+    };
+    let png = plan
+        .pictures
+        .as_deref()
+        .map(str::parse)
+        .transpose()
+        .map_err(|e: String| {
+            anyhow::anyhow!("cannot resume: {}: `pictures`: {e}", plan_path.display())
+        })?;
+    let job = Job {
+        policy: plan.policy.clone(),
+        seeds: plan.seeds(),
+        threads: plan.threads,
+        info_scenes: plan.scenes.clone(),
+        map: plan.map.clone(),
+        out_dir: dir.to_path_buf(),
+        png,
+        log_steps: plan.steps,
+        gif,
+        min_success,
+    };
+    eprintln!(
+        "ronap run: resuming {}: {} of {} episodes were done",
+        dir.display(),
+        writer.done(),
+        job.seeds.len()
+    );
+    if config.team_size() > 0 {
+        run_team(job, config, scenes, Some(writer))
+    } else {
+        run_lone(job, config, scenes, Some(writer))
+    }
+}
+
+/// A lone robot's run, new (`writer` `None`) or resumed.
+fn run_lone(
+    job: Job,
+    config: ValidConfig,
+    scenes: Scenes,
+    writer: Option<RunWriter>,
+) -> Result<ExitCode> {
+    let factory = policy_factory(&job.policy, &config)?;
+    let evaluator = Evaluator::new(config.clone(), scenes);
+    let (first, last) = job.span();
+    if let Some(s) = job.gif.iter().find(|&&s| s < first || s > last) {
+        bail!("--gif {s}: not one of this run's seeds ({first}..={last})");
+    }
     // A scene with no room for a start and goal fails the same way for every seed: say so now.
     evaluator
         .worlds()
         .check_start(first)
         .with_context(|| format!("cannot start episodes in this scene (seed {first})"))?;
-    let threads = args.threads.count();
-    let out_dir = match &args.out {
-        Some(d) => d.clone(),
-        None => default_out_dir(&args.policy),
-    };
     let files = RunFiles {
-        pictures: args.png,
-        steps: args.log_steps,
-        gifs: !args.gif.is_empty(),
+        pictures: job.png,
+        steps: job.log_steps,
+        gifs: !job.gif.is_empty(),
     };
-    let writer = RunWriter::create(&out_dir, files, first)
-        .with_context(|| format!("cannot prepare output directory {}", out_dir.display()))?;
+    let writer = match writer {
+        Some(w) => w,
+        None => job.writer(files)?,
+    };
+    let done = writer.done() as u64;
 
     let cancel = cancel_on_ctrl_c("finishing running episodes and writing what is done");
     let bar = crate::output::progress_bar(
-        args.seeds,
+        job.seeds.len() as u64 - done,
         "{prefix} {wide_bar} {pos}/{len} episodes, {per_sec}, eta {eta}",
-        format!("ronap run {}", args.policy),
+        format!("ronap run {}", job.policy),
     );
     let options = EvalOptions {
-        seeds,
-        threads,
+        seeds: job.seeds.clone(),
+        threads: job.threads,
         recording: Recording::default(),
     };
     let info = RunInfo {
-        policy: args.policy.clone(),
-        scenes: args.episodes.scenes.spec(&config),
-        map: map_source,
+        policy: job.policy.clone(),
+        scenes: job.info_scenes.clone(),
+        map: job.map.clone(),
     };
     let evaluation = evaluate_into(
         &evaluator,
@@ -103,47 +259,58 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         Some(writer),
         &cancel,
         &|_| bar.inc(1),
+        &|r| job.gif.contains(&r.seed),
     )?;
     bar.finish_and_clear();
     let (result, summary) = (&evaluation.result, &evaluation.summary);
     let mut gif_notes = Vec::new();
-    for &seed in &args.gif {
-        if let Some(record) = result.records.iter().find(|r| r.seed == seed) {
-            gif_notes.extend(write_gif(&evaluator, factory.as_ref(), record, &out_dir)?);
+    if evaluation.write_error.is_none() {
+        for &seed in &job.gif {
+            if (seed - first) < summary.episodes as u64 {
+                let record = result.records.iter().find(|r| r.seed == seed);
+                gif_notes.extend(write_gif(
+                    &evaluator,
+                    factory.as_ref(),
+                    seed,
+                    record,
+                    &job.out_dir,
+                )?);
+            }
         }
     }
 
     let mut stdout = std::io::stdout().lock();
     writeln!(
         stdout,
-        "ronap run: policy {}, seeds {first}..{}, {threads} threads",
-        args.policy,
-        first + args.seeds - 1
+        "ronap run: policy {}, seeds {first}..{last}, {} threads",
+        job.policy, job.threads
     )?;
     write!(stdout, "{}", summary.table())?;
-    writeln!(stdout, "outputs in {}", out_dir.display())?;
+    writeln!(stdout, "outputs in {}", job.out_dir.display())?;
     for note in gif_notes {
         eprintln!("ronap run: {note}");
     }
     if let Some(e) = evaluation.write_error {
-        return Err(e.into());
+        return Err(stopped_writing(e, &job.out_dir));
     }
     if let Some(e) = &result.error {
         bail!(
             "run stopped: {e} (the {} finished episodes are saved)",
-            result.records.len()
+            summary.episodes
         );
     }
     if result.cancelled {
         writeln!(
             stdout,
-            "interrupted: {} of {} episodes finished and saved",
-            result.records.len(),
-            args.seeds
+            "interrupted: {} of {} episodes finished and saved (ronap run --resume {} finishes \
+             the run)",
+            summary.episodes,
+            job.seeds.len(),
+            job.out_dir.display()
         )?;
         return Ok(ExitCode::from(130));
     }
-    if let Some(min) = args.min_success {
+    if let Some(min) = job.min_success {
         if summary.success_rate < min {
             eprintln!(
                 "ronap run: success rate {:.1}% is below --min-success {:.1}%",
@@ -160,12 +327,12 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
 /// policy (or `--policy`); `episodes.csv` holds a row per team episode, `robots.csv` a row per
 /// robot.
 fn run_team(
-    args: RunArgs,
-    config: ronap_core::ValidConfig,
-    scenes: ronap_core::Scenes,
-    map_source: Option<ronap_core::scene::map::MapSource>,
+    job: Job,
+    config: ValidConfig,
+    scenes: Scenes,
+    writer: Option<RunWriter>,
 ) -> Result<ExitCode> {
-    if args.log_steps {
+    if job.log_steps {
         bail!(
             "--log-steps does not log team runs yet; run without it (robots.csv holds every \
              robot's figures, --gif SEED animates an episode)"
@@ -176,7 +343,7 @@ fn run_team(
     let mut of_robot = Vec::new();
     let mut k = 0;
     for entry in &config.robots {
-        let name = entry.policy.clone().unwrap_or_else(|| args.policy.clone());
+        let name = entry.policy.clone().unwrap_or_else(|| job.policy.clone());
         let factory = policy_factory(&name, &config.team_robot(k))
             .with_context(|| format!("[[robots]] entry with robot {k}"))?;
         factories.push(factory);
@@ -188,44 +355,47 @@ fn run_team(
     }
     let factories_per_robot: Vec<&dyn ronap_core::policy::PolicyFactory> =
         of_robot.iter().map(|&i| factories[i].as_ref()).collect();
-    let first = args.seed_start;
-    let seeds = seed_range(first, args.seeds)?;
-    check_gif_seeds(&args.gif, first, args.seeds)?;
+    let (first, last) = job.span();
+    if let Some(s) = job.gif.iter().find(|&&s| s < first || s > last) {
+        bail!("--gif {s}: not one of this run's seeds ({first}..={last})");
+    }
     let evaluator = Evaluator::new(config.clone(), scenes);
-    let threads = args.threads.count();
     // A team that cannot be placed fails the same way for every seed: say so before writing.
     ronap_core::sim::team::Team::new(&config, &evaluator.worlds().team(first), first)
         .with_context(|| format!("cannot start team episodes in this scene (seed {first})"))?;
-    let out_dir = args
-        .out
-        .clone()
-        .unwrap_or_else(|| default_out_dir(&args.policy));
-    std::fs::create_dir_all(&out_dir)
-        .with_context(|| format!("cannot prepare output directory {}", out_dir.display()))?;
+    let files = RunFiles {
+        pictures: job.png,
+        steps: false,
+        gifs: false,
+    };
+    let writer = match writer {
+        Some(w) => w,
+        None => job.writer(files)?,
+    };
+    let done = writer.done() as u64;
     let cancel = cancel_on_ctrl_c("finishing running episodes and writing what is done");
     let bar = crate::output::progress_bar(
-        args.seeds,
+        job.seeds.len() as u64 - done,
         "{prefix} {wide_bar} {pos}/{len} team episodes, {per_sec}, eta {eta}",
         format!("ronap run {} robots", names.len()),
     );
     let options = EvalOptions {
-        seeds,
-        threads,
+        seeds: job.seeds.clone(),
+        threads: job.threads,
         recording: Recording::default(),
     };
     let info = RunInfo {
-        policy: args.policy.clone(),
-        scenes: args.episodes.scenes.spec(&config),
-        map: map_source,
+        policy: job.policy.clone(),
+        scenes: job.info_scenes.clone(),
+        map: job.map.clone(),
     };
-    let evaluation = ronap_core::io::run_dir::evaluate_team_into(
+    let evaluation = evaluate_team_into(
         &evaluator,
         &factories_per_robot,
         &names,
         &options,
         &info,
-        Some(&out_dir),
-        args.png,
+        Some(writer),
         &cancel,
         &|_| bar.inc(1),
     )?;
@@ -233,43 +403,47 @@ fn run_team(
     let mut stdout = std::io::stdout().lock();
     writeln!(
         stdout,
-        "ronap run: {} robots ({}), seeds {first}..{}, {threads} threads",
+        "ronap run: {} robots ({}), seeds {first}..{last}, {} threads",
         names.len(),
         summary_of_names(&names),
-        first + args.seeds - 1
+        job.threads
     )?;
     write!(stdout, "{}", evaluation.team.table())?;
     writeln!(stdout, "per robot:")?;
     write!(stdout, "{}", evaluation.summary.table())?;
     let mut gif_notes = Vec::new();
-    for &seed in &args.gif {
-        if let Some(record) = evaluation.result.records.iter().find(|r| r.seed == seed) {
-            gif_notes.extend(write_team_gif(
-                &evaluator,
-                &factories_per_robot,
-                &names,
-                record,
-                &out_dir,
-            )?);
+    if evaluation.write_error.is_none() {
+        for &seed in &job.gif {
+            if (seed - first) < evaluation.team.episodes as u64 {
+                let record = evaluation.result.records.iter().find(|r| r.seed == seed);
+                gif_notes.extend(write_team_gif(
+                    &evaluator,
+                    &factories_per_robot,
+                    &names,
+                    seed,
+                    record,
+                    &job.out_dir,
+                )?);
+            }
         }
     }
-    writeln!(stdout, "outputs in {}", out_dir.display())?;
+    writeln!(stdout, "outputs in {}", job.out_dir.display())?;
     for note in gif_notes {
         eprintln!("ronap run: {note}");
     }
     if let Some(e) = evaluation.write_error {
-        return Err(e.into());
+        return Err(stopped_writing(e, &job.out_dir));
     }
     if let Some(e) = &evaluation.result.error {
         bail!(
             "run stopped: {e} (the {} finished episodes are saved)",
-            evaluation.result.records.len()
+            evaluation.team.episodes
         );
     }
     if evaluation.result.cancelled {
         return Ok(ExitCode::from(130));
     }
-    if let Some(min) = args.min_success {
+    if let Some(min) = job.min_success {
         if evaluation.team.team_success_rate < min {
             eprintln!(
                 "ronap run: team success rate {:.1}% is below --min-success {:.1}%",
@@ -280,6 +454,17 @@ fn run_team(
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The error of a run whose files could not be written (a full disk): what is kept, and how to
+/// go on.
+fn stopped_writing(e: ronap_core::io::atomic::OutputError, dir: &Path) -> anyhow::Error {
+    anyhow::Error::new(e).context(format!(
+        "run stopped: the episodes written so far are kept in {} (as *.partial); free some \
+         space, then ronap run --resume {}",
+        dir.display(),
+        dir.display()
+    ))
 }
 
 /// `8 x geodesic` or `4 x apf, 4 x geodesic`: the policies of a team, counted.
@@ -298,16 +483,17 @@ fn summary_of_names(names: &[String]) -> String {
         .join(", ")
 }
 
-/// Runs the episode of `record` again with a fresh policy, recording its steps, and writes its
-/// animation to `gif/`. Returns a note when the re-run differs from `record` (a policy that is not
-/// deterministic), since the GIF then shows the re-run.
+/// Runs the episode of `seed` again with a fresh policy, recording its steps, and writes its
+/// animation to `gif/`. Returns a note when the re-run differs from the run's `record` (a policy
+/// that is not deterministic), since the GIF then shows the re-run. (A resumed run has no record
+/// of the episodes its earlier process finished.)
 fn write_gif(
     evaluator: &Evaluator,
     factory: &dyn ronap_core::policy::PolicyFactory,
-    record: &EpisodeRecord,
+    seed: u64,
+    record: Option<&EpisodeRecord>,
     out_dir: &std::path::Path,
 ) -> Result<Option<String>> {
-    let seed = record.seed;
     let mut policy = factory.make()?;
     let recording = Recording {
         trajectory: false,
@@ -325,8 +511,9 @@ fn write_gif(
         .join("gif")
         .join(format!("seed-{seed:06}-{}.gif", rerun.outcome.name()));
     ronap_core::io::atomic::write_atomic(&path, |w| w.write_all(&animation.bytes))?;
-    Ok(
-        (rerun.steps != record.steps || rerun.outcome != record.outcome).then(|| {
+    Ok(record
+        .filter(|r| rerun.steps != r.steps || rerun.outcome != r.outcome)
+        .map(|record| {
             format!(
                 "--gif {seed}: the policy is not deterministic; the GIF shows a re-run ({} steps, \
                  {}), episodes.csv the run ({} steps, {})",
@@ -335,31 +522,20 @@ fn write_gif(
                 record.steps,
                 record.outcome.name()
             )
-        }),
-    )
+        }))
 }
 
-/// Refuses a `--gif` seed outside the run's `count` seeds from `first` (a range already
-/// checked not to pass 2^64).
-fn check_gif_seeds(gif: &[u64], first: u64, count: u64) -> Result<()> {
-    let last = first.saturating_add(count.saturating_sub(1));
-    if let Some(s) = gif.iter().find(|&&s| s < first || s > last || count == 0) {
-        bail!("--gif {s}: not one of this run's seeds ({first}..={last})");
-    }
-    Ok(())
-}
-
-/// Runs team episode `record.seed` again with fresh policies and writes its animation to
-/// `gif/`. Returns a note when the re-run differs from `record` (a policy that is not
+/// Runs team episode `seed` again with fresh policies and writes its animation to `gif/`.
+/// Returns a note when the re-run differs from `record` (when the run kept it) (a policy that is not
 /// deterministic), since the GIF then shows the re-run.
 fn write_team_gif(
     evaluator: &Evaluator,
     factories: &[&dyn ronap_core::policy::PolicyFactory],
     names: &[String],
-    record: &ronap_core::eval::TeamRecord,
+    seed: u64,
+    record: Option<&ronap_core::eval::TeamRecord>,
     out_dir: &std::path::Path,
 ) -> Result<Option<String>> {
-    let seed = record.seed;
     let mut policies = factories
         .iter()
         .map(|f| f.make())
@@ -381,18 +557,18 @@ fn write_team_gif(
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot make {}", dir.display()))?;
     let path = dir.join(format!("seed-{seed:06}-{}.gif", rerun.outcome.name()));
     ronap_core::io::atomic::write_atomic(&path, |w| w.write_all(&animation.bytes))?;
-    Ok(
-        (rerun.steps != record.steps || rerun.outcome != record.outcome).then(|| {
+    Ok(record
+        .filter(|r| rerun.steps != r.steps || rerun.outcome != r.outcome)
+        .map(|r| {
             format!(
                 "--gif {seed}: a policy is not deterministic; the GIF shows a re-run ({} steps, \
                  {}), episodes.csv the run ({} steps, {})",
                 rerun.steps,
                 rerun.outcome.name(),
-                record.steps,
-                record.outcome.name()
+                r.steps,
+                r.outcome.name()
             )
-        }),
-    )
+        }))
 }
 
 /// `runs/<policy>-<UTC time>`, with `-2`, `-3`... when a run started in the same second has it.

@@ -393,7 +393,7 @@ fn run_one(
         episodes: options.seeds.len(),
     });
     let eval_options = EvalOptions {
-        seeds: options.seeds.clone(),
+        seeds: options.seeds.clone().into(),
         threads: options.threads,
         recording: Recording::default(),
     };
@@ -410,6 +410,7 @@ fn run_one(
         writer,
         cancel,
         &|_| progress(Progress::Episode),
+        &|_| true,
     )
     .map_err(|source| CompareError::Policy {
         policy: c.name.clone(),

@@ -5,13 +5,16 @@
 //! the thread count; they come back in seed order. A shared cancel flag stops the run between
 //! episodes (Ctrl-C in the CLI) and keeps every finished record.
 
+pub mod ordered;
 pub mod record;
 pub mod summary;
 pub mod team;
 
 pub use record::{EpisodeRecord, Outcome, Recording, StepLog};
-pub use summary::Summary;
-pub use team::{RobotRecord, TeamRecord, TeamRunResult, TeamSummary};
+pub use summary::{Figures, Summary, Tally};
+pub use team::{
+    RobotFigures, RobotRecord, TeamFigures, TeamRecord, TeamRunResult, TeamSummary, TeamTally,
+};
 
 use crate::config::ValidConfig;
 use crate::plan::shortest_path_px;
@@ -19,16 +22,93 @@ use crate::policy::{Policy, PolicyError, PolicyFactory};
 use crate::run::rollout::Rollout;
 use crate::run::RunError;
 use crate::sim::world::{Scenes, World, Worlds};
-use rayon::prelude::*;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use ordered::{run_in_order, Ordered, Window};
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 use std::time::Instant;
+
+/// The seeds of an evaluation, in the order its records come back: a range (held as two numbers
+/// however long) or a list.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Seeds {
+    /// `count` seeds from `start`.
+    Range {
+        /// The first seed.
+        start: u64,
+        /// How many.
+        count: u64,
+    },
+    /// These seeds.
+    List(Vec<u64>),
+}
+
+impl Default for Seeds {
+    fn default() -> Self {
+        Self::List(Vec::new())
+    }
+}
+
+impl From<Vec<u64>> for Seeds {
+    fn from(seeds: Vec<u64>) -> Self {
+        Self::List(seeds)
+    }
+}
+
+impl Seeds {
+    /// How many.
+    pub fn len(&self) -> usize {
+        match self {
+            Self::Range { count, .. } => usize::try_from(*count).unwrap_or(usize::MAX),
+            Self::List(v) => v.len(),
+        }
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The `i`-th seed.
+    pub fn get(&self, i: usize) -> Option<u64> {
+        match self {
+            Self::Range { start, count } => {
+                let i = i as u64;
+                (i < *count).then(|| start.wrapping_add(i))
+            }
+            Self::List(v) => v.get(i).copied(),
+        }
+    }
+
+    /// The first seed.
+    pub fn first(&self) -> Option<u64> {
+        self.get(0)
+    }
+
+    /// The seeds after the first `n`.
+    pub fn after(&self, n: usize) -> Seeds {
+        match self {
+            Self::Range { start, count } => {
+                let n = (n as u64).min(*count);
+                Self::Range {
+                    start: start.wrapping_add(n),
+                    count: count - n,
+                }
+            }
+            Self::List(v) => Self::List(v.get(n..).unwrap_or_default().to_vec()),
+        }
+    }
+
+    /// Every seed, in order.
+    pub fn iter(&self) -> impl Iterator<Item = u64> + '_ {
+        (0..self.len()).filter_map(|i| self.get(i))
+    }
+}
 
 /// What an evaluation runs: which seeds, on how many threads, keeping what.
 #[derive(Clone, Debug, Default)]
 pub struct EvalOptions {
     /// The episode seeds, in the order records come back.
-    pub seeds: Vec<u64>,
+    pub seeds: Seeds,
     /// Worker threads (0: all cores).
     pub threads: usize,
     /// What to keep of each episode beyond its figures.
@@ -175,9 +255,8 @@ impl Evaluator {
         })
     }
 
-    /// Runs `options.seeds` with policies from `factory`. Each record goes to `on_record` as soon
-    /// as its episode ends (from a worker thread), then is stripped of its trajectory and steps.
-    /// Setting `cancel` stops the run between episodes.
+    /// Runs `options.seeds` with policies from `factory`, keeping every record (stripped of its
+    /// trajectory and steps) in seed order: [`Evaluator::stream`] into a vector.
     pub fn run(
         &self,
         factory: &dyn PolicyFactory,
@@ -185,73 +264,110 @@ impl Evaluator {
         cancel: &AtomicBool,
         on_record: &(dyn Fn(&EpisodeRecord) + Sync),
     ) -> Result<RunResult, PolicyError> {
+        let mut records = Vec::new();
+        let end = self.stream(factory, options, cancel, on_record, &mut |r| {
+            records.push(r);
+            true
+        })?;
+        Ok(RunResult {
+            records,
+            cancelled: end.cancelled,
+            error: end.error,
+            wall_time_s: end.wall_time_s,
+        })
+    }
+
+    /// Runs `options.seeds` with policies from `factory`. Each record goes to `on_finish` as
+    /// soon as its episode ends (from a worker thread, in any order), then, stripped of its
+    /// trajectory and steps, to `sink` in seed order on the calling thread; `sink` returning
+    /// `false` stops the run. Memory stays flat however many seeds: workers run at most a
+    /// [`Window`] of episodes ahead of the next record `sink` is waiting for. Setting `cancel`
+    /// stops the run between episodes; the episodes under way finish and are handed on, so what
+    /// `sink` saw is always the first seeds of `options.seeds`.
+    pub fn stream(
+        &self,
+        factory: &dyn PolicyFactory,
+        options: &EvalOptions,
+        cancel: &AtomicBool,
+        on_finish: &(dyn Fn(&EpisodeRecord) + Sync),
+        sink: &mut dyn FnMut(EpisodeRecord) -> bool,
+    ) -> Result<RunEnd, PolicyError> {
         let clock = Instant::now();
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(options.threads)
-            .build()
-            .map_err(|e| PolicyError::Failed(format!("cannot start worker threads: {e}")))?;
-        let first_policy_error: Mutex<Option<PolicyError>> = Mutex::new(None);
+        let pool = worker_pool(options.threads)?;
         // Policies are made at most once per worker and handed from episode to episode, so a
         // costly policy (a Python process, a loaded network) is set up `threads` times, not once
         // per seed.
-        let idle: Mutex<Vec<Box<dyn Policy>>> = Mutex::new(Vec::new());
-        let results: Vec<Option<Result<EpisodeRecord, RunError>>> = pool.install(|| {
-            options
-                .seeds
-                .par_iter()
-                .with_max_len(1)
-                .map(|&seed| {
-                    if cancel.load(Ordering::Relaxed) {
-                        return None;
-                    }
-                    let reused = idle.lock().ok().and_then(|mut v| v.pop());
-                    let mut policy = match reused.map_or_else(|| factory.make(), Ok) {
-                        Ok(p) => p,
-                        Err(e) => {
-                            cancel.store(true, Ordering::Relaxed);
-                            if let Ok(mut slot) = first_policy_error.lock() {
-                                slot.get_or_insert(e);
-                            }
-                            return None;
-                        }
-                    };
-                    let result = self
-                        .run_episode(policy.as_mut(), seed, options.recording)
-                        .map(|mut record| {
-                            on_record(&record);
-                            record.strip();
-                            record
-                        });
-                    if result.is_err() {
-                        cancel.store(true, Ordering::Relaxed);
-                    }
-                    if let Ok(mut v) = idle.lock() {
-                        v.push(policy);
-                    }
-                    Some(result)
-                })
-                .collect()
-        });
-        if let Some(e) = first_policy_error.into_inner().ok().flatten() {
-            return Err(e);
-        }
-        let mut records = Vec::with_capacity(results.len());
-        let mut error = None;
-        let mut cancelled = false;
-        for r in results {
-            match r {
-                Some(Ok(record)) => records.push(record),
-                Some(Err(e)) => {
-                    error.get_or_insert(e);
-                }
-                None => cancelled = true,
-            }
-        }
-        Ok(RunResult {
-            records,
-            cancelled: cancelled && error.is_none(),
+        let work = |policy: &mut Option<Box<dyn Policy>>, i: usize| {
+            let policy = match policy {
+                Some(p) => p,
+                None => policy.insert(factory.make().map_err(Failure::Policy)?),
+            };
+            // `i` is below `options.seeds.len()`, the number of jobs.
+            let seed = options.seeds.get(i).unwrap_or_default();
+            let mut record = self
+                .run_episode(policy.as_mut(), seed, options.recording)
+                .map_err(Failure::Run)?;
+            on_finish(&record);
+            record.strip();
+            Ok(record)
+        };
+        let ended = run_in_order(
+            &pool,
+            options.seeds.len(),
+            Window::for_threads(pool.current_num_threads()),
+            cancel,
+            &work,
+            sink,
+        );
+        RunEnd::of(ended, options.seeds.len(), clock)
+    }
+}
+
+/// How a streamed evaluation ended; its records went to the sink.
+#[derive(Debug)]
+pub struct RunEnd {
+    /// Episodes handed to the sink: the first `episodes` seeds.
+    pub episodes: usize,
+    /// Whether the cancel flag (or the sink) stopped the run before every seed ran.
+    pub cancelled: bool,
+    /// The error of the first failed episode in seed order; the run stopped at it.
+    pub error: Option<RunError>,
+    /// Wall time of the run, seconds.
+    pub wall_time_s: f64,
+}
+
+impl RunEnd {
+    pub(crate) fn of(
+        ended: Ordered<Failure>,
+        count: usize,
+        clock: Instant,
+    ) -> Result<Self, PolicyError> {
+        let error = match ended.failed {
+            Some((_, Failure::Policy(e))) => return Err(e),
+            Some((_, Failure::Run(e))) => Some(e),
+            None => None,
+        };
+        Ok(Self {
+            episodes: ended.handed,
+            cancelled: error.is_none() && ended.handed < count,
             error,
             wall_time_s: clock.elapsed().as_secs_f64(),
         })
     }
+}
+
+/// Why a worker's episode gave no record.
+pub(crate) enum Failure {
+    /// The policy could not be made.
+    Policy(PolicyError),
+    /// The episode failed.
+    Run(RunError),
+}
+
+/// The worker threads of an evaluation (0: all cores).
+pub(crate) fn worker_pool(threads: usize) -> Result<rayon::ThreadPool, PolicyError> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| PolicyError::Failed(format!("cannot start worker threads: {e}")))
 }

@@ -2,6 +2,7 @@
 //! path efficiency (SPL) and speed.
 
 use crate::eval::{EpisodeRecord, Outcome};
+use crate::sim::episode::DynamicMetrics;
 use serde::{Deserialize, Serialize};
 
 /// Summary figures of a set of episodes.
@@ -70,54 +71,152 @@ pub fn wilson95(k: usize, n: usize) -> [f64; 2] {
     [(centre - half).max(0.0), (centre + half).min(1.0)]
 }
 
-impl Summary {
-    /// The summary of `records`, over a run that took `wall_time_s`.
-    pub fn new(records: &[EpisodeRecord], wall_time_s: f64) -> Self {
-        let n = records.len();
-        let count = |o: Outcome| records.iter().filter(|r| r.outcome == o).count();
-        let mean = |f: &dyn Fn(&EpisodeRecord) -> f64| {
-            if n == 0 {
-                0.0
-            } else {
-                records.iter().map(f).sum::<f64>() / n as f64
+/// What a summary needs of one episode: its figures, exactly as the record holds them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Figures {
+    /// How it ended.
+    pub outcome: Outcome,
+    /// Steps taken.
+    pub steps: u32,
+    /// Steps that collided.
+    pub collisions: u32,
+    /// Distance driven, px.
+    pub path_length_px: f64,
+    /// SPL.
+    pub spl: f64,
+    /// Summed reward.
+    pub total_reward: f64,
+    /// How it went among moving obstacles.
+    pub dynamic: Option<DynamicMetrics>,
+}
+
+impl Figures {
+    /// The figures of `record`.
+    pub fn of(record: &EpisodeRecord) -> Self {
+        Self {
+            outcome: record.outcome,
+            steps: record.steps,
+            collisions: record.collisions,
+            path_length_px: record.path_length_px,
+            spl: record.spl,
+            total_reward: record.total_reward,
+            dynamic: record.dynamic,
+        }
+    }
+}
+
+/// The sum of an empty list of floats, where running sums start so that they equal
+/// `Iterator::sum` over the same values in the same order, bit for bit.
+pub(crate) fn empty_sum() -> f64 {
+    std::iter::empty::<f64>().sum()
+}
+
+/// A [`Summary`] being gathered episode by episode: counts and running sums in seed order, so a
+/// run of millions of episodes needs no list of them and gives the same figures, bit for bit, as
+/// [`Summary::new`] over the same records.
+#[derive(Clone, Debug)]
+pub struct Tally {
+    episodes: usize,
+    outcomes: [usize; Outcome::ALL.len()],
+    steps: u64,
+    collisions: f64,
+    step_sum: f64,
+    path_length_px: f64,
+    spl: f64,
+    total_reward: f64,
+    dynamic: usize,
+    dynamic_collisions: f64,
+    with_dynamic_collision: usize,
+    clearance_px: f64,
+    clearances: usize,
+    near_fraction: f64,
+}
+
+impl Default for Tally {
+    fn default() -> Self {
+        Self {
+            episodes: 0,
+            outcomes: [0; Outcome::ALL.len()],
+            steps: 0,
+            collisions: empty_sum(),
+            step_sum: empty_sum(),
+            path_length_px: empty_sum(),
+            spl: empty_sum(),
+            total_reward: empty_sum(),
+            dynamic: 0,
+            dynamic_collisions: empty_sum(),
+            with_dynamic_collision: 0,
+            clearance_px: empty_sum(),
+            clearances: 0,
+            near_fraction: empty_sum(),
+        }
+    }
+}
+
+impl Tally {
+    /// Counts the next episode (in seed order).
+    pub fn add(&mut self, f: &Figures) {
+        self.episodes += 1;
+        if let Some(k) = Outcome::ALL.iter().position(|o| *o == f.outcome) {
+            self.outcomes[k] += 1;
+        }
+        self.steps += u64::from(f.steps);
+        self.collisions += f64::from(f.collisions);
+        self.step_sum += f64::from(f.steps);
+        self.path_length_px += f.path_length_px;
+        self.spl += f.spl;
+        self.total_reward += f.total_reward;
+        if let Some(d) = f.dynamic {
+            self.dynamic += 1;
+            self.dynamic_collisions += f64::from(d.collisions);
+            if d.collisions > 0 {
+                self.with_dynamic_collision += 1;
             }
-        };
-        let successes = count(Outcome::Success);
-        let dynamic: Vec<_> = records
+            if d.min_clearance_px.is_finite() {
+                self.clearance_px += d.min_clearance_px;
+                self.clearances += 1;
+            }
+            self.near_fraction += f64::from(d.near_steps) / f64::from(f.steps.max(1));
+        }
+    }
+
+    /// Episodes counted.
+    pub fn episodes(&self) -> usize {
+        self.episodes
+    }
+
+    /// Steps of the episodes counted.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    fn count(&self, o: Outcome) -> usize {
+        Outcome::ALL
             .iter()
-            .filter_map(|r| r.dynamic.map(|d| (d, r.steps)))
-            .collect();
-        let moving = (!dynamic.is_empty()).then(|| {
-            let k = dynamic.len() as f64;
-            let clear: Vec<f64> = dynamic
-                .iter()
-                .map(|(d, _)| d.min_clearance_px)
-                .filter(|c| c.is_finite())
-                .collect();
+            .position(|x| *x == o)
+            .map_or(0, |k| self.outcomes[k])
+    }
+
+    /// The summary of the episodes counted, over a run that took `wall_time_s` to simulate
+    /// `steps_in_wall_time` steps (all of them, unless the run was resumed).
+    pub fn summary(&self, wall_time_s: f64, steps_in_wall_time: u64) -> Summary {
+        let n = self.episodes;
+        let mean = |sum: f64| if n == 0 { 0.0 } else { sum / n as f64 };
+        let successes = self.count(Outcome::Success);
+        let moving = (self.dynamic > 0).then(|| {
+            let k = self.dynamic as f64;
             MovingSummary {
-                dynamic_collisions_per_episode: dynamic
-                    .iter()
-                    .map(|(d, _)| d.collisions as f64)
-                    .sum::<f64>()
-                    / k,
-                episodes_with_dynamic_collision: dynamic
-                    .iter()
-                    .filter(|(d, _)| d.collisions > 0)
-                    .count(),
-                mean_min_clearance_px: if clear.is_empty() {
+                dynamic_collisions_per_episode: self.dynamic_collisions / k,
+                episodes_with_dynamic_collision: self.with_dynamic_collision,
+                mean_min_clearance_px: if self.clearances == 0 {
                     0.0
                 } else {
-                    clear.iter().sum::<f64>() / clear.len() as f64
+                    self.clearance_px / self.clearances as f64
                 },
-                near_moving_fraction: dynamic
-                    .iter()
-                    .map(|(d, steps)| d.near_steps as f64 / (*steps).max(1) as f64)
-                    .sum::<f64>()
-                    / k,
+                near_moving_fraction: self.near_fraction / k,
             }
         });
-        let steps: u64 = records.iter().map(|r| r.steps as u64).sum();
-        Self {
+        Summary {
             episodes: n,
             successes,
             success_rate: if n == 0 {
@@ -126,23 +225,34 @@ impl Summary {
                 successes as f64 / n as f64
             },
             success_ci95: wilson95(successes, n),
-            timeouts: count(Outcome::Timeout),
-            stuck: count(Outcome::Stuck),
-            collision_ends: count(Outcome::Collision),
-            reward_min_ends: count(Outcome::RewardMin),
-            collisions_per_episode: mean(&|r| r.collisions as f64),
-            mean_steps: mean(&|r| r.steps as f64),
-            mean_path_length_px: mean(&|r| r.path_length_px),
-            spl: mean(&|r| r.spl),
-            mean_return: mean(&|r| r.total_reward),
+            timeouts: self.count(Outcome::Timeout),
+            stuck: self.count(Outcome::Stuck),
+            collision_ends: self.count(Outcome::Collision),
+            reward_min_ends: self.count(Outcome::RewardMin),
+            collisions_per_episode: mean(self.collisions),
+            mean_steps: mean(self.step_sum),
+            mean_path_length_px: mean(self.path_length_px),
+            spl: mean(self.spl),
+            mean_return: mean(self.total_reward),
             wall_time_s,
             steps_per_second: if wall_time_s > 0.0 {
-                steps as f64 / wall_time_s
+                steps_in_wall_time as f64 / wall_time_s
             } else {
                 0.0
             },
             moving,
         }
+    }
+}
+
+impl Summary {
+    /// The summary of `records`, over a run that took `wall_time_s`.
+    pub fn new(records: &[EpisodeRecord], wall_time_s: f64) -> Self {
+        let mut tally = Tally::default();
+        for r in records {
+            tally.add(&Figures::of(r));
+        }
+        tally.summary(wall_time_s, tally.steps())
     }
 
     /// The summary as an aligned two-column table for a terminal.

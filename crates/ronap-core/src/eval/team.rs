@@ -2,18 +2,18 @@
 //! (team success: every robot arrived; makespan; summed path length; robot collisions;
 //! deadlocks), and their summary.
 
+use crate::eval::ordered::{run_in_order, Window};
 use crate::eval::summary::wilson95;
-use crate::eval::{EvalOptions, Evaluator, Outcome};
+use crate::eval::{worker_pool, EvalOptions, Evaluator, Failure, Outcome, RunEnd};
 use crate::geometry::Point;
 use crate::plan::shortest_path_px;
 use crate::policy::{PolicyError, PolicyFactory};
 use crate::run::team::TeamRollout;
 use crate::run::RunError;
 use crate::sim::robot::Pose;
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// One robot of a finished team episode.
@@ -151,60 +151,180 @@ pub struct TeamSummary {
     pub robot_steps_per_second: f64,
 }
 
-impl TeamSummary {
-    /// The summary of `records`, over a run that took `wall_time_s`.
-    pub fn new(records: &[TeamRecord], wall_time_s: f64) -> Self {
-        let n = records.len();
-        let per = |x: f64| if n == 0 { 0.0 } else { x / n as f64 };
-        let team_successes = records
-            .iter()
-            .filter(|r| r.outcome == Outcome::Success)
-            .count();
-        let robots: Vec<&RobotRecord> = records.iter().flat_map(|r| &r.robots).collect();
-        let makespans: Vec<f64> = records
-            .iter()
-            .filter_map(|r| r.makespan.map(f64::from))
-            .collect();
-        let robot_steps: u64 = robots.iter().map(|r| u64::from(r.steps)).sum();
+/// What a team summary needs of one robot of a team episode.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RobotFigures {
+    /// How its episode ended.
+    pub outcome: Outcome,
+    /// Steps it acted.
+    pub steps: u32,
+    /// SPL.
+    pub spl: f64,
+}
+
+/// What a team summary needs of one team episode.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TeamFigures {
+    /// The team's outcome.
+    pub outcome: Outcome,
+    /// Whether it ended in a deadlock.
+    pub deadlock: bool,
+    /// The step the last robot arrived at, when all did.
+    pub makespan: Option<u32>,
+    /// Summed distance driven, px.
+    pub path_length_px: f64,
+    /// Summed steps walls blocked.
+    pub collisions: u32,
+    /// Summed steps other robots blocked.
+    pub robot_collisions: u32,
+    /// Each robot's figures.
+    pub robots: Vec<RobotFigures>,
+}
+
+impl TeamFigures {
+    /// The figures of `record`.
+    pub fn of(record: &TeamRecord) -> Self {
         Self {
-            episodes: n,
-            robots: records.first().map_or(0, |r| r.robots.len()),
-            team_successes,
-            team_success_rate: per(team_successes as f64),
-            team_success_ci95: wilson95(team_successes, n),
-            robot_success_rate: if robots.is_empty() {
-                0.0
-            } else {
-                robots
-                    .iter()
-                    .filter(|r| r.outcome == Outcome::Success)
-                    .count() as f64
-                    / robots.len() as f64
-            },
-            deadlocks: records.iter().filter(|r| r.deadlock).count(),
-            mean_makespan: if makespans.is_empty() {
-                0.0
-            } else {
-                makespans.iter().sum::<f64>() / makespans.len() as f64
-            },
-            mean_path_length_px: per(records.iter().map(|r| r.path_length_px).sum()),
-            robot_collisions_per_episode: per(records
+            outcome: record.outcome,
+            deadlock: record.deadlock,
+            makespan: record.makespan,
+            path_length_px: record.path_length_px,
+            collisions: record.collisions,
+            robot_collisions: record.robot_collisions,
+            robots: record
+                .robots
                 .iter()
-                .map(|r| f64::from(r.robot_collisions))
-                .sum()),
-            collisions_per_episode: per(records.iter().map(|r| f64::from(r.collisions)).sum()),
-            spl: if robots.is_empty() {
+                .map(|r| RobotFigures {
+                    outcome: r.outcome,
+                    steps: r.steps,
+                    spl: r.spl,
+                })
+                .collect(),
+        }
+    }
+}
+
+/// A [`TeamSummary`] being gathered episode by episode (counts and running sums in seed order,
+/// equal bit for bit to [`TeamSummary::new`] over the same records).
+#[derive(Clone, Debug)]
+pub struct TeamTally {
+    episodes: usize,
+    robots_per_episode: Option<usize>,
+    team_successes: usize,
+    robots: usize,
+    robot_successes: usize,
+    deadlocks: usize,
+    makespans: usize,
+    makespan_sum: f64,
+    path_length_px: f64,
+    robot_collisions: f64,
+    collisions: f64,
+    spl: f64,
+    robot_steps: u64,
+}
+
+impl Default for TeamTally {
+    fn default() -> Self {
+        let zero = crate::eval::summary::empty_sum();
+        Self {
+            episodes: 0,
+            robots_per_episode: None,
+            team_successes: 0,
+            robots: 0,
+            robot_successes: 0,
+            deadlocks: 0,
+            makespans: 0,
+            makespan_sum: zero,
+            path_length_px: zero,
+            robot_collisions: zero,
+            collisions: zero,
+            spl: zero,
+            robot_steps: 0,
+        }
+    }
+}
+
+impl TeamTally {
+    /// Counts the next team episode (in seed order).
+    pub fn add(&mut self, f: &TeamFigures) {
+        self.episodes += 1;
+        self.robots_per_episode.get_or_insert(f.robots.len());
+        if f.outcome == Outcome::Success {
+            self.team_successes += 1;
+        }
+        if f.deadlock {
+            self.deadlocks += 1;
+        }
+        if let Some(m) = f.makespan {
+            self.makespans += 1;
+            self.makespan_sum += f64::from(m);
+        }
+        self.path_length_px += f.path_length_px;
+        self.robot_collisions += f64::from(f.robot_collisions);
+        self.collisions += f64::from(f.collisions);
+        for r in &f.robots {
+            self.robots += 1;
+            if r.outcome == Outcome::Success {
+                self.robot_successes += 1;
+            }
+            self.spl += r.spl;
+            self.robot_steps += u64::from(r.steps);
+        }
+    }
+
+    /// Robot steps of the episodes counted.
+    pub fn robot_steps(&self) -> u64 {
+        self.robot_steps
+    }
+
+    /// The summary of the episodes counted, over a run that took `wall_time_s` to simulate
+    /// `robot_steps_in_wall_time` robot steps.
+    pub fn summary(&self, wall_time_s: f64, robot_steps_in_wall_time: u64) -> TeamSummary {
+        let n = self.episodes;
+        let per = |x: f64| if n == 0 { 0.0 } else { x / n as f64 };
+        TeamSummary {
+            episodes: n,
+            robots: self.robots_per_episode.unwrap_or(0),
+            team_successes: self.team_successes,
+            team_success_rate: per(self.team_successes as f64),
+            team_success_ci95: wilson95(self.team_successes, n),
+            robot_success_rate: if self.robots == 0 {
                 0.0
             } else {
-                robots.iter().map(|r| r.spl).sum::<f64>() / robots.len() as f64
+                self.robot_successes as f64 / self.robots as f64
+            },
+            deadlocks: self.deadlocks,
+            mean_makespan: if self.makespans == 0 {
+                0.0
+            } else {
+                self.makespan_sum / self.makespans as f64
+            },
+            mean_path_length_px: per(self.path_length_px),
+            robot_collisions_per_episode: per(self.robot_collisions),
+            collisions_per_episode: per(self.collisions),
+            spl: if self.robots == 0 {
+                0.0
+            } else {
+                self.spl / self.robots as f64
             },
             wall_time_s,
             robot_steps_per_second: if wall_time_s > 0.0 {
-                robot_steps as f64 / wall_time_s
+                robot_steps_in_wall_time as f64 / wall_time_s
             } else {
                 0.0
             },
         }
+    }
+}
+
+impl TeamSummary {
+    /// The summary of `records`, over a run that took `wall_time_s`.
+    pub fn new(records: &[TeamRecord], wall_time_s: f64) -> Self {
+        let mut tally = TeamTally::default();
+        for r in records {
+            tally.add(&TeamFigures::of(r));
+        }
+        tally.summary(wall_time_s, tally.robot_steps())
     }
 
     /// The summary as an aligned two-column table.
@@ -402,8 +522,8 @@ impl Evaluator {
     }
 
     /// Runs `options.seeds` as team episodes, robot `k` driven by a policy from
-    /// `factories[k]` (named `names[k]`). Records come back in seed order whatever the thread
-    /// count; `on_record` hears each as it finishes; `cancel` stops the run between episodes.
+    /// `factories[k]` (named `names[k]`), keeping every record in seed order:
+    /// [`Evaluator::stream_team`] into a vector.
     pub fn run_team(
         &self,
         factories: &[&dyn PolicyFactory],
@@ -412,69 +532,60 @@ impl Evaluator {
         cancel: &AtomicBool,
         on_record: &(dyn Fn(&TeamRecord) + Sync),
     ) -> Result<TeamRunResult, PolicyError> {
-        let clock = Instant::now();
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(options.threads)
-            .build()
-            .map_err(|e| PolicyError::Failed(format!("cannot start worker threads: {e}")))?;
-        let first_policy_error: Mutex<Option<PolicyError>> = Mutex::new(None);
-        let results: Vec<Option<Result<TeamRecord, RunError>>> = pool.install(|| {
-            options
-                .seeds
-                .par_iter()
-                .with_max_len(1)
-                .map(|&seed| {
-                    if cancel.load(Ordering::Relaxed) {
-                        return None;
-                    }
-                    let made: Result<Vec<_>, _> = factories.iter().map(|f| f.make()).collect();
-                    let mut policies = match made {
-                        Ok(p) => p,
-                        Err(e) => {
-                            cancel.store(true, Ordering::Relaxed);
-                            if let Ok(mut slot) = first_policy_error.lock() {
-                                slot.get_or_insert(e);
-                            }
-                            return None;
-                        }
-                    };
-                    let paths = options.recording.trajectory;
-                    let result = self
-                        .run_team_episode(&mut policies, names, seed, paths)
-                        .map(|mut r| {
-                            on_record(&r);
-                            r.paths = Vec::new();
-                            r.scene = None;
-                            r
-                        });
-                    if result.is_err() {
-                        cancel.store(true, Ordering::Relaxed);
-                    }
-                    Some(result)
-                })
-                .collect()
-        });
-        if let Some(e) = first_policy_error.into_inner().ok().flatten() {
-            return Err(e);
-        }
-        let mut records = Vec::with_capacity(results.len());
-        let mut error = None;
-        let mut cancelled = false;
-        for r in results {
-            match r {
-                Some(Ok(record)) => records.push(record),
-                Some(Err(e)) => {
-                    error.get_or_insert(e);
-                }
-                None => cancelled = true,
-            }
-        }
+        let mut records = Vec::new();
+        let end = self.stream_team(factories, names, options, cancel, on_record, &mut |r| {
+            records.push(r);
+            true
+        })?;
         Ok(TeamRunResult {
             records,
-            cancelled: cancelled && error.is_none(),
-            error,
-            wall_time_s: clock.elapsed().as_secs_f64(),
+            cancelled: end.cancelled,
+            error: end.error,
+            wall_time_s: end.wall_time_s,
         })
+    }
+
+    /// Runs `options.seeds` as team episodes as [`Evaluator::stream`] runs lone ones: each record
+    /// to `on_finish` as it ends (any order), then without its paths to `sink` in seed order, with
+    /// flat memory; `sink` returning `false` or `cancel` stops the run after a prefix of seeds.
+    pub fn stream_team(
+        &self,
+        factories: &[&dyn PolicyFactory],
+        names: &[String],
+        options: &EvalOptions,
+        cancel: &AtomicBool,
+        on_finish: &(dyn Fn(&TeamRecord) + Sync),
+        sink: &mut dyn FnMut(TeamRecord) -> bool,
+    ) -> Result<RunEnd, PolicyError> {
+        let clock = Instant::now();
+        let pool = worker_pool(options.threads)?;
+        // A team's policies are made afresh for every episode.
+        let work = |_: &mut Option<()>, i: usize| {
+            let made: Result<Vec<_>, _> = factories.iter().map(|f| f.make()).collect();
+            let mut policies = made.map_err(Failure::Policy)?;
+            let paths = options.recording.trajectory;
+            let mut r = self
+                .run_team_episode(
+                    &mut policies,
+                    names,
+                    options.seeds.get(i).unwrap_or_default(),
+                    paths,
+                )
+                .map_err(Failure::Run)?;
+            on_finish(&r);
+            r.paths = Vec::new();
+            r.scene = None;
+            Ok(r)
+        };
+        let ended = run_in_order(
+            &pool,
+            options.seeds.len(),
+            Window::for_threads(pool.current_num_threads()),
+            cancel,
+            &work,
+            sink,
+        );
+        RunEnd::of(ended, options.seeds.len(), clock)
     }
 }
 
@@ -506,7 +617,7 @@ mod tests {
         let names = vec!["geodesic".to_string(); 4];
         let run = |threads| {
             let options = EvalOptions {
-                seeds: (0..8).collect(),
+                seeds: (0..8).collect::<Vec<_>>().into(),
                 threads,
                 ..Default::default()
             };
@@ -534,7 +645,7 @@ mod tests {
         }
         // Four geodesic robots in a maze mostly all arrive.
         let options = EvalOptions {
-            seeds: (0..8).collect(),
+            seeds: (0..8).collect::<Vec<_>>().into(),
             ..Default::default()
         };
         let records = ev
@@ -572,7 +683,7 @@ mod tests {
         let factories: Vec<&dyn PolicyFactory> = (0..3).map(|_| f.as_ref()).collect();
         let names = vec!["geodesic".to_string(); 3];
         let options = EvalOptions {
-            seeds: (0..6).collect(),
+            seeds: (0..6).collect::<Vec<_>>().into(),
             ..Default::default()
         };
         let records = ev

@@ -31,6 +31,18 @@ pub enum OutputError {
         /// The first failure.
         first: String,
     },
+    /// Another run is writing into the directory.
+    #[error(
+        "{} is in use by another ronap run{}: wait for it to finish or choose another output directory",
+        dir.display(),
+        pid.map_or(String::new(), |p| format!(" (pid {p})"))
+    )]
+    Busy {
+        /// The directory.
+        dir: PathBuf,
+        /// The process holding it, when it said.
+        pid: Option<u32>,
+    },
     /// The file name has an extension no writer knows.
     #[error("cannot write {}: {message}", path.display())]
     Format {

@@ -3,6 +3,9 @@
 
 pub mod atomic;
 pub mod datalog;
+pub mod figures;
+pub mod lock;
 pub mod manifest;
+pub mod partial;
 pub mod run_dir;
 pub mod steplog;

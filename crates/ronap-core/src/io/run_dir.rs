@@ -1,18 +1,26 @@
 //! A run directory: what an evaluation writes, and the one sequence that runs an evaluation into
-//! it (used by `ronap run` and Python's `ronap.evaluate`). `episodes.csv`, `timing.csv` and the
-//! manifest `summary.json` at the end; trajectory pictures (`png/`) and step logs (`steps/`) as
-//! each episode finishes.
+//! it (used by `ronap run`, `ronap compare` and Python's `ronap.evaluate`). The plan `run.json`
+//! first; `episodes.csv` and `timing.csv` (`robots.csv` for teams) row by row in seed order as
+//! episodes finish, under partial names until the end; the manifest `summary.json` at the end;
+//! trajectory pictures (`png/`) and step logs (`steps/`) as each episode finishes. A run stopped
+//! short can be finished by another process ([`RunWriter::resume`]), and a lock keeps two runs
+//! out of one directory.
 //!
 //! Everything here is deterministic given the records except `timing.csv`, which holds the wall
 //! times, so `episodes.csv` is byte-identical whatever the thread count.
 
 use crate::config::ValidConfig;
 use crate::eval::{
-    EpisodeRecord, EvalOptions, Evaluator, Outcome, Recording, RunResult, Summary, TeamRecord,
-    TeamRunResult, TeamSummary,
+    EpisodeRecord, EvalOptions, Evaluator, Figures, Outcome, Recording, RunEnd, RunResult, Seeds,
+    Summary, Tally, TeamFigures, TeamRecord, TeamRunResult, TeamSummary, TeamTally,
 };
 use crate::io::atomic::{save_image, write_atomic, OutputError};
-use crate::io::manifest::{RunManifest, SCHEMA_VERSION};
+use crate::io::figures::{self, FIGURES_FILE};
+use crate::io::lock::RunLock;
+use crate::io::manifest::{
+    ManifestError, RunManifest, RunPlan, PLAN_FILE, PLAN_SCHEMA_VERSION, SCHEMA_VERSION,
+};
+use crate::io::partial::{partial_path, whole_rows, PartialCsv};
 use crate::io::steplog::write_steps;
 use crate::policy::{PolicyError, PolicyFactory};
 use crate::render::trajectory::trajectory_image;
@@ -22,6 +30,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::sync::Mutex;
+use std::time::{Duration, Instant};
 
 /// Which episodes get a trajectory picture.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -44,6 +53,16 @@ impl std::str::FromStr for Pictures {
                 .parse()
                 .map(Self::First)
                 .map_err(|_| format!("{n:?}: expected a number, `failures` or `all`")),
+        }
+    }
+}
+
+impl std::fmt::Display for Pictures {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Pictures::First(n) => write!(f, "{n}"),
+            Pictures::Failures => f.write_str("failures"),
+            Pictures::All => f.write_str("all"),
         }
     }
 }
@@ -89,19 +108,27 @@ pub const DYNAMIC_COLUMNS: [&str; 3] = [
     "near_moving_fraction",
 ];
 
-/// Writes `episodes.csv`: one row per record, with [`DYNAMIC_COLUMNS`] after the others when the
-/// episodes had moving obstacles.
-pub fn write_episodes(records: &[EpisodeRecord], out: &mut dyn Write) -> std::io::Result<()> {
-    let mut w = csv::Writer::from_writer(out);
-    let dynamic = records.iter().any(|r| r.dynamic.is_some());
+/// The `episodes.csv` row of `r` (with [`DYNAMIC_COLUMNS`] when `dynamic`).
+pub fn episode_row(r: &EpisodeRecord, dynamic: bool) -> Vec<String> {
+    let mut row = vec![
+        r.seed.to_string(),
+        r.outcome.name().to_string(),
+        r.steps.to_string(),
+        r.collisions.to_string(),
+        format!("{:.3}", r.path_length_px),
+        r.shortest_px.map_or(String::new(), |l| format!("{l:.3}")),
+        format!("{:.4}", r.spl),
+        format!("{:.4}", r.total_reward),
+        format!("{:.3}", r.start.x),
+        format!("{:.3}", r.start.y),
+        format!("{:.3}", r.start.z_deg),
+        format!("{:.3}", r.goal.x),
+        format!("{:.3}", r.goal.y),
+        r.reason.clone().unwrap_or_default(),
+    ];
     if dynamic {
-        w.write_record(EPISODE_COLUMNS.iter().chain(&DYNAMIC_COLUMNS))?;
-    } else {
-        w.write_record(EPISODE_COLUMNS)?;
-    }
-    for r in records {
-        let extra = r.dynamic.map(|d| {
-            [
+        match r.dynamic {
+            Some(d) => row.extend([
                 d.collisions.to_string(),
                 if d.min_clearance_px.is_finite() {
                     format!("{:.3}", d.min_clearance_px)
@@ -109,40 +136,48 @@ pub fn write_episodes(records: &[EpisodeRecord], out: &mut dyn Write) -> std::io
                     String::new()
                 },
                 format!("{:.4}", d.near_steps as f64 / r.steps.max(1) as f64),
-            ]
-        });
-        let base = [
-            r.seed.to_string(),
-            r.outcome.name().to_string(),
-            r.steps.to_string(),
-            r.collisions.to_string(),
-            format!("{:.3}", r.path_length_px),
-            r.shortest_px.map_or(String::new(), |l| format!("{l:.3}")),
-            format!("{:.4}", r.spl),
-            format!("{:.4}", r.total_reward),
-            format!("{:.3}", r.start.x),
-            format!("{:.3}", r.start.y),
-            format!("{:.3}", r.start.z_deg),
-            format!("{:.3}", r.goal.x),
-            format!("{:.3}", r.goal.y),
-            r.reason.clone().unwrap_or_default(),
-        ];
-        if dynamic {
-            let extra = extra.unwrap_or_default();
-            w.write_record(base.iter().chain(&extra))?;
-        } else {
-            w.write_record(base)?;
+            ]),
+            None => row.extend([String::new(), String::new(), String::new()]),
         }
     }
+    row
+}
+
+/// The `episodes.csv` header (with [`DYNAMIC_COLUMNS`] when `dynamic`).
+pub fn episode_header(dynamic: bool) -> Vec<&'static str> {
+    let mut header = EPISODE_COLUMNS.to_vec();
+    if dynamic {
+        header.extend(DYNAMIC_COLUMNS);
+    }
+    header
+}
+
+/// Writes `episodes.csv`: one row per record, with [`DYNAMIC_COLUMNS`] after the others when the
+/// episodes had moving obstacles.
+pub fn write_episodes(records: &[EpisodeRecord], out: &mut dyn Write) -> std::io::Result<()> {
+    let mut w = csv::Writer::from_writer(out);
+    let dynamic = records.iter().any(|r| r.dynamic.is_some());
+    w.write_record(episode_header(dynamic))?;
+    for r in records {
+        w.write_record(episode_row(r, dynamic))?;
+    }
     w.flush()
+}
+
+/// Columns of `timing.csv`.
+pub const TIMING_COLUMNS: [&str; 2] = ["seed", "wall_time_ms"];
+
+/// The `timing.csv` row of an episode of `seed` that took `wall_time_s`.
+pub fn timing_row(seed: u64, wall_time_s: f64) -> [String; 2] {
+    [seed.to_string(), format!("{:.3}", wall_time_s * 1000.0)]
 }
 
 /// Writes `timing.csv`: each episode's wall time (setup, planning, stepping), milliseconds.
 pub fn write_timing(records: &[EpisodeRecord], out: &mut dyn Write) -> std::io::Result<()> {
     let mut w = csv::Writer::from_writer(out);
-    w.write_record(["seed", "wall_time_ms"])?;
+    w.write_record(TIMING_COLUMNS)?;
     for r in records {
-        w.write_record([r.seed.to_string(), format!("{:.3}", r.wall_time_s * 1000.0)])?;
+        w.write_record(timing_row(r.seed, r.wall_time_s))?;
     }
     w.flush()
 }
@@ -158,46 +193,168 @@ pub struct RunFiles {
     pub gifs: bool,
 }
 
-/// A run directory being written: made (with the sub-directories its files need) and cleared of
-/// an earlier run's per-episode files before the first episode, filled as episodes finish.
+/// The run files written row by row while a run goes on (their partial names until the end).
+const RUN_FILES: [&str; 4] = ["episodes.csv", "timing.csv", "robots.csv", FIGURES_FILE];
+
+/// A run directory being written, locked against other runs for as long as this lives: made
+/// (with the sub-directories its files need) and cleared of an earlier run's files before the
+/// first episode, or taken up again to finish a run stopped short ([`RunWriter::resume`]).
 #[derive(Debug)]
 pub struct RunWriter {
     dir: PathBuf,
     files: RunFiles,
     first_seed: u64,
     errors: Mutex<Vec<String>>,
+    front_end: serde_json::Value,
+    resumed: Option<Resumed>,
+    _lock: RunLock,
+}
+
+/// What a run stopped short had finished.
+#[derive(Debug)]
+struct Resumed {
+    /// The plan it was started with.
+    plan: RunPlan,
+    /// Episodes finished: the first `done` seeds.
+    done: usize,
 }
 
 impl RunWriter {
-    /// Makes `dir` for a run whose seeds start at `first_seed`.
+    /// Makes and locks `dir` for a run whose seeds start at `first_seed`, removing the files of
+    /// an earlier run there.
     pub fn create(dir: &Path, files: RunFiles, first_seed: u64) -> Result<Self, OutputError> {
+        make_dir(dir)?;
+        let lock = RunLock::take(dir)?;
         let subs = [
-            (true, ""),
             (files.pictures.is_some(), "png"),
             (files.steps, "steps"),
             (files.gifs, "gif"),
         ];
         for (wanted, sub) in subs {
             if wanted {
-                let d = dir.join(sub);
-                std::fs::create_dir_all(&d).map_err(|source| OutputError::Io {
-                    path: d.clone(),
-                    source,
-                })?;
+                make_dir(&dir.join(sub))?;
             }
         }
         remove_stale_files(dir)?;
+        for name in RUN_FILES.iter().chain(&["summary.json", PLAN_FILE]) {
+            let path = dir.join(name);
+            remove_if_there(&path)?;
+            remove_if_there(&partial_path(&path))?;
+        }
         Ok(Self {
             dir: dir.to_path_buf(),
             files,
             first_seed,
             errors: Mutex::new(Vec::new()),
+            front_end: serde_json::Value::Null,
+            resumed: None,
+            _lock: lock,
         })
+    }
+
+    /// Locks `dir`, a run stopped short (killed, interrupted or out of disk), to finish it: reads
+    /// its plan (`run.json`) and counts the episodes it finished (the whole rows every one of its
+    /// run files holds; a row torn by a crash is dropped). The caller rebuilds the run from the
+    /// plan and hands this writer to [`evaluate_into`] or [`evaluate_team_into`], which run only
+    /// the seeds left. Pictures and step logs already written are kept.
+    pub fn resume(dir: &Path) -> Result<(Self, RunPlan), ResumeError> {
+        let plan_path = dir.join(PLAN_FILE);
+        if !dir.is_dir() {
+            return Err(ResumeError::NoRun {
+                dir: dir.to_path_buf(),
+                why: "no such directory".into(),
+            });
+        }
+        if !plan_path.exists() {
+            return Err(ResumeError::NoRun {
+                dir: dir.to_path_buf(),
+                why: format!(
+                    "it has no {PLAN_FILE} (runs of older ronap versions cannot be resumed)"
+                ),
+            });
+        }
+        let lock = RunLock::take(dir)?;
+        let plan = RunPlan::read(&plan_path)?;
+        let seeds = plan.seeds().len();
+        let summary = dir.join("summary.json");
+        let stopped_short = RUN_FILES
+            .iter()
+            .any(|name| partial_path(&dir.join(name)).exists())
+            || !summary.exists()
+            || RunManifest::read(&summary).map_or(true, |m| m.interrupted || m.error.is_some());
+        if !stopped_short {
+            return Err(ResumeError::Complete {
+                dir: dir.to_path_buf(),
+                episodes: seeds,
+            });
+        }
+        let team = plan
+            .config
+            .robots
+            .iter()
+            .map(|r| r.count as usize)
+            .sum::<usize>();
+        let mut done = seeds;
+        for (name, per_episode) in [
+            ("episodes.csv", 1),
+            ("timing.csv", 1),
+            ("robots.csv", team),
+            (FIGURES_FILE, 1),
+        ] {
+            if per_episode == 0 {
+                continue;
+            }
+            let path = dir.join(name);
+            let partial = partial_path(&path);
+            let at = if partial.exists() { partial } else { path };
+            let rows = whole_rows(&at)?.saturating_sub(1);
+            done = done.min(rows / per_episode);
+        }
+        remove_if_there(&summary)?;
+        let files = RunFiles {
+            pictures: plan
+                .pictures
+                .as_deref()
+                .map(str::parse)
+                .transpose()
+                .map_err(|message: String| {
+                    ResumeError::Plan(ManifestError::Format {
+                        path: plan_path.clone(),
+                        message: format!("`pictures`: {message}"),
+                    })
+                })?,
+            steps: plan.steps,
+            gifs: plan.gifs,
+        };
+        let writer = Self {
+            dir: dir.to_path_buf(),
+            files,
+            first_seed: plan.seeds().first().unwrap_or(0),
+            errors: Mutex::new(Vec::new()),
+            front_end: plan.front_end.clone(),
+            resumed: Some(Resumed {
+                plan: plan.clone(),
+                done,
+            }),
+            _lock: lock,
+        };
+        Ok((writer, plan))
+    }
+
+    /// Records the front end's own options in the run's plan, for a later `--resume`.
+    pub fn with_front_end(mut self, options: serde_json::Value) -> Self {
+        self.front_end = options;
+        self
     }
 
     /// The directory.
     pub fn dir(&self) -> &Path {
         &self.dir
+    }
+
+    /// The episodes a resumed run had finished (0 for a new run).
+    pub fn done(&self) -> usize {
+        self.resumed.as_ref().map_or(0, |r| r.done)
     }
 
     /// What the evaluator must keep of each episode for this writer's files.
@@ -208,37 +365,163 @@ impl RunWriter {
         }
     }
 
-    /// Writes the per-episode files of `record`; a failure is kept for [`RunWriter::finish`] so
-    /// the run goes on (and its other results are saved).
+    /// Writes the per-episode files of `record`; a failure is kept for the end so the run goes
+    /// on (and its other results are saved).
     pub fn episode(&self, record: &EpisodeRecord) {
         let picture = self
             .files
             .pictures
             .is_some_and(|p| p.wants(record, self.first_seed));
         if let Err(e) = write_episode_files(&self.dir, record, picture, self.files.steps) {
-            if let Ok(mut all) = self.errors.lock() {
-                all.push(e.to_string());
-            }
+            self.note(e);
         }
     }
 
-    /// Writes `episodes.csv`, `timing.csv` and `summary.json`. Then, if an episode's files
-    /// could not be written, says so (how many, and the first).
-    pub fn finish(self, result: &RunResult, manifest: &RunManifest) -> Result<(), OutputError> {
-        write_atomic(&self.dir.join("episodes.csv"), |out| {
-            write_episodes(&result.records, out)
-        })?;
-        write_atomic(&self.dir.join("timing.csv"), |out| {
-            write_timing(&result.records, out)
-        })?;
-        manifest.write(&self.dir.join("summary.json"))?;
-        let errors = self.errors.into_inner().unwrap_or_default();
-        match errors.first() {
-            Some(first) => Err(OutputError::Episodes {
-                count: errors.len(),
-                first: first.clone(),
-            }),
-            None => Ok(()),
+    fn note(&self, e: OutputError) {
+        if let Ok(mut all) = self.errors.lock() {
+            all.push(e.to_string());
+        }
+    }
+
+    /// The plan of this run: the resumed run's own, else one made of what it is.
+    fn plan(&self, config: &ValidConfig, options: &EvalOptions, info: &RunInfo) -> RunPlan {
+        if let Some(r) = &self.resumed {
+            return r.plan.clone();
+        }
+        let first = options.seeds.first().unwrap_or(0);
+        let count = options.seeds.len() as u64;
+        let range = matches!(options.seeds, Seeds::Range { .. })
+            || options
+                .seeds
+                .iter()
+                .enumerate()
+                .all(|(i, s)| Some(s) == first.checked_add(i as u64));
+        RunPlan {
+            schema_version: PLAN_SCHEMA_VERSION,
+            ronap_version: env!("CARGO_PKG_VERSION").to_string(),
+            policy: info.policy.clone(),
+            seed_start: first,
+            seeds_requested: count,
+            seeds: (!range).then(|| options.seeds.iter().collect()),
+            threads: options.threads,
+            scenes: info.scenes.clone(),
+            map: info.map.clone(),
+            pictures: self.files.pictures.map(|p| p.to_string()),
+            steps: self.files.steps,
+            gifs: self.files.gifs,
+            front_end: self.front_end.clone(),
+            config: config.as_sim_config().clone(),
+        }
+    }
+
+    /// Opens the run files (`headers[k]` for `RUN_FILES[k]`; `None`: not written), writing the
+    /// plan first for a new run, or reopening them after the finished episodes for a resumed one.
+    fn open(
+        &self,
+        plan: &RunPlan,
+        headers: [Option<Vec<String>>; 4],
+    ) -> Result<Streams, OutputError> {
+        let done = self.done();
+        if self.resumed.is_none() {
+            plan.write(&self.dir.join(PLAN_FILE))?;
+        }
+        let team: usize = plan.config.robots.iter().map(|r| r.count as usize).sum();
+        let mut files = Vec::new();
+        for (name, header) in RUN_FILES.iter().zip(headers) {
+            let Some(header) = header else { continue };
+            let header: Vec<&str> = header.iter().map(String::as_str).collect();
+            let path = self.dir.join(name);
+            let rows = if *name == "robots.csv" {
+                done * team
+            } else {
+                done
+            };
+            files.push(if self.resumed.is_some() {
+                PartialCsv::reopen(&path, &header, rows)?
+            } else {
+                PartialCsv::create(&path, &header)?
+            });
+        }
+        Ok(Streams {
+            files,
+            flushed: Instant::now(),
+        })
+    }
+
+    /// The errors of per-episode files, as one.
+    fn episode_errors(&self) -> Option<OutputError> {
+        let errors = self
+            .errors
+            .lock()
+            .map(|mut e| std::mem::take(&mut *e))
+            .unwrap_or_default();
+        errors.first().map(|first| OutputError::Episodes {
+            count: errors.len(),
+            first: first.clone(),
+        })
+    }
+}
+
+/// Makes `dir` and its parents.
+fn make_dir(dir: &Path) -> Result<(), OutputError> {
+    std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })
+}
+
+/// Removes `path` if it is there.
+fn remove_if_there(path: &Path) -> Result<(), OutputError> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(OutputError::Io {
+            path: path.to_path_buf(),
+            source: e,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// The run files under way, in the order of [`RUN_FILES`] (those the run writes).
+#[derive(Debug)]
+struct Streams {
+    files: Vec<PartialCsv>,
+    flushed: Instant,
+}
+
+impl Streams {
+    /// How often what is buffered goes to the files, so a killed run loses at most this much.
+    const FLUSH_EVERY: Duration = Duration::from_secs(1);
+
+    /// Adds one episode's rows (`rows[k]` to file `k`).
+    fn add(&mut self, rows: &[Vec<Vec<String>>]) -> Result<(), OutputError> {
+        for (file, rows) in self.files.iter_mut().zip(rows) {
+            for row in rows {
+                file.row(row)?;
+            }
+        }
+        if self.flushed.elapsed() >= Self::FLUSH_EVERY {
+            for file in &mut self.files {
+                file.flush()?;
+            }
+            self.flushed = Instant::now();
+        }
+        Ok(())
+    }
+
+    /// Renames the files to their final names; the exact figures are kept (for a later
+    /// `--resume`) unless the run is `complete`.
+    fn finish(self, dir: &Path, complete: bool) -> Result<(), OutputError> {
+        for file in self.files {
+            file.finish()?;
+        }
+        let figures = dir.join(FIGURES_FILE);
+        if complete {
+            remove_if_there(&figures)
+        } else {
+            std::fs::rename(&figures, partial_path(&figures)).map_err(|source| OutputError::Io {
+                path: figures,
+                source,
+            })
         }
     }
 }
@@ -292,6 +575,33 @@ fn remove_stale_files(dir: &Path) -> Result<(), OutputError> {
     Ok(())
 }
 
+/// A run that cannot be resumed.
+#[derive(Debug, thiserror::Error)]
+pub enum ResumeError {
+    /// The directory holds no run stopped short.
+    #[error("cannot resume {}: {why}", dir.display())]
+    NoRun {
+        /// The directory.
+        dir: PathBuf,
+        /// Why not.
+        why: String,
+    },
+    /// The run is complete: nothing to do.
+    #[error("the run in {} is already complete ({episodes} episodes); nothing to resume", dir.display())]
+    Complete {
+        /// The directory.
+        dir: PathBuf,
+        /// Its episodes.
+        episodes: usize,
+    },
+    /// The plan cannot be read, or is of another schema or ronap version.
+    #[error("cannot resume: {0}")]
+    Plan(#[from] ManifestError),
+    /// The directory cannot be locked or its files read.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+}
+
 /// What a run is, for its manifest: the policy's name and where its episodes took place.
 #[derive(Clone, Debug)]
 pub struct RunInfo {
@@ -303,13 +613,24 @@ pub struct RunInfo {
     pub map: Option<MapSource>,
 }
 
-/// A finished evaluation: the records, their summary and the manifest that went to
-/// `summary.json` (or would have, for a run without a directory).
+impl RunInfo {
+    /// The run a plan describes.
+    pub fn of(plan: &RunPlan) -> Self {
+        Self {
+            policy: plan.policy.clone(),
+            scenes: plan.scenes.clone(),
+            map: plan.map.clone(),
+        }
+    }
+}
+
+/// A finished evaluation: the records kept, the summary of every episode of the run and the
+/// manifest that went to `summary.json` (or would have, for a run without a directory).
 #[derive(Debug)]
 pub struct Evaluation {
-    /// The records and how the run stopped.
+    /// How the run stopped, and the records the caller chose to keep (in seed order).
     pub result: RunResult,
-    /// The figures.
+    /// The figures of every finished episode (those of a resumed run's earlier process too).
     pub summary: Summary,
     /// The manifest.
     pub manifest: RunManifest,
@@ -317,9 +638,15 @@ pub struct Evaluation {
     pub write_error: Option<OutputError>,
 }
 
-/// Runs an evaluation and, given a `writer`, writes it into its directory: per-episode files as
-/// episodes finish, the run files at the end (also after an interruption or a failing episode,
-/// so finished episodes are never lost). `on_record` hears every finished episode (progress).
+/// Runs an evaluation and, given a `writer`, writes it into its directory as it goes:
+/// `episodes.csv`, `timing.csv` (and the exact figures a resume needs) row by row in seed order
+/// under their partial names, per-episode files as episodes finish, `summary.json` at the end,
+/// when the run files take their final names (also after an interruption or a failing episode,
+/// so finished episodes are never lost; not after a write error, so no file under a final name
+/// is ever half-written). Memory stays flat however many episodes: only the records `keep`
+/// accepts are kept. A resumed `writer` runs only the seeds its run had not finished.
+/// `on_record` hears every finished episode (progress).
+#[allow(clippy::too_many_arguments)]
 pub fn evaluate_into(
     evaluator: &Evaluator,
     factory: &dyn PolicyFactory,
@@ -328,26 +655,148 @@ pub fn evaluate_into(
     writer: Option<RunWriter>,
     cancel: &AtomicBool,
     on_record: &(dyn Fn(&EpisodeRecord) + Sync),
+    keep: &dyn Fn(&EpisodeRecord) -> bool,
 ) -> Result<Evaluation, PolicyError> {
     let mut options = options.clone();
     if let Some(w) = &writer {
         options.recording = w.recording();
     }
-    let result = evaluator.run(factory, &options, cancel, &|r: &EpisodeRecord| {
-        if let Some(w) = &writer {
-            w.episode(r);
+    let config = evaluator.config();
+    let mut tally = Tally::default();
+    let mut write_error = None;
+    let mut streams = None;
+    let done = writer.as_ref().map_or(0, RunWriter::done);
+    if let Some(w) = &writer {
+        let plan = w.plan(config, &options, info);
+        match w.open(&plan, lone_headers(!config.moving.is_empty())) {
+            Ok(s) => streams = Some(s),
+            Err(e) => write_error = Some(e),
         }
-        on_record(r);
-    })?;
-    let summary = Summary::new(&result.records, result.wall_time_s);
-    let manifest = manifest(evaluator.config(), &options, info, &result, &summary);
-    let write_error = writer.and_then(|w| w.finish(&result, &manifest).err());
+        if write_error.is_none() && done > 0 {
+            if let Err(e) = restore(&w.dir, done, &mut |row| {
+                let (_, f) = figures::parse_lone(row)?;
+                tally.add(&f);
+                Ok(())
+            }) {
+                write_error = Some(e);
+            }
+        }
+    }
+    let steps_before = tally.steps();
+    let mut kept = Vec::new();
+    let end = if write_error.is_some() {
+        RunEnd {
+            episodes: 0,
+            cancelled: false,
+            error: None,
+            wall_time_s: 0.0,
+        }
+    } else {
+        let rest = EvalOptions {
+            seeds: options.seeds.after(done),
+            ..options.clone()
+        };
+        let dynamic = !config.moving.is_empty();
+        let on_finish = |r: &EpisodeRecord| {
+            if let Some(w) = &writer {
+                w.episode(r);
+            }
+            on_record(r);
+        };
+        evaluator.stream(factory, &rest, cancel, &on_finish, &mut |r| {
+            let f = Figures::of(&r);
+            if let Some(s) = &mut streams {
+                let rows = [
+                    vec![episode_row(&r, dynamic)],
+                    vec![timing_row(r.seed, r.wall_time_s).to_vec()],
+                    vec![figures::lone_row(r.seed, &f)],
+                ];
+                if let Err(e) = s.add(&rows) {
+                    write_error = Some(e);
+                    return false;
+                }
+            }
+            tally.add(&f);
+            if keep(&r) {
+                kept.push(r);
+            }
+            true
+        })?
+    };
+    let result = RunResult {
+        records: kept,
+        cancelled: end.cancelled && write_error.is_none(),
+        error: end.error,
+        wall_time_s: end.wall_time_s,
+    };
+    let summary = tally.summary(result.wall_time_s, tally.steps() - steps_before);
+    let manifest = manifest(config, &options, info, &result, &summary);
+    if let (Some(w), None) = (&writer, &write_error) {
+        write_error = finish(w, streams, &manifest, &result).err();
+    }
     Ok(Evaluation {
         result,
         summary,
         manifest,
         write_error,
     })
+}
+
+/// The headers of a lone robot's run files, in the order of [`RUN_FILES`].
+fn lone_headers(dynamic: bool) -> [Option<Vec<String>>; 4] {
+    let strings = |h: &[&str]| Some(h.iter().map(|c| c.to_string()).collect());
+    [
+        strings(&episode_header(dynamic)),
+        strings(&TIMING_COLUMNS),
+        None,
+        strings(&figures::LONE_COLUMNS),
+    ]
+}
+
+/// Reads the exact figures of the first `done` episodes of the run in `dir` into `add`.
+fn restore(
+    dir: &Path,
+    done: usize,
+    add: &mut dyn FnMut(&csv::StringRecord) -> Result<(), String>,
+) -> Result<(), OutputError> {
+    let path = partial_path(&dir.join(FIGURES_FILE));
+    let bad = |message: String| OutputError::Format {
+        path: path.clone(),
+        message,
+    };
+    let mut reader = csv::ReaderBuilder::new()
+        .flexible(true)
+        .from_path(&path)
+        .map_err(|e| bad(e.to_string()))?;
+    let mut row = csv::StringRecord::new();
+    for k in 0..done {
+        let line = k + 2;
+        match reader.read_record(&mut row) {
+            Ok(true) => add(&row).map_err(|m| bad(format!("row {line}: {m}")))?,
+            Ok(false) => return Err(bad(format!("ends before row {line}"))),
+            Err(e) => return Err(bad(format!("row {line}: {e}"))),
+        }
+    }
+    Ok(())
+}
+
+/// Ends a run's files: the run files to their final names, then `summary.json`, then whether
+/// any per-episode file failed.
+fn finish(
+    writer: &RunWriter,
+    streams: Option<Streams>,
+    manifest: &RunManifest,
+    result: &RunResult,
+) -> Result<(), OutputError> {
+    let complete = !result.cancelled && result.error.is_none();
+    if let Some(s) = streams {
+        s.finish(&writer.dir, complete)?;
+    }
+    manifest.write(&writer.dir.join("summary.json"))?;
+    match writer.episode_errors() {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
 }
 
 fn manifest(
@@ -361,7 +810,7 @@ fn manifest(
         schema_version: SCHEMA_VERSION,
         ronap_version: env!("CARGO_PKG_VERSION").to_string(),
         policy: info.policy.clone(),
-        seed_start: options.seeds.first().copied().unwrap_or(0),
+        seed_start: options.seeds.first().unwrap_or(0),
         seeds_requested: options.seeds.len() as u64,
         threads: options.threads,
         scenes: info.scenes.clone(),
@@ -388,27 +837,32 @@ pub const TEAM_COLUMNS: [&str; 10] = [
     "deadlock",
 ];
 
+/// The team `episodes.csv` row of `r`.
+pub fn team_episode_row(r: &TeamRecord) -> Vec<String> {
+    vec![
+        r.seed.to_string(),
+        r.outcome.name().to_string(),
+        r.robots.len().to_string(),
+        r.robots
+            .iter()
+            .filter(|x| x.outcome == Outcome::Success)
+            .count()
+            .to_string(),
+        r.steps.to_string(),
+        r.makespan.map_or(String::new(), |m| m.to_string()),
+        format!("{:.3}", r.path_length_px),
+        r.collisions.to_string(),
+        r.robot_collisions.to_string(),
+        r.deadlock.to_string(),
+    ]
+}
+
 /// Writes a team run's `episodes.csv`: one row per team episode.
 pub fn write_team_episodes(records: &[TeamRecord], out: &mut dyn Write) -> std::io::Result<()> {
     let mut w = csv::Writer::from_writer(out);
     w.write_record(TEAM_COLUMNS)?;
     for r in records {
-        w.write_record([
-            r.seed.to_string(),
-            r.outcome.name().to_string(),
-            r.robots.len().to_string(),
-            r.robots
-                .iter()
-                .filter(|x| x.outcome == Outcome::Success)
-                .count()
-                .to_string(),
-            r.steps.to_string(),
-            r.makespan.map_or(String::new(), |m| m.to_string()),
-            format!("{:.3}", r.path_length_px),
-            r.collisions.to_string(),
-            r.robot_collisions.to_string(),
-            r.deadlock.to_string(),
-        ])?;
+        w.write_record(team_episode_row(r))?;
     }
     w.flush()
 }
@@ -441,13 +895,12 @@ pub const ROBOT_COLUMNS: [&str; 24] = [
     "reason",
 ];
 
-/// Writes a team run's `robots.csv`: one row per robot of every episode.
-pub fn write_robots(records: &[TeamRecord], out: &mut dyn Write) -> std::io::Result<()> {
-    let mut w = csv::Writer::from_writer(out);
-    w.write_record(ROBOT_COLUMNS)?;
-    for r in records {
-        for x in &r.robots {
-            w.write_record([
+/// The `robots.csv` rows of `r`: one per robot.
+pub fn robot_rows(r: &TeamRecord) -> Vec<Vec<String>> {
+    r.robots
+        .iter()
+        .map(|x| {
+            vec![
                 r.seed.to_string(),
                 x.robot.to_string(),
                 x.policy.clone(),
@@ -476,7 +929,18 @@ pub fn write_robots(records: &[TeamRecord], out: &mut dyn Write) -> std::io::Res
                 format!("{:.3}", x.goal.x),
                 format!("{:.3}", x.goal.y),
                 x.reason.clone().unwrap_or_default(),
-            ])?;
+            ]
+        })
+        .collect()
+}
+
+/// Writes a team run's `robots.csv`: one row per robot of every episode.
+pub fn write_robots(records: &[TeamRecord], out: &mut dyn Write) -> std::io::Result<()> {
+    let mut w = csv::Writer::from_writer(out);
+    w.write_record(ROBOT_COLUMNS)?;
+    for r in records {
+        for row in robot_rows(r) {
+            w.write_record(row)?;
         }
     }
     w.flush()
@@ -485,7 +949,7 @@ pub fn write_robots(records: &[TeamRecord], out: &mut dyn Write) -> std::io::Res
 /// A finished team evaluation.
 #[derive(Debug)]
 pub struct TeamEvaluation {
-    /// The records and how the run stopped.
+    /// How the run stopped (no records are kept: they went to the run files).
     pub result: TeamRunResult,
     /// The team figures.
     pub team: TeamSummary,
@@ -495,9 +959,9 @@ pub struct TeamEvaluation {
     pub write_error: Option<OutputError>,
 }
 
-/// Runs a team evaluation (robot `k` driven by `factories[k]`, named `names[k]`) and, given
-/// `dir`, writes `episodes.csv` (team rows), `robots.csv`, `timing.csv` and `summary.json` into
-/// it at the end, also after an interruption or a failing episode.
+/// Runs a team evaluation (robot `k` driven by `factories[k]`, named `names[k]`) and, given a
+/// `writer`, writes `episodes.csv` (team rows), `robots.csv` and `timing.csv` row by row in seed
+/// order as [`evaluate_into`] does, pictures as episodes finish and `summary.json` at the end.
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate_team_into(
     evaluator: &Evaluator,
@@ -505,94 +969,122 @@ pub fn evaluate_team_into(
     names: &[String],
     options: &EvalOptions,
     info: &RunInfo,
-    dir: Option<&Path>,
-    pictures: Option<Pictures>,
+    writer: Option<RunWriter>,
     cancel: &AtomicBool,
     on_record: &(dyn Fn(&TeamRecord) + Sync),
 ) -> Result<TeamEvaluation, PolicyError> {
     let mut options = options.clone();
-    options.recording.trajectory = pictures.is_some() && dir.is_some();
-    let first = options.seeds.first().copied().unwrap_or(0);
-    let picture_errors: Mutex<Vec<String>> = Mutex::new(Vec::new());
-    if let (Some(dir), Some(_)) = (dir, pictures) {
-        let png = dir.join("png");
-        if let Err(e) = std::fs::create_dir_all(&png) {
-            return Err(PolicyError::Failed(format!(
-                "cannot make {}: {e}",
-                png.display()
-            )));
+    let pictures = writer.as_ref().and_then(|w| w.files.pictures);
+    options.recording.trajectory = pictures.is_some();
+    let config = evaluator.config();
+    let first = options.seeds.first().unwrap_or(0);
+    let (mut team, mut robots) = (TeamTally::default(), Tally::default());
+    let mut write_error = None;
+    let mut streams = None;
+    let done = writer.as_ref().map_or(0, RunWriter::done);
+    let size = config.team_size();
+    if let Some(w) = &writer {
+        let plan = w.plan(config, &options, info);
+        let strings = |h: &[&str]| Some(h.iter().map(|c| c.to_string()).collect());
+        let headers = [
+            strings(&TEAM_COLUMNS),
+            strings(&TIMING_COLUMNS),
+            strings(&ROBOT_COLUMNS),
+            Some(figures::team_columns(size)),
+        ];
+        match w.open(&plan, headers) {
+            Ok(s) => streams = Some(s),
+            Err(e) => write_error = Some(e),
         }
-        if let Err(e) = remove_stale_files(dir) {
-            return Err(PolicyError::Failed(e.to_string()));
+        if write_error.is_none() && done > 0 {
+            if let Err(e) = restore(&w.dir, done, &mut |row| {
+                let (_, t, lone) = figures::parse_team(row, size)?;
+                team.add(&t);
+                for f in &lone {
+                    robots.add(f);
+                }
+                Ok(())
+            }) {
+                write_error = Some(e);
+            }
         }
     }
-    let result = evaluator.run_team(factories, names, &options, cancel, &|r: &TeamRecord| {
-        if let (Some(dir), Some(p)) = (dir, pictures) {
-            if p.wants_seed(r.seed, r.outcome, first) {
-                if let Some(img) = crate::render::team::team_image(r, 1.0) {
-                    let path = dir.join("png").join(format!(
-                        "seed-{:06}-{}.png",
-                        r.seed,
-                        r.outcome.name()
-                    ));
-                    if let Err(e) = save_image(&path, &img) {
-                        if let Ok(mut all) = picture_errors.lock() {
-                            all.push(e.to_string());
+    let (robot_steps_before, steps_before) = (team.robot_steps(), robots.steps());
+    let end = if write_error.is_some() {
+        RunEnd {
+            episodes: 0,
+            cancelled: false,
+            error: None,
+            wall_time_s: 0.0,
+        }
+    } else {
+        let rest = EvalOptions {
+            seeds: options.seeds.after(done),
+            ..options.clone()
+        };
+        let on_finish = |r: &TeamRecord| {
+            if let (Some(w), Some(p)) = (&writer, pictures) {
+                if p.wants_seed(r.seed, r.outcome, first) {
+                    if let Some(img) = crate::render::team::team_image(r, 1.0) {
+                        let path = w.dir.join("png").join(format!(
+                            "seed-{:06}-{}.png",
+                            r.seed,
+                            r.outcome.name()
+                        ));
+                        if let Err(e) = save_image(&path, &img) {
+                            w.note(e);
                         }
                     }
                 }
             }
-        }
-        on_record(r);
-    })?;
-    let options = &options;
-    let team = TeamSummary::new(&result.records, result.wall_time_s);
-    let robots: Vec<EpisodeRecord> = result
-        .records
-        .iter()
-        .flat_map(|r| r.robots.iter().map(|x| x.as_episode(r.seed)))
-        .collect();
-    let summary = Summary::new(&robots, result.wall_time_s);
-    let write_error = dir.and_then(|dir| {
-        let write = || -> Result<(), OutputError> {
-            std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
-                path: dir.to_path_buf(),
-                source,
-            })?;
-            write_atomic(&dir.join("episodes.csv"), |out| {
-                write_team_episodes(&result.records, out)
-            })?;
-            write_atomic(&dir.join("robots.csv"), |out| {
-                write_robots(&result.records, out)
-            })?;
-            write_atomic(&dir.join("timing.csv"), |out| {
-                let mut w = csv::Writer::from_writer(out);
-                w.write_record(["seed", "wall_time_ms"])?;
-                for r in &result.records {
-                    w.write_record([r.seed.to_string(), format!("{:.3}", r.wall_time_s * 1e3)])?;
-                }
-                w.flush()
-            })?;
-            let run = RunResult {
-                records: Vec::new(),
-                cancelled: result.cancelled,
-                error: result.error.clone(),
-                wall_time_s: result.wall_time_s,
-            };
-            let mut m = manifest(evaluator.config(), options, info, &run, &summary);
-            m.team = Some(team.clone());
-            m.write(&dir.join("summary.json"))?;
-            let errors = picture_errors.into_inner().unwrap_or_default();
-            match errors.first() {
-                Some(first) => Err(OutputError::Episodes {
-                    count: errors.len(),
-                    first: first.clone(),
-                }),
-                None => Ok(()),
-            }
+            on_record(r);
         };
-        write().err()
-    });
+        evaluator.stream_team(factories, names, &rest, cancel, &on_finish, &mut |r| {
+            let t = TeamFigures::of(&r);
+            let lone: Vec<Figures> = r
+                .robots
+                .iter()
+                .map(|x| Figures::of(&x.as_episode(r.seed)))
+                .collect();
+            if let Some(s) = &mut streams {
+                let rows = [
+                    vec![team_episode_row(&r)],
+                    vec![timing_row(r.seed, r.wall_time_s).to_vec()],
+                    robot_rows(&r),
+                    vec![figures::team_row(r.seed, &t, &lone)],
+                ];
+                if let Err(e) = s.add(&rows) {
+                    write_error = Some(e);
+                    return false;
+                }
+            }
+            team.add(&t);
+            for f in &lone {
+                robots.add(f);
+            }
+            true
+        })?
+    };
+    let result = TeamRunResult {
+        records: Vec::new(),
+        cancelled: end.cancelled && write_error.is_none(),
+        error: end.error,
+        wall_time_s: end.wall_time_s,
+    };
+    let wall = result.wall_time_s;
+    let team = team.summary(wall, team.robot_steps() - robot_steps_before);
+    let summary = robots.summary(wall, robots.steps() - steps_before);
+    if let (Some(w), None) = (&writer, &write_error) {
+        let run = RunResult {
+            records: Vec::new(),
+            cancelled: result.cancelled,
+            error: result.error.clone(),
+            wall_time_s: wall,
+        };
+        let mut m = manifest(config, &options, info, &run, &summary);
+        m.team = Some(team.clone());
+        write_error = finish(w, streams, &m, &run).err();
+    }
     Ok(TeamEvaluation {
         result,
         team,

@@ -1,0 +1,295 @@
+//! End-to-end tests of long runs: outputs streamed as episodes finish, a run killed with
+//! SIGKILL finished by `--resume` to the same bytes, one run per directory, a full disk.
+
+use crate::util::{ok, repo_root, ronap, rows, stderr, stdout, BIN};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// Starts `ronap` with `args` in the background.
+fn spawn(args: &[&str]) -> Child {
+    Command::new(BIN)
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Waits (up to 60 s) until `done` holds, panicking with `what` otherwise.
+fn wait_for(what: &str, done: impl Fn() -> bool) {
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while !done() {
+        assert!(Instant::now() < deadline, "timed out waiting for {what}");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+/// Lines in `path` (0 when it is missing).
+fn lines(path: &Path) -> usize {
+    std::fs::read(path).map_or(0, |b| b.iter().filter(|&&c| c == b'\n').count())
+}
+
+/// The figures of a summary.json without its wall-time fields.
+fn summary_without_times(dir: &Path) -> String {
+    std::fs::read_to_string(dir.join("summary.json"))
+        .unwrap()
+        .lines()
+        .filter(|l| !l.contains("wall_time_s") && !l.contains("steps_per_second"))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+/// Runs `args` + `--out out_full` to the end; then again into `out_killed`, killed with SIGKILL
+/// once its partial episodes.csv holds some rows, and finished with `--resume`. Checks the
+/// killed run's partial file and that the resumed run equals the uninterrupted one.
+fn kill_and_resume(args: &[&str], files: &[&str]) {
+    let dir = tempfile::tempdir().unwrap();
+    let (full, killed) = (dir.path().join("full"), dir.path().join("killed"));
+    let with_out = |out: &PathBuf| {
+        let mut a = args.to_vec();
+        a.extend(["--out", out.to_str().unwrap()]);
+        a.iter().map(|s| s.to_string()).collect::<Vec<_>>()
+    };
+    let a: Vec<String> = with_out(&full);
+    ok(&ronap(&a.iter().map(String::as_str).collect::<Vec<_>>()));
+
+    let a: Vec<String> = with_out(&killed);
+    let mut child = spawn(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let partial = killed.join("episodes.csv.partial");
+    wait_for("rows in episodes.csv.partial", || lines(&partial) > 2);
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(
+        !killed.join("episodes.csv").exists(),
+        "the run finished before it was killed: make it longer"
+    );
+    assert!(!killed.join("summary.json").exists());
+    // What the killed run left is readable: whole rows, seeds from the first, in order (a torn
+    // last line aside).
+    let text = std::fs::read_to_string(&partial).unwrap();
+    let whole = &text[..text.rfind('\n').unwrap() + 1];
+    let mut reader = csv::Reader::from_reader(whole.as_bytes());
+    for (k, row) in reader.records().enumerate() {
+        assert_eq!(row.unwrap()[0], k.to_string(), "row {k} of {text}");
+    }
+
+    let o = ronap(&["run", "--resume", killed.to_str().unwrap()]);
+    ok(&o);
+    assert!(stderr(&o).contains("resuming"), "{}", stderr(&o));
+    for file in files {
+        assert_eq!(
+            std::fs::read(full.join(file)).unwrap(),
+            std::fs::read(killed.join(file)).unwrap(),
+            "{file} differs after a resume"
+        );
+    }
+    assert_eq!(summary_without_times(&full), summary_without_times(&killed));
+    let leftovers: Vec<_> = std::fs::read_dir(&killed)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".partial"))
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+}
+
+#[cfg(unix)]
+#[test]
+fn a_run_killed_with_sigkill_is_resumed_to_the_same_bytes() {
+    // A few seconds in all, so the kill lands mid-run.
+    kill_and_resume(
+        &[
+            "run",
+            "--policy",
+            "apf",
+            "--seeds",
+            "3000",
+            "--threads",
+            "2",
+        ],
+        &["episodes.csv"],
+    );
+}
+
+#[cfg(unix)]
+#[test]
+fn a_team_run_killed_with_sigkill_is_resumed_to_the_same_bytes() {
+    // Several episodes a second: the first rows are flushed after a second, well before the end.
+    let scenario = repo_root().join("scenarios/warehouse-team.toml");
+    kill_and_resume(
+        &[
+            "run",
+            "--scenario",
+            scenario.to_str().unwrap(),
+            "--policy",
+            "random",
+            "--seeds",
+            "16",
+            "--threads",
+            "2",
+        ],
+        &["episodes.csv", "robots.csv"],
+    );
+}
+
+#[test]
+fn resuming_a_finished_run_says_so_and_changes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("r");
+    ok(&ronap(&[
+        "run",
+        "--policy",
+        "geodesic",
+        "--seeds",
+        "5",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    let before = std::fs::read(out.join("summary.json")).unwrap();
+    let o = ronap(&["run", "--resume", out.to_str().unwrap()]);
+    let text = ok(&o);
+    assert!(text.contains("already complete (5 episodes)"), "{text}");
+    assert_eq!(std::fs::read(out.join("summary.json")).unwrap(), before);
+    assert_eq!(rows(&out.join("episodes.csv")).len(), 6);
+
+    // A plan of another schema is refused by name; so is a directory without one, and other
+    // flags beside --resume.
+    let plan = out.join("run.json");
+    let text = std::fs::read_to_string(&plan).unwrap();
+    std::fs::write(
+        &plan,
+        text.replace("\"schema_version\": 1", "\"schema_version\": 99"),
+    )
+    .unwrap();
+    crate::util::assert_rejected(
+        &["run", "--resume", out.to_str().unwrap()],
+        &["run.json", "schema_version 99"],
+    );
+    std::fs::remove_file(&plan).unwrap();
+    crate::util::assert_rejected(
+        &["run", "--resume", out.to_str().unwrap()],
+        &["cannot resume", "run.json"],
+    );
+    crate::util::assert_rejected(
+        &["run", "--resume", out.to_str().unwrap(), "--seeds", "3"],
+        &["--resume", "cannot be used with"],
+    );
+}
+
+#[test]
+fn a_second_run_into_a_directory_in_use_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("busy");
+    let o = out.to_str().unwrap();
+    let mut first = spawn(&[
+        "run",
+        "--policy",
+        "random",
+        "--seeds",
+        "1000000",
+        "--threads",
+        "1",
+        "--out",
+        o,
+    ]);
+    wait_for("the first run's plan", || out.join("run.json").exists());
+    let err = crate::util::assert_rejected(
+        &["run", "--policy", "apf", "--seeds", "5", "--out", o],
+        &[
+            o,
+            "in use by another ronap run",
+            &format!("pid {}", first.id()),
+        ],
+    );
+    assert!(err.contains("choose another output directory"), "{err}");
+    // Nor may a resume take it over.
+    crate::util::assert_rejected(&["run", "--resume", o], &[o, "in use"]);
+    wait_for("rows in episodes.csv.partial", || {
+        lines(&out.join("episodes.csv.partial")) > 2
+    });
+    first.kill().unwrap();
+    first.wait().unwrap();
+    // The first run's rows were not mixed with anything: seeds in order from 0.
+    let text = std::fs::read_to_string(out.join("episodes.csv.partial")).unwrap();
+    let whole = &text[..text.rfind('\n').unwrap() + 1];
+    let mut reader = csv::Reader::from_reader(whole.as_bytes());
+    for (k, row) in reader.records().enumerate() {
+        assert_eq!(row.unwrap()[0], k.to_string());
+    }
+    // Once the holder is gone, the directory is free again.
+    ok(&ronap(&[
+        "run", "--policy", "apf", "--seeds", "3", "--out", o,
+    ]));
+    assert_eq!(rows(&out.join("episodes.csv")).len(), 4);
+}
+
+/// A 64 KiB tmpfs mounted for the length of a test (root only).
+struct SmallDisk(PathBuf);
+
+impl SmallDisk {
+    fn mount(at: &Path) -> Option<Self> {
+        std::fs::create_dir_all(at).unwrap();
+        let mounted = Command::new("mount")
+            .args([
+                "-t",
+                "tmpfs",
+                "-o",
+                "size=64k",
+                "tmpfs",
+                at.to_str().unwrap(),
+            ])
+            .stderr(Stdio::null())
+            .status()
+            .is_ok_and(|s| s.success());
+        mounted.then(|| Self(at.to_path_buf()))
+    }
+}
+
+impl Drop for SmallDisk {
+    fn drop(&mut self) {
+        let _ = Command::new("umount").arg(&self.0).status();
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn a_full_disk_is_one_clear_error_and_leaves_no_half_written_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(disk) = SmallDisk::mount(&dir.path().join("small")) else {
+        eprintln!("skipped: cannot mount a tmpfs here (needs root)");
+        return;
+    };
+    let out = disk.0.join("run");
+    let o = ronap(&[
+        "run",
+        "--policy",
+        "random",
+        "--seeds",
+        "20000",
+        "--max-steps",
+        "20",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}\n{}", stdout(&o));
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    for part in [
+        "No space left on device",
+        "episodes written so far are kept",
+        "--resume",
+        ".partial",
+    ] {
+        assert!(err.contains(part), "{err:?} lacks {part:?}");
+    }
+    assert!(!err.contains("panicked"), "{err}");
+    // Nothing under a final name: the partial files hold what was finished.
+    for name in ["episodes.csv", "timing.csv", "summary.json"] {
+        assert!(
+            !out.join(name).exists(),
+            "{name} was written on a full disk"
+        );
+    }
+    assert!(out.join("episodes.csv.partial").exists());
+    drop(disk);
+}

@@ -1,0 +1,262 @@
+//! `figures.csv.partial`: the exact figures of each finished episode of a run under way, one row
+//! per episode in seed order, so that a resumed run's summary equals an uninterrupted run's bit
+//! for bit (`episodes.csv` rounds its numbers). Floats are written as the hexadecimal bits of
+//! the `f64`; the file is removed once the run is complete.
+
+use crate::eval::{Figures, Outcome, RobotFigures, TeamFigures};
+use crate::sim::episode::DynamicMetrics;
+
+/// The file's name inside a run directory (it only ever exists as a partial file).
+pub const FIGURES_FILE: &str = "figures.csv";
+
+/// Columns for a lone robot's episodes.
+pub const LONE_COLUMNS: [&str; 10] = [
+    "seed",
+    "outcome",
+    "steps",
+    "collisions",
+    "path_length_bits",
+    "spl_bits",
+    "return_bits",
+    "dynamic_collisions",
+    "min_clearance_bits",
+    "near_steps",
+];
+
+const TEAM_BASE: [&str; 7] = [
+    "seed",
+    "outcome",
+    "deadlock",
+    "makespan",
+    "path_length_bits",
+    "collisions",
+    "robot_collisions",
+];
+
+const ROBOT_FIELDS: [&str; 6] = [
+    "outcome",
+    "steps",
+    "collisions",
+    "path_length_bits",
+    "spl_bits",
+    "return_bits",
+];
+
+/// Columns for team episodes of `robots` robots.
+pub fn team_columns(robots: usize) -> Vec<String> {
+    let mut columns: Vec<String> = TEAM_BASE.iter().map(|c| c.to_string()).collect();
+    for k in 0..robots {
+        columns.extend(ROBOT_FIELDS.iter().map(|f| format!("robot{k}_{f}")));
+    }
+    columns
+}
+
+fn bits(x: f64) -> String {
+    format!("{:016x}", x.to_bits())
+}
+
+/// The row of a lone robot's episode of `seed`.
+pub fn lone_row(seed: u64, f: &Figures) -> Vec<String> {
+    let mut row = vec![
+        seed.to_string(),
+        f.outcome.name().to_string(),
+        f.steps.to_string(),
+        f.collisions.to_string(),
+        bits(f.path_length_px),
+        bits(f.spl),
+        bits(f.total_reward),
+    ];
+    match f.dynamic {
+        Some(d) => row.extend([
+            d.collisions.to_string(),
+            bits(d.min_clearance_px),
+            d.near_steps.to_string(),
+        ]),
+        None => row.extend([String::new(), String::new(), String::new()]),
+    }
+    row
+}
+
+/// The row of a team episode of `seed`: the team's figures, then each robot's (`robots[k]`).
+pub fn team_row(seed: u64, team: &TeamFigures, robots: &[Figures]) -> Vec<String> {
+    let mut row = vec![
+        seed.to_string(),
+        team.outcome.name().to_string(),
+        u8::from(team.deadlock).to_string(),
+        team.makespan.map_or(String::new(), |m| m.to_string()),
+        bits(team.path_length_px),
+        team.collisions.to_string(),
+        team.robot_collisions.to_string(),
+    ];
+    for r in robots {
+        row.extend([
+            r.outcome.name().to_string(),
+            r.steps.to_string(),
+            r.collisions.to_string(),
+            bits(r.path_length_px),
+            bits(r.spl),
+            bits(r.total_reward),
+        ]);
+    }
+    row
+}
+
+/// Reads fields of a row in order, naming the column of a bad one.
+struct Fields<'a> {
+    row: &'a csv::StringRecord,
+    at: usize,
+}
+
+impl Fields<'_> {
+    fn text(&mut self) -> Result<&str, String> {
+        let field = self
+            .row
+            .get(self.at)
+            .ok_or_else(|| format!("no field {}", self.at + 1))?;
+        self.at += 1;
+        Ok(field)
+    }
+
+    fn parse<T: std::str::FromStr>(&mut self) -> Result<T, String> {
+        let at = self.at + 1;
+        let text = self.text()?;
+        text.parse()
+            .map_err(|_| format!("field {at}: {text:?} is not a number"))
+    }
+
+    fn bits(&mut self) -> Result<f64, String> {
+        let at = self.at + 1;
+        let text = self.text()?;
+        u64::from_str_radix(text, 16)
+            .map(f64::from_bits)
+            .map_err(|_| format!("field {at}: {text:?} is not a float's bits"))
+    }
+
+    fn outcome(&mut self) -> Result<Outcome, String> {
+        let at = self.at + 1;
+        let text = self.text()?;
+        Outcome::from_name(text).ok_or_else(|| format!("field {at}: {text:?} is not an outcome"))
+    }
+
+    fn optional<T: std::str::FromStr>(&mut self) -> Result<Option<T>, String> {
+        if self.row.get(self.at).is_some_and(str::is_empty) {
+            self.at += 1;
+            return Ok(None);
+        }
+        self.parse().map(Some)
+    }
+}
+
+/// A lone robot's figures from `row` (made by [`lone_row`]): its seed and figures.
+pub fn parse_lone(row: &csv::StringRecord) -> Result<(u64, Figures), String> {
+    let mut f = Fields { row, at: 0 };
+    let seed = f.parse()?;
+    let figures = Figures {
+        outcome: f.outcome()?,
+        steps: f.parse()?,
+        collisions: f.parse()?,
+        path_length_px: f.bits()?,
+        spl: f.bits()?,
+        total_reward: f.bits()?,
+        dynamic: match f.optional::<u32>()? {
+            Some(collisions) => Some(DynamicMetrics {
+                collisions,
+                min_clearance_px: f.bits()?,
+                near_steps: f.parse()?,
+            }),
+            None => None,
+        },
+    };
+    Ok((seed, figures))
+}
+
+/// A team episode's figures from `row` (made by [`team_row`] for `robots` robots): its seed, the
+/// team's figures and each robot's as a lone robot's.
+pub fn parse_team(
+    row: &csv::StringRecord,
+    robots: usize,
+) -> Result<(u64, TeamFigures, Vec<Figures>), String> {
+    let mut f = Fields { row, at: 0 };
+    let seed = f.parse()?;
+    let mut team = TeamFigures {
+        outcome: f.outcome()?,
+        deadlock: f.parse::<u8>()? != 0,
+        makespan: f.optional()?,
+        path_length_px: f.bits()?,
+        collisions: f.parse()?,
+        robot_collisions: f.parse()?,
+        robots: Vec::with_capacity(robots),
+    };
+    let mut lone = Vec::with_capacity(robots);
+    for _ in 0..robots {
+        let r = Figures {
+            outcome: f.outcome()?,
+            steps: f.parse()?,
+            collisions: f.parse()?,
+            path_length_px: f.bits()?,
+            spl: f.bits()?,
+            total_reward: f.bits()?,
+            dynamic: None,
+        };
+        team.robots.push(RobotFigures {
+            outcome: r.outcome,
+            steps: r.steps,
+            spl: r.spl,
+        });
+        lone.push(r);
+    }
+    Ok((seed, team, lone))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn figures_come_back_bit_for_bit() {
+        let lone = Figures {
+            outcome: Outcome::Stuck,
+            steps: 17,
+            collisions: 3,
+            path_length_px: 0.1 + 0.2,
+            spl: -0.0,
+            total_reward: -1.0e-300,
+            dynamic: Some(DynamicMetrics {
+                collisions: 2,
+                min_clearance_px: f64::INFINITY,
+                near_steps: 5,
+            }),
+        };
+        let row = csv::StringRecord::from(lone_row(9, &lone));
+        let (seed, back) = parse_lone(&row).expect("parses");
+        assert_eq!(seed, 9);
+        assert_eq!(back.spl.to_bits(), (-0.0f64).to_bits());
+        assert_eq!(back.path_length_px.to_bits(), (0.1f64 + 0.2).to_bits());
+        assert_eq!(back, lone);
+        let plain = Figures {
+            dynamic: None,
+            ..lone
+        };
+        let row = csv::StringRecord::from(lone_row(1, &plain));
+        assert_eq!(parse_lone(&row).expect("parses").1, plain);
+
+        let team = TeamFigures {
+            outcome: Outcome::Deadlock,
+            deadlock: true,
+            makespan: None,
+            path_length_px: 12.5,
+            collisions: 1,
+            robot_collisions: 4,
+            robots: vec![RobotFigures {
+                outcome: Outcome::Stuck,
+                steps: 17,
+                spl: -0.0,
+            }],
+        };
+        let row = csv::StringRecord::from(team_row(4, &team, &[plain]));
+        assert_eq!(row.len(), team_columns(1).len());
+        let (seed, t, robots) = parse_team(&row, 1).expect("parses");
+        assert_eq!((seed, &t, robots.as_slice()), (4, &team, &[plain][..]));
+        assert!(parse_team(&row, 2).is_err());
+    }
+}
