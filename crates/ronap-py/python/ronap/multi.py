@@ -41,7 +41,7 @@ class MultiNavEnv(_Base):  # type: ignore[misc,valid-type]
 
     Configure it as ``NavEnv``: ``scenario`` (a TOML file or a nested dict with ``robots``
     entries), ``config`` and keyword overrides. ``reset(seed=s)`` plays team episode ``s``,
-    the same as ``ronap run --scenario ... `` seed ``s``.
+    the same as seed ``s`` of ``ronap run --scenario``.
     """
 
     metadata = {"name": "ronap_multi_nav_v0", "render_modes": ["rgb_array"], "render_fps": 30}
