@@ -164,3 +164,25 @@ def test_mazes_as_arrays():
     small = ronap.maze_occupancy(7, scale=0.5)
     assert np.array_equal(small, np.all(img == 0, axis=-1))
     assert set(ronap.policies()) == {"apf", "geodesic", "geodesic-wait", "random"}
+
+
+def test_out_of_range_counts_and_seeds_are_config_errors_naming_them():
+    cases = [
+        (lambda: ronap.VecNavEnv(-1), "num_envs = -1"),
+        (lambda: ronap.VecNavEnv(0), "num_envs = 0"),
+        (lambda: ronap.VecNavEnv(2.5), "num_envs = 2.5"),
+        (lambda: ronap.VecNavEnv(2, threads=-3), "threads = -3"),
+        (lambda: ronap.VecNavEnv(2).reset(seed=-1), "seed = -1"),
+        (lambda: ronap.NavEnv().reset(seed=-1), "seed = -1"),
+        (lambda: ronap.NavEnv().reset(seed=2**64), "seed = 18446744073709551616"),
+        (lambda: ronap.evaluate("apf", seeds=[3, -1]), "seeds[1] = -1"),
+        (lambda: ronap.evaluate("apf", seeds=[True]), "seeds[0] = True"),
+        (lambda: ronap.evaluate("apf", seeds=5), "seeds = 5"),
+        (lambda: ronap.compare(["apf", "random"], seeds=[1.5]), "seeds[0] = 1.5"),
+    ]
+    for make, named in cases:
+        with pytest.raises(ronap.ConfigError) as e:
+            make()
+        assert named in str(e.value), (named, str(e.value))
+    # Whole floats and numpy integers are whole numbers.
+    assert ronap.evaluate("apf", seeds=[np.int64(1), 2.0])["summary"]["episodes"] == 2

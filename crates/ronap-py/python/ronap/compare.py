@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any, Callable, Iterable, Mapping, Sequence
 
 from . import _ronap
-from .config import ScenarioLike, checked_config
+from .config import ScenarioLike, checked_config, checked_seeds
 
 
 def compare(
@@ -50,7 +50,7 @@ def compare(
     ``disagreements.png``, ``seeds.csv``, ``compare.json``, ``report.md`` and ``report.html``.
     The configuration is given as for ``evaluate``.
     """
-    seeds = [int(s) for s in seeds]
+    seeds = checked_seeds(seeds)
     command = _call(policies, seeds, scenario=scenario, config=config, maze_seed=maze_seed, map=map,
                     continuous=continuous, runs=list(runs), by_difficulty=by_difficulty, bins=bins,
                     resamples=resamples, **fields)

@@ -117,3 +117,28 @@ def _merged(
             raise ConfigError(f"keyword {name!r}: expected section_field, e.g. maze_cols")
         _merge(merged, section, field, value)
     return merged
+
+
+_U64 = 2**64
+
+
+def checked_int(name: str, value: Any, least: int = 0, below: int = _U64) -> int:
+    """``value`` as an int in ``[least, below)``, else a ``ConfigError`` naming ``name`` and the
+    value (bools, floats with a fraction and out-of-range numbers included)."""
+    if isinstance(value, bool) or not hasattr(value, "__index__"):
+        if not (isinstance(value, float) and value.is_integer()):
+            raise ConfigError(f"{name} = {value!r}: expected a whole number")
+    number = int(value)
+    if not least <= number < below:
+        high = "2^64 - 1" if below == _U64 else str(below - 1)
+        raise ConfigError(f"{name} = {value!r}: must be between {least} and {high}")
+    return number
+
+
+def checked_seeds(seeds: Any) -> list[int]:
+    """Episode seeds as a list of ints in ``[0, 2^64)``; a ``ConfigError`` names the first bad one."""
+    try:
+        items = list(seeds)
+    except TypeError:
+        raise ConfigError(f"seeds = {seeds!r}: expected an iterable of whole numbers (e.g. range(1000))") from None
+    return [checked_int(f"seeds[{i}]", s) for i, s in enumerate(items)]

@@ -12,7 +12,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from . import _ronap
-from .config import ScenarioLike, checked_config
+from .config import ScenarioLike, checked_config, checked_int
 
 _SEED_LIMIT = 2**63
 
@@ -77,6 +77,8 @@ class NavEnv(gym.Env):
             self.action_space = spaces.Discrete(3)
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        if seed is not None:
+            seed = checked_int("seed", seed)
         super().reset(seed=seed)
         episode_seed = seed if seed is not None else int(self.np_random.integers(0, _SEED_LIMIT))
         return self._env.reset(int(episode_seed))
@@ -122,6 +124,8 @@ class VecNavEnv(VectorEnv):
         threads: int = 0,
         **fields: Any,
     ) -> None:
+        num_envs = checked_int("num_envs", num_envs, least=1, below=2**31)
+        threads = checked_int("threads", threads, below=2**16)
         checked = checked_config(config, fields, scenario)
         self.config = json.loads(checked.json)
         self._vec = _ronap.VecEnv(num_envs, checked, maze_seed, None if map is None else str(map), threads)
@@ -145,7 +149,8 @@ class VecNavEnv(VectorEnv):
         elif not isinstance(seed, (int, np.integer)):
             raise _ronap.ConfigError(f"seed {seed!r}: VecNavEnv takes one int (environment i gets seed + i)")
         else:
-            self._rng = np.random.default_rng(int(seed))
+            seed = checked_int("seed", seed)
+            self._rng = np.random.default_rng(seed)
         obs, infos = self._vec.reset(int(seed))
         return obs, self._infos(infos)
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any, Callable, Iterable, Mapping
 
 from . import _ronap
-from .config import ScenarioLike, checked_config
+from .config import ScenarioLike, checked_config, checked_seeds
 
 
 def evaluate(
@@ -53,7 +53,7 @@ def evaluate(
     A policy that raises or returns an invalid action or NaN raises ``PolicyError`` naming the seed
     and step.
     """
-    seeds = [int(s) for s in seeds]
+    seeds = checked_seeds(seeds)
     return _ronap.evaluate(
         policy,
         seeds,

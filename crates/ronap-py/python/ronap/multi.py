@@ -9,7 +9,7 @@ import numpy as np
 from gymnasium import spaces
 
 from . import _ronap
-from .config import ScenarioLike, checked_config
+from .config import ScenarioLike, checked_config, checked_int
 
 try:  # PettingZoo is optional: without it MultiNavEnv still works, as a plain class.
     from pettingzoo import ParallelEnv as _Base
@@ -102,12 +102,10 @@ class MultiNavEnv(_Base):  # type: ignore[misc,valid-type]
         self, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, np.ndarray], dict[str, dict[str, Any]]]:
         if seed is not None:
-            self._rng = np.random.default_rng(seed)
-            episode_seed = int(seed)
+            episode_seed = checked_int("seed", seed)
+            self._rng = np.random.default_rng(episode_seed)
         else:
             episode_seed = int(self._rng.integers(0, _SEED_LIMIT))
-        if not 0 <= episode_seed < 2**64:
-            raise _ronap.ConfigError(f"seed = {seed}: must be between 0 and 2^64 - 1")
         self.seed_used = episode_seed
         obs, infos = self._env.reset(episode_seed)
         self.agents = list(self.possible_agents)
@@ -219,10 +217,8 @@ class VecMultiNavEnv:
         threads: int = 0,
         **fields: Any,
     ) -> None:
-        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)) or num_envs < 1:
-            raise _ronap.ConfigError(f"num_envs = {num_envs!r}: must be an integer of at least 1")
-        if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 0:
-            raise _ronap.ConfigError(f"threads = {threads!r}: must be an integer of at least 0")
+        num_envs = checked_int("num_envs", num_envs, least=1, below=2**31)
+        threads = checked_int("threads", threads, below=2**16)
         checked = checked_config(config, fields, scenario)
         self._vec = _ronap.VecMultiEnv(int(num_envs), checked, maze_seed, None if map is None else str(map), int(threads))
         self.config = json.loads(checked.json)
@@ -236,10 +232,9 @@ class VecMultiNavEnv:
         self._started = False
 
     def reset(self, seed: int = 0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-        if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= seed < 2**64:
-            raise _ronap.ConfigError(f"seed = {seed!r}: must be an integer between 0 and 2^64 - 1")
+        seed = checked_int("seed", seed)
         self._started = True
-        return self._vec.reset(int(seed))
+        return self._vec.reset(seed)
 
     def step(
         self, actions: Any, messages: Any = None
