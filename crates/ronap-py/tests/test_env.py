@@ -186,3 +186,19 @@ def test_out_of_range_counts_and_seeds_are_config_errors_naming_them():
         assert named in str(e.value), (named, str(e.value))
     # Whole floats and numpy integers are whole numbers.
     assert ronap.evaluate("apf", seeds=[np.int64(1), 2.0])["summary"]["episodes"] == 2
+
+
+def test_vec_env_refuses_step_before_reset_and_fractional_actions():
+    vec = ronap.VecNavEnv(2)
+    with pytest.raises(ronap.RonapError, match="before reset"):
+        vec.step(np.array([1, 1]))
+    vec.reset(seed=0)
+    with pytest.raises(ronap.ActionError, match="2.5 for environment 0"):
+        vec.step(np.array([2.5, 1.0]))
+    with pytest.raises(ronap.ActionError, match="dtype bool"):
+        vec.step(np.array([True, False]))
+    vec.step(np.array([1.0, 2.0]))  # whole floats are whole actions
+    env = ronap.NavEnv()
+    env.reset(seed=0)
+    with pytest.raises(ronap.ActionError, match="bool"):
+        env.step(True)

@@ -84,6 +84,8 @@ class NavEnv(gym.Env):
         return self._env.reset(int(episode_seed))
 
     def step(self, action):
+        if isinstance(action, (bool, np.bool_)):
+            raise _ronap.ActionError(f"action {action!r}: expected 0 (LEFT), 1 (AHEAD) or 2 (RIGHT), not a bool")
         if self.continuous:
             scaled = np.asarray(action, dtype=np.float64)
             if scaled.shape != (2,):
@@ -137,6 +139,7 @@ class VecNavEnv(VectorEnv):
         self.action_space = batch_space(self.single_action_space, num_envs)
         self._mask = np.ones(num_envs, dtype=bool)
         self._rng = np.random.default_rng()
+        self._started = False
 
     def _infos(self, infos: dict) -> dict:
         for key in list(infos):
@@ -152,10 +155,22 @@ class VecNavEnv(VectorEnv):
             seed = checked_int("seed", seed)
             self._rng = np.random.default_rng(seed)
         obs, infos = self._vec.reset(int(seed))
+        self._started = True
         return obs, self._infos(infos)
 
     def step(self, actions):
+        if not self._started:
+            raise _ronap.RonapError("step() before reset(): call reset(seed=...) first")
         actions = np.asarray(actions)
+        if actions.dtype.kind == "b" or actions.dtype.kind not in "iuf":
+            raise _ronap.ActionError(f"actions of dtype {actions.dtype}: expected integers 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)")
+        if actions.dtype.kind == "f":
+            whole = np.isfinite(actions) & (actions == np.round(actions))
+            if not np.all(whole):
+                bad = int(np.argmin(whole.reshape(-1)))
+                raise _ronap.ActionError(
+                    f"action {float(actions.reshape(-1)[bad])} for environment {bad}: expected 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)"
+                )
         if actions.dtype != np.int64:
             actions = actions.astype(np.int64)
         obs, rewards, terminated, truncated, infos = self._vec.step(actions)
