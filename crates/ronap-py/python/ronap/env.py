@@ -61,6 +61,19 @@ class NavEnv(gym.Env):
             raise _ronap.ConfigError(f"render_view {render_view!r}: expected 'top' or 'first_person'")
         checked = checked_config(config, fields, scenario)
         self._env = _ronap.Env(checked, maze_seed, None if map is None else str(map), continuous)
+        # What pickling needs to build this environment again (see __getstate__).
+        self._init_args = dict(
+            render_mode=render_mode,
+            scenario=scenario,
+            config=config,
+            continuous=continuous,
+            maze_seed=maze_seed,
+            map=map,
+            render_view=render_view,
+            render_scale=render_scale,
+            **fields,
+        )
+        self._episode: tuple[int, list[Any]] | None = None
         self.config = json.loads(checked.json)
         self.render_mode = render_mode
         self.render_view = render_view
@@ -81,6 +94,7 @@ class NavEnv(gym.Env):
             seed = checked_int("seed", seed)
         super().reset(seed=seed)
         episode_seed = seed if seed is not None else int(self.np_random.integers(0, _SEED_LIMIT))
+        self._episode = (int(episode_seed), [])
         return self._env.reset(int(episode_seed))
 
     def step(self, action):
@@ -91,7 +105,26 @@ class NavEnv(gym.Env):
             if scaled.shape != (2,):
                 raise _ronap.ActionError(f"action {action!r}: expected two numbers in [-1, 1]")
             action = (scaled * self._action_scale).tolist()
-        return self._env.step(action)
+        result = self._env.step(action)
+        if self._episode is not None:
+            self._episode[1].append(action)
+        return result
+
+    def __getstate__(self) -> dict[str, Any]:
+        """How to build this environment again and replay its episode so far: the model is
+        deterministic, so the copy continues exactly where this one is (for Ray, multiprocessing
+        and copy.deepcopy). A scenario given as a file is read again where the copy is made."""
+        return {"init": self._init_args, "episode": self._episode, "np_random": self._np_random}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__(**state["init"])  # type: ignore[misc]
+        self._np_random = state["np_random"]
+        if state["episode"] is not None:
+            seed, actions = state["episode"]
+            self._env.reset(seed)
+            for action in actions:
+                self._env.step(action)
+            self._episode = (seed, list(actions))
 
     def render(self):
         if self.render_mode != "rgb_array":
