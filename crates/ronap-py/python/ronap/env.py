@@ -194,17 +194,25 @@ class VecNavEnv(VectorEnv):
     def step(self, actions):
         if not self._started:
             raise _ronap.RonapError("step() before reset(): call reset(seed=...) first")
-        actions = np.asarray(actions)
-        if actions.dtype.kind == "b" or actions.dtype.kind not in "iuf":
-            raise _ronap.ActionError(f"actions of dtype {actions.dtype}: expected integers 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)")
-        if actions.dtype.kind == "f":
-            whole = np.isfinite(actions) & (actions == np.round(actions))
-            if not np.all(whole):
-                bad = int(np.argmin(whole.reshape(-1)))
-                raise _ronap.ActionError(
-                    f"action {float(actions.reshape(-1)[bad])} for environment {bad}: expected 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)"
-                )
-        if actions.dtype != np.int64:
-            actions = actions.astype(np.int64)
+        actions = discrete_actions(actions, (self.num_envs,))
         obs, rewards, terminated, truncated, infos = self._vec.step(actions)
         return obs, rewards, terminated, truncated, self._infos(infos)
+
+
+def discrete_actions(actions: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """``actions`` as a contiguous int64 array of ``shape``: integers, or whole floats; an
+    ``ActionError`` names a wrong shape, dtype or fractional value (and where it is)."""
+    a = np.asarray(actions)
+    if a.shape != shape:
+        raise _ronap.ActionError(f"actions of shape {a.shape}: expected {shape}")
+    if a.dtype.kind not in "iuf":
+        raise _ronap.ActionError(f"actions of dtype {a.dtype}: expected integers 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)")
+    if a.dtype.kind == "f":
+        whole = (np.isfinite(a) & (a == np.round(a))).reshape(-1)
+        if not np.all(whole):
+            bad = int(np.argmin(whole))
+            where = np.unravel_index(bad, shape)
+            raise _ronap.ActionError(
+                f"action {float(a.reshape(-1)[bad])} at {tuple(int(i) for i in where)}: expected 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)"
+            )
+    return np.ascontiguousarray(a, dtype=np.int64)

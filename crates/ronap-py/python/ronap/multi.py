@@ -10,6 +10,7 @@ from gymnasium import spaces
 
 from . import _ronap
 from .config import ScenarioLike, checked_config, checked_int
+from .env import discrete_actions
 
 try:  # PettingZoo is optional: without it MultiNavEnv still works, as a plain class.
     from pettingzoo import ParallelEnv as _Base
@@ -241,21 +242,15 @@ class VecMultiNavEnv:
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, np.ndarray]]:
         if not self._started:
             raise _ronap.RonapError("step() before reset()")
-        a = np.asarray(actions)
         shape = (self.num_envs, self.num_agents)
-        if a.shape != shape:
-            raise _ronap.ActionError(f"actions of shape {a.shape}: expected {shape}")
-        if a.dtype.kind == "f" and not np.all(np.isfinite(a) & (a == np.round(a))):
-            raise _ronap.ActionError("actions: expected whole numbers 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)")
-        if a.dtype.kind not in "iuf":
-            raise _ronap.ActionError(f"actions of dtype {a.dtype}: expected integers 0, 1 or 2")
+        a = discrete_actions(actions, shape)
         flat_messages = None
         if messages is not None:
             m = np.ascontiguousarray(messages, dtype=np.float32)
             if m.shape != (*shape, self.message_size):
                 raise _ronap.ActionError(f"messages of shape {m.shape}: expected {(*shape, self.message_size)}")
             flat_messages = m.reshape(-1)
-        return self._vec.step(np.ascontiguousarray(a, dtype=np.int64).reshape(-1), flat_messages)
+        return self._vec.step(a.reshape(-1), flat_messages)
 
     def close(self) -> None:
         pass
