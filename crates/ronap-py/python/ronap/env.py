@@ -89,7 +89,9 @@ class NavEnv(gym.Env):
         else:
             self.action_space = spaces.Discrete(3)
 
-    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
         if seed is not None:
             seed = checked_int("seed", seed)
         super().reset(seed=seed)
@@ -97,7 +99,7 @@ class NavEnv(gym.Env):
         self._episode = (int(episode_seed), [])
         return self._env.reset(int(episode_seed))
 
-    def step(self, action):
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         if isinstance(action, (bool, np.bool_)):
             raise _ronap.ActionError(f"action {action!r}: expected 0 (LEFT), 1 (AHEAD) or 2 (RIGHT), not a bool")
         if self.continuous:
@@ -126,7 +128,7 @@ class NavEnv(gym.Env):
                 self._env.step(action)
             self._episode = (seed, list(actions))
 
-    def render(self):
+    def render(self) -> np.ndarray | None:  # type: ignore[override]
         if self.render_mode != "rgb_array":
             return None
         if self.render_view == "top":
@@ -174,12 +176,14 @@ class VecNavEnv(VectorEnv):
         self._rng = np.random.default_rng()
         self._started = False
 
-    def _infos(self, infos: dict) -> dict:
+    def _infos(self, infos: dict[str, Any]) -> dict[str, Any]:
         for key in list(infos):
             infos["_" + key] = self._mask
         return infos
 
-    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
         if seed is None:
             seed = int(self._rng.integers(0, _SEED_LIMIT))
         elif not isinstance(seed, (int, np.integer)):
@@ -191,7 +195,7 @@ class VecNavEnv(VectorEnv):
         self._started = True
         return obs, self._infos(infos)
 
-    def step(self, actions):
+    def step(self, actions: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         if not self._started:
             raise _ronap.RonapError("step() before reset(): call reset(seed=...) first")
         actions = discrete_actions(actions, (self.num_envs,))
