@@ -224,3 +224,11 @@ def test_nav_env_pickles_mid_episode_and_goes_on_the_same():
             break
     # The seed generator travels too: the next unseeded episodes agree.
     np.testing.assert_array_equal(env.reset()[0], copy.reset()[0])
+
+
+def test_make_vec_vector_entry_point_steps_in_rust():
+    vec = gym.make_vec("ronap/Nav-v0", num_envs=4, vectorization_mode="vector_entry_point", maze_cols=5)
+    assert isinstance(vec, ronap.VecNavEnv) and vec.num_envs == 4
+    obs, _ = vec.reset(seed=3)
+    direct = ronap.VecNavEnv(4, maze_cols=5)
+    np.testing.assert_array_equal(obs, direct.reset(seed=3)[0])

@@ -61,7 +61,11 @@ def _register() -> None:
     import gymnasium
 
     if "ronap/Nav-v0" not in gymnasium.registry:
-        gymnasium.register(id="ronap/Nav-v0", entry_point="ronap.env:NavEnv")
+        gymnasium.register(
+            id="ronap/Nav-v0",
+            entry_point="ronap.env:NavEnv",
+            vector_entry_point="ronap.env:VecNavEnv",
+        )
 
 
 _register()
