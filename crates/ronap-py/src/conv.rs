@@ -242,14 +242,19 @@ pub fn action(value: &Bound<'_, PyAny>, continuous: bool) -> Result<Action, Stri
             _ => Err("expected two finite numbers (v, w)".into()),
         };
     }
-    match value.extract::<i64>() {
-        Ok(i) => usize::try_from(i)
-            .ok()
-            .and_then(DiscreteAction::from_index)
-            .map(Action::from)
-            .ok_or_else(|| DISCRETE.to_string()),
-        Err(_) => Err(DISCRETE.to_string()),
-    }
+    value
+        .extract::<i64>()
+        .ok()
+        .and_then(discrete)
+        .ok_or_else(|| DISCRETE.to_string())
+}
+
+/// The discrete action of index `i` (0 LEFT, 1 AHEAD, 2 RIGHT), if it is one.
+pub fn discrete(i: i64) -> Option<Action> {
+    usize::try_from(i)
+        .ok()
+        .and_then(DiscreteAction::from_index)
+        .map(Action::from)
 }
 
 /// The action a Python policy returned, or what is wrong with it (`returned X, expected ...`).

@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use ronap_core::run::team::TeamRollout;
 use ronap_core::run::team_batch::{RobotStep, TeamBatch};
-use ronap_core::sim::robot::{Action, DiscreteAction};
+use ronap_core::sim::robot::Action;
 use ronap_core::sim::team::Team;
 use ronap_core::sim::world::Worlds;
 use ronap_core::Point;
@@ -375,18 +375,14 @@ impl VecMultiEnv {
             .iter()
             .enumerate()
             .map(|(j, &a)| {
-                usize::try_from(a)
-                    .ok()
-                    .and_then(DiscreteAction::from_index)
-                    .map(Action::from)
-                    .ok_or_else(|| {
-                        ActionError::new_err(format!(
-                            "action {a} for environment {}, robot_{}: expected 0 (LEFT), \
+                conv::discrete(a).ok_or_else(|| {
+                    ActionError::new_err(format!(
+                        "action {a} for environment {}, robot_{}: expected 0 (LEFT), \
                              1 (AHEAD) or 2 (RIGHT)",
-                            j / r,
-                            j % r
-                        ))
-                    })
+                        j / r,
+                        j % r
+                    ))
+                })
             })
             .collect::<PyResult<Vec<Action>>>()?;
         let messages = match &messages {

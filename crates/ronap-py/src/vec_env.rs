@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use ronap_core::run::batch::{Autoreset, Batch, BatchOptions, EnvStep, SeedOrder};
 use ronap_core::sim::world::Worlds;
-use ronap_core::{Action, DiscreteAction, Status};
+use ronap_core::{Action, Status};
 
 /// Many RoNAP environments stepped together.
 #[pyclass(module = "ronap._ronap")]
@@ -109,16 +109,12 @@ impl VecEnv {
             .iter()
             .enumerate()
             .map(|(i, &a)| {
-                usize::try_from(a)
-                    .ok()
-                    .and_then(DiscreteAction::from_index)
-                    .map(Action::from)
-                    .ok_or_else(|| {
-                        errors::ActionError::new_err(format!(
-                            "action {a} for environment {i}: expected 0 (LEFT), 1 (AHEAD) or \
+                conv::discrete(a).ok_or_else(|| {
+                    errors::ActionError::new_err(format!(
+                        "action {a} for environment {i}: expected 0 (LEFT), 1 (AHEAD) or \
                              2 (RIGHT)"
-                        ))
-                    })
+                    ))
+                })
             })
             .collect::<PyResult<Vec<Action>>>()?;
         py.allow_threads(|| self.batch.step_actions(&actions))

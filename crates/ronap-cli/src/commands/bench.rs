@@ -104,20 +104,7 @@ impl Bench {
     /// Steps episodes for `duration` on `threads` threads, starting a new placement whenever one
     /// ends; returns steps per second.
     fn steps_per_second(&self, threads: usize, duration: Duration) -> Result<f64> {
-        let start = Instant::now();
-        let total: u64 = std::thread::scope(|s| {
-            let handles: Vec<_> = (0..threads)
-                .map(|t| s.spawn(move || self.step_for(t as u64 * 1_000_000, duration)))
-                .collect();
-            handles
-                .into_iter()
-                .map(|h| {
-                    h.join()
-                        .unwrap_or_else(|_| Err(anyhow::anyhow!("a bench thread panicked")))
-                })
-                .sum::<Result<u64>>()
-        })?;
-        Ok(total as f64 / start.elapsed().as_secs_f64())
+        per_second_on(threads, |first_seed| self.step_for(first_seed, duration))
     }
 
     /// Steps episodes for `duration`, from `first_seed` on; returns the number of steps.
@@ -172,25 +159,9 @@ impl Bench {
             per_step * 1e3,
             group(robots as f64 / per_step)
         )?;
-        let start = Instant::now();
-        let total: u64 = std::thread::scope(|s| {
-            let handles: Vec<_> = (0..threads)
-                .map(|t| {
-                    s.spawn(move || {
-                        self.team_steps_for(t as u64 * 1_000_000, duration)
-                            .map(|r| r.0)
-                    })
-                })
-                .collect();
-            handles
-                .into_iter()
-                .map(|h| {
-                    h.join()
-                        .unwrap_or_else(|_| Err(anyhow::anyhow!("a bench thread panicked")))
-                })
-                .sum::<Result<u64>>()
+        let rate = per_second_on(threads, |first_seed| {
+            self.team_steps_for(first_seed, duration).map(|r| r.0)
         })?;
-        let rate = total as f64 / start.elapsed().as_secs_f64();
         writeln!(
             out,
             "  {threads} thread{}        {:>14} team steps/s ({} robot-steps/s)",
@@ -261,6 +232,26 @@ impl Bench {
         }
         Ok(start.elapsed().as_secs_f64() * 1e9 / scans as f64)
     }
+}
+
+/// Runs `count(first_seed)` on each of `threads` threads at once (thread `t` from seed
+/// `t * 1,000,000`) and returns the summed count per second of wall time.
+fn per_second_on(threads: usize, count: impl Fn(u64) -> Result<u64> + Sync) -> Result<f64> {
+    let start = Instant::now();
+    let count = &count;
+    let total: u64 = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..threads)
+            .map(|t| s.spawn(move || count(t as u64 * 1_000_000)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| {
+                h.join()
+                    .unwrap_or_else(|_| Err(anyhow::anyhow!("a bench thread panicked")))
+            })
+            .sum::<Result<u64>>()
+    })?;
+    Ok(total as f64 / start.elapsed().as_secs_f64())
 }
 
 /// Runs `ronap bench`.
