@@ -1519,11 +1519,12 @@ pub struct ConfigFile {
 impl ConfigFile {
     /// Reads `path` (not yet parsed).
     pub fn read(path: &std::path::Path) -> Result<Self, ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ConfigError::File {
-            path: path.to_path_buf(),
-            line: None,
-            message: format!("cannot read: {e}"),
-        })?;
+        let text = crate::io::bounded::read_to_string(path, crate::io::bounded::TEXT_LIMIT)
+            .map_err(|e| ConfigError::File {
+                path: path.to_path_buf(),
+                line: None,
+                message: format!("cannot read: {e}"),
+            })?;
         Ok(Self {
             path: path.to_path_buf(),
             text,

@@ -563,7 +563,8 @@ type Places = Vec<[String; 5]>;
 
 fn read_episodes(path: &Path) -> Result<(Vec<SeedResult>, Places), String> {
     let what = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
-    let mut reader = csv::Reader::from_path(path).map_err(|e| what(&e))?;
+    let mut reader =
+        csv::Reader::from_reader(crate::io::bounded::open_lines(path).map_err(|e| what(&e))?);
     let headers = reader.headers().map_err(|e| what(&e))?.clone();
     let column = |name: &str| {
         headers

@@ -243,10 +243,16 @@ pub enum DataLogError {
 
 /// Reads a data log of either [`Format`] into observations for a laser of `range_px`.
 pub fn read(path: &Path, range_px: f64) -> Result<(DataSet, Format), DataLogError> {
-    let text = std::fs::read_to_string(path).map_err(|source| DataLogError::Io {
+    let io = |source| DataLogError::Io {
         path: path.to_path_buf(),
         source,
-    })?;
+    };
+    let mut text = String::new();
+    std::io::Read::read_to_string(
+        &mut crate::io::bounded::open_lines(path).map_err(io)?,
+        &mut text,
+    )
+    .map_err(io)?;
     parse(&text, path, range_px)
 }
 

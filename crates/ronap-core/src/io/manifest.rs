@@ -87,16 +87,26 @@ fn read_versioned<T: serde::de::DeserializeOwned>(
     path: &Path,
     version: u32,
 ) -> Result<T, ManifestError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ManifestError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = crate::io::bounded::read_to_string(path, crate::io::bounded::TEXT_LIMIT).map_err(
+        |source| ManifestError::Read {
+            path: path.to_path_buf(),
+            source,
+        },
+    )?;
+    parse_versioned(&text, path, version)
+}
+
+/// Parses the JSON `text` of schema `version` into `T` ([`read_versioned`]; `path` names it).
+fn parse_versioned<T: serde::de::DeserializeOwned>(
+    text: &str,
+    path: &Path,
+    version: u32,
+) -> Result<T, ManifestError> {
     let format = |message: String| ManifestError::Format {
         path: path.to_path_buf(),
         message,
     };
-    let value: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| format(e.to_string()))?;
+    let value: serde_json::Value = serde_json::from_str(text).map_err(|e| format(e.to_string()))?;
     match value.get("schema_version").and_then(|v| v.as_u64()) {
         Some(v) if v == u64::from(version) => {}
         Some(v) => {
@@ -113,6 +123,11 @@ impl RunManifest {
     /// Reads `path`.
     pub fn read(path: &Path) -> Result<Self, ManifestError> {
         read_versioned(path, SCHEMA_VERSION)
+    }
+
+    /// Parses the text of a manifest; `path` names it in errors.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, ManifestError> {
+        parse_versioned(text, path, SCHEMA_VERSION)
     }
 
     /// Writes the manifest to `path`, atomically.

@@ -65,12 +65,22 @@ pub struct StepsError {
 /// Reads a step log ([`write_steps`]; the heading may also be a `heading` column, as in data
 /// logs): one episode's consecutive steps, numbered from 1. Extra columns are ignored.
 pub fn read_steps(path: &Path) -> Result<Vec<LoggedStep>, StepsError> {
+    let file = crate::io::bounded::open_lines(path).map_err(|e| StepsError {
+        path: path.to_path_buf(),
+        line: None,
+        message: e.to_string(),
+    })?;
+    parse_steps(file, path)
+}
+
+/// Parses a step log read from `input` ([`read_steps`]); `path` names it in errors.
+pub fn parse_steps(input: impl std::io::Read, path: &Path) -> Result<Vec<LoggedStep>, StepsError> {
     let error = |line: Option<u64>, message: String| StepsError {
         path: path.to_path_buf(),
         line,
         message,
     };
-    let mut reader = csv::Reader::from_path(path).map_err(|e| error(None, e.to_string()))?;
+    let mut reader = csv::Reader::from_reader(input);
     let header = reader
         .headers()
         .map_err(|e| error(Some(1), e.to_string()))?

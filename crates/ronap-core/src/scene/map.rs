@@ -23,7 +23,7 @@ pub enum MapError {
         source: std::io::Error,
     },
     /// A line of the YAML file is malformed or a value is out of range.
-    #[error("map file {}, line {line}: {message}", path.display())]
+    #[error("map file {}{}: {message}", path.display(), at_line(*line))]
     Yaml {
         /// The file.
         path: PathBuf,
@@ -62,13 +62,23 @@ pub struct RosMap {
     pub negate: bool,
 }
 
+/// `, line N`, or nothing for line 0 (a missing key).
+fn at_line(line: usize) -> String {
+    if line == 0 {
+        String::new()
+    } else {
+        format!(", line {line}")
+    }
+}
+
 impl RosMap {
     /// Reads a map YAML file (the flat `key: value` subset `map_server` writes).
     pub fn load(path: &Path) -> Result<Self, MapError> {
-        let text = std::fs::read_to_string(path).map_err(|source| MapError::Read {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = crate::io::bounded::read_to_string(path, crate::io::bounded::TEXT_LIMIT)
+            .map_err(|source| MapError::Read {
+                path: path.to_path_buf(),
+                source,
+            })?;
         Self::parse(&text, path)
     }
 
@@ -154,7 +164,17 @@ impl RosMap {
 
     /// The scene of this map: obstacles where the occupancy is not below `free_thresh`.
     pub fn scene(&self, config: &MapConfig, reach_px: f64) -> Result<Scene, MapError> {
-        let image = crate::scene::read_image(&self.image)?.to_luma8();
+        self.scene_of(&crate::scene::read_image(&self.image)?, config, reach_px)
+    }
+
+    /// The scene of this map with `image` as its image (read from [`RosMap::image`]).
+    pub fn scene_of(
+        &self,
+        image: &image::DynamicImage,
+        config: &MapConfig,
+        reach_px: f64,
+    ) -> Result<Scene, MapError> {
+        let image = image.to_luma8();
         let occupied: Vec<bool> = image
             .pixels()
             .map(|p| {
@@ -167,6 +187,7 @@ impl RosMap {
                 occupancy >= self.free_thresh
             })
             .collect();
+        crate::scene::check_runs(&occupied, image.width(), &self.image)?;
         Ok(Scene::from_occupancy(
             image.width(),
             image.height(),

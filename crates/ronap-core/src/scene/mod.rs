@@ -39,6 +39,34 @@ pub enum SceneError {
         /// What the decoder said.
         message: String,
     },
+    /// The image has more pixels than ronap reads.
+    #[error(
+        "map image {} is {width} x {height} pixels, over the {} megapixels ronap reads: scale it \
+         down and raise map.resolution_px (scene px per pixel)",
+        path.display(),
+        MAX_IMAGE_PIXELS >> 20
+    )]
+    ImageTooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Width in pixels.
+        width: u32,
+        /// Height in pixels.
+        height: u32,
+    },
+    /// The image's obstacles are too many separate pieces.
+    #[error(
+        "map image {} has {runs} runs of obstacle pixels, over the {} ronap reads (a dithered \
+         or noisy image?): clean it, or change map.threshold",
+        path.display(),
+        MAX_IMAGE_RUNS
+    )]
+    ImageTooBusy {
+        /// The file.
+        path: PathBuf,
+        /// Runs of obstacle pixels along its rows.
+        runs: usize,
+    },
     /// The image has no pixels.
     #[error("map image {} is empty ({width} x {height} pixels)", path.display())]
     EmptyImage {
@@ -74,18 +102,80 @@ pub enum SceneSource {
     Boxes,
 }
 
+/// Largest map image read, in pixels (64 megapixels, 8192 x 8192): a scene costs tens of bytes
+/// per pixel, and a few bytes of a compressed file can claim any size.
+pub const MAX_IMAGE_PIXELS: u64 = 1 << 26;
+
+/// Most runs of obstacle pixels along the rows (about the boxes a scene is built of) a map image
+/// may hold: a scene costs some hundreds of bytes a box, and a dithered or noisy image can hold a
+/// box for every other pixel.
+pub const MAX_IMAGE_RUNS: usize = 1 << 20;
+
+/// Refuses an occupancy raster of `width` columns (from the image at `path`) whose obstacles are
+/// more than [`MAX_IMAGE_RUNS`] runs of pixels.
+pub fn check_runs(occupied: &[bool], width: u32, path: &Path) -> Result<(), SceneError> {
+    let width = (width as usize).max(1);
+    let runs: usize = occupied
+        .chunks(width)
+        .map(|row| {
+            row.iter()
+                .zip(std::iter::once(&false).chain(row.iter()))
+                .filter(|(&now, &before)| now && !before)
+                .count()
+        })
+        .sum();
+    if runs > MAX_IMAGE_RUNS {
+        return Err(SceneError::ImageTooBusy {
+            path: path.to_path_buf(),
+            runs,
+        });
+    }
+    Ok(())
+}
+
 /// Reads and decodes an image file (PNG, PGM, or any format the decoder recognises), refusing
-/// an empty one.
+/// an empty one and one over [`MAX_IMAGE_PIXELS`].
 pub fn read_image(path: &Path) -> Result<image::DynamicImage, SceneError> {
+    let reader = image::ImageReader::open(path).map_err(|e| SceneError::ImageRead {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    decode_image(reader, path)
+}
+
+/// Decodes the image of `bytes` ([`read_image`]); `path` names it in errors.
+pub fn decode_image_bytes(bytes: &[u8], path: &Path) -> Result<image::DynamicImage, SceneError> {
+    decode_image(image::ImageReader::new(std::io::Cursor::new(bytes)), path)
+}
+
+fn decode_image<R: std::io::BufRead + std::io::Seek>(
+    reader: image::ImageReader<R>,
+    path: &Path,
+) -> Result<image::DynamicImage, SceneError> {
     let read_error = |message: String| SceneError::ImageRead {
         path: path.to_path_buf(),
         message,
     };
-    let reader = image::ImageReader::open(path)
-        .map_err(|e| read_error(e.to_string()))?
+    let mut reader = reader
         .with_guessed_format()
         .map_err(|e| read_error(e.to_string()))?;
-    let image = reader.decode().map_err(|e| read_error(e.to_string()))?;
+    let mut limits = image::Limits::default();
+    // Eight bytes a pixel: the widest pixels (RGBA of 16 bits) of the largest image read.
+    limits.max_alloc = Some(MAX_IMAGE_PIXELS * 8);
+    reader.limits(limits);
+    let decoder = reader
+        .into_decoder()
+        .map_err(|e| read_error(e.to_string()))?;
+    let (width, height) = image::ImageDecoder::dimensions(&decoder);
+    if u64::from(width) * u64::from(height) > MAX_IMAGE_PIXELS {
+        return Err(SceneError::ImageTooLarge {
+            path: path.to_path_buf(),
+            width,
+            height,
+        });
+    }
+    let image =
+        image::DynamicImage::from_decoder(decoder).map_err(|e| read_error(e.to_string()))?;
     if image.width() == 0 || image.height() == 0 {
         return Err(SceneError::EmptyImage {
             path: path.to_path_buf(),
@@ -343,7 +433,27 @@ impl Scene {
 
     /// Reads a PNG or PGM file (any format the decoder knows) as a scene.
     pub fn load_image(path: &Path, config: &MapConfig, reach_px: f64) -> Result<Self, SceneError> {
-        Ok(Self::from_image(&read_image(path)?, config, reach_px))
+        Self::from_user_image(&read_image(path)?, config, reach_px, path)
+    }
+
+    /// Like [`Scene::from_image`], for an image a user gave as `path`: refused, naming it, if its
+    /// obstacles are more than [`MAX_IMAGE_RUNS`] runs of pixels.
+    pub fn from_user_image(
+        image: &image::DynamicImage,
+        config: &MapConfig,
+        reach_px: f64,
+        path: &Path,
+    ) -> Result<Self, SceneError> {
+        let grey = image.to_luma8();
+        let occupied: Vec<bool> = grey.pixels().map(|p| p.0[0] <= config.threshold).collect();
+        check_runs(&occupied, grey.width(), path)?;
+        Ok(Self::from_occupancy(
+            grey.width(),
+            grey.height(),
+            &occupied,
+            config.resolution_px,
+            reach_px,
+        ))
     }
 
     /// Width, px.
