@@ -1,5 +1,6 @@
 //! `ronap`: the command-line front of ronap-core. Parses arguments, writes files, reports errors;
-//! the model itself lives in the core.
+//! the model itself lives in the core. A library only so that the fuzz target and tests reach the
+//! argument parser ([`parse`]); the binary is [`main`].
 
 mod args;
 mod commands;
@@ -18,6 +19,7 @@ const EXIT_BAD_INPUT: u8 = 2;
 /// Fast robot-navigation analysis on the RoNAP model: seeded mazes, a 17-beam laser, discrete
 /// actions, random start and goal.
 #[derive(Parser, Debug)]
+#[doc(hidden)]
 #[command(
     name = "ronap",
     version,
@@ -25,7 +27,7 @@ const EXIT_BAD_INPUT: u8 = 2;
     propagate_version = true,
     allow_negative_numbers = true
 )]
-struct Cli {
+pub struct Cli {
     #[command(subcommand)]
     command: Command,
 }
@@ -60,7 +62,17 @@ enum Command {
     Config(config::ConfigArgs),
 }
 
-fn main() -> ExitCode {
+/// Parses a command line (`args[0]` is the program's name), as `ronap` does, without running it.
+pub fn parse<I, T>(args: I) -> Result<Cli, clap::Error>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    Cli::try_parse_from(args)
+}
+
+/// The `ronap` command: parses the process's arguments and runs the command they name.
+pub fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {

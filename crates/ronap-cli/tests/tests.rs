@@ -4,9 +4,11 @@
 // Test helpers may panic on setup failures: that is a failed test, as intended.
 #![allow(clippy::unwrap_used)]
 
+mod args;
 mod cli;
 mod compare;
 mod learn;
+mod limits;
 mod replay;
 mod run;
 mod stream;
