@@ -130,3 +130,48 @@ def test_a_log_that_does_not_match_its_run_is_refused(tmp_path, ronap_bin):
     assert r.returncode == 2 and "step" in r.stderr, r.stderr
     assert not (tmp_path / "x.gif").exists()
     assert len(lines) > 2
+
+
+ODD_RETURNS = '''
+import numpy as np
+
+def np_int(obs):
+    return np.int64(1)
+
+def whole_float(obs):
+    return np.float64(1.0)
+
+def a_bool(obs):
+    return True
+
+def nothing(obs):
+    return None
+
+def an_array(obs):
+    return np.array([1, 2])
+
+def a_fraction(obs):
+    return 1.5
+'''
+
+
+def test_cli_python_policies_returning_odd_values(tmp_path, ronap_bin):
+    """numpy integers and whole floats are actions (as in ronap.evaluate); bools, None, arrays and
+    fractions are refused naming seed, step and the value, exit 2, never a crash of the worker."""
+    policy = tmp_path / "odd.py"
+    policy.write_text(ODD_RETURNS)
+    run = lambda fn, out: subprocess.run(
+        [ronap_bin, "run", "--policy", f"py:{policy}:{fn}", "--seeds", "2", "--max-steps", "20",
+         "--out", str(tmp_path / out)], capture_output=True, text=True)
+    ahead = subprocess.run(
+        [ronap_bin, "run", "--policy", "py:" + str(tmp_path / "odd.py") + ":np_int", "--seeds", "2",
+         "--max-steps", "20", "--out", str(tmp_path / "int")], capture_output=True, text=True)
+    assert ahead.returncode == 0, ahead.stderr
+    floats = run("whole_float", "float")
+    assert floats.returncode == 0, floats.stderr
+    assert (tmp_path / "int" / "episodes.csv").read_bytes() == (tmp_path / "float" / "episodes.csv").read_bytes()
+    for fn, shown in [("a_bool", "True"), ("nothing", "None"), ("an_array", "array([1, 2])"), ("a_fraction", "1.5")]:
+        r = run(fn, fn)
+        assert r.returncode == 2, (fn, r.returncode, r.stderr)
+        assert "seed 0, step 1" in r.stderr and f"returned {shown}" in r.stderr, (fn, r.stderr)
+        assert "Traceback" not in r.stderr and "panicked" not in r.stderr, r.stderr

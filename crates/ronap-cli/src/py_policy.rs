@@ -71,18 +71,30 @@ for line in sys.stdin:
     message = None
     if listens and isinstance(a, (tuple, list)) and len(a) == 2:
         a, message = a
-    if isinstance(a, bool) or not hasattr(a, "__index__"):
+    # An integer (numpy's too), or a whole float such as a network's argmax; never a bool.
+    index = None
+    if not (isinstance(a, bool) or type(a).__name__ in ("bool_", "bool")):
+        try:
+            index = a.__index__()
+        except Exception:
+            try:
+                whole = float(a) if getattr(a, "shape", ()) == () else None
+            except Exception:
+                whole = None
+            if whole is not None and whole == whole and whole % 1 == 0 and abs(whole) < 1e15:
+                index = int(whole)
+    if index is None:
         say(f"BAD {a!r}")
         continue
     if message is None:
-        say(f"A {a.__index__()}")
+        say(f"A {index}")
         continue
     try:
         floats = [float(x) for x in (message.tolist() if hasattr(message, "tolist") else message)]
     except Exception:
         say(f"BADM {message!r}")
         continue
-    say(f"A {a.__index__()} M " + " ".join(repr(x) for x in floats))
+    say(f"A {index} M " + " ".join(repr(x) for x in floats))
 "#;
 
 /// Makes Python policies from `py:FILE:FUNCTION`.

@@ -242,11 +242,24 @@ pub fn action(value: &Bound<'_, PyAny>, continuous: bool) -> Result<Action, Stri
             _ => Err("expected two finite numbers (v, w)".into()),
         };
     }
-    value
-        .extract::<i64>()
-        .ok()
-        .and_then(discrete)
-        .ok_or_else(|| DISCRETE.to_string())
+    if value.is_instance_of::<pyo3::types::PyBool>()
+        || value
+            .get_type()
+            .name()
+            .is_ok_and(|n| n == "bool_" || n == "bool")
+    {
+        return Err(format!("{DISCRETE}, not a bool"));
+    }
+    // An integer, or a whole float (what a network's argmax often is).
+    let index = match value.extract::<i64>() {
+        Ok(i) => Some(i),
+        Err(_) => value
+            .extract::<f64>()
+            .ok()
+            .filter(|x| x.fract() == 0.0 && x.abs() < 1e15)
+            .map(|x| x as i64),
+    };
+    index.and_then(discrete).ok_or_else(|| DISCRETE.to_string())
 }
 
 /// The discrete action of index `i` (0 LEFT, 1 AHEAD, 2 RIGHT), if it is one.

@@ -4,6 +4,8 @@ on top of an optional scenario (a TOML file or a dict of the same structure)."""
 from __future__ import annotations
 
 import json
+import math
+import numbers
 import os
 from typing import Any, Mapping, Union
 
@@ -44,7 +46,24 @@ def _plain(value: Any) -> Any:
     raise ConfigError(f"{value!r}: not a configuration value (expected numbers, strings, booleans, lists or dicts)")
 
 
+def _check_finite(value: Any, at: str) -> None:
+    """Refuses NaN and infinities anywhere in ``value``, naming the key (json would write them as
+    words no configuration reader takes)."""
+    if isinstance(value, Mapping):
+        for key, v in value.items():
+            _check_finite(v, f"{at}.{key}" if at else str(key))
+    elif isinstance(value, (list, tuple)):
+        for i, v in enumerate(value):
+            _check_finite(v, f"{at}[{i}]")
+    elif isinstance(value, (float, numbers.Real)) and not isinstance(value, (bool, int)):
+        if not math.isfinite(float(value)):
+            raise ConfigError(f"{at} = {float(value)}: must be a finite number")
+    elif hasattr(value, "tolist") and not isinstance(value, (str, bytes)):
+        _check_finite(value.tolist(), at)
+
+
 def _json(value: Any) -> str:
+    _check_finite(value, "")
     return json.dumps(value, default=_plain)
 
 

@@ -208,7 +208,8 @@ def discrete_actions(actions: Any, shape: tuple[int, ...]) -> np.ndarray:
     ``ActionError`` names a wrong shape, dtype or fractional value (and where it is)."""
     a = np.asarray(actions)
     if a.shape != shape:
-        raise _ronap.ActionError(f"actions of shape {a.shape}: expected {shape}")
+        given = "" if isinstance(actions, np.ndarray) else f" {repr(actions)[:60]} ({type(actions).__name__})"
+        raise _ronap.ActionError(f"actions{given} of shape {a.shape}: expected {shape}")
     if a.dtype.kind not in "iuf":
         raise _ronap.ActionError(f"actions of dtype {a.dtype}: expected integers 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)")
     if a.dtype.kind == "f":
