@@ -3,11 +3,12 @@
 
 use crate::conv::{self, Config};
 use crate::errors;
-use numpy::PyArray1;
+use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use ronap_core::eval::{EvalOptions, Evaluator};
 use ronap_core::io::run_dir::{evaluate_into, Pictures, RunFiles, RunInfo, RunWriter};
+use ronap_core::policy::batched::{BatchPolicy, Batched};
 use ronap_core::policy::{Decision, Policy, PolicyError, PolicyFactory};
 use ronap_core::{Action, Episode, World};
 use std::sync::atomic::AtomicBool;
@@ -116,6 +117,90 @@ impl PolicyFactory for PyPolicyFactory {
     }
 }
 
+/// A Python callable that decides for many observations at once: an `(n, width)` float32 array
+/// in, `n` actions out (or `(n, 2)` normalised speeds when continuous).
+struct PyBatchPolicy {
+    callable: Py<PyAny>,
+    continuous: bool,
+    /// Full speeds the normalised continuous actions scale to: px and degrees a step.
+    speeds: (f64, f64),
+}
+
+impl PyBatchPolicy {
+    fn decide(
+        &self,
+        py: Python<'_>,
+        observations: &[f32],
+        width: usize,
+        actions: &mut Vec<Action>,
+    ) -> Result<(), String> {
+        let rows = observations.len() / width.max(1);
+        let obs = PyArray1::from_slice(py, observations)
+            .reshape([rows, width])
+            .map_err(|e| e.to_string())?;
+        let raised = |e: PyErr| {
+            format!(
+                "raised {}",
+                e.value(py)
+                    .repr()
+                    .map_or_else(|_| e.to_string(), |r| r.to_string())
+            )
+        };
+        let value = self.callable.call1(py, (obs,)).map_err(raised)?;
+        let shown = || {
+            let text = value.bind(py).to_string();
+            if text.chars().count() > 80 {
+                format!("{}...", text.chars().take(80).collect::<String>())
+            } else {
+                text
+            }
+        };
+        let env = py.import("ronap.env").map_err(|e| e.to_string())?;
+        if self.continuous {
+            let array = env
+                .getattr("continuous_actions")
+                .and_then(|f| f.call1((value.bind(py), (rows, 2))))
+                .map_err(|e| format!("returned {}: {}", shown(), e.value(py)))?;
+            let pairs: Vec<f64> = array
+                .call_method0("ravel")
+                .and_then(|a| a.extract())
+                .map_err(|e| e.to_string())?;
+            let (v_max, w_max) = self.speeds;
+            actions.extend(pairs.chunks(2).map(|p| Action::Continuous {
+                v: p[0] * v_max,
+                w_deg: p[1] * w_max,
+            }));
+        } else {
+            let array = env
+                .getattr("discrete_actions")
+                .and_then(|f| f.call1((value.bind(py), (rows,))))
+                .map_err(|e| format!("returned {}: {}", shown(), e.value(py)))?;
+            let indices: Vec<i64> = array.extract().map_err(|e| e.to_string())?;
+            for (row, &i) in indices.iter().enumerate() {
+                actions.push(conv::discrete(i).ok_or_else(|| {
+                    format!(
+                        "returned action {i} for row {row}: expected 0 (LEFT), 1 (AHEAD) or \
+                         2 (RIGHT)"
+                    )
+                })?);
+            }
+        }
+        Ok(())
+    }
+}
+
+impl BatchPolicy for PyBatchPolicy {
+    fn act_batch(
+        &mut self,
+        observations: &[f32],
+        width: usize,
+        actions: &mut Vec<Action>,
+    ) -> Result<(), PolicyError> {
+        Python::with_gil(|py| self.decide(py, observations, width, actions))
+            .map_err(PolicyError::Failed)
+    }
+}
+
 /// The policy `policy` names or is: a built-in or network name, or a callable (observation ->
 /// action), with the name reports give it.
 fn policy_factory(
@@ -152,7 +237,7 @@ fn policy_factory(
 /// "episodes": [...]} with the figures and rows `ronap run` reports, and writes its files (the
 /// same files, `summary.json` in the same schema) into `out` when given.
 #[pyfunction]
-#[pyo3(signature = (policy, seeds, config, maze_seed = None, map_path = None, threads = 0, continuous = false, out = None, png = None, log_steps = false, thread_safe = false))]
+#[pyo3(signature = (policy, seeds, config, maze_seed = None, map_path = None, threads = 0, continuous = false, out = None, png = None, log_steps = false, thread_safe = false, batch = 0))]
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate<'py>(
     py: Python<'py>,
@@ -167,6 +252,7 @@ pub fn evaluate<'py>(
     png: Option<String>,
     log_steps: bool,
     thread_safe: bool,
+    batch: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     let config = config.valid();
     let Some(&first) = seeds.first() else {
@@ -174,7 +260,30 @@ pub fn evaluate<'py>(
             "seeds is empty: give at least one seed",
         ));
     };
-    let (factory, name) = policy_factory(policy, config, continuous, thread_safe)?;
+    let (factory, name) = if batch > 0 {
+        if !policy.is_callable() || policy.extract::<String>().is_ok() {
+            return Err(errors::ConfigError::new_err(format!(
+                "batch = {batch}: batches are for Python callables; {policy} runs in Rust already"
+            )));
+        }
+        let name = policy
+            .getattr("__name__")
+            .and_then(|n| n.extract::<String>())
+            .unwrap_or_else(|_| "python".into());
+        let robot = &config.robot;
+        let decide = PyBatchPolicy {
+            callable: policy.clone().unbind(),
+            continuous,
+            speeds: (robot.max_linear_speed_px, robot.max_angular_speed_deg),
+        };
+        let factory: Box<dyn PolicyFactory> =
+            Box::new(Batched::new(Box::new(decide), batch, name.clone()));
+        (factory, name)
+    } else {
+        policy_factory(policy, config, continuous, thread_safe)?
+    };
+    // A batch of N is N episodes under way, a worker each.
+    let threads = if batch > 0 { batch } else { threads };
     let pictures: Option<Pictures> = png
         .as_deref()
         .map(str::parse)

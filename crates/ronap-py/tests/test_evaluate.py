@@ -121,3 +121,55 @@ def test_evaluate_runs_a_shipped_network():
     assert result["summary"]["success_rate"] > 0.5
     with pytest.raises(ronap.ConfigError, match="not a decision rule"):
         ronap.evaluate(f"mlp:{weights}@hottest", range(2))
+
+
+def _toward_goal_rows(obs):
+    d = obs[:, -1].astype(np.float64) * 360.0
+    return np.where((15 < d) & (d < 180), 0, np.where((180 <= d) & (d < 345), 2, 1))
+
+
+def test_batched_python_policy_gives_the_same_files_with_fewer_calls(tmp_path):
+    calls, rows = [], []
+
+    def batched(obs):
+        assert obs.dtype == np.float32 and obs.ndim == 2 and obs.shape[1] == 18
+        calls.append(1)
+        rows.append(obs.shape[0])
+        return _toward_goal_rows(obs)
+
+    one = ronap.evaluate(toward_goal, range(24), threads=1, episode_max_steps=300, out=str(tmp_path / "one"))
+    many = ronap.evaluate(batched, range(24), batch=8, episode_max_steps=300, out=str(tmp_path / "many"))
+    assert (tmp_path / "one" / "episodes.csv").read_bytes() == (tmp_path / "many" / "episodes.csv").read_bytes()
+    steps = sum(r["steps"] for r in one["episodes"])
+    assert len(calls) < steps / 3, (len(calls), steps)
+    assert max(rows) == 8
+    assert many["summary"]["episodes"] == 24
+
+
+def test_batched_continuous_policy_matches_unbatched():
+    one = ronap.evaluate(lambda obs: (1.0, 0.3), range(6), threads=1, continuous=True, episode_max_steps=40)
+    many = ronap.evaluate(lambda obs: np.tile([1.0, 0.3], (len(obs), 1)), range(6), batch=4, continuous=True, episode_max_steps=40)
+    strip = lambda res: [{k: v for k, v in r.items() if k != "wall_time_s"} for r in res["episodes"]]
+    assert strip(one) == strip(many)
+
+
+@pytest.mark.parametrize(
+    "policy, message",
+    [
+        (lambda obs: np.ones(len(obs) + 1, int), r"seed \d+, step 1: .*shape"),
+        (lambda obs: np.full(len(obs), 5), r"action 5 for row"),
+        (lambda obs: np.full(len(obs), 0.5), r"0.5"),
+        (lambda obs: None, r"returned None"),
+        (lambda obs: (_ for _ in ()).throw(ValueError("no idea")), r"raised ValueError\('no idea'\)"),
+    ],
+)
+def test_bad_batched_policies_raise_policy_error(policy, message):
+    with pytest.raises(ronap.PolicyError, match=message):
+        ronap.evaluate(policy, range(4), batch=2)
+
+
+def test_batch_is_for_callables_and_counted():
+    with pytest.raises(ronap.ConfigError, match="batch = 4"):
+        ronap.evaluate("apf", range(4), batch=4)
+    with pytest.raises(ronap.ConfigError, match="batch = -1"):
+        ronap.evaluate(toward_goal, range(4), batch=-1)

@@ -100,6 +100,7 @@ def evaluate(
     png: str | None = None,
     log_steps: bool = False,
     thread_safe: bool = False,
+    batch: int = 0,
 ) -> dict[str, Any]: ...
 def compare(
     policies: list[Any],

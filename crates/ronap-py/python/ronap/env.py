@@ -221,3 +221,19 @@ def discrete_actions(actions: Any, shape: tuple[int, ...]) -> np.ndarray:
                 f"action {float(a.reshape(-1)[bad])} at {tuple(int(i) for i in where)}: expected 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)"
             )
     return np.ascontiguousarray(a, dtype=np.int64)
+
+
+def continuous_actions(actions: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """``actions`` as a contiguous float64 array of ``shape`` (normalised speeds in [-1, 1]); an
+    ``ActionError`` names a wrong shape or dtype or a value that is not finite (and where it is)."""
+    a = np.asarray(actions)
+    if a.shape != shape:
+        given = "" if isinstance(actions, np.ndarray) else f" {repr(actions)[:60]} ({type(actions).__name__})"
+        raise _ronap.ActionError(f"actions{given} of shape {a.shape}: expected {shape}")
+    if a.dtype.kind not in "iuf":
+        raise _ronap.ActionError(f"actions of dtype {a.dtype}: expected numbers (v / v_max, w / w_max)")
+    finite = np.isfinite(a).reshape(-1)
+    if not np.all(finite):
+        where = np.unravel_index(int(np.argmin(finite)), shape)
+        raise _ronap.ActionError(f"action {float(a[where])} at {tuple(int(i) for i in where)}: expected finite numbers")
+    return np.ascontiguousarray(a, dtype=np.float64)
