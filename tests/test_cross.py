@@ -175,3 +175,30 @@ def test_cli_python_policies_returning_odd_values(tmp_path, ronap_bin):
         assert r.returncode == 2, (fn, r.returncode, r.stderr)
         assert "seed 0, step 1" in r.stderr and f"returned {shown}" in r.stderr, (fn, r.stderr)
         assert "Traceback" not in r.stderr and "panicked" not in r.stderr, r.stderr
+
+
+BATCHED = '''
+import numpy as np
+
+def rows(obs):
+    d = obs[:, -1].astype(np.float64) * 360.0
+    return np.where((15 < d) & (d < 180), 0, np.where((180 <= d) & (d < 345), 2, 1))
+
+def too_few(obs):
+    return np.ones(len(obs) - 1 if len(obs) > 1 else 2, int)
+'''
+
+
+def test_cli_batch_gives_the_same_bytes_as_unbatched(tmp_path, ronap_bin):
+    policy = tmp_path / "policy.py"
+    policy.write_text(POLICY_FILE + BATCHED)
+    base = [ronap_bin, "run", "--seeds", "12", "--max-steps", "300"]
+    one = subprocess.run(base + ["--policy", f"py:{policy}:act", "--out", str(tmp_path / "one")], capture_output=True, text=True)
+    many = subprocess.run(base + ["--policy", f"py:{policy}:rows", "--batch", "6", "--out", str(tmp_path / "many")], capture_output=True, text=True)
+    assert one.returncode == 0 and many.returncode == 0, one.stderr + many.stderr
+    assert (tmp_path / "one" / "episodes.csv").read_bytes() == (tmp_path / "many" / "episodes.csv").read_bytes()
+    assert "batches of up to 6 episodes" in many.stdout
+    bad = subprocess.run(base + ["--policy", f"py:{policy}:too_few", "--batch", "4", "--out", str(tmp_path / "bad")], capture_output=True, text=True)
+    assert bad.returncode == 2 and "expected" in bad.stderr and "actions" in bad.stderr, bad.stderr
+    refused = subprocess.run(base + ["--policy", "apf", "--batch", "4", "--out", str(tmp_path / "apf")], capture_output=True, text=True)
+    assert refused.returncode == 2 and "--batch 4" in refused.stderr, refused.stderr

@@ -8,10 +8,15 @@
 //! `$RONAP_PYTHON`, else `python3`; the observation reaches the function as a float32 numpy array
 //! when numpy is installed, else as a list.
 //!
+//! With `ronap run --batch N` one process serves every worker: a line `B <rows> <width> <values>`
+//! carries the observations of the episodes waiting for an action, the function gets them as a
+//! `(rows, width)` array and returns one action per row, answered `A <index> <index> ...`.
+//!
 //! A function of one argument gets the observation and returns an action. A function of two gets
 //! the observation and the team's inbox (a list of dicts: `from`, `pose`, `goal`, `message`,
 //! nearest sender first; empty for a lone robot) and returns an action or `(action, message)`.
 
+use ronap_core::policy::batched::{BatchPolicy, Batched};
 use ronap_core::policy::{Decision, Policy, PolicyError, PolicyFactory};
 use ronap_core::{Action, DiscreteAction, Episode, World};
 use std::io::{BufRead, BufReader, Write};
@@ -49,8 +54,44 @@ except (TypeError, ValueError):
     listens = False
 def arr(values):
     return np.asarray(values, dtype=np.float32) if np is not None else values
+def index_of(a):
+    # An integer (numpy's too), or a whole float such as a network's argmax; never a bool.
+    if isinstance(a, bool) or type(a).__name__ in ("bool_", "bool"):
+        return None
+    try:
+        return a.__index__()
+    except Exception:
+        try:
+            whole = float(a) if getattr(a, "shape", ()) == () else None
+        except Exception:
+            whole = None
+        if whole is not None and whole == whole and whole % 1 == 0 and abs(whole) < 1e15:
+            return int(whole)
+    return None
 say("READY")
 for line in sys.stdin:
+    if line.startswith("B "):
+        # A batch: rows, width, then the observations row after row; one action per row back.
+        words = line.split()
+        rows, width = int(words[1]), int(words[2])
+        values = [float(x) for x in words[3:]]
+        obs = np.asarray(values, dtype=np.float32).reshape(rows, width) if np is not None else \
+            [values[r * width:(r + 1) * width] for r in range(rows)]
+        try:
+            a = fn(obs)
+        except Exception as e:
+            say(f"ERR {e!r}")
+            continue
+        try:
+            items = list(a.tolist() if hasattr(a, "tolist") else a)
+        except Exception:
+            items = None
+        indices = None if items is None or len(items) != rows else [index_of(x) for x in items]
+        if indices is None or any(i is None for i in indices):
+            say(f"BAD {a!r}")
+        else:
+            say("A " + " ".join(str(i) for i in indices))
+        continue
     head, _, tail = line.partition("|")
     obs = arr([float(x) for x in head.split()])
     try:
@@ -71,18 +112,7 @@ for line in sys.stdin:
     message = None
     if listens and isinstance(a, (tuple, list)) and len(a) == 2:
         a, message = a
-    # An integer (numpy's too), or a whole float such as a network's argmax; never a bool.
-    index = None
-    if not (isinstance(a, bool) or type(a).__name__ in ("bool_", "bool")):
-        try:
-            index = a.__index__()
-        except Exception:
-            try:
-                whole = float(a) if getattr(a, "shape", ()) == () else None
-            except Exception:
-                whole = None
-            if whole is not None and whole == whole and whole % 1 == 0 and abs(whole) < 1e15:
-                index = int(whole)
+    index = index_of(a)
     if index is None:
         say(f"BAD {a!r}")
         continue
@@ -158,6 +188,61 @@ impl PyPolicyFactory {
         match process.read()?.as_str() {
             "READY" => Ok(process),
             other => Err(other.strip_prefix("ERR ").unwrap_or(other).to_string()),
+        }
+    }
+}
+
+impl PyPolicyFactory {
+    /// The function as a batched policy (`ronap run --batch N`): one Python process, called with
+    /// an `(n, observation size)` array of the episodes waiting for an action, n up to `rows`.
+    pub fn batched(&self, rows: usize) -> Result<Batched, String> {
+        Ok(Batched::new(
+            Box::new(self.spawn()?),
+            rows,
+            PolicyFactory::name(self),
+        ))
+    }
+}
+
+impl BatchPolicy for PyProcess {
+    fn act_batch(
+        &mut self,
+        observations: &[f32],
+        width: usize,
+        actions: &mut Vec<Action>,
+    ) -> Result<(), PolicyError> {
+        let rows = observations.len() / width.max(1);
+        let mut line = String::with_capacity(observations.len() * 12 + 16);
+        line.push_str(&format!("B {rows} {width}"));
+        for v in observations {
+            line.push_str(&format!(" {v:?}"));
+        }
+        line.push('\n');
+        self.stdin
+            .write_all(line.as_bytes())
+            .map_err(|e| PolicyError::Failed(format!("cannot write to the Python process: {e}")))?;
+        let answer = self.read().map_err(PolicyError::Failed)?;
+        let expected = format!("expected {rows} actions, each 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)");
+        if let Some(rest) = answer.strip_prefix("A ") {
+            for word in rest.split_whitespace() {
+                let action = word
+                    .parse::<usize>()
+                    .ok()
+                    .and_then(DiscreteAction::from_index)
+                    .ok_or_else(|| {
+                        PolicyError::Failed(format!("returned action {word}, {expected}"))
+                    })?;
+                actions.push(Action::Discrete(action));
+            }
+            Ok(())
+        } else if let Some(repr) = answer.strip_prefix("BAD ") {
+            Err(PolicyError::Failed(format!("returned {repr}, {expected}")))
+        } else if let Some(message) = answer.strip_prefix("ERR ") {
+            Err(PolicyError::Failed(format!("raised {message}")))
+        } else {
+            Err(PolicyError::Failed(format!(
+                "unexpected answer {answer:?} from the Python process"
+            )))
         }
     }
 }

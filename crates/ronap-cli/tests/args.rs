@@ -47,6 +47,7 @@ const FLAGS: &[&str] = &[
     "--size",
     "--fps",
     "--summary",
+    "--batch",
     "--help",
     "-h",
     "--version",

@@ -10,6 +10,7 @@ use ronap_core::io::manifest::PLAN_FILE;
 use ronap_core::io::run_dir::{
     evaluate_into, evaluate_team_into, Pictures, ResumeError, RunFiles, RunInfo, RunWriter,
 };
+use ronap_core::policy::PolicyFactory;
 use ronap_core::scene::map::MapSource;
 use ronap_core::sim::world::SceneSpec;
 use ronap_core::{Scenes, ValidConfig};
@@ -59,6 +60,11 @@ pub struct RunArgs {
     /// views and strides: `--log-steps` and `ronap replay`) [default: none].
     #[arg(long, allow_negative_numbers = true, value_name = "SEED", value_parser = seed)]
     gif: Vec<u64>,
+    /// For a py: policy, run N episodes side by side and call the function once for all of
+    /// those waiting for an action, with an (n, observation size) array (n up to N), expecting n
+    /// actions: the same episodes as unbatched, with far fewer calls (0: one call per step).
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 0, value_parser = clap::value_parser!(u16))]
+    batch: u16,
     /// Exit with code 1 when the success rate is below this fraction (a gate for CI).
     #[arg(long, allow_negative_numbers = true, value_name = "F", value_parser = fraction)]
     min_success: Option<f64>,
@@ -96,8 +102,19 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         log_steps: args.log_steps,
         gif: args.gif,
         min_success: args.min_success,
+        batch: usize::from(args.batch),
     };
+    if job.batch > 0 && !job.policy.starts_with("py:") {
+        bail!(
+            "--batch {}: batches are for py:FILE:FUNCTION policies; {} runs in Rust already",
+            job.batch,
+            job.policy
+        );
+    }
     if config.team_size() > 0 {
+        if job.batch > 0 {
+            bail!("--batch {}: not for team runs", job.batch);
+        }
         run_team(job, config, scenes, None)
     } else {
         run_lone(job, config, scenes, None)
@@ -116,6 +133,8 @@ struct Job {
     log_steps: bool,
     gif: Vec<u64>,
     min_success: Option<f64>,
+    /// Episodes a py: policy decides for at once (0: one at a time).
+    batch: usize,
 }
 
 impl Job {
@@ -131,7 +150,7 @@ impl Job {
 
     /// What `ronap run` keeps in the plan beyond the core's fields, for `--resume`.
     fn front_end(&self) -> serde_json::Value {
-        serde_json::json!({ "gif": self.gif, "min_success": self.min_success })
+        serde_json::json!({ "gif": self.gif, "min_success": self.min_success, "batch": self.batch })
     }
 
     /// The writer of a new run into `out_dir`.
@@ -173,6 +192,13 @@ fn resume(dir: &Path) -> Result<ExitCode> {
         None | Some(serde_json::Value::Null) => None,
         Some(v) => Some(v.as_f64().ok_or_else(|| bad("min_success", v))?),
     };
+    let batch = match front.get("batch") {
+        None | Some(serde_json::Value::Null) => 0,
+        Some(v) => v
+            .as_u64()
+            .and_then(|b| usize::try_from(b).ok())
+            .ok_or_else(|| bad("batch", v))?,
+    };
     let png = plan
         .pictures
         .as_deref()
@@ -192,6 +218,7 @@ fn resume(dir: &Path) -> Result<ExitCode> {
         log_steps: plan.steps,
         gif,
         min_success,
+        batch,
     };
     eprintln!(
         "ronap run: resuming {}: {} of {} episodes were done",
@@ -213,7 +240,16 @@ fn run_lone(
     scenes: Scenes,
     writer: Option<RunWriter>,
 ) -> Result<ExitCode> {
-    let factory = policy_factory(&job.policy, &config)?;
+    let (factory, threads) = match job.policy.strip_prefix("py:") {
+        // A batch of N is N episodes under way, a worker each.
+        Some(spec) if job.batch > 0 => {
+            let batched = crate::py_policy::PyPolicyFactory::new(spec)
+                .and_then(|f| f.batched(job.batch))
+                .map_err(anyhow::Error::msg)?;
+            (Box::new(batched) as Box<dyn PolicyFactory>, job.batch)
+        }
+        _ => (policy_factory(&job.policy, &config)?, job.threads),
+    };
     let evaluator = Evaluator::new(config.clone(), scenes);
     let (first, last) = job.span();
     if let Some(s) = job.gif.iter().find(|&&s| s < first || s > last) {
@@ -243,7 +279,7 @@ fn run_lone(
     );
     let options = EvalOptions {
         seeds: job.seeds.clone(),
-        threads: job.threads,
+        threads,
         recording: Recording::default(),
     };
     let info = RunInfo {
@@ -282,8 +318,13 @@ fn run_lone(
     let mut stdout = std::io::stdout().lock();
     writeln!(
         stdout,
-        "ronap run: policy {}, seeds {first}..{last}, {} threads",
-        job.policy, job.threads
+        "ronap run: policy {}, seeds {first}..{last}, {}",
+        job.policy,
+        if job.batch > 0 {
+            format!("batches of up to {} episodes", job.batch)
+        } else {
+            format!("{} threads", job.threads)
+        }
     )?;
     write!(stdout, "{}", summary.table())?;
     writeln!(stdout, "outputs in {}", job.out_dir.display())?;
