@@ -70,12 +70,16 @@ impl<R: Read> LineLimited<R> {
 impl<R: Read> Read for LineLimited<R> {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
         let n = self.inner.read(buf)?;
-        let got = &buf[..n];
-        self.run = match got.iter().rposition(|&b| b == b'\n') {
-            Some(at) => got.len() - at - 1,
-            None => self.run + got.len(),
-        };
-        if self.run > self.limit {
+        let mut longest = 0;
+        for line in buf[..n].split_inclusive(|&b| b == b'\n') {
+            let ends = line.last() == Some(&b'\n');
+            self.run += line.len() - usize::from(ends);
+            longest = longest.max(self.run);
+            if ends {
+                self.run = 0;
+            }
+        }
+        if longest > self.limit {
             return Err(io::Error::new(
                 io::ErrorKind::InvalidData,
                 format!(
