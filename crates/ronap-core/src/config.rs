@@ -1519,11 +1519,13 @@ pub struct ConfigFile {
 impl ConfigFile {
     /// Reads `path` (not yet parsed).
     pub fn read(path: &std::path::Path) -> Result<Self, ConfigError> {
-        let text = crate::io::bounded::read_to_string(path, crate::io::bounded::TEXT_LIMIT)
-            .map_err(|e| ConfigError::File {
-                path: path.to_path_buf(),
-                line: None,
-                message: format!("cannot read: {e}"),
+        let text =
+            crate::bounded::read_to_string(path, crate::bounded::TEXT_LIMIT).map_err(|e| {
+                ConfigError::File {
+                    path: path.to_path_buf(),
+                    line: None,
+                    message: format!("cannot read: {e}"),
+                }
             })?;
         Ok(Self {
             path: path.to_path_buf(),

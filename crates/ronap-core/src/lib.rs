@@ -10,7 +10,8 @@
 //!
 //! | layer | holds |
 //! | --- | --- |
-//! | [`config`] | every model field with its default, and their validation (uses nothing) |
+//! | [`bounded`] | reading a user's file within a size bound (uses nothing) |
+//! | [`config`] | every model field with its default, and their validation |
 //! | [`geometry`] | points, boxes, the bin index, the ray grid, parry2d as the reference geometry |
 //! | [`scene`] | the scene's obstacles, mazes, image and ROS maps, the free-space grid |
 //! | [`sim`] | robot and actions, laser, random streams, placement, the episode, worlds and scenes |
@@ -23,6 +24,7 @@
 //! | [`collect`] | labelled data: expert and human collection |
 //! | [`compare`] | several policies on the same seeds: paired statistics, pictures, a report |
 
+pub mod bounded;
 pub mod collect;
 pub mod compare;
 pub mod config;

@@ -564,7 +564,7 @@ type Places = Vec<[String; 5]>;
 fn read_episodes(path: &Path) -> Result<(Vec<SeedResult>, Places), String> {
     let what = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
     let mut reader =
-        csv::Reader::from_reader(crate::io::bounded::open_lines(path).map_err(|e| what(&e))?);
+        csv::Reader::from_reader(crate::bounded::open_lines(path).map_err(|e| what(&e))?);
     let headers = reader.headers().map_err(|e| what(&e))?.clone();
     let column = |name: &str| {
         headers

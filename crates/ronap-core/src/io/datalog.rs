@@ -249,7 +249,7 @@ pub fn read(path: &Path, range_px: f64) -> Result<(DataSet, Format), DataLogErro
     };
     let mut text = String::new();
     std::io::Read::read_to_string(
-        &mut crate::io::bounded::open_lines(path).map_err(io)?,
+        &mut crate::bounded::open_lines(path).map_err(io)?,
         &mut text,
     )
     .map_err(io)?;

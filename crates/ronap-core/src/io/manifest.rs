@@ -87,12 +87,13 @@ fn read_versioned<T: serde::de::DeserializeOwned>(
     path: &Path,
     version: u32,
 ) -> Result<T, ManifestError> {
-    let text = crate::io::bounded::read_to_string(path, crate::io::bounded::TEXT_LIMIT).map_err(
-        |source| ManifestError::Read {
-            path: path.to_path_buf(),
-            source,
-        },
-    )?;
+    let text =
+        crate::bounded::read_to_string(path, crate::bounded::TEXT_LIMIT).map_err(|source| {
+            ManifestError::Read {
+                path: path.to_path_buf(),
+                source,
+            }
+        })?;
     parse_versioned(&text, path, version)
 }
 

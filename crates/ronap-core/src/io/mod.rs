@@ -2,7 +2,6 @@
 //! logs. Uses every layer below it; the layers below never touch a file they were not handed.
 
 pub mod atomic;
-pub mod bounded;
 pub mod datalog;
 pub mod figures;
 pub mod lock;

@@ -65,7 +65,7 @@ pub struct StepsError {
 /// Reads a step log ([`write_steps`]; the heading may also be a `heading` column, as in data
 /// logs): one episode's consecutive steps, numbered from 1. Extra columns are ignored.
 pub fn read_steps(path: &Path) -> Result<Vec<LoggedStep>, StepsError> {
-    let file = crate::io::bounded::open_lines(path).map_err(|e| StepsError {
+    let file = crate::bounded::open_lines(path).map_err(|e| StepsError {
         path: path.to_path_buf(),
         line: None,
         message: e.to_string(),

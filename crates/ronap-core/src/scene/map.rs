@@ -74,10 +74,12 @@ fn at_line(line: usize) -> String {
 impl RosMap {
     /// Reads a map YAML file (the flat `key: value` subset `map_server` writes).
     pub fn load(path: &Path) -> Result<Self, MapError> {
-        let text = crate::io::bounded::read_to_string(path, crate::io::bounded::TEXT_LIMIT)
-            .map_err(|source| MapError::Read {
-                path: path.to_path_buf(),
-                source,
+        let text =
+            crate::bounded::read_to_string(path, crate::bounded::TEXT_LIMIT).map_err(|source| {
+                MapError::Read {
+                    path: path.to_path_buf(),
+                    source,
+                }
             })?;
         Self::parse(&text, path)
     }

@@ -31,13 +31,12 @@ pub enum MlpError {
 impl Mlp {
     /// Reads a weights file.
     pub fn load(path: &Path) -> Result<Self, MlpError> {
-        let bytes =
-            crate::io::bounded::read(path, crate::io::bounded::WEIGHTS_LIMIT).map_err(|e| {
-                MlpError::Io {
-                    path: path.to_path_buf(),
-                    message: e.to_string(),
-                }
-            })?;
+        let bytes = crate::bounded::read(path, crate::bounded::WEIGHTS_LIMIT).map_err(|e| {
+            MlpError::Io {
+                path: path.to_path_buf(),
+                message: e.to_string(),
+            }
+        })?;
         Self::from_bytes(&bytes).map_err(|message| MlpError::Invalid {
             path: path.to_path_buf(),
             message,
