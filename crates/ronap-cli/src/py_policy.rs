@@ -218,10 +218,7 @@ impl BatchPolicy for PyProcess {
             line.push_str(&format!(" {v:?}"));
         }
         line.push('\n');
-        self.stdin
-            .write_all(line.as_bytes())
-            .map_err(|e| PolicyError::Failed(format!("cannot write to the Python process: {e}")))?;
-        let answer = self.read().map_err(PolicyError::Failed)?;
+        let answer = self.ask(&line)?;
         let expected = format!("expected {rows} actions, each 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)");
         if let Some(rest) = answer.strip_prefix("A ") {
             for word in rest.split_whitespace() {
@@ -235,14 +232,8 @@ impl BatchPolicy for PyProcess {
                 actions.push(Action::Discrete(action));
             }
             Ok(())
-        } else if let Some(repr) = answer.strip_prefix("BAD ") {
-            Err(PolicyError::Failed(format!("returned {repr}, {expected}")))
-        } else if let Some(message) = answer.strip_prefix("ERR ") {
-            Err(PolicyError::Failed(format!("raised {message}")))
         } else {
-            Err(PolicyError::Failed(format!(
-                "unexpected answer {answer:?} from the Python process"
-            )))
+            Err(refused(&answer, &expected))
         }
     }
 }
@@ -278,6 +269,28 @@ impl PyProcess {
             Err(e) => Err(format!("cannot read from the Python process: {e}")),
         }
     }
+}
+
+impl PyProcess {
+    /// Sends `line` (a request ending in a line break) and reads the answer.
+    fn ask(&mut self, line: &str) -> Result<String, PolicyError> {
+        self.stdin
+            .write_all(line.as_bytes())
+            .map_err(|e| PolicyError::Failed(format!("cannot write to the Python process: {e}")))?;
+        self.read().map_err(PolicyError::Failed)
+    }
+}
+
+/// What an answer other than an action (`BAD <repr>`, `ERR <message>`, anything else) means;
+/// `expected` says what an action is.
+fn refused(answer: &str, expected: &str) -> PolicyError {
+    PolicyError::Failed(if let Some(repr) = answer.strip_prefix("BAD ") {
+        format!("returned {repr}, {expected}")
+    } else if let Some(message) = answer.strip_prefix("ERR ") {
+        format!("raised {message}")
+    } else {
+        format!("unexpected answer {answer:?} from the Python process")
+    })
 }
 
 impl Drop for PyProcess {
@@ -323,10 +336,7 @@ impl Policy for PyProcess {
         line.push_str("| ");
         line.push_str(&self.inbox);
         line.push('\n');
-        self.stdin
-            .write_all(line.as_bytes())
-            .map_err(|e| PolicyError::Failed(format!("cannot write to the Python process: {e}")))?;
-        let answer = self.read().map_err(PolicyError::Failed)?;
+        let answer = self.ask(&line)?;
         let expected = "expected 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)";
         if let Some(rest) = answer.strip_prefix("A ") {
             let (index, message) = rest.split_once(" M ").unwrap_or((rest, ""));
@@ -351,14 +361,8 @@ impl Policy for PyProcess {
             Err(PolicyError::Failed(format!(
                 "returned the message {repr}, expected numbers"
             )))
-        } else if let Some(repr) = answer.strip_prefix("BAD ") {
-            Err(PolicyError::Failed(format!("returned {repr}, {expected}")))
-        } else if let Some(message) = answer.strip_prefix("ERR ") {
-            Err(PolicyError::Failed(format!("raised {message}")))
         } else {
-            Err(PolicyError::Failed(format!(
-                "unexpected answer {answer:?} from the Python process"
-            )))
+            Err(refused(&answer, expected))
         }
     }
 }

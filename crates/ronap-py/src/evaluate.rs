@@ -122,6 +122,9 @@ impl PolicyFactory for PyPolicyFactory {
 struct PyBatchPolicy {
     callable: Py<PyAny>,
     continuous: bool,
+    /// `ronap.env.discrete_actions` or `continuous_actions`: the returned actions as a checked
+    /// array, or an `ActionError` naming what is wrong.
+    check: Py<PyAny>,
     /// Full speeds the normalised continuous actions scale to: px and degrees a step.
     speeds: (f64, f64),
 }
@@ -155,12 +158,16 @@ impl PyBatchPolicy {
                 text
             }
         };
-        let env = py.import("ronap.env").map_err(|e| e.to_string())?;
+        // The returned actions as an array of `shape`, checked.
+        let checked = |shape: &[usize]| {
+            let shape = pyo3::types::PyTuple::new(py, shape).map_err(|e| e.to_string())?;
+            self.check
+                .bind(py)
+                .call1((value.bind(py), shape))
+                .map_err(|e| format!("returned {}: {}", shown(), e.value(py)))
+        };
         if self.continuous {
-            let array = env
-                .getattr("continuous_actions")
-                .and_then(|f| f.call1((value.bind(py), (rows, 2))))
-                .map_err(|e| format!("returned {}: {}", shown(), e.value(py)))?;
+            let array = checked(&[rows, 2])?;
             let pairs: Vec<f64> = array
                 .call_method0("ravel")
                 .and_then(|a| a.extract())
@@ -171,10 +178,7 @@ impl PyBatchPolicy {
                 w_deg: p[1] * w_max,
             }));
         } else {
-            let array = env
-                .getattr("discrete_actions")
-                .and_then(|f| f.call1((value.bind(py), (rows,))))
-                .map_err(|e| format!("returned {}: {}", shown(), e.value(py)))?;
+            let array = checked(&[rows])?;
             let indices: Vec<i64> = array.extract().map_err(|e| e.to_string())?;
             for (row, &i) in indices.iter().enumerate() {
                 actions.push(conv::discrete(i).ok_or_else(|| {
@@ -271,9 +275,18 @@ pub fn evaluate<'py>(
             .and_then(|n| n.extract::<String>())
             .unwrap_or_else(|_| "python".into());
         let robot = &config.robot;
+        let check = py
+            .import("ronap.env")?
+            .getattr(if continuous {
+                "continuous_actions"
+            } else {
+                "discrete_actions"
+            })?
+            .unbind();
         let decide = PyBatchPolicy {
             callable: policy.clone().unbind(),
             continuous,
+            check,
             speeds: (robot.max_linear_speed_px, robot.max_angular_speed_deg),
         };
         let factory: Box<dyn PolicyFactory> =

@@ -133,6 +133,14 @@ pub fn check_runs(occupied: &[bool], width: u32, path: &Path) -> Result<(), Scen
     Ok(())
 }
 
+/// Width, height and the occupancy raster of `image` (image order): grey value <= `threshold`
+/// is an obstacle.
+fn occupancy(image: &image::DynamicImage, threshold: u8) -> (u32, u32, Vec<bool>) {
+    let grey = image.to_luma8();
+    let occupied = grey.pixels().map(|p| p.0[0] <= threshold).collect();
+    (grey.width(), grey.height(), occupied)
+}
+
 /// Reads and decodes an image file (PNG, PGM, or any format the decoder recognises), refusing
 /// an empty one and one over [`MAX_IMAGE_PIXELS`].
 pub fn read_image(path: &Path) -> Result<image::DynamicImage, SceneError> {
@@ -420,15 +428,8 @@ impl Scene {
 
     /// A scene from a decoded image: grey value <= `threshold` is an obstacle.
     pub fn from_image(image: &image::DynamicImage, config: &MapConfig, reach_px: f64) -> Self {
-        let grey = image.to_luma8();
-        let occupied: Vec<bool> = grey.pixels().map(|p| p.0[0] <= config.threshold).collect();
-        Self::from_occupancy(
-            grey.width(),
-            grey.height(),
-            &occupied,
-            config.resolution_px,
-            reach_px,
-        )
+        let (width, height, occupied) = occupancy(image, config.threshold);
+        Self::from_occupancy(width, height, &occupied, config.resolution_px, reach_px)
     }
 
     /// Reads a PNG or PGM file (any format the decoder knows) as a scene.
@@ -444,12 +445,11 @@ impl Scene {
         reach_px: f64,
         path: &Path,
     ) -> Result<Self, SceneError> {
-        let grey = image.to_luma8();
-        let occupied: Vec<bool> = grey.pixels().map(|p| p.0[0] <= config.threshold).collect();
-        check_runs(&occupied, grey.width(), path)?;
+        let (width, height, occupied) = occupancy(image, config.threshold);
+        check_runs(&occupied, width, path)?;
         Ok(Self::from_occupancy(
-            grey.width(),
-            grey.height(),
+            width,
+            height,
             &occupied,
             config.resolution_px,
             reach_px,

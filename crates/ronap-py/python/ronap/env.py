@@ -203,13 +203,20 @@ class VecNavEnv(VectorEnv):
         return obs, rewards, terminated, truncated, self._infos(infos)
 
 
-def discrete_actions(actions: Any, shape: tuple[int, ...]) -> np.ndarray:
-    """``actions`` as a contiguous int64 array of ``shape``: integers, or whole floats; an
-    ``ActionError`` names a wrong shape, dtype or fractional value (and where it is)."""
+def _shaped(actions: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """``actions`` as an array, refused (an ``ActionError`` naming a non-array value and its type)
+    unless of ``shape``."""
     a = np.asarray(actions)
     if a.shape != shape:
         given = "" if isinstance(actions, np.ndarray) else f" {repr(actions)[:60]} ({type(actions).__name__})"
         raise _ronap.ActionError(f"actions{given} of shape {a.shape}: expected {shape}")
+    return a
+
+
+def discrete_actions(actions: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """``actions`` as a contiguous int64 array of ``shape``: integers, or whole floats; an
+    ``ActionError`` names a wrong shape, dtype or fractional value (and where it is)."""
+    a = _shaped(actions, shape)
     if a.dtype.kind not in "iuf":
         raise _ronap.ActionError(f"actions of dtype {a.dtype}: expected integers 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)")
     if a.dtype.kind == "f":
@@ -226,10 +233,7 @@ def discrete_actions(actions: Any, shape: tuple[int, ...]) -> np.ndarray:
 def continuous_actions(actions: Any, shape: tuple[int, ...]) -> np.ndarray:
     """``actions`` as a contiguous float64 array of ``shape`` (normalised speeds in [-1, 1]); an
     ``ActionError`` names a wrong shape or dtype or a value that is not finite (and where it is)."""
-    a = np.asarray(actions)
-    if a.shape != shape:
-        given = "" if isinstance(actions, np.ndarray) else f" {repr(actions)[:60]} ({type(actions).__name__})"
-        raise _ronap.ActionError(f"actions{given} of shape {a.shape}: expected {shape}")
+    a = _shaped(actions, shape)
     if a.dtype.kind not in "iuf":
         raise _ronap.ActionError(f"actions of dtype {a.dtype}: expected numbers (v / v_max, w / w_max)")
     finite = np.isfinite(a).reshape(-1)
