@@ -131,6 +131,9 @@ fn setup(c: &mut Criterion) {
     group.bench_function("distance_field", |b| {
         b.iter(|| ronap_core::plan::DistanceField::new(world.scene(), grid, goal, 5.0, 4.0))
     });
+    group.bench_function("grid_path", |b| {
+        b.iter(|| ronap_core::plan::grid_path(world.scene(), grid, start, goal, 5.0, 4.0))
+    });
     let field = ronap_core::plan::DistanceField::new(world.scene(), grid, goal, 5.0, 1.0);
     let path = field
         .path(world.scene(), grid, start, 5.0)

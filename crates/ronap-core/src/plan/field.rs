@@ -23,18 +23,6 @@ pub struct DistanceField {
     parent: Vec<u32>,
 }
 
-/// The 8 neighbour offsets with their step lengths in cells.
-const NEIGHBOURS: [(isize, isize, f64); 8] = [
-    (1, 0, 1.0),
-    (-1, 0, 1.0),
-    (0, 1, 1.0),
-    (0, -1, 1.0),
-    (1, 1, std::f64::consts::SQRT_2),
-    (1, -1, std::f64::consts::SQRT_2),
-    (-1, 1, std::f64::consts::SQRT_2),
-    (-1, -1, std::f64::consts::SQRT_2),
-];
-
 /// Cells around a point searched to attach it to the grid (a 5 x 5 block).
 const ATTACH_CELLS: isize = 2;
 
@@ -44,87 +32,18 @@ impl DistanceField {
     /// shortest paths; more keeps paths away from walls).
     pub fn new(scene: &Scene, grid: &FreeGrid, goal: Point, radius: f64, close_cost: f64) -> Self {
         let (cols, rows) = grid.size();
-        let cell_px = grid.cell_px();
-        // Dial's algorithm: integer step costs (12 along an axis, 17 on a diagonal, within 0.2% of
-        // 12 sqrt 2) in a ring of buckets, so each cell is settled in O(1). The smoothed path, not
-        // this cost, is what gets measured, so the integer rounding does not reach any metric.
-        const AXIS: u32 = 12;
-        const DIAGONAL: u32 = 17;
-        let close = close_cost.max(1.0).round() as u32;
-        let ring = (DIAGONAL * close + 1) as usize;
-        let mut cost = vec![u32::MAX; cols * rows];
-        let mut parent = vec![ROOT; cols * rows];
-        let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); ring];
-        let mut pending = 0usize;
-        let units_per_px = AXIS as f64 / cell_px;
-        for (i, d) in attach(scene, grid, goal, radius) {
-            let c = (d * units_per_px).round() as u32;
-            if c < cost[i] {
-                cost[i] = c;
-                buckets[c as usize % ring].push(i as u32);
-                pending += 1;
-            }
-        }
-        let mut current = 0u32;
-        let mut bucket = Vec::new();
-        while pending > 0 {
-            std::mem::swap(&mut bucket, &mut buckets[current as usize % ring]);
-            for &i in &bucket {
-                let i = i as usize;
-                if cost[i] > current {
-                    // A start cost a ring or more ahead (the goal's attachments spread wider than
-                    // one step): keep it for a later turn of the ring.
-                    buckets[current as usize % ring].push(i as u32);
-                    continue;
-                }
-                pending -= 1;
-                if cost[i] < current {
-                    continue;
-                }
-                let (c, r) = ((i % cols) as isize, (i / cols) as isize);
-                for &(dc, dr, _) in &NEIGHBOURS {
-                    let (nc, nr) = (c + dc, r + dr);
-                    if nc < 0 || nr < 0 || nc >= cols as isize || nr >= rows as isize {
-                        continue;
-                    }
-                    let j = nr as usize * cols + nc as usize;
-                    if !grid.is_free_index(j) || !grid.linked(i, j) {
-                        continue;
-                    }
-                    let diagonal = dc != 0 && dr != 0;
-                    if diagonal
-                        && !(grid.is_free(nc as usize, r as usize)
-                            && grid.is_free(c as usize, nr as usize))
-                    {
-                        continue;
-                    }
-                    let base = if diagonal { DIAGONAL } else { AXIS };
-                    let weight = if grid.is_close(i) || grid.is_close(j) {
-                        close
-                    } else {
-                        1
-                    };
-                    let nd = current + base * weight;
-                    if nd < cost[j] {
-                        cost[j] = nd;
-                        parent[j] = i as u32;
-                        buckets[nd as usize % ring].push(j as u32);
-                        pending += 1;
-                    }
-                }
-            }
-            bucket.clear();
-            current += 1;
-        }
-        let px_per_unit = cell_px / AXIS as f64;
+        let mut work = Work::default();
+        work.run(scene, grid, goal, radius, close_cost, None);
+        let px_per_unit = grid.cell_px() / AXIS as f64;
         Self {
             cols,
             rows,
-            cell_px,
+            cell_px: grid.cell_px(),
             goal,
-            cost: cost
-                .into_iter()
-                .map(|c| {
+            cost: work
+                .cost
+                .iter()
+                .map(|&c| {
                     if c == u32::MAX {
                         f64::INFINITY
                     } else {
@@ -132,7 +51,7 @@ impl DistanceField {
                     }
                 })
                 .collect(),
-            parent,
+            parent: work.parent,
         }
     }
 
@@ -166,22 +85,234 @@ impl DistanceField {
         start: Point,
         radius: f64,
     ) -> Option<Vec<Point>> {
-        let (first, _) = attach(scene, grid, start, radius)
-            .into_iter()
-            .filter(|&(i, _)| self.cost[i].is_finite())
-            .min_by(|a, b| (a.1 + self.cost[a.0]).total_cmp(&(b.1 + self.cost[b.0])))?;
-        let mut points = vec![start];
-        let mut i = first;
-        loop {
-            points.push(self.center(i));
-            if self.parent[i] == ROOT {
-                break;
-            }
-            i = self.parent[i] as usize;
-        }
-        points.push(self.goal);
-        Some(points)
+        let first = best_entry(&attach(scene, grid, start, radius), |i| self.cost[i])?;
+        Some(walk(start, first, self.goal, &self.parent, |i| {
+            self.center(i)
+        }))
     }
+}
+
+/// The grid path a [`DistanceField`] towards `goal` gives from `start` (the same points as
+/// `DistanceField::new(..).path(..)`), searching only as far from the goal as `start` lies: the
+/// search stops once no cell it has not settled could begin a shorter path, which on average
+/// settles about half the cells a whole field does. Buffers are kept per thread between calls.
+pub fn grid_path(
+    scene: &Scene,
+    grid: &FreeGrid,
+    start: Point,
+    goal: Point,
+    radius: f64,
+    close_cost: f64,
+) -> Option<Vec<Point>> {
+    let entries = attach(scene, grid, start, radius);
+    if entries.is_empty() {
+        return None;
+    }
+    WORK.with_borrow_mut(|work| {
+        work.run(scene, grid, goal, radius, close_cost, Some(&entries));
+        let px_per_unit = grid.cell_px() / AXIS as f64;
+        let cost = |i: usize| match work.cost[i] {
+            u32::MAX => f64::INFINITY,
+            c => c as f64 * px_per_unit,
+        };
+        // Entries the search stopped short of are provably no better than the best settled one,
+        // so leaving them out picks the same entry as the whole field does.
+        let settled = |i: usize| work.cost[i] <= work.reached;
+        let first = best_entry(
+            &entries,
+            |i| if settled(i) { cost(i) } else { f64::INFINITY },
+        )?;
+        let (cols, cell_px) = (grid.size().0, grid.cell_px());
+        let center = |i: usize| {
+            Point::new(
+                ((i % cols) as f64 + 0.5) * cell_px,
+                ((i / cols) as f64 + 0.5) * cell_px,
+            )
+        };
+        Some(walk(start, first, goal, &work.parent, center))
+    })
+}
+
+/// Axis step cost, in the integer units of the search (see [`Work::run`]).
+const AXIS: u32 = 12;
+/// Diagonal step cost (within 0.2% of 12 sqrt 2).
+const DIAGONAL: u32 = 17;
+/// Step costs of the moves E, W, N, S, NE, SE, NW, SW.
+const STEP: [u32; 8] = [
+    AXIS, AXIS, AXIS, AXIS, DIAGONAL, DIAGONAL, DIAGONAL, DIAGONAL,
+];
+
+thread_local! {
+    /// Each thread's search buffers for [`grid_path`].
+    static WORK: std::cell::RefCell<Work> = std::cell::RefCell::default();
+}
+
+/// The search's buffers, reusable between searches over grids of any size.
+#[derive(Default)]
+struct Work {
+    /// Cost to the goal per cell, in units ([`AXIS`] per cell side); `u32::MAX` where not reached.
+    cost: Vec<u32>,
+    /// Next cell towards the goal, or [`ROOT`].
+    parent: Vec<u32>,
+    /// Dial's ring of buckets: cells by cost modulo the ring's length.
+    buckets: Vec<Vec<u32>>,
+    /// Cells of the current bucket being settled.
+    bucket: Vec<u32>,
+    /// Every cell of cost up to this is settled (final cost and parent).
+    reached: u32,
+}
+
+impl Work {
+    /// Dijkstra from the cells `goal` attaches to, by Dial's algorithm: integer step costs
+    /// ([`AXIS`] along an axis, [`DIAGONAL`] on a diagonal) in a ring of buckets, so each cell is
+    /// settled in O(1). The smoothed path, not this cost, is what gets measured, so the integer
+    /// rounding does not reach any metric.
+    ///
+    /// With `targets` (cells and their straight-line distance in px from a start), it stops as
+    /// soon as every target it has not settled would, even at the least cost still possible,
+    /// give a longer path than the best settled one; without, it settles every reachable cell.
+    fn run(
+        &mut self,
+        scene: &Scene,
+        grid: &FreeGrid,
+        goal: Point,
+        radius: f64,
+        close_cost: f64,
+        targets: Option<&[(usize, f64)]>,
+    ) {
+        let (cols, rows) = grid.size();
+        let n = cols * rows;
+        let cell_px = grid.cell_px();
+        let close = close_cost.max(1.0).round() as u32;
+        let ring = (DIAGONAL * close + 1) as usize;
+        self.cost.clear();
+        self.cost.resize(n, u32::MAX);
+        self.parent.clear();
+        self.parent.resize(n, ROOT);
+        self.buckets.resize_with(ring, Vec::new);
+        self.buckets.truncate(ring);
+        self.buckets.iter_mut().for_each(Vec::clear);
+        self.reached = 0;
+        let (cost, parent, buckets) = (&mut self.cost, &mut self.parent, &mut self.buckets);
+        let mut pending = 0usize;
+        let units_per_px = AXIS as f64 / cell_px;
+        let px_per_unit = cell_px / AXIS as f64;
+        for (i, d) in attach(scene, grid, goal, radius) {
+            let c = (d * units_per_px).round() as u32;
+            if c < cost[i] {
+                cost[i] = c;
+                buckets[c as usize % ring].push(i as u32);
+                pending += 1;
+            }
+        }
+        let (moves, near) = (grid.moves(), grid.close_cells());
+        let w = cols as isize;
+        let offsets: [isize; 8] = [1, -1, w, -w, w + 1, 1 - w, w - 1, -w - 1];
+        // Targets lie in a small block: a range check spares looking them up for most cells.
+        let lowest = targets
+            .into_iter()
+            .flatten()
+            .map(|t| t.0)
+            .min()
+            .unwrap_or(1);
+        let highest = targets
+            .into_iter()
+            .flatten()
+            .map(|t| t.0)
+            .max()
+            .unwrap_or(0);
+        // The best path through a settled target so far, px (a start's straight line plus its
+        // cell's cost).
+        let mut best = f64::INFINITY;
+        let mut current = 0u32;
+        let mut bucket = std::mem::take(&mut self.bucket);
+        while pending > 0 {
+            std::mem::swap(&mut bucket, &mut buckets[current as usize % ring]);
+            for &i in &bucket {
+                let i = i as usize;
+                if cost[i] > current {
+                    // A start cost a ring or more ahead (the goal's attachments spread wider than
+                    // one step): keep it for a later turn of the ring.
+                    buckets[current as usize % ring].push(i as u32);
+                    continue;
+                }
+                pending -= 1;
+                if cost[i] < current {
+                    continue;
+                }
+                // Open moves as bits in the order E, W, N, S, NE, SE, NW, SW: the order decides
+                // which of two equal-cost parents a cell keeps.
+                let mut open = moves[i] as u32;
+                let here_close = near[i];
+                while open != 0 {
+                    let k = open.trailing_zeros() as usize;
+                    open &= open - 1;
+                    let j = i.wrapping_add(offsets[k] as usize);
+                    let weight = if here_close || near[j] { close } else { 1 };
+                    let nd = current + STEP[k] * weight;
+                    if nd < cost[j] {
+                        cost[j] = nd;
+                        parent[j] = i as u32;
+                        buckets[nd as usize % ring].push(j as u32);
+                        pending += 1;
+                    }
+                }
+                if (lowest..=highest).contains(&i) {
+                    for &(t, d) in targets.unwrap_or_default() {
+                        if t == i {
+                            best = best.min(d + current as f64 * px_per_unit);
+                        }
+                    }
+                }
+            }
+            bucket.clear();
+            self.reached = current;
+            if let Some(targets) = targets {
+                // A target not yet settled costs at least `current + 1` units.
+                let floor = (current + 1) as f64 * px_per_unit;
+                if best.is_finite()
+                    && targets
+                        .iter()
+                        .all(|&(t, d)| cost[t] <= current || d + floor > best)
+                {
+                    break;
+                }
+            }
+            current += 1;
+        }
+        self.bucket = bucket;
+    }
+}
+
+/// Of the cells a start attaches to (with their distances), the one beginning the shortest path
+/// under `cost` (the first of equals); `None` when none is reachable.
+fn best_entry(entries: &[(usize, f64)], cost: impl Fn(usize) -> f64) -> Option<usize> {
+    entries
+        .iter()
+        .filter(|&&(i, _)| cost(i).is_finite())
+        .min_by(|a, b| (a.1 + cost(a.0)).total_cmp(&(b.1 + cost(b.0))))
+        .map(|&(i, _)| i)
+}
+
+/// `start`, the centres of the cells from `first` down `parent` to the root, and `goal`.
+fn walk(
+    start: Point,
+    first: usize,
+    goal: Point,
+    parent: &[u32],
+    center: impl Fn(usize) -> Point,
+) -> Vec<Point> {
+    let mut points = vec![start];
+    let mut i = first;
+    loop {
+        points.push(center(i));
+        if parent[i] == ROOT {
+            break;
+        }
+        i = parent[i] as usize;
+    }
+    points.push(goal);
+    points
 }
 
 /// Free cells near `p` that a disc of `radius` at `p` can reach in a straight line, with the
@@ -206,4 +337,51 @@ fn attach(scene: &Scene, grid: &FreeGrid, p: Point, radius: f64) -> Vec<(usize, 
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::ValidConfig;
+    use crate::sim::world::World;
+
+    /// The early-stopping search gives exactly the whole field's path: in mazes and warehouses,
+    /// plain and wall-shy costs, near and far starts.
+    #[test]
+    fn grid_path_is_the_whole_fields_path() {
+        let config = ValidConfig::default();
+        let mut compared = 0;
+        for seed in 0..12u64 {
+            let world = if seed % 3 == 2 {
+                World::warehouse(config.clone(), seed)
+            } else {
+                World::maze(config.clone(), seed)
+            };
+            let (scene, grid) = (world.scene(), world.grid());
+            let Ok(episode) = world.episode(seed) else {
+                continue;
+            };
+            let goal = episode.goal();
+            for close_cost in [1.0, 4.0] {
+                let field = DistanceField::new(scene, grid, goal, 5.0, close_cost);
+                let cells = grid.region_cells(0);
+                for k in 0..25 {
+                    let cell = cells[(k * 7919 + seed as usize * 131) % cells.len()] as usize;
+                    let (cols, _) = grid.size();
+                    let start = grid.center(cell % cols, cell / cols)
+                        + crate::geometry::Vector::new(1.3, -0.7);
+                    let whole = field.path(scene, grid, start, 5.0);
+                    let early = grid_path(scene, grid, start, goal, 5.0, close_cost);
+                    assert_eq!(whole, early, "seed {seed} cost {close_cost} start {start}");
+                    compared += 1;
+                }
+                // The goal's own cell and a point outside the scene.
+                let here = grid_path(scene, grid, goal, goal, 5.0, close_cost);
+                assert_eq!(field.path(scene, grid, goal, 5.0), here);
+                let outside = Point::new(-10.0, -10.0);
+                assert_eq!(grid_path(scene, grid, outside, goal, 5.0, close_cost), None);
+            }
+        }
+        assert!(compared > 400, "{compared}");
+    }
 }

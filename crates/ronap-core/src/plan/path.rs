@@ -3,7 +3,7 @@
 //! path; and the shortest-path length of a world, SPL's yardstick.
 
 use crate::geometry::Point;
-use crate::plan::field::DistanceField;
+use crate::plan::field::grid_path;
 use crate::scene::freespace::FreeGrid;
 use crate::scene::Scene;
 use crate::sim::world::World;
@@ -97,8 +97,7 @@ pub fn shortest_path(
     goal: Point,
     radius: f64,
 ) -> Option<Vec<Point>> {
-    let field = DistanceField::new(scene, grid, goal, radius, 1.0);
-    let path = field.path(scene, grid, start, radius)?;
+    let path = grid_path(scene, grid, start, goal, radius, 1.0)?;
     Some(smooth(scene, &path, radius))
 }
 

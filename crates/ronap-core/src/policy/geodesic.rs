@@ -7,7 +7,7 @@
 use super::follow::{FollowStep, Follower};
 use super::{Decision, Policy, PolicyError};
 use crate::geometry::Point;
-use crate::plan::{smooth, DistanceField};
+use crate::plan::{grid_path, smooth, DistanceField};
 use crate::sim::episode::Episode;
 use crate::sim::robot::DiscreteAction;
 use crate::sim::world::World;
@@ -83,29 +83,23 @@ impl Policy for GeodesicWait {
 /// (smoothing the whole path for every sample costs 3x the time and changes 0.5% of labels).
 const EXPERT_PATH_POINTS: usize = 80;
 
-/// Plans `field`'s path from `from` and a follower of it; with `prefix`, of only the first
-/// `prefix` grid points of the path.
-fn plan(
-    world: &World,
-    field: &DistanceField,
-    from: Point,
-    prefix: Option<usize>,
-) -> Option<Follower> {
+/// A follower of a grid `path`, smoothed; with `prefix`, of only its first `prefix` points.
+fn follow(world: &World, mut path: Vec<Point>, prefix: Option<usize>) -> Follower {
+    if let Some(n) = prefix {
+        path.truncate(n.max(2));
+    }
     let radius = world.config().robot.radius_px;
-    let (scene, grid) = (world.scene(), world.grid());
-    field.path(scene, grid, from, radius).map(|mut path| {
-        if let Some(n) = prefix {
-            path.truncate(n.max(2));
-        }
-        let path = smooth(scene, &path, radius + MARGIN_PX);
-        Follower::new(path, world.config().robot.move_speed_px * 2.0)
-    })
+    let path = smooth(world.scene(), &path, radius + MARGIN_PX);
+    Follower::new(path, world.config().robot.move_speed_px * 2.0)
 }
 
 impl Policy for Geodesic {
     fn reset(&mut self, world: &World, episode: &Episode) -> Result<(), PolicyError> {
-        let field = Expert::field(world, episode.goal());
-        self.follower = plan(world, &field, episode.pose().position(), None);
+        let radius = world.config().robot.radius_px;
+        let (scene, grid) = (world.scene(), world.grid());
+        let from = episode.pose().position();
+        let path = grid_path(scene, grid, from, episode.goal(), radius, CLOSE_COST);
+        self.follower = path.map(|path| follow(world, path, None));
         Ok(())
     }
 
@@ -149,7 +143,9 @@ impl Expert {
     /// robot is already at the end of the path.
     pub fn action(&self, world: &World, episode: &Episode) -> Option<DiscreteAction> {
         let from = episode.pose().position();
-        match plan(world, &self.field, from, Some(EXPERT_PATH_POINTS))?.next(episode) {
+        let radius = world.config().robot.radius_px;
+        let path = self.field.path(world.scene(), world.grid(), from, radius)?;
+        match follow(world, path, Some(EXPERT_PATH_POINTS)).next(episode) {
             FollowStep::Act(a) => Some(a),
             FollowStep::Arrived | FollowStep::Stuck => None,
         }

@@ -27,12 +27,14 @@ pub struct FreeGrid {
     free: Vec<bool>,
     /// Free cells whose centre is within `margin_px` of touching an obstacle.
     close: Vec<bool>,
-    /// Links that are blocked, per cell: bit 0 to the east, 1 north, 2 north-east, 3 north-west.
-    unlinked: Vec<u8>,
     /// Region label of each free cell (`u32::MAX` for blocked cells).
     region: Vec<u32>,
     /// Cells of each region, largest region first.
-    regions: Vec<Vec<u32>>,
+    regions: std::sync::OnceLock<Vec<Vec<u32>>>,
+    /// Number of regions.
+    region_count: usize,
+    /// The 8-neighbour moves open from each cell, as bits (see [`FreeGrid::moves`]).
+    moves: Vec<u8>,
 }
 
 impl FreeGrid {
@@ -95,7 +97,6 @@ impl FreeGrid {
                 }
             }
         }
-        // Label regions by flood fill, numbering them in the order their first cell is met.
         let mut unlinked = vec![0u8; cols * rows];
         let maze_is_safe = !scene.has_added_obstacles()
             && match scene.source() {
@@ -108,6 +109,9 @@ impl FreeGrid {
         // of it is within cell/sqrt 2 of one of them. The margin must cover that to skip a check.
         let exact = !maze_is_safe && margin_px * 2.0 >= cell_px * std::f64::consts::SQRT_2;
         for r in 0..rows {
+            if maze_is_safe {
+                break;
+            }
             for c in 0..cols {
                 let i = r * cols + c;
                 if !free[i] {
@@ -120,97 +124,33 @@ impl FreeGrid {
                     (3, c > 0 && r + 1 < rows, (i + cols).wrapping_sub(1)),
                 ];
                 for (bit, inside, j) in links {
-                    if !inside || !free[j] {
+                    if !inside || !free[j] || (exact && !(close[i] && close[j])) {
                         continue;
                     }
-                    let must_check = if exact {
-                        close[i] && close[j]
-                    } else {
-                        !maze_is_safe
-                    };
-                    if must_check {
-                        let a = Point::new((c as f64 + 0.5) * cell_px, (r as f64 + 0.5) * cell_px);
-                        let b = Point::new(
-                            ((j % cols) as f64 + 0.5) * cell_px,
-                            ((j / cols) as f64 + 0.5) * cell_px,
-                        );
-                        if !scene.sweep_clear(a, b, radius) {
-                            unlinked[i] |= 1 << bit;
-                        }
+                    let a = Point::new((c as f64 + 0.5) * cell_px, (r as f64 + 0.5) * cell_px);
+                    let b = Point::new(
+                        ((j % cols) as f64 + 0.5) * cell_px,
+                        ((j / cols) as f64 + 0.5) * cell_px,
+                    );
+                    if !scene.sweep_clear(a, b, radius) {
+                        unlinked[i] |= 1 << bit;
                     }
                 }
             }
         }
-        let linked = |i: usize, j: usize| link_open(&unlinked, cols, i, j);
-        let mut region = vec![u32::MAX; cols * rows];
-        let mut sizes: Vec<usize> = Vec::new();
-        let mut stack = Vec::new();
-        for seed in 0..cols * rows {
-            if !free[seed] || region[seed] != u32::MAX {
-                continue;
-            }
-            let label = sizes.len() as u32;
-            let mut size = 0;
-            region[seed] = label;
-            stack.push(seed);
-            while let Some(i) = stack.pop() {
-                size += 1;
-                let (c, r) = (i % cols, i / cols);
-                let mut visit = |j: usize| {
-                    if free[j] && region[j] == u32::MAX && linked(i, j) {
-                        region[j] = label;
-                        stack.push(j);
-                    }
-                };
-                if c > 0 {
-                    visit(i - 1);
-                }
-                if c + 1 < cols {
-                    visit(i + 1);
-                }
-                if r > 0 {
-                    visit(i - cols);
-                }
-                if r + 1 < rows {
-                    visit(i + cols);
-                }
-            }
-            sizes.push(size);
-        }
-        // Renumber largest first (ties keep discovery order, so the result is deterministic) and
-        // list each region's cells in increasing index order with one pass over the grid.
-        let mut order: Vec<usize> = (0..sizes.len()).collect();
-        order.sort_by_key(|&k| std::cmp::Reverse(sizes[k]));
-        let mut relabel = vec![0u32; sizes.len()];
-        for (new, &old) in order.iter().enumerate() {
-            relabel[old] = new as u32;
-        }
-        let mut regions: Vec<Vec<u32>> = order
-            .iter()
-            .map(|&k| Vec::with_capacity(sizes[k]))
-            .collect();
-        for (i, l) in region.iter_mut().enumerate() {
-            if *l != u32::MAX {
-                *l = relabel[*l as usize];
-                regions[*l as usize].push(i as u32);
-            }
-        }
+        let (region, region_count) = label_regions(cols, rows, &free, &unlinked);
+        let moves = open_moves(cols, rows, &free, &unlinked);
         Self {
             cell_px,
             cols,
             rows,
             free,
             close,
-            unlinked,
             region,
-            regions,
+            regions: std::sync::OnceLock::new(),
+            region_count,
+            moves,
         }
-    }
-
-    /// Whether the disc can drive straight between the centres of neighbouring cells `i` and `j`
-    /// (both free; `true` for cells that are not neighbours).
-    pub fn linked(&self, i: usize, j: usize) -> bool {
-        link_open(&self.unlinked, self.cols, i, j)
     }
 
     /// Whether free cell `index` (`row * cols + col`) is within the margin of an obstacle.
@@ -221,6 +161,18 @@ impl FreeGrid {
     /// Whether cell `index` (`row * cols + col`) is free.
     pub fn is_free_index(&self, index: usize) -> bool {
         self.free[index]
+    }
+
+    /// The moves a disc can make from each cell to a neighbouring cell, as bits in the order
+    /// E, W, N, S, NE, SE, NW, SW (row + 1 is north): a move is open when the target cell is free
+    /// and linked and, for a diagonal, both cells beside it are free (paths never cut a corner).
+    pub(crate) fn moves(&self) -> &[u8] {
+        &self.moves
+    }
+
+    /// Close flags of every cell (meaningful for free cells only).
+    pub(crate) fn close_cells(&self) -> &[bool] {
+        &self.close
     }
 
     /// Cell side, px.
@@ -263,12 +215,21 @@ impl FreeGrid {
 
     /// Number of connected regions.
     pub fn region_count(&self) -> usize {
-        self.regions.len()
+        self.region_count
     }
 
-    /// Cells `row * cols + col` of region `label`, in increasing order.
+    /// Cells `row * cols + col` of region `label`, in increasing order (listed on first use).
     pub fn region_cells(&self, label: u32) -> &[u32] {
-        self.regions.get(label as usize).map_or(&[], Vec::as_slice)
+        let regions = self.regions.get_or_init(|| {
+            let mut regions = vec![Vec::new(); self.region_count];
+            for (i, &l) in self.region.iter().enumerate() {
+                if l != u32::MAX {
+                    regions[l as usize].push(i as u32);
+                }
+            }
+            regions
+        });
+        regions.get(label as usize).map_or(&[], Vec::as_slice)
     }
 
     /// Number of free cells.
@@ -277,23 +238,283 @@ impl FreeGrid {
     }
 }
 
-/// Whether the link between neighbouring cells `i` and `j` is open in `unlinked`.
-fn link_open(unlinked: &[u8], cols: usize, i: usize, j: usize) -> bool {
-    let (lo, hi) = (i.min(j), i.max(j));
-    let bit = match hi - lo {
-        1 => 0,
-        d if d == cols => 1,
-        d if d == cols + 1 => 2,
-        d if d + 1 == cols => 3,
-        _ => return true,
-    };
-    unlinked[lo] & (1 << bit) == 0
+/// Connected regions of free cells over 4-neighbour links: each free cell's label (`u32::MAX` for
+/// blocked cells; 0 is the largest region, ties in the order of their lowest cell) and the number
+/// of regions.
+///
+/// Union-find over runs: each row splits into runs of free cells linked east-west; a run joins
+/// the runs below it that it is linked to; every set's root is its lowest cell.
+fn label_regions(cols: usize, rows: usize, free: &[bool], unlinked: &[u8]) -> (Vec<u32>, usize) {
+    fn root(parent: &mut [u32], mut i: u32) -> u32 {
+        while parent[i as usize] != i {
+            let up = parent[parent[i as usize] as usize];
+            parent[i as usize] = up;
+            i = up;
+        }
+        i
+    }
+    // `run[i]`: the first cell of free cell i's run. `parent`: over run starts only.
+    let mut run = vec![u32::MAX; cols * rows];
+    let mut parent = vec![u32::MAX; cols * rows];
+    for r in 0..rows {
+        let here = r * cols;
+        let mut start = u32::MAX;
+        let mut below_last = u32::MAX;
+        for c in 0..cols {
+            let i = here + c;
+            if !free[i] {
+                start = u32::MAX;
+                continue;
+            }
+            if start == u32::MAX || unlinked[i - 1] & 1 != 0 {
+                start = i as u32;
+                parent[i] = start;
+                below_last = u32::MAX;
+            }
+            run[i] = start;
+            if r > 0 && free[i - cols] && unlinked[i - cols] & 2 == 0 {
+                let below = run[i - cols];
+                if below != below_last {
+                    below_last = below;
+                    let (a, b) = (root(&mut parent, start), root(&mut parent, below));
+                    if a != b {
+                        let (lo, hi) = (a.min(b), a.max(b));
+                        parent[hi as usize] = lo;
+                    }
+                }
+            }
+        }
+    }
+    // Label sets in the order of their lowest cell (met before the set's other cells), a run at a
+    // time, counting cells.
+    let mut region = run;
+    let mut sizes: Vec<usize> = Vec::new();
+    let mut i = 0;
+    while i < cols * rows {
+        if region[i] == u32::MAX {
+            i += 1;
+            continue;
+        }
+        let start = i;
+        let top = root(&mut parent, start as u32) as usize;
+        let label = if top == start {
+            sizes.push(0);
+            (sizes.len() - 1) as u32
+        } else {
+            region[top]
+        };
+        while i < cols * rows && region[i] == start as u32 {
+            region[i] = label;
+            i += 1;
+        }
+        sizes[label as usize] += i - start;
+    }
+    // Renumber largest first (ties keep discovery order, so the result is deterministic).
+    let mut order: Vec<usize> = (0..sizes.len()).collect();
+    order.sort_by_key(|&k| std::cmp::Reverse(sizes[k]));
+    let mut relabel = vec![0u32; sizes.len()];
+    for (new, &old) in order.iter().enumerate() {
+        relabel[old] = new as u32;
+    }
+    for l in region.iter_mut().filter(|l| **l != u32::MAX) {
+        *l = relabel[*l as usize];
+    }
+    (region, sizes.len())
+}
+
+/// [`FreeGrid::moves`] of every cell.
+fn open_moves(cols: usize, rows: usize, free: &[bool], unlinked: &[u8]) -> Vec<u8> {
+    let mut moves = vec![0u8; cols * rows];
+    // A move's bit: its target free, its link open, and for a diagonal both side cells free.
+    // Interior cells, row by row over slices (no bounds left to check, so the loop vectorises),
+    // in arithmetic rather than branches.
+    let row = |r: usize| r * cols..(r + 1) * cols;
+    let f = |s: &[bool], k: usize| s[k] as u8;
+    let open = |s: &[u8], k: usize, bit: u8| !s[k] >> bit & 1;
+    for r in 1..rows.saturating_sub(1) {
+        let (fs_, fh, fn_) = (&free[row(r - 1)], &free[row(r)], &free[row(r + 1)]);
+        let (us, uh) = (&unlinked[row(r - 1)], &unlinked[row(r)]);
+        let out = &mut moves[row(r)];
+        for (c, out) in out.iter_mut().enumerate().take(cols - 1).skip(1) {
+            let (fe, fw, fno, fs) = (f(fh, c + 1), f(fh, c - 1), f(fn_, c), f(fs_, c));
+            let bits = (fe & open(uh, c, 0))
+                | (fw & open(uh, c - 1, 0)) << 1
+                | (fno & open(uh, c, 1)) << 2
+                | (fs & open(us, c, 1)) << 3
+                | (fe & fno & f(fn_, c + 1) & open(uh, c, 2)) << 4
+                | (fe & fs & f(fs_, c + 1) & open(us, c + 1, 3)) << 5
+                | (fw & fno & f(fn_, c - 1) & open(uh, c, 3)) << 6
+                | (fw & fs & f(fs_, c - 1) & open(us, c - 1, 2)) << 7;
+            *out = bits * f(fh, c);
+        }
+    }
+    // The border, checking bounds: the first and last rows, the first and last columns.
+    let last = rows - 1;
+    let rims = (0..rows).flat_map(|r| {
+        let every = r == 0 || r == last;
+        let cs: Vec<usize> = if every {
+            (0..cols).collect()
+        } else {
+            vec![0, cols - 1]
+        };
+        cs.into_iter().map(move |c| (c, r))
+    });
+    for (c, r) in rims {
+        let i = r * cols + c;
+        if !free[i] {
+            continue;
+        }
+        let fe = c + 1 < cols && free[i + 1];
+        let fw = c > 0 && free[i - 1];
+        let fno = r + 1 < rows && free[i + cols];
+        let fs = r > 0 && free[i - cols];
+        let mut bits = (fe && unlinked[i] & 1 == 0) as u8
+            | ((fw && unlinked[i - 1] & 1 == 0) as u8) << 1
+            | ((fno && unlinked[i] & 2 == 0) as u8) << 2
+            | ((fs && unlinked[i - cols] & 2 == 0) as u8) << 3;
+        if fe && fno {
+            bits |= ((free[i + cols + 1] && unlinked[i] & 4 == 0) as u8) << 4;
+        }
+        if fe && fs {
+            bits |= ((free[i + 1 - cols] && unlinked[i + 1 - cols] & 8 == 0) as u8) << 5;
+        }
+        if fw && fno {
+            bits |= ((free[i + cols - 1] && unlinked[i] & 8 == 0) as u8) << 6;
+        }
+        if fw && fs {
+            bits |= ((free[i - cols - 1] && unlinked[i - cols - 1] & 4 == 0) as u8) << 7;
+        }
+        moves[i] = bits;
+    }
+    moves
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::geometry::Aabb;
+
+    /// Whether the link from cell `(c, r)` to its neighbour `(c + dc, r + dr)` is open: the bit
+    /// is kept by the lower cell of the two (east, north, north-east, north-west).
+    fn link(unlinked: &[u8], cols: usize, c: usize, r: usize, dc: isize, dr: isize) -> bool {
+        let up = dr > 0 || (dr == 0 && dc > 0);
+        let (lc, lr, dir) = if up {
+            (c as isize, r as isize, (dc, dr))
+        } else {
+            (c as isize + dc, r as isize + dr, (-dc, -dr))
+        };
+        let bit = match dir {
+            (1, 0) => 0,
+            (0, 1) => 1,
+            (1, 1) => 2,
+            (-1, 1) => 3,
+            _ => unreachable!("not a neighbour"),
+        };
+        unlinked[lr as usize * cols + lc as usize] & (1 << bit) == 0
+    }
+
+    /// The flood fill regions were first labelled with: seeds in index order, 4-neighbour links.
+    fn flood_labels(cols: usize, rows: usize, free: &[bool], unlinked: &[u8]) -> Vec<u32> {
+        let mut region = vec![u32::MAX; cols * rows];
+        let mut sizes = Vec::new();
+        for seed in 0..cols * rows {
+            if !free[seed] || region[seed] != u32::MAX {
+                continue;
+            }
+            let label = sizes.len() as u32;
+            let (mut size, mut stack) = (0, vec![seed]);
+            region[seed] = label;
+            while let Some(i) = stack.pop() {
+                size += 1;
+                let (c, r) = (i % cols, i / cols);
+                let near = [
+                    (c > 0).then(|| (i - 1, -1, 0)),
+                    (c + 1 < cols).then(|| (i + 1, 1, 0)),
+                    (r > 0).then(|| (i - cols, 0, -1)),
+                    (r + 1 < rows).then(|| (i + cols, 0, 1)),
+                ];
+                for (j, dc, dr) in near.into_iter().flatten() {
+                    if free[j] && region[j] == u32::MAX && link(unlinked, cols, c, r, dc, dr) {
+                        region[j] = label;
+                        stack.push(j);
+                    }
+                }
+            }
+            sizes.push(size);
+        }
+        let mut order: Vec<usize> = (0..sizes.len()).collect();
+        order.sort_by_key(|&k| std::cmp::Reverse(sizes[k]));
+        let mut relabel = vec![0u32; sizes.len()];
+        for (new, &old) in order.iter().enumerate() {
+            relabel[old] = new as u32;
+        }
+        region
+            .iter()
+            .map(|&l| {
+                if l == u32::MAX {
+                    l
+                } else {
+                    relabel[l as usize]
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn union_find_labels_regions_as_the_flood_fill_did() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        for case in 0..300 {
+            let (cols, rows) = (rng.random_range(1..30), rng.random_range(1..30));
+            let density = rng.random_range(0.0..1.0);
+            let free: Vec<bool> = (0..cols * rows).map(|_| rng.random_bool(density)).collect();
+            let unlinked: Vec<u8> = (0..cols * rows)
+                .map(|_| {
+                    if rng.random_bool(0.2) {
+                        rng.random_range(0..16)
+                    } else {
+                        0
+                    }
+                })
+                .collect();
+            let (region, count) = label_regions(cols, rows, &free, &unlinked);
+            let flood = flood_labels(cols, rows, &free, &unlinked);
+            assert_eq!(region, flood, "case {case}");
+            let labels = flood.iter().filter(|&&l| l != u32::MAX);
+            assert_eq!(count, labels.max().map_or(0, |&l| l as usize + 1));
+            let moves = open_moves(cols, rows, &free, &unlinked);
+            for i in 0..cols * rows {
+                let (c, r) = ((i % cols) as isize, (i / cols) as isize);
+                let steps = [
+                    (1, 0),
+                    (-1, 0),
+                    (0, 1),
+                    (0, -1),
+                    (1, 1),
+                    (1, -1),
+                    (-1, 1),
+                    (-1, -1),
+                ];
+                for (bit, (dc, dr)) in steps.into_iter().enumerate() {
+                    let (nc, nr) = (c + dc, r + dr);
+                    let inside = |c: isize, r: isize| {
+                        c >= 0 && r >= 0 && c < cols as isize && r < rows as isize
+                    };
+                    let at = |c: isize, r: isize| r as usize * cols + c as usize;
+                    let open = free[i]
+                        && inside(nc, nr)
+                        && free[at(nc, nr)]
+                        && link(&unlinked, cols, c as usize, r as usize, dc, dr)
+                        && (dc == 0 || dr == 0 || (free[at(nc, r)] && free[at(c, nr)]));
+                    assert_eq!(
+                        moves[i] >> bit & 1 == 1,
+                        open,
+                        "case {case} cell {i} move {bit}"
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn a_wall_splits_a_room_into_two_regions() {
