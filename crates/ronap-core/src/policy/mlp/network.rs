@@ -65,11 +65,11 @@ impl Activation {
         match self {
             Self::Relu => v.iter_mut().for_each(|x| *x = x.max(0.0)),
             Self::Tanh => v.iter_mut().for_each(|x| *x = x.tanh()),
-            Self::LeakyRelu(s) => v.iter_mut().for_each(|x| {
-                if *x < 0.0 {
-                    *x *= s;
-                }
-            }),
+            // A select rather than a branch: the sign of a hidden unit is a coin toss to the
+            // branch predictor, and the select vectorises.
+            Self::LeakyRelu(s) => v
+                .iter_mut()
+                .for_each(|x| *x = if *x < 0.0 { *x * s } else { *x }),
         }
     }
 }
@@ -206,13 +206,37 @@ impl Mlp {
 }
 
 /// `y += W x` for the column-major `weights` (column j holds the weights from input j), adding
-/// the columns in input order: a loop over the outputs that vectorises.
+/// the columns in input order. Outputs go in blocks held in registers across all the inputs (32,
+/// then 8, then one at a time), so each weight is loaded once and each output stored once; every
+/// output's sum keeps the same order, so the result is the same bit for bit.
 fn add_columns(y: &mut [f32], x: &[f32], weights: &[f32], outputs: usize) {
+    let mut o = 0;
+    while o + 32 <= outputs {
+        add_block::<32>(y, x, weights, outputs, o);
+        o += 32;
+    }
+    while o + 8 <= outputs {
+        add_block::<8>(y, x, weights, outputs, o);
+        o += 8;
+    }
+    while o < outputs {
+        add_block::<1>(y, x, weights, outputs, o);
+        o += 1;
+    }
+}
+
+/// [`add_columns`] for outputs `o..o + B`.
+#[inline(always)]
+fn add_block<const B: usize>(y: &mut [f32], x: &[f32], weights: &[f32], outputs: usize, o: usize) {
+    let mut acc = [0.0f32; B];
+    acc.copy_from_slice(&y[o..o + B]);
     for (&xj, column) in x.iter().zip(weights.chunks_exact(outputs)) {
-        for (yi, &w) in y.iter_mut().zip(column) {
-            *yi += xj * w;
+        let w = &column[o..o + B];
+        for (a, &w) in acc.iter_mut().zip(w) {
+            *a += xj * w;
         }
     }
+    y[o..o + B].copy_from_slice(&acc);
 }
 
 /// Buffers for [`Mlp::forward_into`], reused from step to step.
