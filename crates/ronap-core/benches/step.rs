@@ -117,6 +117,14 @@ fn setup(c: &mut Criterion) {
     group.bench_function("maze_scene", |b| {
         b.iter(|| maze_scene(&config, black_box(3)))
     });
+    // What an RL reset of the default scene costs: a new maze and its index, then placement.
+    let mut seed = 0u64;
+    group.bench_function("reset", |b| {
+        b.iter(|| {
+            seed += 1;
+            Episode::new(&config, Arc::new(maze_scene(&config, seed)), seed).expect("places")
+        })
+    });
     group.bench_function("free_grid", |b| {
         b.iter_batched(
             || maze_scene(&config, 3),

@@ -36,33 +36,32 @@ impl BinIndex {
         let bin_of = |v: f64, lo: f64, n: usize| -> usize {
             (((v - lo) / bin_px).floor().max(0.0) as usize).min(n - 1)
         };
-        // Two passes (count, then fill) build the compressed rows without per-bin vectors.
-        let mut counts = vec![0u32; cols * rows + 1];
-        let for_each_bin = |b: &Aabb, f: &mut dyn FnMut(usize)| {
+        // The bins a box reaches: a rectangle of columns c0..=c1 by rows r0..=r1.
+        let span = |b: &Aabb| {
             let grown = b.inflated(reach_px);
-            if grown.max.x < area.min.x
+            let outside = grown.max.x < area.min.x
                 || grown.max.y < area.min.y
                 || grown.min.x > area.max.x
-                || grown.min.y > area.max.y
-            {
-                return;
-            }
-            let (c0, c1) = (
-                bin_of(grown.min.x, area.min.x, cols),
-                bin_of(grown.max.x, area.min.x, cols),
-            );
-            let (r0, r1) = (
-                bin_of(grown.min.y, area.min.y, rows),
-                bin_of(grown.max.y, area.min.y, rows),
-            );
-            for r in r0..=r1 {
-                for c in c0..=c1 {
-                    f(r * cols + c);
+                || grown.min.y > area.max.y;
+            (!outside).then(|| {
+                let columns =
+                    bin_of(grown.min.x, area.min.x, cols)..=bin_of(grown.max.x, area.min.x, cols);
+                let rows =
+                    bin_of(grown.min.y, area.min.y, rows)..=bin_of(grown.max.y, area.min.y, rows);
+                (columns, rows)
+            })
+        };
+        // Two passes (count, then fill) build the compressed rows without per-bin vectors; each
+        // box touches a row of bins at a time as one slice (a loop that vectorises).
+        let spans: Vec<_> = boxes.iter().map(span).collect();
+        let mut counts = vec![0u32; cols * rows + 1];
+        for (columns, rs) in spans.iter().flatten() {
+            for r in rs.clone() {
+                let row = r * cols + 1;
+                for n in &mut counts[row + columns.start()..=row + columns.end()] {
+                    *n += 1;
                 }
             }
-        };
-        for b in boxes {
-            for_each_bin(b, &mut |bin| counts[bin + 1] += 1);
         }
         for i in 1..counts.len() {
             counts[i] += counts[i - 1];
@@ -70,11 +69,18 @@ impl BinIndex {
         let starts = counts;
         let mut fill = starts.clone();
         let mut items = vec![0u32; starts[cols * rows] as usize];
-        for (i, b) in boxes.iter().enumerate() {
-            for_each_bin(b, &mut |bin| {
-                items[fill[bin] as usize] = i as u32;
-                fill[bin] += 1;
-            });
+        for (i, (columns, rs)) in spans
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| Some((i, s.as_ref()?)))
+        {
+            for r in rs.clone() {
+                let row = r * cols;
+                for next in &mut fill[row + columns.start()..=row + columns.end()] {
+                    items[*next as usize] = i as u32;
+                    *next += 1;
+                }
+            }
         }
         Self {
             origin: area.min,
