@@ -39,6 +39,33 @@ fn colour_count(img: &image::RgbImage, pred: impl Fn(&image::Rgb<u8>) -> bool) -
 }
 
 #[test]
+fn maze_draws_every_robot_of_a_team_in_its_colour() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("team.png");
+    let scenario = repo_root().join("scenarios/warehouse-team.toml");
+    let o = ronap(&[
+        "maze",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--seed",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let img = image::open(&out).unwrap().to_rgb8();
+    // The first four robots' colours (tab10 blue, orange, green, red), each at its start.
+    for colour in [[31, 119, 180], [255, 127, 14], [44, 160, 44], [214, 39, 40]] {
+        let n = colour_count(&img, |p| p.0 == colour);
+        assert!(n > 20, "{colour:?}: {n} pixels");
+    }
+    // Text is a one-robot maze's only: a team's picture needs --out.
+    let o = ronap(&["maze", "--scenario", scenario.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--out"), "{}", stderr(&o));
+}
+
+#[test]
 fn maze_png_has_walls_floor_start_and_goal() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("maze.png");

@@ -5,8 +5,10 @@ use crate::args::{positive, seed, SimArgs};
 use anyhow::{Context, Result};
 use clap::Args;
 use ronap_core::render::{Canvas, GOAL, MOVER, START};
+use ronap_core::run::team::TeamRollout;
 use ronap_core::sim::placement::{needs_region_grid, sample_placement};
 use ronap_core::sim::world::{SceneSpec, Worlds};
+use ronap_core::ValidConfig;
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -41,8 +43,12 @@ pub fn run(args: MazeArgs) -> Result<ExitCode> {
     let config = args.sim.config()?;
     let seed = args.seed.or(config.scene.seed).unwrap_or(0);
     let (scenes, _) = SceneSpec::resolve(&config.scene, Some(seed), None).load(&config)?;
-    let world = Worlds::new(config.clone(), scenes).world(seed);
+    let worlds = Worlds::new(config.clone(), scenes);
+    let world = worlds.world(seed);
     let scene = world.scene().clone();
+    if !config.robots.is_empty() {
+        return team_picture(&args, &config, &worlds, seed);
+    }
     let placement = if args.start_goal {
         let grid = needs_region_grid(&config, &scene).then(|| world.grid());
         Some(sample_placement(&config, &scene, grid, seed).context("cannot place start and goal")?)
@@ -67,12 +73,7 @@ pub fn run(args: MazeArgs) -> Result<ExitCode> {
     };
     match &args.out {
         Some(path) => {
-            let pixels = scene.width() * scene.height() * args.scale * args.scale;
-            anyhow::ensure!(
-                pixels <= 4.0e8,
-                "--scale {}: the picture would have {pixels:.0} pixels (at most 400 million)",
-                args.scale
-            );
+            check_size(&scene, args.scale)?;
             let mut canvas = Canvas::new(&scene, args.scale);
             canvas.tracks(&tracks);
             // Where each one starts (or first appears), drawn over its track.
@@ -107,5 +108,36 @@ pub fn run(args: MazeArgs) -> Result<ExitCode> {
             }
         }
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Refuses a picture of more than 400 million pixels.
+fn check_size(scene: &ronap_core::Scene, scale: f64) -> Result<()> {
+    let pixels = scene.width() * scene.height() * scale * scale;
+    anyhow::ensure!(
+        pixels <= 4.0e8,
+        "--scale {scale}: the picture would have {pixels:.0} pixels (at most 400 million)"
+    );
+    Ok(())
+}
+
+/// A team scenario (`[[robots]]`): every robot at its start and its goals in visiting order, in
+/// its own colour (always drawn: a team's scene says little without them). Needs `--out`.
+fn team_picture(
+    args: &MazeArgs,
+    config: &ValidConfig,
+    worlds: &Worlds,
+    seed: u64,
+) -> Result<ExitCode> {
+    let path = args
+        .out
+        .as_ref()
+        .context("the scenario has a team ([[robots]]): give --out FILE.png for its picture")?;
+    let rollout = TeamRollout::placed(config, worlds.team(seed), seed)
+        .context("cannot place the team's robots")?;
+    let team = rollout.team();
+    check_size(team.robot(0).scene(), args.scale)?;
+    let image = ronap_core::render::team::team_setup(team, args.scale);
+    ronap_core::io::atomic::save_image(path, &image)?;
     Ok(ExitCode::SUCCESS)
 }

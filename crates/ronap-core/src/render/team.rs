@@ -71,6 +71,33 @@ pub fn team_frame(team: &Team, paths: &[Vec<Point>], scale: f64) -> RgbImage {
     canvas.into_image()
 }
 
+/// The picture of a team's set-up before it moves: each robot's goals, in its visiting order, as
+/// faded discs joined by thin lines from its start (where it will head, not where it drove), and
+/// each robot at its start with its heading, in its own colour; moving obstacles where they start.
+pub fn team_setup(team: &Team, scale: f64) -> RgbImage {
+    let first = team.robot(0);
+    let mut canvas = Canvas::new(first.scene(), scale);
+    let least = 3.0 / scale;
+    for (k, r) in team.robots().iter().enumerate() {
+        let colour = faded(policy_colour(k));
+        let mut legs = vec![r.start().position()];
+        legs.extend_from_slice(team.goals(k));
+        canvas.path(&legs, 1.0, colour);
+        let tolerance = r.config().episode.goal_tolerance_px.max(least);
+        for &g in team.goals(k) {
+            canvas.fill_disc(g, tolerance, colour);
+        }
+    }
+    if let Some(movers) = team.movers() {
+        canvas.movers(movers);
+    }
+    for (k, r) in team.robots().iter().enumerate() {
+        let radius = r.config().robot.radius_px.max(least);
+        canvas.robot(r.start(), radius, policy_colour(k));
+    }
+    canvas.into_image()
+}
+
 /// Every colour of team pictures: the scene's and moving obstacles' ([`crate::render::PALETTE`]),
 /// each robot colour and its faded goal colour.
 pub fn team_palette() -> Vec<Rgb<u8>> {
