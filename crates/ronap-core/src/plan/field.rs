@@ -94,8 +94,8 @@ impl DistanceField {
 
 /// The grid path a [`DistanceField`] towards `goal` gives from `start` (the same points as
 /// `DistanceField::new(..).path(..)`), searching only as far from the goal as `start` lies: the
-/// search stops once no cell it has not settled could begin a shorter path, which on average
-/// settles about half the cells a whole field does. Buffers are kept per thread between calls.
+/// search stops once no cell it has not settled could begin a shorter path, so it settles only
+/// the cells about as near the goal as `start` is. Buffers are kept per thread between calls.
 pub fn grid_path(
     scene: &Scene,
     grid: &FreeGrid,
