@@ -36,7 +36,7 @@ impl BinIndex {
         let bin_of = |v: f64, lo: f64, n: usize| -> usize {
             (((v - lo) / bin_px).floor().max(0.0) as usize).min(n - 1)
         };
-        // The bins a box reaches: a rectangle of columns c0..=c1 by rows r0..=r1.
+        // The bins a box reaches: a rectangle of bin columns by a band of bin rows.
         let span = |b: &Aabb| {
             let grown = b.inflated(reach_px);
             let outside = grown.max.x < area.min.x
@@ -46,9 +46,9 @@ impl BinIndex {
             (!outside).then(|| {
                 let columns =
                     bin_of(grown.min.x, area.min.x, cols)..=bin_of(grown.max.x, area.min.x, cols);
-                let rows =
+                let band =
                     bin_of(grown.min.y, area.min.y, rows)..=bin_of(grown.max.y, area.min.y, rows);
-                (columns, rows)
+                (columns, band)
             })
         };
         // Two passes (count, then fill) build the compressed rows without per-bin vectors; each

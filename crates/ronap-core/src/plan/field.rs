@@ -209,18 +209,10 @@ impl Work {
         let w = cols as isize;
         let offsets: [isize; 8] = [1, -1, w, -w, w + 1, 1 - w, w - 1, -w - 1];
         // Targets lie in a small block: a range check spares looking them up for most cells.
-        let lowest = targets
+        let (lowest, highest) = targets
             .into_iter()
             .flatten()
-            .map(|t| t.0)
-            .min()
-            .unwrap_or(1);
-        let highest = targets
-            .into_iter()
-            .flatten()
-            .map(|t| t.0)
-            .max()
-            .unwrap_or(0);
+            .fold((usize::MAX, 0), |(lo, hi), t| (lo.min(t.0), hi.max(t.0)));
         // The best path through a settled target so far, px (a start's straight line plus its
         // cell's cost).
         let mut best = f64::INFINITY;
