@@ -108,32 +108,32 @@ impl FreeGrid {
         // A link between centres both at least radius + cell/sqrt 2 clear cannot fail: every point
         // of it is within cell/sqrt 2 of one of them. The margin must cover that to skip a check.
         let exact = !maze_is_safe && margin_px * 2.0 >= cell_px * std::f64::consts::SQRT_2;
-        for r in 0..rows {
-            if maze_is_safe {
-                break;
-            }
-            for c in 0..cols {
-                let i = r * cols + c;
-                if !free[i] {
-                    continue;
-                }
-                let links = [
-                    (0u8, c + 1 < cols, i + 1),
-                    (1, r + 1 < rows, i + cols),
-                    (2, c + 1 < cols && r + 1 < rows, i + cols + 1),
-                    (3, c > 0 && r + 1 < rows, (i + cols).wrapping_sub(1)),
-                ];
-                for (bit, inside, j) in links {
-                    if !inside || !free[j] || (exact && !(close[i] && close[j])) {
+        // A maze whose walls are too thick to slip between needs no link checked.
+        if !maze_is_safe {
+            for r in 0..rows {
+                for c in 0..cols {
+                    let i = r * cols + c;
+                    if !free[i] {
                         continue;
                     }
-                    let a = Point::new((c as f64 + 0.5) * cell_px, (r as f64 + 0.5) * cell_px);
-                    let b = Point::new(
-                        ((j % cols) as f64 + 0.5) * cell_px,
-                        ((j / cols) as f64 + 0.5) * cell_px,
-                    );
-                    if !scene.sweep_clear(a, b, radius) {
-                        unlinked[i] |= 1 << bit;
+                    let links = [
+                        (0u8, c + 1 < cols, i + 1),
+                        (1, r + 1 < rows, i + cols),
+                        (2, c + 1 < cols && r + 1 < rows, i + cols + 1),
+                        (3, c > 0 && r + 1 < rows, (i + cols).wrapping_sub(1)),
+                    ];
+                    for (bit, inside, j) in links {
+                        if !inside || !free[j] || (exact && !(close[i] && close[j])) {
+                            continue;
+                        }
+                        let a = Point::new((c as f64 + 0.5) * cell_px, (r as f64 + 0.5) * cell_px);
+                        let b = Point::new(
+                            ((j % cols) as f64 + 0.5) * cell_px,
+                            ((j / cols) as f64 + 0.5) * cell_px,
+                        );
+                        if !scene.sweep_clear(a, b, radius) {
+                            unlinked[i] |= 1 << bit;
+                        }
                     }
                 }
             }
