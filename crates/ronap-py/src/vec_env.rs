@@ -1,130 +1,314 @@
 //! A batch of environments stepped together in Rust, across cores, with the GIL released: the
-//! core's [`Batch`] with Gymnasium's next-step autoreset, its flat buffers handed over as numpy
-//! arrays with no Python object per environment. Environment `i`'s `k`-th episode has seed
-//! `base + i + k * n`, where `base` is the seed given to `reset` and `n` the number of
-//! environments.
+//! core's [`Batch`] with any of Gymnasium's three autoreset modes, its flat buffers handed over as
+//! numpy arrays with no Python object per environment. An environment's episode seeds follow
+//! from the seed it starts with: `s, s + n, s + 2n, ...` for `n` environments.
 
 use crate::conv::{self, Config};
 use crate::errors;
-use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1};
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList};
 use ronap_core::run::batch::{Autoreset, Batch, BatchOptions, EnvStep, SeedOrder};
+use ronap_core::run::RunError;
 use ronap_core::sim::world::Worlds;
-use ronap_core::{Action, Status};
+use ronap_core::{Action, Point, Status};
 
 /// Many RoNAP environments stepped together.
 #[pyclass(module = "ronap._ronap")]
 pub struct VecEnv {
     batch: Batch,
+    continuous: bool,
+    /// Each environment's path in its episode so far, kept when it may be drawn.
+    paths: Option<Vec<Vec<Point>>>,
+}
+
+/// What a reset or a step hands back besides rewards and flags: observations, infos, and for the
+/// episodes same-step autoreset restarted (`None` when there are none) a mask of them, their last
+/// observations and their final infos.
+type Arrays<'py> = (
+    Bound<'py, PyAny>,
+    Bound<'py, PyDict>,
+    Option<(
+        Bound<'py, PyArray1<bool>>,
+        Bound<'py, PyAny>,
+        Bound<'py, PyDict>,
+    )>,
+);
+
+/// The info arrays of `records`, one entry per environment.
+fn infos<'py>(py: Python<'py>, records: &[EnvStep]) -> PyResult<Bound<'py, PyDict>> {
+    let n = records.len();
+    let d = PyDict::new(py);
+    let float = |f: &dyn Fn(&EnvStep) -> f64| PyArray1::from_iter(py, records.iter().map(f));
+    let flag = |f: &dyn Fn(&EnvStep) -> bool| PyArray1::from_iter(py, records.iter().map(f));
+    let int = |f: &dyn Fn(&EnvStep) -> u64| PyArray1::from_iter(py, records.iter().map(f));
+    d.set_item("distance", float(&|s| s.distance_px))?;
+    d.set_item("collided", flag(&|s| s.collided))?;
+    d.set_item("success", flag(&|s| s.status == Status::Success))?;
+    let poses: Vec<f64> = records
+        .iter()
+        .flat_map(|s| [s.pose.x, s.pose.y, s.pose.z_deg])
+        .collect();
+    d.set_item("pose", PyArray1::from_vec(py, poses).reshape([n, 3])?)?;
+    let goals: Vec<f64> = records.iter().flat_map(|s| [s.goal.x, s.goal.y]).collect();
+    d.set_item("goal", PyArray1::from_vec(py, goals).reshape([n, 2])?)?;
+    let status = PyList::new(py, records.iter().map(|s| s.status.name()))?;
+    d.set_item("status", status)?;
+    d.set_item("steps", int(&|s| u64::from(s.steps)))?;
+    d.set_item("collisions", int(&|s| u64::from(s.collisions)))?;
+    d.set_item("seed", int(&|s| s.seed))?;
+    d.set_item("total_reward", float(&|s| s.total_reward))?;
+    if records.iter().any(|s| s.dynamic_collisions.is_some()) {
+        d.set_item(
+            "dynamic_collisions",
+            int(&|s| u64::from(s.dynamic_collisions.unwrap_or(0))),
+        )?;
+    }
+    Ok(d)
+}
+
+/// A batch's error: stepping an ended environment is the caller's mistake (`RonapError`), the
+/// rest as [`errors::run`] says.
+fn run_error(e: &RunError) -> PyErr {
+    match e {
+        RunError::Ended { env } => errors::RonapError::new_err(format!(
+            "environment {env}: its episode ended and autoreset is disabled: reset it first \
+             (reset(options={{\"reset_mask\": mask}}))"
+        )),
+        _ => errors::run(e),
+    }
 }
 
 impl VecEnv {
-    fn arrays<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyDict>)> {
-        let (n, d) = (self.batch.len(), self.batch.observation_size());
-        let obs = PyArray1::from_slice(py, self.batch.observations()).reshape([n, d])?;
-        let steps = self.batch.steps();
-        let infos = PyDict::new(py);
-        let column = |f: &dyn Fn(&EnvStep) -> f64| PyArray1::from_iter(py, steps.iter().map(f));
-        let flags = |f: &dyn Fn(&EnvStep) -> bool| PyArray1::from_iter(py, steps.iter().map(f));
-        infos.set_item("distance", column(&|s| s.distance_px))?;
-        infos.set_item("collided", flags(&|s| s.collided))?;
-        infos.set_item(
-            "success",
-            flags(&|s| !s.reset && s.status == Status::Success),
-        )?;
-        let poses: Vec<f64> = steps
+    /// Whether the step `s` ended an episode that same-step autoreset then restarted.
+    fn restarted(&self, s: &EnvStep) -> bool {
+        self.batch.options().autoreset == Autoreset::SameStep && !s.reset && s.status.is_done()
+    }
+
+    /// Each environment's current state: the step it took, or the start of the episode that
+    /// replaced the one it ended.
+    fn current(&self) -> Vec<EnvStep> {
+        self.batch
+            .steps()
             .iter()
-            .flat_map(|s| [s.pose.x, s.pose.y, s.pose.z_deg])
+            .enumerate()
+            .map(|(i, s)| match self.batch.episode(i) {
+                Some(e) if self.restarted(s) => EnvStep::start(e),
+                _ => *s,
+            })
+            .collect()
+    }
+
+    /// Adds each selected environment's new position to its path (a new path for a new episode).
+    fn track(&mut self, which: Option<&[bool]>) {
+        let current = self.current();
+        let Some(paths) = self.paths.as_mut() else {
+            return;
+        };
+        for (i, (path, now)) in paths.iter_mut().zip(&current).enumerate() {
+            if which.is_some_and(|w| !w[i]) {
+                continue;
+            }
+            if now.reset {
+                path.clear();
+            }
+            path.push(now.pose.position());
+        }
+    }
+
+    fn arrays<'py>(&self, py: Python<'py>) -> PyResult<Arrays<'py>> {
+        let (n, d) = (self.batch.len(), self.batch.observation_size());
+        let current = self.current();
+        let obs = PyArray1::from_slice(py, self.batch.observations()).reshape([n, d])?;
+        let info = infos(py, &current)?;
+        let ended: Vec<bool> = self
+            .batch
+            .steps()
+            .iter()
+            .map(|s| self.restarted(s))
             .collect();
-        infos.set_item("pose", PyArray1::from_vec(py, poses).reshape([n, 3])?)?;
-        Ok((obs.into_any(), infos))
+        let finals = if ended.contains(&true) {
+            let last = PyArray1::from_slice(py, self.batch.final_observations()).reshape([n, d])?;
+            Some((
+                PyArray1::from_vec(py, ended),
+                last.into_any(),
+                infos(py, self.batch.steps())?,
+            ))
+        } else {
+            None
+        };
+        Ok((obs.into_any(), info, finals))
     }
 }
 
 #[pymethods]
 impl VecEnv {
-    /// `num_envs` environments under `config`, stepped on `threads` threads (0: all cores).
+    /// `num_envs` environments under `config`, stepped on `threads` threads (0: all cores), with
+    /// `autoreset` "next_step", "same_step" or "disabled"; `continuous` takes (v, w) actions;
+    /// `render` keeps each environment's path so it can be drawn.
     #[new]
-    #[pyo3(signature = (num_envs, config, maze_seed = None, map_path = None, threads = 0))]
+    #[pyo3(signature = (num_envs, config, maze_seed = None, map_path = None, threads = 0, autoreset = "next_step", continuous = false, render = false))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         num_envs: usize,
         config: &Config,
         maze_seed: Option<u64>,
         map_path: Option<&str>,
         threads: usize,
+        autoreset: &str,
+        continuous: bool,
+        render: bool,
     ) -> PyResult<Self> {
         if num_envs == 0 {
             return Err(errors::ConfigError::new_err(
                 "num_envs = 0: must be at least 1",
             ));
         }
+        let autoreset = match autoreset {
+            "next_step" => Autoreset::NextStep,
+            "same_step" => Autoreset::SameStep,
+            "disabled" => Autoreset::Disabled,
+            other => {
+                return Err(errors::ConfigError::new_err(format!(
+                    "autoreset_mode {other:?}: expected \"next_step\", \"same_step\" or \
+                     \"disabled\""
+                )))
+            }
+        };
         let (_, scenes, _) = conv::scenes(config.valid(), maze_seed, map_path)?;
         let options = BatchOptions {
             envs: num_envs,
             threads,
-            autoreset: Autoreset::NextStep,
+            autoreset,
             seed_order: SeedOrder::Strided,
         };
         let batch = Batch::new(Worlds::new(config.valid().clone(), scenes), options)
             .map_err(|e| errors::RonapError::new_err(e.to_string()))?;
-        Ok(Self { batch })
+        Ok(Self {
+            batch,
+            continuous,
+            paths: render.then(|| vec![Vec::new(); num_envs]),
+        })
     }
 
-    /// Starts every environment: environment `i` gets seed `seed + i`. Returns (observations,
-    /// infos).
+    /// Starts the environments `mask` selects (all when None), each with its seed from `seeds`
+    /// (one per environment) or, for None, the next seed of its sequence. Returns
+    /// (observations, infos, None).
     fn reset<'py>(
         &mut self,
         py: Python<'py>,
-        seed: u64,
-    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyDict>)> {
-        py.allow_threads(|| self.batch.reset(seed))
-            .map_err(|e| errors::run(&e))?;
+        seeds: Vec<Option<u64>>,
+        mask: Option<Vec<bool>>,
+    ) -> PyResult<Arrays<'py>> {
+        let which = mask.unwrap_or_else(|| vec![true; self.batch.len()]);
+        py.allow_threads(|| self.batch.restart(&which, &seeds))
+            .map_err(|e| run_error(&e))?;
+        self.track(Some(&which));
         self.arrays(py)
     }
 
-    /// Steps every environment with `actions` (one index per environment: 0 LEFT, 1 AHEAD,
-    /// 2 RIGHT). Returns (observations, rewards, terminations, truncations, infos).
+    /// Steps every environment with `actions`: one index per environment (0 LEFT, 1 AHEAD,
+    /// 2 RIGHT) as an int64 array, or for a continuous batch an (n, 2) float64 array of
+    /// (v px/step, w deg/step). Returns (observations, rewards, terminations, truncations,
+    /// infos, finals): `finals` is None, or for the episodes same-step autoreset restarted
+    /// (ended mask, their last observations, their final infos).
     #[allow(clippy::type_complexity)]
     fn step<'py>(
         &mut self,
         py: Python<'py>,
-        actions: PyReadonlyArray1<'py, i64>,
+        actions: &Bound<'py, PyAny>,
     ) -> PyResult<(
         Bound<'py, PyAny>,
         Bound<'py, PyArray1<f64>>,
         Bound<'py, PyArray1<bool>>,
         Bound<'py, PyArray1<bool>>,
         Bound<'py, PyDict>,
+        Option<(
+            Bound<'py, PyArray1<bool>>,
+            Bound<'py, PyAny>,
+            Bound<'py, PyDict>,
+        )>,
     )> {
-        let actions = actions.as_slice()?;
         let n = self.batch.len();
-        if actions.len() != n {
-            return Err(errors::ActionError::new_err(format!(
-                "{} actions for {n} environments",
-                actions.len()
-            )));
-        }
-        let actions = actions
-            .iter()
-            .enumerate()
-            .map(|(i, &a)| {
-                conv::discrete(a).ok_or_else(|| {
-                    errors::ActionError::new_err(format!(
-                        "action {a} for environment {i}: expected 0 (LEFT), 1 (AHEAD) or \
-                             2 (RIGHT)"
-                    ))
+        let actions: Vec<Action> = if self.continuous {
+            let a: PyReadonlyArray2<'py, f64> = actions.extract()?;
+            let a = a.as_array();
+            if a.dim() != (n, 2) {
+                return Err(errors::ActionError::new_err(format!(
+                    "actions of shape {:?} for {n} environments: expected ({n}, 2)",
+                    a.shape()
+                )));
+            }
+            a.rows()
+                .into_iter()
+                .enumerate()
+                .map(|(i, r)| match (r[0], r[1]) {
+                    (v, w_deg) if v.is_finite() && w_deg.is_finite() => {
+                        Ok(Action::Continuous { v, w_deg })
+                    }
+                    (v, w) => Err(errors::ActionError::new_err(format!(
+                        "action ({v}, {w}) for environment {i}: expected finite numbers"
+                    ))),
                 })
-            })
-            .collect::<PyResult<Vec<Action>>>()?;
+                .collect::<PyResult<_>>()?
+        } else {
+            let a: PyReadonlyArray1<'py, i64> = actions.extract()?;
+            let a = a.as_slice()?;
+            if a.len() != n {
+                return Err(errors::ActionError::new_err(format!(
+                    "{} actions for {n} environments",
+                    a.len()
+                )));
+            }
+            a.iter()
+                .enumerate()
+                .map(|(i, &a)| {
+                    conv::discrete(a).ok_or_else(|| {
+                        errors::ActionError::new_err(format!(
+                            "action {a} for environment {i}: expected 0 (LEFT), 1 (AHEAD) or \
+                             2 (RIGHT)"
+                        ))
+                    })
+                })
+                .collect::<PyResult<_>>()?
+        };
         py.allow_threads(|| self.batch.step_actions(&actions))
-            .map_err(|e| errors::run(&e))?;
+            .map_err(|e| run_error(&e))?;
+        self.track(None);
         let steps = self.batch.steps();
         let rewards = PyArray1::from_iter(py, steps.iter().map(|s| s.reward));
         let terminated = PyArray1::from_iter(py, steps.iter().map(|s| s.status.is_terminated()));
         let truncated = PyArray1::from_iter(py, steps.iter().map(|s| s.status.is_truncated()));
-        let (obs, infos) = self.arrays(py)?;
-        Ok((obs, rewards, terminated, truncated, infos))
+        let (obs, infos, finals) = self.arrays(py)?;
+        Ok((obs, rewards, terminated, truncated, infos, finals))
+    }
+
+    /// The picture of environment `i`'s current state, as `Env.render` draws it ("top" with the
+    /// path so far, or "first_person").
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        i: usize,
+        view: &str,
+        scale: f64,
+    ) -> PyResult<Bound<'py, numpy::PyArray3<u8>>> {
+        let episode = self
+            .batch
+            .episode(i)
+            .ok_or_else(|| errors::RonapError::new_err("render() before reset()"))?;
+        let img = match view {
+            "top" => {
+                let path = self.paths.as_ref().map_or(&[][..], |p| &p[i][..]);
+                ronap_core::render::top_down(episode, path, scale)
+            }
+            "first_person" => ronap_core::render::first_person(episode, scale as u32),
+            other => {
+                return Err(errors::ConfigError::new_err(format!(
+                    "render view {other:?}: expected \"top\" or \"first_person\""
+                )))
+            }
+        };
+        conv::image(py, img)
     }
 
     /// Number of environments.

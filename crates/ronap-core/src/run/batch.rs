@@ -6,6 +6,7 @@
 //! Every environment's episodes and random numbers follow from their seeds, and seeds are handed
 //! out in environment order, so a batch steps the same bits on any number of threads.
 
+use crate::geometry::Point;
 use crate::run::RunError;
 use crate::sim::episode::{Episode, Status};
 use crate::sim::rng::{stream, Rng, Stream};
@@ -25,6 +26,9 @@ pub enum Autoreset {
     /// At once, in the step that ended it: the buffer shows the new episode's first observation
     /// and [`Batch::final_observations`] the last one of the episode that ended.
     SameStep,
+    /// Never: the caller restarts ended environments with [`Batch::restart`]; stepping one
+    /// before that is refused ([`RunError::Ended`]).
+    Disabled,
 }
 
 /// Which seed an environment's next episode gets, in a batch reset with seed `base` over `n`
@@ -68,8 +72,15 @@ pub struct EnvStep {
     pub distance_px: f64,
     /// Pose after the step.
     pub pose: Pose,
+    /// The episode's (current) goal.
+    pub goal: Point,
     /// Steps taken in the episode so far.
     pub steps: u32,
+    /// Steps of the episode so far that collided with a wall or a static obstacle.
+    pub collisions: u32,
+    /// Steps of the episode so far with contact between the robot and a moving obstacle (`None`
+    /// when the scene has none).
+    pub dynamic_collisions: Option<u32>,
     /// Summed reward of the episode so far.
     pub total_reward: f64,
     /// Whether this was a reset: the environment started a new episode and did not step.
@@ -86,13 +97,17 @@ impl EnvStep {
             collided,
             distance_px: episode.distance_px(),
             pose: episode.pose(),
+            goal: episode.goal(),
             steps: episode.steps(),
+            collisions: episode.collisions(),
+            dynamic_collisions: episode.dynamic_metrics().map(|m| m.collisions),
             total_reward: episode.total_reward(),
             reset: false,
         }
     }
 
-    fn start(episode: &Episode) -> Self {
+    /// The record of `episode` just started: what a reset reports.
+    pub fn start(episode: &Episode) -> Self {
         Self {
             reset: true,
             ..Self::of(episode, None, 0.0, false)
@@ -174,6 +189,47 @@ impl Batch {
             .for_each(|_, env, obs, _, out| Self::start(worlds, stride, env, obs, out))
     }
 
+    /// Starts afresh the environments `which` selects (one flag per environment): each with its
+    /// seed from `seeds` (one per environment) when given, else with its next one (the seed an
+    /// automatic reset would have given it). The others are left as they are. An environment's
+    /// later episodes follow from the seed it starts with, in the batch's seed order.
+    pub fn restart(&mut self, which: &[bool], seeds: &[Option<u64>]) -> Result<(), RunError> {
+        let n = self.lanes.envs.len();
+        for (what, given) in [("reset flags", which.len()), ("seeds", seeds.len())] {
+            if given != n {
+                return Err(RunError::Count {
+                    what,
+                    given,
+                    envs: n,
+                });
+            }
+        }
+        let stride = self.stride();
+        let mut next = self.next_seed;
+        for ((env, &on), &seed) in self.lanes.envs.iter_mut().zip(which).zip(seeds) {
+            if !on {
+                continue;
+            }
+            match (seed, stride) {
+                (Some(s), _) => env.next_seed = s,
+                (None, Some(_)) => {}
+                (None, None) => {
+                    env.next_seed = next;
+                    next = next.wrapping_add(1);
+                }
+            }
+        }
+        self.next_seed = next;
+        let worlds = &self.worlds;
+        self.lanes.for_each(|i, env, obs, _, out| {
+            if which[i] {
+                Self::start(worlds, stride, env, obs, out)
+            } else {
+                Ok(())
+            }
+        })
+    }
+
     /// How far apart an environment's episode seeds are: `n` for [`SeedOrder::Strided`].
     fn stride(&self) -> Option<u64> {
         (self.options.seed_order == SeedOrder::Strided).then_some(self.lanes.envs.len() as u64)
@@ -196,8 +252,18 @@ impl Batch {
                     Some(_) => Ok(()),
                 })?;
         }
-        let (worlds, stride) = (&self.worlds, self.stride());
         let autoreset = self.options.autoreset;
+        if autoreset == Autoreset::Disabled {
+            let ended = self.lanes.envs.iter().position(|e| {
+                e.episode
+                    .as_ref()
+                    .is_some_and(|episode| episode.status().is_done())
+            });
+            if let Some(env) = ended {
+                return Err(RunError::Ended { env });
+            }
+        }
+        let (worlds, stride) = (&self.worlds, self.stride());
         self.lanes.for_each(|i, env, obs, last, out| {
             let Some(episode) = env.episode.as_mut() else {
                 return Ok(());
@@ -317,6 +383,11 @@ impl Batch {
         self.lanes.observation_size
     }
 
+    /// How the batch runs.
+    pub fn options(&self) -> &BatchOptions {
+        &self.options
+    }
+
     /// The worlds episodes run in.
     pub fn worlds(&self) -> &Worlds {
         &self.worlds
@@ -357,5 +428,117 @@ impl Lanes {
             })
         };
         results.into_iter().collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::SimConfig;
+    use crate::sim::robot::DiscreteAction;
+    use crate::sim::world::Scenes;
+
+    fn batch(envs: usize, threads: usize, autoreset: Autoreset) -> Batch {
+        let mut c = SimConfig::default();
+        c.episode.max_steps = 30;
+        let worlds = Worlds::new(c.validate().unwrap(), Scenes::MazePerSeed);
+        let options = BatchOptions {
+            envs,
+            threads,
+            autoreset,
+            seed_order: SeedOrder::Strided,
+        };
+        Batch::new(worlds, options).unwrap()
+    }
+
+    fn actions(n: usize, t: usize) -> Vec<Action> {
+        (0..n)
+            .map(|i| DiscreteAction::from_index((i + t) % 3).unwrap().into())
+            .collect()
+    }
+
+    /// Every (seed, steps, reward, status) a batch reports over `steps` steps of a fixed pattern,
+    /// restarting ended environments by hand when automatic resets are disabled.
+    fn trace(b: &mut Batch, steps: usize) -> Vec<(u64, u32, u64, Status, bool)> {
+        let n = b.len();
+        let mut out = Vec::new();
+        for t in 0..steps {
+            b.step_actions(&actions(n, t)).unwrap();
+            out.extend(
+                b.steps()
+                    .iter()
+                    .map(|s| (s.seed, s.steps, s.reward.to_bits(), s.status, s.reset)),
+            );
+            if b.options.autoreset == Autoreset::Disabled {
+                let ended: Vec<bool> = b.steps().iter().map(|s| s.status.is_done()).collect();
+                if ended.contains(&true) {
+                    b.restart(&ended, &vec![None; n]).unwrap();
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn restarting_by_hand_plays_the_episodes_same_step_autoreset_plays() {
+        let mut same = batch(5, 1, Autoreset::SameStep);
+        let mut off = batch(5, 1, Autoreset::Disabled);
+        same.reset(7).unwrap();
+        off.reset(7).unwrap();
+        let (a, b) = (trace(&mut same, 200), trace(&mut off, 200));
+        assert!(a.iter().any(|s| s.3.is_done()), "some episode ends");
+        assert_eq!(a, b);
+        assert_eq!(same.observations(), off.observations());
+    }
+
+    #[test]
+    fn stepping_an_ended_environment_without_autoreset_is_refused_and_steps_nothing() {
+        let mut b = batch(3, 1, Autoreset::Disabled);
+        b.reset(0).unwrap();
+        let mut t = 0;
+        while !b.steps().iter().any(|s| s.status.is_done()) {
+            b.step_actions(&actions(3, t)).unwrap();
+            t += 1;
+        }
+        let env = b.steps().iter().position(|s| s.status.is_done()).unwrap();
+        let before = b.steps().to_vec();
+        assert_eq!(b.step_actions(&actions(3, t)), Err(RunError::Ended { env }));
+        assert_eq!(b.steps(), &before[..]);
+    }
+
+    #[test]
+    fn restart_gives_chosen_environments_their_seeds_and_leaves_the_others() {
+        let mut b = batch(4, 1, Autoreset::NextStep);
+        b.reset(100).unwrap();
+        b.step_actions(&actions(4, 0)).unwrap();
+        let kept = b.steps()[1];
+        b.restart(&[true, false, true, false], &[Some(55), None, None, None])
+            .unwrap();
+        let s = b.steps();
+        assert_eq!((s[0].seed, s[0].reset), (55, true));
+        assert_eq!(s[1], kept);
+        // Environment 2 had seed 102: its next one is 4 later.
+        assert_eq!((s[2].seed, s[2].reset), (106, true));
+        assert_eq!(b.episode(0).unwrap().steps(), 0);
+        assert_eq!(b.episode(1).unwrap().steps(), 1);
+        assert_eq!(
+            b.restart(&[true; 3], &[None; 4]),
+            Err(RunError::Count {
+                what: "reset flags",
+                given: 3,
+                envs: 4
+            })
+        );
+    }
+
+    #[test]
+    fn a_batch_steps_the_same_bits_on_one_and_two_threads() {
+        let run = |threads| {
+            let mut b = batch(40, threads, Autoreset::SameStep);
+            b.reset(3).unwrap();
+            let t = trace(&mut b, 60);
+            (t, b.observations().to_vec())
+        };
+        assert_eq!(run(1), run(2));
     }
 }

@@ -51,6 +51,22 @@ pub enum RunError {
         /// Environments.
         envs: usize,
     },
+    /// A batch was given another number of per-environment values than it has environments.
+    #[error("{given} {what} for {envs} environments")]
+    Count {
+        /// What was given.
+        what: &'static str,
+        /// How many.
+        given: usize,
+        /// Environments.
+        envs: usize,
+    },
+    /// A batch without automatic resets was asked to step an environment whose episode ended.
+    #[error("environment {env}: its episode ended; restart it before stepping it again")]
+    Ended {
+        /// The environment.
+        env: usize,
+    },
     /// The worker threads could not start.
     #[error("cannot start worker threads: {0}")]
     Threads(String),

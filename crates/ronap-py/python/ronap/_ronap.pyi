@@ -41,9 +41,26 @@ class Env:
     def observation_size(self) -> int: ...
 
 class VecEnv:
-    def __init__(self, num_envs: int, config: Config, maze_seed: int | None = None, map_path: str | None = None, threads: int = 0) -> None: ...
-    def reset(self, seed: int) -> tuple[np.ndarray, dict[str, np.ndarray]]: ...
-    def step(self, actions: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, np.ndarray]]: ...
+    def __init__(
+        self,
+        num_envs: int,
+        config: Config,
+        maze_seed: int | None = None,
+        map_path: str | None = None,
+        threads: int = 0,
+        autoreset: str = "next_step",
+        continuous: bool = False,
+        render: bool = False,
+    ) -> None: ...
+    def reset(
+        self, seeds: list[int | None], mask: list[bool] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any], tuple[np.ndarray, np.ndarray, dict[str, Any]] | None]: ...
+    def step(
+        self, actions: np.ndarray
+    ) -> tuple[
+        np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any], tuple[np.ndarray, np.ndarray, dict[str, Any]] | None
+    ]: ...
+    def render(self, i: int, view: str, scale: float) -> np.ndarray: ...
     @property
     def num_envs(self) -> int: ...
     @property

@@ -136,19 +136,54 @@ class NavEnv(gym.Env):
         return self._env.render("first_person", 400.0)
 
 
+_AUTORESET = {
+    AutoresetMode.NEXT_STEP: "next_step",
+    AutoresetMode.SAME_STEP: "same_step",
+    AutoresetMode.DISABLED: "disabled",
+}
+
+
+def _autoreset_mode(mode: AutoresetMode | str) -> AutoresetMode:
+    """``mode`` as an ``AutoresetMode``: the enum, its value ("NextStep") or its name in any case
+    ("next_step", "SAME_STEP")."""
+    if isinstance(mode, AutoresetMode):
+        return mode
+    for m in AutoresetMode:
+        if isinstance(mode, str) and mode in (m.value, m.name, m.name.lower()):
+            return m
+    raise _ronap.ConfigError(f"autoreset_mode {mode!r}: expected 'next_step', 'same_step' or 'disabled' (or a gymnasium AutoresetMode)")
+
+
 class VecNavEnv(VectorEnv):
     """``num_envs`` RoNAP environments stepped together in Rust, across cores, with the GIL
     released; observations, rewards and flags come back as numpy arrays.
 
-    Next-step autoreset: the step after an episode ends resets that environment (its action is
-    ignored) and returns the new episode's first observation with reward 0. ``reset(seed=s)`` gives
-    environment ``i`` the episode seeds ``s + i``, ``s + i + n``, ``s + i + 2n``, ...
+    Seeds: ``reset(seed=s)`` gives environment ``i`` the episode seeds ``s + i``, ``s + i + n``,
+    ``s + i + 2n``, ... (``n`` environments); ``reset(seed=[s0, s1, ...])`` starts environment
+    ``i`` at ``s_i`` (then ``s_i + n``, ...), ``None`` in the list meaning its next seed;
+    ``reset()`` draws the base seed from the vector environment's generator.
+    ``reset(options={"reset_mask": mask})`` restarts only the environments ``mask`` selects, each
+    with its next seed unless ``seed`` gives one.
+
+    ``autoreset_mode`` (Gymnasium's ``AutoresetMode`` or "next_step", "same_step", "disabled"):
+    next-step (default) resets an environment on the step after its episode ends (that step's
+    action is ignored, its reward 0); same-step resets it within the ending step and puts the last
+    observation and info in ``infos["final_obs"]`` and ``infos["final_info"]``; disabled leaves it
+    to ``reset_mask`` (stepping an ended environment raises ``RonapError``). Every mode plays
+    the same episodes.
+
+    Actions: one of 0 (LEFT), 1 (AHEAD), 2 (RIGHT) per environment, or with ``continuous=True``
+    an ``(n, 2)`` array of ``(v / v_max, w / w_max)`` in [-1, 1]. Infos, one array entry per
+    environment: distance, collided, success, pose, goal, status, steps, collisions, seed (and
+    dynamic_collisions with moving obstacles). ``render_mode="rgb_array"``: ``render()`` returns
+    one picture per environment, as ``NavEnv`` draws it.
 
     ``scenario``, ``config``, keyword arguments, ``maze_seed`` and ``map`` configure every
-    environment as they do ``NavEnv``.
+    environment as they do ``NavEnv``; ``max_episode_steps`` (as ``gymnasium.make_vec`` passes
+    it) sets ``episode_max_steps``.
     """
 
-    metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
+    metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": ["rgb_array"], "render_fps": 30}
 
     def __init__(
         self,
@@ -159,48 +194,134 @@ class VecNavEnv(VectorEnv):
         maze_seed: int | None = None,
         map: str | None = None,
         threads: int = 0,
+        continuous: bool = False,
+        autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+        render_mode: str | None = None,
+        render_view: str = "top",
+        render_scale: float = 0.5,
+        max_episode_steps: int | None = None,
         **fields: Any,
     ) -> None:
         num_envs = checked_int("num_envs", num_envs, least=1, below=2**31)
         threads = checked_int("threads", threads, below=2**16)
+        mode = _autoreset_mode(autoreset_mode)
+        if render_mode not in (None, "rgb_array"):
+            raise _ronap.ConfigError(f"render_mode {render_mode!r}: expected None or 'rgb_array'")
+        if render_view not in ("top", "first_person"):
+            raise _ronap.ConfigError(f"render_view {render_view!r}: expected 'top' or 'first_person'")
+        if max_episode_steps is not None:
+            fields = {**fields, "episode_max_steps": max_episode_steps}
         checked = checked_config(config, fields, scenario)
         self.config = json.loads(checked.json)
-        self._vec = _ronap.VecEnv(num_envs, checked, maze_seed, None if map is None else str(map), threads)
+        self._vec = _ronap.VecEnv(
+            num_envs,
+            checked,
+            maze_seed,
+            None if map is None else str(map),
+            threads,
+            _AUTORESET[mode],
+            bool(continuous),
+            render_mode is not None,
+        )
+        self.metadata = {**type(self).metadata, "autoreset_mode": mode}
         self.num_envs = num_envs
+        self.continuous = bool(continuous)
+        self.render_mode = render_mode
+        self.render_view = render_view
+        self.render_scale = render_scale
         n = self._vec.observation_size
         self.single_observation_space = spaces.Box(0.0, 1.0, (n,), np.float32)
-        self.single_action_space = spaces.Discrete(3)
+        if self.continuous:
+            robot = self.config["robot"]
+            self._action_scale = np.array([robot["max_linear_speed_px"], robot["max_angular_speed_deg"]], np.float64)
+            self.single_action_space: spaces.Space[Any] = spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
+        else:
+            self.single_action_space = spaces.Discrete(3)
         self.observation_space = batch_space(self.single_observation_space, num_envs)
         self.action_space = batch_space(self.single_action_space, num_envs)
-        self._mask = np.ones(num_envs, dtype=bool)
+        self._all = np.ones(num_envs, dtype=bool)
         self._rng = np.random.default_rng()
         self._started = False
 
-    def _infos(self, infos: dict[str, Any]) -> dict[str, Any]:
+    def _infos(self, infos: dict[str, Any], mask: np.ndarray) -> dict[str, Any]:
+        """Gymnasium's vector infos: every value an array over the environments, and beside each
+        key ``_key``, the mask of environments it holds a value for."""
         for key in list(infos):
-            infos["_" + key] = self._mask
+            if isinstance(infos[key], list):
+                infos[key] = np.asarray(infos[key])
+            infos["_" + key] = mask
         return infos
 
-    def reset(
-        self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[np.ndarray, dict[str, Any]]:
+    def _seeds(self, seed: Any, mask: np.ndarray | None) -> list[int | None]:
+        n = self.num_envs
         if seed is None:
-            seed = int(self._rng.integers(0, _SEED_LIMIT))
-        elif not isinstance(seed, (int, np.integer)):
-            raise _ronap.ConfigError(f"seed {seed!r}: VecNavEnv takes one int (environment i gets seed + i)")
-        else:
-            seed = checked_int("seed", seed)
-            self._rng = np.random.default_rng(seed)
-        obs, infos = self._vec.reset(int(seed))
+            if mask is not None and self._started:
+                return [None] * n
+            base = int(self._rng.integers(0, _SEED_LIMIT))
+            return [base + i for i in range(n)]
+        if isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)):
+            base = checked_int("seed", seed)
+            self._rng = np.random.default_rng(base)
+            return [checked_int("seed", base + i) for i in range(n)]
+        if isinstance(seed, (list, tuple, np.ndarray)):
+            if len(seed) != n:
+                raise _ronap.ConfigError(f"seed: {len(seed)} seeds for {n} environments")
+            seeds = [None if s is None else checked_int(f"seed[{i}]", s) for i, s in enumerate(seed)]
+            if not self._started and None in seeds:
+                raise _ronap.ConfigError("seed: the first reset() needs a seed for every environment (or seed=None or one int)")
+            given = [s for s in seeds if s is not None]
+            if given:
+                self._rng = np.random.default_rng(given)
+            return seeds
+        raise _ronap.ConfigError(f"seed {seed!r}: expected None, an int (environment i gets seed + i) or a list of {n} ints or None")
+
+    def reset(
+        self, *, seed: int | list[int | None] | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        mask: np.ndarray | None = None
+        if options:
+            unknown = sorted(set(options) - {"reset_mask"})
+            if unknown:
+                raise _ronap.ConfigError(f"options {unknown}: VecNavEnv takes only 'reset_mask'")
+            if "reset_mask" in options:
+                mask = np.asarray(options["reset_mask"])
+                if mask.dtype != np.bool_ or mask.shape != (self.num_envs,):
+                    raise _ronap.ConfigError(
+                        f"reset_mask of dtype {mask.dtype} and shape {mask.shape}: expected {self.num_envs} bools"
+                    )
+                if not self._started and not mask.all():
+                    raise _ronap.ConfigError("reset_mask: the first reset() starts every environment")
+        seeds = self._seeds(seed, mask)
+        obs, infos, _ = self._vec.reset(seeds, None if mask is None else [bool(m) for m in mask])
         self._started = True
-        return obs, self._infos(infos)
+        return obs, self._infos(infos, self._all if mask is None else mask.copy())
 
     def step(self, actions: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         if not self._started:
             raise _ronap.RonapError("step() before reset(): call reset(seed=...) first")
-        actions = discrete_actions(actions, (self.num_envs,))
-        obs, rewards, terminated, truncated, infos = self._vec.step(actions)
-        return obs, rewards, terminated, truncated, self._infos(infos)
+        if self.continuous:
+            a = continuous_actions(actions, (self.num_envs, 2)) * self._action_scale
+        else:
+            a = discrete_actions(actions, (self.num_envs,))
+        obs, rewards, terminated, truncated, infos, finals = self._vec.step(a)
+        infos = self._infos(infos, self._all)
+        if finals is not None:
+            ended, last, final_infos = finals
+            final_obs = np.full(self.num_envs, None, dtype=object)
+            for i in np.flatnonzero(ended):
+                final_obs[i] = last[i].copy()
+            infos["final_obs"] = final_obs
+            infos["_final_obs"] = ended
+            infos["final_info"] = self._infos(final_infos, ended)
+            infos["_final_info"] = ended
+        return obs, rewards, terminated, truncated, infos
+
+    def render(self) -> tuple[np.ndarray, ...] | None:  # type: ignore[override]
+        """One picture per environment (``render_mode="rgb_array"``), else None."""
+        if self.render_mode != "rgb_array":
+            return None
+        scale = self.render_scale if self.render_view == "top" else 400.0
+        return tuple(self._vec.render(i, self.render_view, scale) for i in range(self.num_envs))
 
 
 def _shaped(actions: Any, shape: tuple[int, ...]) -> np.ndarray:

@@ -1,0 +1,122 @@
+"""Stable-Baselines3's ``VecEnv`` over ronap's Rust-stepped environments.
+
+``pip install ronap[sb3]`` (Stable-Baselines3 and torch), then::
+
+    from stable_baselines3 import PPO
+    import ronap.sb3
+
+    env = ronap.sb3.VecEnv(16, maze_cols=6, maze_rows=6)
+    model = PPO("MlpPolicy", env).learn(200_000)
+
+``VecEnv(n, **config)`` takes the keyword arguments of ``ronap.VecNavEnv`` (``scenario``,
+``config``, ``section_field=value``, ``maze_seed``, ``map``, ``threads``, ``continuous``,
+``render_mode``). It steps all ``n`` environments in one call into Rust, across cores, and
+follows SB3's conventions exactly: ``dones`` is terminated or truncated, an environment whose
+episode ends is reset within the same step, and its info holds ``terminal_observation``,
+``TimeLimit.truncated``, ``is_success`` and ``episode`` (``r``, ``l``, ``t``, as SB3's
+``Monitor`` writes, so PPO logs ``ep_rew_mean`` without a wrapper), beside ronap's own info
+(status, seed, steps, collisions, distance, ...). Infos of environments whose episode goes on
+are empty, which keeps a step cheap.
+
+Seeds: ``env.seed(s)`` before ``reset()`` gives environment ``i`` the episode seeds ``s + i``,
+``s + i + n``, ... (``ronap run`` seeds), so a run is reproducible.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Iterable, Sequence
+from typing import Any
+
+import numpy as np
+
+try:
+    from stable_baselines3.common.vec_env.base_vec_env import (
+        VecEnv as _VecEnv,
+        VecEnvIndices,
+        VecEnvObs,
+        VecEnvStepReturn,
+    )
+except ImportError as e:  # pragma: no cover - depends on the installed extras
+    raise ImportError("ronap.sb3 needs Stable-Baselines3: pip install 'ronap[sb3]' (or stable-baselines3)") from e
+
+from .env import VecNavEnv
+
+__all__ = ["VecEnv"]
+
+
+class VecEnv(_VecEnv):
+    """``num_envs`` ronap environments as one Stable-Baselines3 ``VecEnv`` (see the module's
+    documentation)."""
+
+    def __init__(self, num_envs: int, **config: Any) -> None:
+        config.pop("autoreset_mode", None)
+        self.venv = VecNavEnv(num_envs, autoreset_mode="same_step", **config)
+        self.render_mode = self.venv.render_mode
+        super().__init__(self.venv.num_envs, self.venv.single_observation_space, self.venv.single_action_space)
+        self._actions: np.ndarray | None = None
+        self._start = time.monotonic()
+
+    def reset(self) -> VecEnvObs:
+        seeds = self._seeds
+        seed: list[int | None] | None = None if all(s is None for s in seeds) else list(seeds)
+        obs, infos = self.venv.reset(seed=seed)
+        self.reset_infos = self._unbatched(infos, range(self.num_envs))
+        self._reset_seeds()
+        self._reset_options()
+        return obs
+
+    def step_async(self, actions: np.ndarray) -> None:
+        self._actions = actions
+
+    def step_wait(self) -> VecEnvStepReturn:
+        if self._actions is None:
+            raise RuntimeError("step_wait() without step_async()")
+        actions = np.asarray(self._actions)
+        if not self.venv.continuous:
+            actions = actions.reshape(self.num_envs)
+        obs, rewards, terminated, truncated, infos = self.venv.step(actions)
+        self._actions = None
+        dones = terminated | truncated
+        ended = np.flatnonzero(dones)
+        out: list[dict[str, Any]] = [{} for _ in range(self.num_envs)]
+        if ended.size:
+            final = infos["final_info"]
+            elapsed = round(time.monotonic() - self._start, 6)
+            for i, info in zip(ended, self._unbatched(final, ended)):
+                info["terminal_observation"] = infos["final_obs"][i]
+                info["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
+                info["is_success"] = bool(info["success"])
+                info["episode"] = {"r": float(info["total_reward"]), "l": int(info["steps"]), "t": elapsed}
+                out[i] = info
+        return obs, rewards.astype(np.float32), dones, out
+
+    @staticmethod
+    def _unbatched(infos: dict[str, Any], indices: Iterable[int]) -> list[dict[str, Any]]:
+        """Per-environment info dicts from a vector info dict (the ``_key`` masks left out)."""
+        keys = [k for k in infos if not k.startswith("_") and isinstance(infos[k], np.ndarray)]
+        return [{k: infos[k][i].item() if infos[k][i].ndim == 0 else infos[k][i] for k in keys} for i in indices]
+
+    def close(self) -> None:
+        self.venv.close()
+
+    def get_images(self) -> Sequence[np.ndarray | None]:
+        frames = self.venv.render()
+        return [None] * self.num_envs if frames is None else list(frames)
+
+    def get_attr(self, attr_name: str, indices: VecEnvIndices = None) -> list[Any]:
+        """The attribute of the (shared) environment configuration, once per index."""
+        value = getattr(self.venv, attr_name)
+        return [value for _ in self._get_indices(indices)]
+
+    def set_attr(self, attr_name: str, value: Any, indices: VecEnvIndices = None) -> None:
+        """Sets the attribute on the vector environment, which every index shares."""
+        setattr(self.venv, attr_name, value)
+
+    def env_method(self, method_name: str, *method_args: Any, indices: VecEnvIndices = None, **method_kwargs: Any) -> list[Any]:
+        """Calls the vector environment's method once and returns its result for every index."""
+        result = getattr(self.venv, method_name)(*method_args, **method_kwargs)
+        return [result for _ in self._get_indices(indices)]
+
+    def env_is_wrapped(self, wrapper_class: type, indices: VecEnvIndices = None) -> list[bool]:
+        return [False for _ in self._get_indices(indices)]
