@@ -5,7 +5,7 @@
 
 `evaluate`: a PPO MlpPolicy (as SB3 builds it, untrained, seed 0) run by ronap.evaluate over the
 seeds, one predict() per observation (batch 0) and batched; the episodes must be the same.
-`train`: PPO (SB3's defaults, seed 0) for the same timesteps on ronap.sb3.VecEnv(envs) and on
+`train`: PPO (SB3's defaults unless --epochs/--batch-size, seed 0) for the same timesteps on ronap.sb3.VecEnv(envs) and on
 SB3's make_vec_env(ronap.NavEnv, n_envs=envs) (DummyVecEnv), each then evaluated greedily on the
 held-out seeds 100000.. (batched); prints wall time, steps/s and success of both.
 """
@@ -56,7 +56,7 @@ def train(args):
         ("make_vec_env(NavEnv)", lambda: make_vec_env(ronap.NavEnv, n_envs=args.envs, seed=0, env_kwargs=config)),
     ]:
         env = make()
-        model = PPO("MlpPolicy", env, seed=0, device="cpu")
+        model = PPO("MlpPolicy", env, seed=0, device="cpu", n_epochs=args.epochs, batch_size=args.batch_size)
         start = time.perf_counter()
         model.learn(args.timesteps)
         wall = time.perf_counter() - start
@@ -80,6 +80,8 @@ def main():
     t.add_argument("--cols", type=int, default=5)
     t.add_argument("--rows", type=int, default=5)
     t.add_argument("--eval-seeds", type=int, default=500)
+    t.add_argument("--epochs", type=int, default=10, help="PPO n_epochs (SB3's default 10)")
+    t.add_argument("--batch-size", type=int, default=64, help="PPO batch_size (SB3's default 64)")
     p.add_argument("--torch-threads", type=int, default=0, help="torch.set_num_threads (0: torch's default)")
     args = p.parse_args()
     if args.torch_threads:

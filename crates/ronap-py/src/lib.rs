@@ -9,6 +9,7 @@ mod conv;
 mod env;
 mod errors;
 mod evaluate;
+mod mlp;
 mod multi_env;
 mod vec_env;
 
@@ -90,6 +91,8 @@ fn _ronap(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(builtin_policies, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::compare, m)?)?;
+    m.add_function(wrap_pyfunction!(mlp::write_mlp, m)?)?;
+    m.add_function(wrap_pyfunction!(mlp::mlp_outputs, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -5,7 +5,7 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use indicatif::ProgressBar;
 use ronap_core::eval::Evaluator;
-use ronap_core::io::atomic::write_atomic;
+use ronap_core::io::atomic::save_network;
 use ronap_core::io::datalog;
 use ronap_core::policy::mlp::{DecisionRule, Mlp};
 use ronap_learn::bc::{self, BcOptions};
@@ -218,8 +218,7 @@ fn check_out(path: &Path) -> Result<()> {
 }
 
 fn save(mlp: &Mlp, path: &Path) -> Result<()> {
-    let bytes = mlp.to_bytes().map_err(anyhow::Error::msg)?;
-    write_atomic(path, |w| w.write_all(&bytes))?;
+    save_network(path, mlp)?;
     Ok(())
 }
 

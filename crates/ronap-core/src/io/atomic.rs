@@ -96,6 +96,15 @@ pub fn write_atomic(
     Ok(())
 }
 
+/// Saves a network as ronap's weights file (safetensors), atomically.
+pub fn save_network(path: &Path, mlp: &crate::policy::mlp::Mlp) -> Result<(), OutputError> {
+    let bytes = mlp.to_bytes().map_err(|message| OutputError::Format {
+        path: path.to_path_buf(),
+        message,
+    })?;
+    write_atomic(path, |w| w.write_all(&bytes))
+}
+
 /// Saves an image as PNG (or PGM/PPM for a `.pgm`/`.ppm` path), atomically.
 pub fn save_image(path: &Path, image: &image::RgbImage) -> Result<(), OutputError> {
     let ext = path

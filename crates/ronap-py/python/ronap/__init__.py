@@ -8,6 +8,10 @@
   built-in policy.
 - ``compare(policies, seeds)``: several policies on the same seeds with paired statistics, as
   ``ronap compare``.
+- ``export_policy(model, path)`` / ``import_torch(file, path)``: SB3 models, torch modules and
+  ``torch.save`` files (legacy ones too, read without torch) as ronap weights files, to run at
+  Rust speed as ``mlp:PATH``; ``mlp_outputs(path, obs)`` runs one on a batch.
+- ``ronap.sb3.VecEnv(n)``: a Stable-Baselines3 ``VecEnv`` stepped in Rust (``pip install ronap[sb3]``).
 - ``maze_occupancy`` / ``maze_image``: scenes as numpy arrays; ``default_config()``, ``policies()``.
 
 ``NavEnv``, ``VecNavEnv``, ``evaluate`` and ``make_config`` take ``scenario=``: a TOML scenario
@@ -32,6 +36,7 @@ from .compare import compare
 from .config import default_config, make_config
 from .env import NavEnv, VecNavEnv
 from .evaluate import evaluate
+from .export import export_policy, import_torch, mlp_outputs
 from .multi import MultiNavEnv, VecMultiNavEnv
 from .scenes import maze_image, maze_occupancy, policies
 
@@ -50,9 +55,12 @@ __all__ = [
     "compare",
     "default_config",
     "evaluate",
+    "export_policy",
+    "import_torch",
     "make_config",
     "maze_image",
     "maze_occupancy",
+    "mlp_outputs",
     "policies",
 ]
 

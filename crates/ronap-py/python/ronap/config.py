@@ -12,7 +12,7 @@ from typing import Any, Mapping, Union
 from . import _ronap
 from ._ronap import ConfigError
 
-ScenarioLike = Union[str, os.PathLike, Mapping[str, Any]]
+ScenarioLike = Union[str, "os.PathLike[str]", Mapping[str, Any]]
 """A scenario: the path of a TOML scenario file (as ``ronap run --scenario`` takes) or a dict
 nested like it (``{"scene": {"kind": "warehouse"}, "moving": [{"count": 5}]}``)."""
 

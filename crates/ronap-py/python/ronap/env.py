@@ -17,7 +17,7 @@ from .config import ScenarioLike, checked_config, checked_int
 _SEED_LIMIT = 2**63
 
 
-class NavEnv(gym.Env):
+class NavEnv(gym.Env[np.ndarray, Any]):
     """One RoNAP episode at a time.
 
     Observation: ``float32[beams + 1]``, the laser readings over their range and the goal
@@ -40,7 +40,12 @@ class NavEnv(gym.Env):
     ``reset()`` draws the next episode seed from the environment's generator.
     """
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
+    metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 30}
+    observation_space: spaces.Space[Any]
+    action_space: spaces.Space[Any]
+    config: dict[str, Any]
+    continuous: bool
+    render_mode: str | None
 
     def __init__(
         self,
@@ -154,7 +159,7 @@ def _autoreset_mode(mode: AutoresetMode | str) -> AutoresetMode:
     raise _ronap.ConfigError(f"autoreset_mode {mode!r}: expected 'next_step', 'same_step' or 'disabled' (or a gymnasium AutoresetMode)")
 
 
-class VecNavEnv(VectorEnv):
+class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
     """``num_envs`` RoNAP environments stepped together in Rust, across cores, with the GIL
     released; observations, rewards and flags come back as numpy arrays.
 
@@ -183,7 +188,15 @@ class VecNavEnv(VectorEnv):
     it) sets ``episode_max_steps``.
     """
 
-    metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": ["rgb_array"], "render_fps": 30}
+    metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": ["rgb_array"], "render_fps": 30}
+    observation_space: spaces.Space[Any]
+    action_space: spaces.Space[Any]
+    single_observation_space: spaces.Space[Any]
+    single_action_space: spaces.Space[Any]
+    config: dict[str, Any]
+    num_envs: int
+    continuous: bool
+    render_mode: str | None
 
     def __init__(
         self,
@@ -234,7 +247,7 @@ class VecNavEnv(VectorEnv):
         if self.continuous:
             robot = self.config["robot"]
             self._action_scale = np.array([robot["max_linear_speed_px"], robot["max_angular_speed_deg"]], np.float64)
-            self.single_action_space: spaces.Space[Any] = spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
+            self.single_action_space = spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
         else:
             self.single_action_space = spaces.Discrete(3)
         self.observation_space = batch_space(self.single_observation_space, num_envs)

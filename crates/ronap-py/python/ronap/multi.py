@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import json
-from typing import Any, Mapping
+from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 from gymnasium import spaces
@@ -12,15 +12,20 @@ from . import _ronap
 from .config import ScenarioLike, checked_config, checked_int
 from .env import discrete_actions
 
-try:  # PettingZoo is optional: without it MultiNavEnv still works, as a plain class.
-    from pettingzoo import ParallelEnv as _Base
-except ImportError:  # pragma: no cover - exercised only without pettingzoo
-    _Base = object  # type: ignore[assignment,misc]
+if TYPE_CHECKING:
+    from pettingzoo import ParallelEnv
+
+    _Base = ParallelEnv[str, np.ndarray, Any]
+else:
+    try:  # PettingZoo is optional: without it MultiNavEnv still works, as a plain class.
+        from pettingzoo import ParallelEnv as _Base
+    except ImportError:  # pragma: no cover - exercised only without pettingzoo
+        _Base = object
 
 _SEED_LIMIT = 2**63
 
 
-class MultiNavEnv(_Base):  # type: ignore[misc,valid-type]
+class MultiNavEnv(_Base):
     """The robots of a scenario's ``[[robots]]`` entries in one scene, as a PettingZoo
     ``ParallelEnv``: agents ``robot_0``, ``robot_1``, ... in entry order.
 
@@ -45,7 +50,12 @@ class MultiNavEnv(_Base):  # type: ignore[misc,valid-type]
     the same as seed ``s`` of ``ronap run --scenario``.
     """
 
-    metadata = {"name": "ronap_multi_nav_v0", "render_modes": ["rgb_array"], "render_fps": 30}
+    metadata: dict[str, Any] = {"name": "ronap_multi_nav_v0", "render_modes": ["rgb_array"], "render_fps": 30}
+    config: dict[str, Any]
+    render_mode: str | None
+    render_scale: float
+    continuous: bool
+    message_size: int
 
     def __init__(
         self,
@@ -206,6 +216,11 @@ class VecMultiNavEnv:
     ``seed + i``, ``seed + i + num_envs``, ...: the same episodes ``MultiNavEnv`` plays with those
     seeds, on any number of threads.
     """
+
+    config: dict[str, Any]
+    possible_agents: list[str]
+    single_observation_space: spaces.Box
+    single_action_space: spaces.Space[Any]
 
     def __init__(
         self,

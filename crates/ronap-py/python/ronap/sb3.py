@@ -35,10 +35,9 @@ try:
         VecEnv as _VecEnv,
         VecEnvIndices,
         VecEnvObs,
-        VecEnvStepReturn,
     )
-except ImportError as e:  # pragma: no cover - depends on the installed extras
-    raise ImportError("ronap.sb3 needs Stable-Baselines3: pip install 'ronap[sb3]' (or stable-baselines3)") from e
+except ImportError:  # pragma: no cover - depends on the installed extras
+    raise ImportError("ronap.sb3 needs Stable-Baselines3: pip install 'ronap[sb3]' (or stable-baselines3)") from None
 
 from .env import VecNavEnv
 
@@ -49,13 +48,17 @@ class VecEnv(_VecEnv):
     """``num_envs`` ronap environments as one Stable-Baselines3 ``VecEnv`` (see the module's
     documentation)."""
 
+    venv: VecNavEnv
+    render_mode: str | None
+    reset_infos: list[dict[str, Any]]
+
     def __init__(self, num_envs: int, **config: Any) -> None:
         config.pop("autoreset_mode", None)
         self.venv = VecNavEnv(num_envs, autoreset_mode="same_step", **config)
         self.render_mode = self.venv.render_mode
         super().__init__(self.venv.num_envs, self.venv.single_observation_space, self.venv.single_action_space)
         self._actions: np.ndarray | None = None
-        self._start = time.monotonic()
+        self._start: float = time.monotonic()
 
     def reset(self) -> VecEnvObs:
         seeds = self._seeds
@@ -69,7 +72,7 @@ class VecEnv(_VecEnv):
     def step_async(self, actions: np.ndarray) -> None:
         self._actions = actions
 
-    def step_wait(self) -> VecEnvStepReturn:
+    def step_wait(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[dict[str, Any]]]:
         if self._actions is None:
             raise RuntimeError("step_wait() without step_async()")
         actions = np.asarray(self._actions)
