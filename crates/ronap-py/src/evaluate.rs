@@ -7,7 +7,9 @@ use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use ronap_core::eval::{EvalOptions, Evaluator};
-use ronap_core::io::run_dir::{evaluate_into, Pictures, RunFiles, RunInfo, RunWriter};
+use ronap_core::io::run_dir::{
+    evaluate_into, BlockRun, EpisodeRows, Pictures, RunFiles, RunInfo, RunWriter,
+};
 use ronap_core::policy::batched::{BatchPolicy, Batched};
 use ronap_core::policy::{Decision, Policy, PolicyError, PolicyFactory};
 use ronap_core::{Action, Episode, World};
@@ -218,10 +220,7 @@ fn policy_factory(
             .map_err(|e| errors::ConfigError::new_err(e.to_string()))?;
         (factory, name)
     } else if policy.is_callable() {
-        let name = policy
-            .getattr("__name__")
-            .and_then(|n| n.extract::<String>())
-            .unwrap_or_else(|_| "python".into());
+        let name = policy_name(policy);
         let factory = PyPolicyFactory {
             callable: policy.clone().unbind(),
             continuous,
@@ -241,7 +240,7 @@ fn policy_factory(
 /// "episodes": [...]} with the figures and rows `ronap run` reports, and writes its files (the
 /// same files, `summary.json` in the same schema) into `out` when given.
 #[pyfunction]
-#[pyo3(signature = (policy, seeds, config, maze_seed = None, map_path = None, threads = 0, continuous = false, out = None, png = None, log_steps = false, thread_safe = false, batch = 0))]
+#[pyo3(signature = (policy, seeds, config, maze_seed = None, map_path = None, threads = 0, continuous = false, out = None, png = None, log_steps = false, thread_safe = false, batch = 0, rows = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate<'py>(
     py: Python<'py>,
@@ -257,6 +256,7 @@ pub fn evaluate<'py>(
     log_steps: bool,
     thread_safe: bool,
     batch: usize,
+    rows: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let config = config.valid();
     let Some(&first) = seeds.first() else {
@@ -270,10 +270,7 @@ pub fn evaluate<'py>(
                 "batch = {batch}: batches are for Python callables; {policy} runs in Rust already"
             )));
         }
-        let name = policy
-            .getattr("__name__")
-            .and_then(|n| n.extract::<String>())
-            .unwrap_or_else(|_| "python".into());
+        let name = policy_name(policy);
         let robot = &config.robot;
         let check = py
             .import("ronap.env")?
@@ -349,12 +346,32 @@ pub fn evaluate<'py>(
     let d = PyDict::new(py);
     let summary = serde_json::to_value(&evaluation.summary).unwrap_or_default();
     d.set_item("summary", conv::json(py, &summary)?)?;
-    let rows = PyList::empty(py);
+    let episodes = PyList::empty(py);
     for r in &evaluation.result.records {
-        rows.append(conv::record(py, r)?)?;
+        episodes.append(conv::record(py, r)?)?;
     }
-    d.set_item("episodes", rows)?;
+    d.set_item("episodes", episodes)?;
+    if rows {
+        let dynamic = !config.moving.is_empty();
+        let all = PyList::empty(py);
+        for r in &evaluation.result.records {
+            let e = EpisodeRows::of(r, dynamic);
+            all.append((e.seed, e.episode, e.timing, e.figures))?;
+        }
+        d.set_item("rows", all)?;
+    }
     Ok(d)
+}
+
+/// The name a run reports for `policy`: a built-in's or weights file's name as given, a Python
+/// callable's `__name__` (or "python").
+pub fn policy_name(policy: &Bound<'_, PyAny>) -> String {
+    policy.extract::<String>().unwrap_or_else(|_| {
+        policy
+            .getattr("__name__")
+            .and_then(|n| n.extract::<String>())
+            .unwrap_or_else(|_| "python".into())
+    })
 }
 
 /// Compares `policies` (built-in names or callables) on the same `seeds` as `ronap compare` does;
@@ -451,4 +468,92 @@ pub fn compare<'py>(
     let value = serde_json::to_value(&comparison)
         .map_err(|e| errors::OutputError::new_err(e.to_string()))?;
     conv::json(py, &value)
+}
+
+/// One episode's rows as Python holds them: (seed, episode row, timing row, figures row).
+type RowsTuple = (u64, Vec<String>, Vec<String>, Vec<String>);
+
+/// A run whose seed blocks are evaluated elsewhere (Ray tasks) and handed in as rows, written into
+/// `out` as `ronap run` writes one run of all the seeds (the core's `BlockRun`).
+#[pyclass(module = "ronap._ronap", name = "BlockRun")]
+pub struct PyBlockRun {
+    run: Option<BlockRun>,
+}
+
+#[pymethods]
+impl PyBlockRun {
+    /// Starts the run of `policy` (a name or a callable, for its name) over `seeds` under
+    /// `config` in directory `out` (made, locked, cleared of an earlier run's files).
+    #[new]
+    #[pyo3(signature = (out, policy, seeds, config, maze_seed = None, map_path = None, threads = 0))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        out: std::path::PathBuf,
+        policy: &Bound<'_, PyAny>,
+        seeds: Vec<u64>,
+        config: &Config,
+        maze_seed: Option<u64>,
+        map_path: Option<&str>,
+        threads: usize,
+    ) -> PyResult<Self> {
+        let Some(&first) = seeds.first() else {
+            return Err(errors::ConfigError::new_err(
+                "seeds is empty: give at least one seed",
+            ));
+        };
+        let (spec, _, map) = conv::scenes(config.valid(), maze_seed, map_path)?;
+        let writer = RunWriter::create(&out, RunFiles::default(), first).map_err(errors::output)?;
+        let info = RunInfo {
+            policy: policy_name(policy),
+            scenes: spec,
+            map,
+        };
+        let options = EvalOptions {
+            seeds: seeds.into(),
+            threads,
+            ..EvalOptions::default()
+        };
+        let run =
+            BlockRun::create(writer, config.valid(), &options, &info).map_err(errors::output)?;
+        Ok(Self { run: Some(run) })
+    }
+
+    /// Adds the rows of the next episodes (each `(seed, episode row, timing row, figures row)`,
+    /// as `evaluate(..., rows=True)` returns them), in seed order.
+    fn add(&mut self, rows: Vec<RowsTuple>) -> PyResult<()> {
+        let run = self
+            .run
+            .as_mut()
+            .ok_or_else(|| errors::RonapError::new_err("the run is finished"))?;
+        let rows: Vec<EpisodeRows> = rows
+            .into_iter()
+            .map(|(seed, episode, timing, figures)| EpisodeRows {
+                seed,
+                episode,
+                timing,
+                figures,
+            })
+            .collect();
+        run.add(&rows).map_err(errors::output)
+    }
+
+    /// Ends the run after `wall_time_s` seconds (complete when every seed's rows came, else
+    /// marked interrupted, its files left for a resume); returns the summary (`summary.json`'s)
+    /// and the table `ronap run` prints of it.
+    fn finish(&mut self, py: Python<'_>, wall_time_s: f64) -> PyResult<(PyObject, String)> {
+        let run = self
+            .run
+            .take()
+            .ok_or_else(|| errors::RonapError::new_err("the run is finished"))?;
+        let manifest = run.finish(wall_time_s).map_err(errors::output)?;
+        let value = serde_json::to_value(&manifest.summary).unwrap_or_default();
+        Ok((conv::json(py, &value)?, manifest.summary.table()))
+    }
+}
+
+/// Checks that `policy` can run under `config` (a known name, a weights file that fits the
+/// observation, or a callable) without running it; raises `ConfigError` naming what is wrong.
+#[pyfunction]
+pub fn check_policy(policy: &Bound<'_, PyAny>, config: &Config) -> PyResult<()> {
+    policy_factory(policy, config.valid(), false, false).map(|_| ())
 }

@@ -83,6 +83,7 @@ fn _ronap(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Scenario>()?;
     m.add_class::<env::Env>()?;
     m.add_class::<vec_env::VecEnv>()?;
+    m.add_class::<evaluate::PyBlockRun>()?;
     m.add_class::<multi_env::MultiEnv>()?;
     m.add_class::<multi_env::VecMultiEnv>()?;
     m.add_function(wrap_pyfunction!(default_config_json, m)?)?;
@@ -91,6 +92,7 @@ fn _ronap(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(builtin_policies, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::compare, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate::check_policy, m)?)?;
     m.add_function(wrap_pyfunction!(mlp::write_mlp, m)?)?;
     m.add_function(wrap_pyfunction!(mlp::mlp_outputs, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -706,12 +706,7 @@ pub fn evaluate_into(
         evaluator.stream(factory, &rest, cancel, &on_finish, &mut |r| {
             let f = Figures::of(&r);
             if let Some(s) = &mut streams {
-                let rows = [
-                    vec![episode_row(&r, dynamic)],
-                    vec![timing_row(r.seed, r.wall_time_s).to_vec()],
-                    vec![figures::lone_row(r.seed, &f)],
-                ];
-                if let Err(e) = s.add(&rows) {
+                if let Err(e) = s.add(&EpisodeRows::with(&r, &f, dynamic).files()) {
                     write_error = Some(e);
                     return false;
                 }
@@ -740,6 +735,145 @@ pub fn evaluate_into(
         manifest,
         write_error,
     })
+}
+
+/// The rows one finished episode adds to a lone robot's run files: its `episodes.csv` and
+/// `timing.csv` rows and its exact figures (what the summary is made of). What a seed block
+/// evaluated elsewhere hands back to the [`BlockRun`] that writes the whole run.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct EpisodeRows {
+    /// The episode seed.
+    pub seed: u64,
+    /// Its `episodes.csv` row.
+    pub episode: Vec<String>,
+    /// Its `timing.csv` row.
+    pub timing: Vec<String>,
+    /// Its exact figures, as the figures file holds them.
+    pub figures: Vec<String>,
+}
+
+impl EpisodeRows {
+    /// The rows of `record`, whose figures are `f`; `dynamic`: the scene has moving obstacles.
+    pub fn with(record: &EpisodeRecord, f: &Figures, dynamic: bool) -> Self {
+        Self {
+            seed: record.seed,
+            episode: episode_row(record, dynamic),
+            timing: timing_row(record.seed, record.wall_time_s).to_vec(),
+            figures: figures::lone_row(record.seed, f),
+        }
+    }
+
+    /// The rows of `record`.
+    pub fn of(record: &EpisodeRecord, dynamic: bool) -> Self {
+        Self::with(record, &Figures::of(record), dynamic)
+    }
+
+    /// The rows for each run file, in the order of [`RUN_FILES`] (no `robots.csv`).
+    fn files(&self) -> [Vec<Vec<String>>; 3] {
+        [
+            vec![self.episode.clone()],
+            vec![self.timing.clone()],
+            vec![self.figures.clone()],
+        ]
+    }
+}
+
+/// A lone robot's run whose episodes were evaluated elsewhere (seed blocks on other machines)
+/// and come back as [`EpisodeRows`], written into the files [`evaluate_into`] writes for the
+/// same run: the same `episodes.csv` bytes, the same summary figures, the same plan (so a
+/// killed run can be taken up again with [`RunWriter::resume`]).
+pub struct BlockRun {
+    writer: RunWriter,
+    streams: Streams,
+    tally: Tally,
+    config: ValidConfig,
+    options: EvalOptions,
+    info: RunInfo,
+    /// How many of the seeds have their rows.
+    next: usize,
+    steps_before: u64,
+}
+
+impl BlockRun {
+    /// Starts the run of `options.seeds` under `config` in `writer`'s directory (or, for a
+    /// resumed writer, takes it up after the episodes it had).
+    pub fn create(
+        writer: RunWriter,
+        config: &ValidConfig,
+        options: &EvalOptions,
+        info: &RunInfo,
+    ) -> Result<Self, OutputError> {
+        let plan = writer.plan(config, options, info);
+        let streams = writer.open(&plan, lone_headers(!config.moving.is_empty()))?;
+        let mut tally = Tally::default();
+        let done = writer.done();
+        if done > 0 {
+            restore(&writer.dir, done, &mut |row| {
+                let (_, f) = figures::parse_lone(row)?;
+                tally.add(&f);
+                Ok(())
+            })?;
+        }
+        let steps_before = tally.steps();
+        Ok(Self {
+            writer,
+            streams,
+            tally,
+            config: config.clone(),
+            options: options.clone(),
+            info: info.clone(),
+            next: done,
+            steps_before,
+        })
+    }
+
+    /// The seeds whose rows have not come yet, in order.
+    pub fn remaining(&self) -> Seeds {
+        self.options.seeds.after(self.next)
+    }
+
+    /// Adds the rows of the next episodes, in seed order: each must be the run's next seed.
+    pub fn add(&mut self, rows: &[EpisodeRows]) -> Result<(), OutputError> {
+        for r in rows {
+            let expected = self.options.seeds.get(self.next);
+            if expected != Some(r.seed) {
+                return Err(OutputError::Format {
+                    path: self.writer.dir.join("episodes.csv"),
+                    message: match expected {
+                        Some(e) => format!("rows of seed {} came where seed {e} is next", r.seed),
+                        None => format!("rows of seed {} came after the run's last seed", r.seed),
+                    },
+                });
+            }
+            let record = csv::StringRecord::from(r.figures.clone());
+            let (_, f) = figures::parse_lone(&record).map_err(|message| OutputError::Format {
+                path: self.writer.dir.join(FIGURES_FILE),
+                message: format!("seed {}: {message}", r.seed),
+            })?;
+            self.streams.add(&r.files())?;
+            self.tally.add(&f);
+            self.next += 1;
+        }
+        Ok(())
+    }
+
+    /// Ends the run after `wall_time_s` seconds: the files to their final names (kept partial,
+    /// for a resume, when seeds are missing) and `summary.json`. Returns what it holds.
+    pub fn finish(self, wall_time_s: f64) -> Result<RunManifest, OutputError> {
+        let missing = self.next < self.options.seeds.len();
+        let result = RunResult {
+            records: Vec::new(),
+            cancelled: missing,
+            error: None,
+            wall_time_s,
+        };
+        let summary = self
+            .tally
+            .summary(wall_time_s, self.tally.steps() - self.steps_before);
+        let manifest = manifest(&self.config, &self.options, &self.info, &result, &summary);
+        finish(&self.writer, Some(self.streams), &manifest, &result)?;
+        Ok(manifest)
+    }
 }
 
 /// The headers of a lone robot's run files, in the order of [`RUN_FILES`].
@@ -1091,4 +1225,136 @@ pub fn evaluate_team_into(
         summary,
         write_error,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::policy::Builtin;
+    use crate::sim::world::Scenes;
+
+    fn setting() -> (ValidConfig, Evaluator, RunInfo) {
+        let mut c = crate::SimConfig::default();
+        c.episode.max_steps = 120;
+        let config = c.validate().unwrap();
+        let evaluator = Evaluator::new(config.clone(), Scenes::MazePerSeed);
+        let info = RunInfo {
+            policy: "apf".into(),
+            scenes: SceneSpec::MazePerSeed,
+            map: None,
+        };
+        (config, evaluator, info)
+    }
+
+    fn options(start: u64, count: u64) -> EvalOptions {
+        EvalOptions {
+            seeds: Seeds::Range { start, count },
+            threads: 2,
+            ..EvalOptions::default()
+        }
+    }
+
+    /// The rows of seeds `start..start + count`, evaluated on their own (a block elsewhere).
+    fn block(evaluator: &Evaluator, start: u64, count: u64) -> Vec<EpisodeRows> {
+        let result = evaluator
+            .run(
+                &Builtin::Apf,
+                &options(start, count),
+                &AtomicBool::new(false),
+                &|_| {},
+            )
+            .unwrap();
+        result
+            .records
+            .iter()
+            .map(|r| EpisodeRows::of(r, false))
+            .collect()
+    }
+
+    fn without_timing(m: &RunManifest) -> Summary {
+        Summary {
+            wall_time_s: 0.0,
+            steps_per_second: 0.0,
+            ..m.summary.clone()
+        }
+    }
+
+    #[test]
+    fn a_run_written_from_blocks_equals_one_run() {
+        let (config, evaluator, info) = setting();
+        let tmp = tempfile::tempdir().unwrap();
+        let (one, blocks) = (tmp.path().join("one"), tmp.path().join("blocks"));
+        let writer = RunWriter::create(&one, RunFiles::default(), 0).unwrap();
+        let whole = evaluate_into(
+            &evaluator,
+            &Builtin::Apf,
+            &options(0, 30),
+            &info,
+            Some(writer),
+            &AtomicBool::new(false),
+            &|_| {},
+            &|_| false,
+        )
+        .unwrap();
+        let writer = RunWriter::create(&blocks, RunFiles::default(), 0).unwrap();
+        let mut run = BlockRun::create(writer, &config, &options(0, 30), &info).unwrap();
+        for start in [0, 12, 24] {
+            run.add(&block(&evaluator, start, (30 - start).min(12)))
+                .unwrap();
+        }
+        let manifest = run.finish(1.0).unwrap();
+        let read = |dir: &Path, name: &str| std::fs::read(dir.join(name)).unwrap();
+        assert_eq!(read(&one, "episodes.csv"), read(&blocks, "episodes.csv"));
+        assert_eq!(read(&one, PLAN_FILE), read(&blocks, PLAN_FILE));
+        assert_eq!(without_timing(&whole.manifest), without_timing(&manifest));
+        assert!(!blocks.join(FIGURES_FILE).exists());
+        assert!(!partial_path(&blocks.join("episodes.csv")).exists());
+    }
+
+    #[test]
+    fn rows_out_of_order_are_refused_and_a_stopped_block_run_resumes() {
+        let (config, evaluator, info) = setting();
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().join("run");
+        let writer = RunWriter::create(&dir, RunFiles::default(), 5).unwrap();
+        let mut run = BlockRun::create(writer, &config, &options(5, 20), &info).unwrap();
+        let e = run.add(&block(&evaluator, 15, 5)).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("rows of seed 15 came where seed 5 is next"),
+            "{e}"
+        );
+        run.add(&block(&evaluator, 5, 10)).unwrap();
+        assert_eq!(
+            run.remaining(),
+            Seeds::Range {
+                start: 15,
+                count: 10
+            }
+        );
+        // Stopped short (the driver killed): the finished rows stay, partial.
+        let stopped = run.finish(1.0).unwrap();
+        assert!(stopped.interrupted);
+        let (writer, plan) = RunWriter::resume(&dir).unwrap();
+        assert_eq!(writer.done(), 10);
+        let info = RunInfo::of(&plan);
+        let mut run = BlockRun::create(writer, &config, &options(5, 20), &info).unwrap();
+        run.add(&block(&evaluator, 15, 10)).unwrap();
+        let resumed = run.finish(1.0).unwrap();
+        let whole = tmp.path().join("whole");
+        let mut run = BlockRun::create(
+            RunWriter::create(&whole, RunFiles::default(), 5).unwrap(),
+            &config,
+            &options(5, 20),
+            &info,
+        )
+        .unwrap();
+        run.add(&block(&evaluator, 5, 20)).unwrap();
+        let manifest = run.finish(1.0).unwrap();
+        assert_eq!(
+            std::fs::read(dir.join("episodes.csv")).unwrap(),
+            std::fs::read(whole.join("episodes.csv")).unwrap()
+        );
+        assert_eq!(without_timing(&resumed), without_timing(&manifest));
+    }
 }

@@ -118,6 +118,7 @@ def evaluate(
     log_steps: bool = False,
     thread_safe: bool = False,
     batch: int = 0,
+    rows: bool = False,
 ) -> dict[str, Any]: ...
 def compare(
     policies: list[Any],
@@ -141,3 +142,18 @@ def write_mlp(
     path: str, weights: list[np.ndarray], biases: list[np.ndarray], activation: str, metadata: dict[str, str]
 ) -> None: ...
 def mlp_outputs(path: str, observations: np.ndarray) -> np.ndarray: ...
+def check_policy(policy: Any, config: Config) -> None: ...
+
+class BlockRun:
+    def __init__(
+        self,
+        out: str | os.PathLike[str],
+        policy: Any,
+        seeds: list[int],
+        config: Config,
+        maze_seed: int | None = None,
+        map_path: str | None = None,
+        threads: int = 0,
+    ) -> None: ...
+    def add(self, rows: list[tuple[int, list[str], list[str], list[str]]]) -> None: ...
+    def finish(self, wall_time_s: float) -> tuple[dict[str, Any], str]: ...

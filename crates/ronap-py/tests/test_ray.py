@@ -1,0 +1,125 @@
+"""ronap.ray on a local Ray cluster of 2 CPUs: the same episodes.csv bytes and summary figures as
+one `ronap run`, policies that travel as weights or pickled callables, a killed worker's task run
+again without a duplicated or lost episode, a failing policy's error as ronap's exception."""
+
+import json
+import os
+import pathlib
+import pickle
+import subprocess
+import sys
+
+import pytest
+import ray
+
+import ronap
+import ronap.ray
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
+TIMING = {"wall_time_s", "steps_per_second"}
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    context = ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    yield context.address_info["address"]
+    ray.shutdown()
+
+
+def figures(run_dir):
+    summary = json.loads((pathlib.Path(run_dir) / "summary.json").read_text())["summary"]
+    return {k: v for k, v in summary.items() if k not in TIMING}
+
+
+def ronap_run(ronap_bin, out, *args):
+    r = subprocess.run([ronap_bin, "run", "--out", str(out), *args], capture_output=True, text=True, cwd=ROOT)
+    assert r.returncode == 0, r.stderr
+
+
+def test_blocks_write_the_bytes_of_one_run(cluster, ronap_bin, tmp_path):
+    result = ronap.ray.evaluate("apf", range(5, 48), out=tmp_path / "ray", block=7)
+    ronap_run(ronap_bin, tmp_path / "one", "--policy", "apf", "--seeds", "43", "--seed-start", "5")
+    assert (tmp_path / "ray" / "episodes.csv").read_bytes() == (tmp_path / "one" / "episodes.csv").read_bytes()
+    assert figures(tmp_path / "ray") == figures(tmp_path / "one")
+    assert result["summary"]["episodes"] == 43 and "success rate" in result["table"]
+
+
+def test_a_network_travels_as_its_bytes(cluster, ronap_bin, tmp_path):
+    net = "mlp:policies/bc.safetensors"
+    cwd = os.getcwd()
+    os.chdir(ROOT)
+    try:
+        ronap.ray.evaluate(net, range(24), out=tmp_path / "ray", block=5, maze_cols=6, maze_rows=6)
+    finally:
+        os.chdir(cwd)
+    ronap_run(ronap_bin, tmp_path / "one", "--policy", net, "--seeds", "24", "--cols", "6", "--rows", "6")
+    assert (tmp_path / "ray" / "episodes.csv").read_bytes() == (tmp_path / "one" / "episodes.csv").read_bytes()
+    assert figures(tmp_path / "ray") == figures(tmp_path / "one")
+
+
+def dies_once(marker, after):
+    """A policy whose worker process dies the first time it has made `after` decisions (a marker
+    file says it has), then behaves: a killed task, run again. Made in a function, so Ray pickles
+    it by value (workers cannot import the tests)."""
+
+    class DiesOnce:
+        def __init__(self):
+            self.calls = 0
+            self.__name__ = "dies_once"
+
+        def __call__(self, obs):
+            self.calls += 1
+            if self.calls == after and not os.path.exists(marker):
+                open(marker, "w").close()
+                os._exit(1)
+            return 1 if obs[8] > 0.5 else 0
+
+    return DiesOnce()
+
+
+def test_a_killed_task_is_run_again_without_duplicates(cluster, tmp_path):
+    policy = dies_once(str(tmp_path / "died"), after=300)
+    ronap.ray.evaluate(policy, range(30), out=tmp_path / "ray", block=6, retries=2, episode_max_steps=60)
+    assert (tmp_path / "died").exists(), "the worker was killed once"
+    ronap.evaluate(dies_once(str(tmp_path / "died"), after=300), range(30), out=str(tmp_path / "one"), episode_max_steps=60)
+    rows = (tmp_path / "ray" / "episodes.csv").read_text().splitlines()
+    assert len(rows) == 31 and [r.split(",")[0] for r in rows[1:]] == [str(s) for s in range(30)]
+    assert (tmp_path / "ray" / "episodes.csv").read_bytes() == (tmp_path / "one" / "episodes.csv").read_bytes()
+
+
+def test_a_failing_policy_raises_ronaps_error_and_keeps_what_finished(cluster, tmp_path):
+    def bad(obs):
+        raise ValueError("no")
+
+    with pytest.raises(ronap.PolicyError, match="no"):
+        ronap.ray.evaluate(bad, range(10), out=tmp_path / "ray", block=5)
+    assert json.loads((tmp_path / "ray" / "summary.json").read_text())["interrupted"]
+    with pytest.raises(ronap.ConfigError, match="seeds is empty"):
+        ronap.ray.evaluate("apf", [], out=tmp_path / "x")
+    with pytest.raises(ronap.ConfigError, match="block = 0"):
+        ronap.ray.evaluate("apf", range(3), block=0)
+
+
+def test_errors_and_environments_pickle():
+    e = pickle.loads(pickle.dumps(ronap.PolicyError("seed 3, step 4: no")))
+    assert isinstance(e, ronap.PolicyError) and isinstance(e, ronap.RonapError) and "seed 3" in str(e)
+    env = ronap.NavEnv(maze_cols=5)
+    env.reset(seed=2)
+    env.step(1)
+    copy = pickle.loads(pickle.dumps(env))
+    assert (copy.step(1)[0] == env.step(1)[0]).all()
+
+
+def test_the_command_line(cluster, ronap_bin, tmp_path):
+    r = subprocess.run(
+        [sys.executable, "-m", "ronap.ray", "--policy", "random", "--seeds", "20", "--block", "6", "--out", str(tmp_path / "ray"), "--address", cluster],
+        capture_output=True,
+        text=True,
+        cwd=ROOT,
+    )
+    assert r.returncode == 0, r.stderr
+    assert "success rate" in r.stdout and "20/20 episodes" in r.stderr
+    ronap_run(ronap_bin, tmp_path / "one", "--policy", "random", "--seeds", "20")
+    assert (tmp_path / "ray" / "episodes.csv").read_bytes() == (tmp_path / "one" / "episodes.csv").read_bytes()
+    bad = subprocess.run([sys.executable, "-m", "ronap.ray", "--policy", "nope", "--seeds", "2", "--out", str(tmp_path / "b"), "--address", cluster], capture_output=True, text=True)
+    assert bad.returncode == 2 and bad.stderr.startswith("error") and "nope" in bad.stderr
