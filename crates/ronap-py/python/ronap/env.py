@@ -38,6 +38,12 @@ class NavEnv(gym.Env[np.ndarray, Any]):
 
     ``reset(seed=s)`` plays the episode of seed ``s`` (the same as ``ronap run`` seed ``s``);
     ``reset()`` draws the next episode seed from the environment's generator.
+
+    The episode limit is ``episode_max_steps`` (default 2000), after which ``truncated`` is
+    true and ``info["status"]`` is "timeout". ``gymnasium.make("ronap/Nav-v0",
+    max_episode_steps=N)`` wraps Gymnasium's ``TimeLimit`` around it instead, which truncates at
+    N without the environment knowing (``info["status"]`` stays "running"): give
+    ``episode_max_steps=N`` to make N the environment's own limit.
     """
 
     metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 30}
