@@ -100,6 +100,9 @@ def _network(
         others = [_kind(m) for m in modules if _kind(m) not in _ACTIVATIONS and _kind(m) not in _PASS and _kind(m) != "Linear"]
         if others:
             raise ConfigError(f"{where}: has a {others[0]}; ronap's network has Linear layers and one of {sorted(_ACTIVATIONS)}")
+        kinds = sorted({_activation_name(m) for m in acts})
+        if len(kinds) > 1:
+            raise ConfigError(f"{where}: several activations ({', '.join(kinds)}); ronap's network has one")
         return _network(_interleaved(linears, acts[0] if acts else None), where, activation)
     layers: list[tuple[np.ndarray, np.ndarray]] = []
     found: set[str] = set()
