@@ -16,11 +16,14 @@ fn spawn(args: &[&str]) -> Child {
         .unwrap()
 }
 
-/// Waits (up to 60 s) until `done` holds, panicking with `what` otherwise.
-fn wait_for(what: &str, done: impl Fn() -> bool) {
+/// Waits (up to 60 s) until `done` holds while `child` runs, panicking with `what` otherwise.
+fn wait_for(child: &mut Child, what: &str, done: impl Fn() -> bool) {
     let deadline = Instant::now() + Duration::from_secs(60);
     while !done() {
         assert!(Instant::now() < deadline, "timed out waiting for {what}");
+        if let Some(status) = child.try_wait().unwrap() {
+            panic!("the run ended ({status}) before {what}: make it longer");
+        }
         std::thread::sleep(Duration::from_millis(10));
     }
 }
@@ -57,7 +60,9 @@ fn kill_and_resume(args: &[&str], files: &[&str]) {
     let a: Vec<String> = with_out(&killed);
     let mut child = spawn(&a.iter().map(String::as_str).collect::<Vec<_>>());
     let partial = killed.join("episodes.csv.partial");
-    wait_for("rows in episodes.csv.partial", || lines(&partial) > 2);
+    wait_for(&mut child, "rows in episodes.csv.partial", || {
+        lines(&partial) > 2
+    });
     child.kill().unwrap();
     child.wait().unwrap();
     assert!(
@@ -96,14 +101,14 @@ fn kill_and_resume(args: &[&str], files: &[&str]) {
 #[cfg(unix)]
 #[test]
 fn a_run_killed_with_sigkill_is_resumed_to_the_same_bytes() {
-    // A few seconds in all, so the kill lands mid-run.
+    // About 3 s on two cores here, so the kill lands mid-run on a faster machine too.
     kill_and_resume(
         &[
             "run",
             "--policy",
             "apf",
             "--seeds",
-            "3000",
+            "20000",
             "--threads",
             "2",
         ],
@@ -114,7 +119,8 @@ fn a_run_killed_with_sigkill_is_resumed_to_the_same_bytes() {
 #[cfg(unix)]
 #[test]
 fn a_team_run_killed_with_sigkill_is_resumed_to_the_same_bytes() {
-    // Several episodes a second: the first rows are flushed after a second, well before the end.
+    // About 30 episodes a second on two cores here (3.5 s): the first rows are flushed after a
+    // second (a team episode's rows do not fill a write buffer sooner), well before the end.
     let scenario = repo_root().join("scenarios/warehouse-team.toml");
     kill_and_resume(
         &[
@@ -124,7 +130,7 @@ fn a_team_run_killed_with_sigkill_is_resumed_to_the_same_bytes() {
             "--policy",
             "random",
             "--seeds",
-            "16",
+            "120",
             "--threads",
             "2",
         ],
@@ -192,7 +198,9 @@ fn a_second_run_into_a_directory_in_use_is_refused() {
         "--out",
         o,
     ]);
-    wait_for("the first run's plan", || out.join("run.json").exists());
+    wait_for(&mut first, "the first run's plan", || {
+        out.join("run.json").exists()
+    });
     let err = crate::util::assert_rejected(
         &["run", "--policy", "apf", "--seeds", "5", "--out", o],
         &[
@@ -204,7 +212,7 @@ fn a_second_run_into_a_directory_in_use_is_refused() {
     assert!(err.contains("choose another output directory"), "{err}");
     // Nor may a resume take it over.
     crate::util::assert_rejected(&["run", "--resume", o], &[o, "in use"]);
-    wait_for("rows in episodes.csv.partial", || {
+    wait_for(&mut first, "rows in episodes.csv.partial", || {
         lines(&out.join("episodes.csv.partial")) > 2
     });
     first.kill().unwrap();
