@@ -12,7 +12,8 @@ use ronap_core::io::run_dir::{
 };
 use ronap_core::policy::batched::{BatchPolicy, Batched};
 use ronap_core::policy::{Decision, Policy, PolicyError, PolicyFactory};
-use ronap_core::{Action, Episode, World};
+use ronap_core::sim::world::Scenes;
+use ronap_core::{Action, Episode, ValidConfig, World};
 use std::sync::atomic::AtomicBool;
 use std::sync::{Arc, Condvar, Mutex};
 
@@ -259,11 +260,7 @@ pub fn evaluate<'py>(
     rows: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let config = config.valid();
-    let Some(&first) = seeds.first() else {
-        return Err(errors::ConfigError::new_err(
-            "seeds is empty: give at least one seed",
-        ));
-    };
+    let first = first_seed(&seeds)?;
     let (factory, name) = if batch > 0 {
         if !policy.is_callable() || policy.extract::<String>().is_ok() {
             return Err(errors::ConfigError::new_err(format!(
@@ -299,7 +296,7 @@ pub fn evaluate<'py>(
         .map(str::parse)
         .transpose()
         .map_err(|e| errors::ConfigError::new_err(format!("png = {e}")))?;
-    let (spec, scenes, map) = conv::scenes(config, maze_seed, map_path)?;
+    let (info, scenes) = run_info(name, config, maze_seed, map_path)?;
     let writer = out
         .as_deref()
         .map(|dir| {
@@ -316,11 +313,6 @@ pub fn evaluate<'py>(
         seeds: seeds.into(),
         threads,
         ..EvalOptions::default()
-    };
-    let info = RunInfo {
-        policy: name,
-        scenes: spec,
-        map,
     };
     let cancel = AtomicBool::new(false);
     let evaluation = py
@@ -470,6 +462,32 @@ pub fn compare<'py>(
     conv::json(py, &value)
 }
 
+/// The first of `seeds`; an empty list is refused.
+fn first_seed(seeds: &[u64]) -> PyResult<u64> {
+    seeds
+        .first()
+        .copied()
+        .ok_or_else(|| errors::ConfigError::new_err("seeds is empty: give at least one seed"))
+}
+
+/// What a run's files record of `policy` and the scene under `config`, and the scenes it runs in.
+fn run_info(
+    policy: String,
+    config: &ValidConfig,
+    maze_seed: Option<u64>,
+    map_path: Option<&str>,
+) -> PyResult<(RunInfo, Scenes)> {
+    let (spec, scenes, map) = conv::scenes(config, maze_seed, map_path)?;
+    Ok((
+        RunInfo {
+            policy,
+            scenes: spec,
+            map,
+        },
+        scenes,
+    ))
+}
+
 /// One episode's rows as Python holds them: (seed, episode row, timing row, figures row).
 type RowsTuple = (u64, Vec<String>, Vec<String>, Vec<String>);
 
@@ -496,18 +514,9 @@ impl PyBlockRun {
         map_path: Option<&str>,
         threads: usize,
     ) -> PyResult<Self> {
-        let Some(&first) = seeds.first() else {
-            return Err(errors::ConfigError::new_err(
-                "seeds is empty: give at least one seed",
-            ));
-        };
-        let (spec, _, map) = conv::scenes(config.valid(), maze_seed, map_path)?;
+        let first = first_seed(&seeds)?;
+        let (info, _) = run_info(policy_name(policy), config.valid(), maze_seed, map_path)?;
         let writer = RunWriter::create(&out, RunFiles::default(), first).map_err(errors::output)?;
-        let info = RunInfo {
-            policy: policy_name(policy),
-            scenes: spec,
-            map,
-        };
         let options = EvalOptions {
             seeds: seeds.into(),
             threads,

@@ -25,14 +25,14 @@ pub struct VecEnv {
 /// What a reset or a step hands back besides rewards and flags: observations, infos, and for the
 /// episodes same-step autoreset restarted (`None` when there are none) a mask of them, their last
 /// observations and their final infos.
-type Arrays<'py> = (
+type Arrays<'py> = (Bound<'py, PyAny>, Bound<'py, PyDict>, Option<Finals<'py>>);
+
+/// The episodes same-step autoreset restarted: a mask of them, their last observations and their
+/// final infos.
+type Finals<'py> = (
+    Bound<'py, PyArray1<bool>>,
     Bound<'py, PyAny>,
     Bound<'py, PyDict>,
-    Option<(
-        Bound<'py, PyArray1<bool>>,
-        Bound<'py, PyAny>,
-        Bound<'py, PyDict>,
-    )>,
 );
 
 /// The info arrays of `records`, one entry per environment.
@@ -223,11 +223,7 @@ impl VecEnv {
         Bound<'py, PyArray1<bool>>,
         Bound<'py, PyArray1<bool>>,
         Bound<'py, PyDict>,
-        Option<(
-            Bound<'py, PyArray1<bool>>,
-            Bound<'py, PyAny>,
-            Bound<'py, PyDict>,
-        )>,
+        Option<Finals<'py>>,
     )> {
         let n = self.batch.len();
         let actions: Vec<Action> = if self.continuous {
