@@ -112,15 +112,123 @@ fn dqn_trains_and_writes_weights() {
         "200",
         "--report-every",
         "1000",
+        "--shaping",
+        "geodesic",
+        "--eval-every",
+        "1000",
+        "--eval-seeds",
+        "5",
         "--out",
         weights.to_str().unwrap(),
     ]));
     assert!(
-        out.contains("mean return") && out.contains("success"),
+        out.contains("mean return") && out.contains("success") && out.contains("validation"),
         "{out}"
     );
     let mlp = ronap_core::policy::mlp::Mlp::load(&weights).unwrap();
     assert_eq!(mlp.metadata["output"], "q_values");
+    assert_eq!(mlp.metadata["decision"], "sample:0.3");
+    // The curves beside the weights: a row per report, validation from the first.
+    let log = std::fs::read_to_string(dir.path().join("dqn-training.csv")).unwrap();
+    let lines: Vec<&str> = log.lines().collect();
+    assert_eq!(
+        lines[0],
+        "steps,episodes,mean_return,success_rate,epsilon,loss,learning_rate,validation_success"
+    );
+    assert_eq!(lines.len(), 4, "{log}");
+    assert!(lines[1..].iter().all(|l| !l.ends_with(',')), "{log}");
+    let png = image::open(dir.path().join("dqn-training.png")).unwrap();
+    assert!(png.width() >= 800, "{}", png.width());
+    assert!(out.contains("dqn-training.png"), "{out}");
+}
+
+#[test]
+fn bc_writes_its_accuracy_curves_beside_the_weights() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("rows.csv");
+    let o = ronap(&[
+        "collect",
+        "--expert",
+        "geodesic",
+        "--samples",
+        "300",
+        "--out",
+        data.to_str().unwrap(),
+    ]);
+    ok(&o);
+    let weights = dir.path().join("bc.safetensors");
+    ok(&ronap(&[
+        "train",
+        "bc",
+        "--data",
+        data.to_str().unwrap(),
+        "--epochs",
+        "3",
+        "--hidden",
+        "8",
+        "--out",
+        weights.to_str().unwrap(),
+    ]));
+    let log = std::fs::read_to_string(dir.path().join("bc-training.csv")).unwrap();
+    assert!(
+        log.starts_with("epoch,loss,train_accuracy,test_accuracy\n1,"),
+        "{log}"
+    );
+    assert_eq!(log.lines().count(), 4);
+    assert!(image::open(dir.path().join("bc-training.png")).is_ok());
+    assert_eq!(
+        ronap_core::policy::mlp::Mlp::load(&weights)
+            .unwrap()
+            .metadata["decision"],
+        "sample:2"
+    );
+}
+
+#[test]
+fn a_network_trained_with_history_runs_with_it_and_is_refused_without() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = dir.path().join("memory.toml");
+    std::fs::write(&scenario, "[observation]\nhistory = 3\n").unwrap();
+    let weights = dir.path().join("m.safetensors");
+    ok(&ronap(&[
+        "train",
+        "dqn",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--steps",
+        "600",
+        "--envs",
+        "4",
+        "--batch",
+        "16",
+        "--hidden",
+        "8",
+        "--eval-every",
+        "0",
+        "--out",
+        weights.to_str().unwrap(),
+    ]));
+    let mlp = ronap_core::policy::mlp::Mlp::load(&weights).unwrap();
+    assert_eq!(mlp.inputs(), 3 * 18 + 2 * 3);
+    let policy = format!("mlp:{}", weights.display());
+    let run_dir = dir.path().join("run");
+    ok(&ronap(&[
+        "run",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--policy",
+        &policy,
+        "--seeds",
+        "3",
+        "--max-steps",
+        "50",
+        "--out",
+        run_dir.to_str().unwrap(),
+    ]));
+    crate::util::assert_rejected(
+        &["run", "--policy", &policy, "--seeds", "3"],
+        &["60 inputs", "18 values", "observation.history"],
+    );
 }
 
 #[test]

@@ -428,6 +428,49 @@ pub struct RewardConfig {
     pub turn: f64,
     /// r_d, added on success. Default 10.
     pub success: f64,
+    /// How progress is paid to a learner. Default `none`: the paper's straight-line term r_b.
+    #[serde(skip_serializing_if = "Shaping::is_none")]
+    pub shaping: Shaping,
+    /// The discount gamma of the shaping term `F = gamma Phi(s') - Phi(s)`; set it to the
+    /// learner's (`ronap train dqn` sets it to its `--gamma`). Default 0.99.
+    #[serde(skip_serializing_if = "is_default_shaping_gamma")]
+    pub shaping_gamma: f64,
+}
+
+/// Values per remembered action in an observation with history.
+pub const ACTION_MEMORY: usize = 3;
+
+/// Most frames an observation may hold.
+pub const MAX_HISTORY: u32 = 64;
+
+/// The default [`RewardConfig::shaping_gamma`].
+const SHAPING_GAMMA: f64 = 0.99;
+
+fn is_default_shaping_gamma(gamma: &f64) -> bool {
+    *gamma == SHAPING_GAMMA
+}
+
+/// How progress towards the goal is paid (SPEC "Reward"; Ng, Harada and Russell 1999).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Shaping {
+    /// The paper's r_b: `progress_per_px` per px of straight-line progress.
+    #[default]
+    None,
+    /// Potential-based shaping along the geodesic: r_b is replaced by
+    /// `F = gamma Phi(s') - Phi(s)` with `Phi = -progress_per_px x` (geodesic distance to the
+    /// goal for the robot's disc), and `Phi = 0` once an episode ends by success, collision or
+    /// `reward_min`. It keeps the optimal policy of the other three terms and no longer pays for
+    /// heading into a dead end. Uses the map only for the reward a learner is given: the
+    /// observation is unchanged, and `episodes.csv`'s `total_reward` stays the paper's return.
+    Geodesic,
+}
+
+impl Shaping {
+    /// Whether this is the paper's reward.
+    pub fn is_none(&self) -> bool {
+        *self == Self::None
+    }
 }
 
 impl Default for RewardConfig {
@@ -437,6 +480,8 @@ impl Default for RewardConfig {
             progress_per_px: 0.1,
             turn: -0.05,
             success: 10.0,
+            shaping: Shaping::None,
+            shaping_gamma: SHAPING_GAMMA,
         }
     }
 }
@@ -494,6 +539,9 @@ pub struct SimConfig {
     pub laser: LaserConfig,
     /// Start, goal, episode end.
     pub episode: EpisodeConfig,
+    /// What a policy observes beyond the current values.
+    #[serde(skip_serializing_if = "ObservationConfig::is_default")]
+    pub observation: ObservationConfig,
     /// Reward terms.
     pub reward: RewardConfig,
     /// The artificial potential field policy.
@@ -508,6 +556,31 @@ pub struct SimConfig {
     /// How the robots of a team talk (SPEC "Several robots", communication).
     #[serde(skip_serializing_if = "TeamConfig::is_default")]
     pub team: TeamConfig,
+}
+
+/// Observation memory (SPEC "Observation and reward"): with `history = k`, the observation is
+/// the last `k` frames of the paper's values, newest first, then the last `k - 1` actions, newest
+/// first, each as three values in [0, 1] (one-hot LEFT, AHEAD, RIGHT; a continuous action as
+/// `w+ / w_max, v / v_max, w- / w_max`). At an episode's start the past frames repeat the first
+/// and the past actions are zeros.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ObservationConfig {
+    /// Frames observed, the current one included (1: the paper's observation). Default 1.
+    pub history: u32,
+}
+
+impl Default for ObservationConfig {
+    fn default() -> Self {
+        Self { history: 1 }
+    }
+}
+
+impl ObservationConfig {
+    /// Whether this is the paper's observation.
+    pub fn is_default(&self) -> bool {
+        *self == Self::default()
+    }
 }
 
 /// Communication between the robots of a team: each broadcasts its pose, goal and a message of
@@ -664,6 +737,13 @@ impl ValidConfig {
     /// Length of the observation a policy sees: one value per laser beam, then the goal
     /// direction (SPEC "Observation and reward").
     pub fn observation_size(&self) -> usize {
+        let k = self.observation.history.max(1) as usize;
+        self.frame_size() * k + ACTION_MEMORY * (k - 1)
+    }
+
+    /// Length of one frame of the observation: one value per laser beam, the goal direction and
+    /// a team's neighbour slots. The observation is this alone unless `observation.history` > 1.
+    pub fn frame_size(&self) -> usize {
         self.laser.beams as usize + 1 + self.team.neighbours as usize * self.team.slot_size()
     }
 
@@ -900,6 +980,24 @@ impl SimConfig {
         finite("reward.progress_per_px", w.progress_per_px)?;
         finite("reward.turn", w.turn)?;
         finite("reward.success", w.success)?;
+        check(
+            (1..=MAX_HISTORY).contains(&self.observation.history),
+            "observation.history",
+            self.observation.history,
+            "must be a whole number from 1 to 64",
+        )?;
+        check(
+            self.observation.history == 1 || self.robots.is_empty(),
+            "observation.history",
+            self.observation.history,
+            "must be 1 with [[robots]] (a team's observations carry no history yet)",
+        )?;
+        check(
+            w.shaping_gamma > 0.0 && w.shaping_gamma <= 1.0,
+            "reward.shaping_gamma",
+            w.shaping_gamma.to_string(),
+            "must be in (0, 1]",
+        )?;
 
         let a = &self.apf;
         non_negative("apf.gravity_gain", a.gravity_gain)?;
@@ -1254,10 +1352,13 @@ const FIELD_DOCS: &[(&str, &str, &str, Option<&str>)] = &[
     ("team", "comm_range_px", "Several robots: range of each robot's broadcast (pose, goal, message), px.", None),
     ("team", "message_size", "Several robots: floats in the message a policy broadcasts each step (0: pose and goal only).", None),
     ("team", "neighbours", "Several robots: nearest senders in the observation, after the paper's values (0: the paper's observation).", None),
+    ("observation", "history", "Frames a policy observes, newest first, then the last history - 1 actions (three values each: LEFT, AHEAD, RIGHT); 1: the paper's 18 values.", None),
     ("reward", "collision", "r_a: added on a step that collided.", None),
     ("reward", "progress_per_px", "r_b: per px of progress towards the goal (negative when moving away).", None),
     ("reward", "turn", "r_c: added on LEFT and RIGHT (scaled by |w| / w_max for continuous actions).", None),
     ("reward", "success", "r_d: added on reaching the goal.", None),
+    ("reward", "shaping", "How progress is paid to a learner: \"none\" (r_b, the paper's) or \"geodesic\" (r_b replaced by F = gamma Phi(s') - Phi(s), Phi = -progress_per_px x geodesic distance to the goal, 0 once an episode ends other than by a time-out: keeps the optimal policy, pays nothing for dead ends; episodes.csv keeps the paper's return).", None),
+    ("reward", "shaping_gamma", "gamma of the geodesic shaping term; the learner's discount (ronap train dqn sets it to its --gamma).", None),
     ("apf", "gravity_gain", "APF policy: attraction gain xi, per px^2.", None),
     ("apf", "repulsion_gain", "APF policy: repulsion gain eta, px^2.", None),
     ("apf", "influence_px", "APF policy: distance d0 beyond which obstacles do not repel, px.", None),
@@ -1373,6 +1474,21 @@ impl SimConfig {
         // [team] is left out of written configurations when it has its defaults: show them here.
         if let (Some(table), Ok(team)) = (value.as_table_mut(), toml::Value::try_from(&self.team)) {
             table.entry("team").or_insert(team);
+        }
+        // So are [observation] and reward shaping.
+        if let (Some(table), Ok(observation)) = (
+            value.as_table_mut(),
+            toml::Value::try_from(&self.observation),
+        ) {
+            table.entry("observation").or_insert(observation);
+        }
+        if let Some(reward) = value.get_mut("reward").and_then(|r| r.as_table_mut()) {
+            if let Ok(kind) = toml::Value::try_from(self.reward.shaping) {
+                reward.entry("shaping").or_insert(kind);
+            }
+            reward
+                .entry("shaping_gamma")
+                .or_insert(toml::Value::Float(self.reward.shaping_gamma));
         }
         let mut section = "";
         for &(sec, field, doc, example) in FIELD_DOCS {
@@ -1659,6 +1775,9 @@ mod documented_tests {
         c.scene.seed = Some(1);
         c.scene.file = Some("m.png".into());
         c.team.neighbours = 1;
+        c.observation.history = 2;
+        c.reward.shaping = Shaping::Geodesic;
+        c.reward.shaping_gamma = 0.9;
         let full = toml::Value::try_from(&c).unwrap();
         let mut count = 0;
         for (sec, table) in full.as_table().unwrap() {

@@ -10,18 +10,27 @@
 //! terminate`, the summed reward reaching `reward_min`) gets target `y = r`, as Algorithm 1 has
 //! it. A time-out also ends the episode but is not a property of the state, so its target still
 //! bootstraps (`y = r + gamma max Q_target`), as time limits should.
+//!
+//! On top of Algorithm 1's shape, each an option: n-step returns (the discounted rewards of up
+//! to n steps, then `gamma^n max Q_target` of where they led, cut short where the episode ends),
+//! Double-DQN targets, a dueling head, the Huber loss, clipping of the gradient's norm, a linear
+//! learning-rate decay, prioritised replay (Schaul et al. 2016: proportional, with importance
+//! weights) and validation on held-out seeds that keeps the best network.
 
-use crate::net::{batch, Net, TrainActivation};
+use crate::net::{Net, TrainActivation};
+use crate::replay::{NStep, Replay};
 use crate::LearnError;
-use candle_core::{Device, Tensor, D};
+use candle_core::backprop::GradStore;
+use candle_core::{Var, D};
 use candle_nn::optim::Optimizer;
 use rand::{Rng as _, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use ronap_core::eval::Evaluator;
-use ronap_core::policy::mlp::Mlp;
+use ronap_core::eval::{EvalOptions, Evaluator, Outcome, Recording, Seeds};
+use ronap_core::policy::mlp::{DecisionRule, Mlp, MlpFactory};
 use ronap_core::run::batch::{Autoreset, Batch, BatchOptions, SeedOrder};
 use ronap_core::{Action, DiscreteAction, Status};
 use std::collections::{HashMap, VecDeque};
+use std::sync::atomic::AtomicBool;
 
 /// Training settings.
 #[derive(Clone, Debug, PartialEq)]
@@ -56,10 +65,70 @@ pub struct DqnOptions {
     pub warmup: usize,
     /// Use the online network to choose the next action in the target (Double DQN).
     pub double: bool,
+    /// Steps summed before bootstrapping (n of n-step returns; 1: Algorithm 1's).
+    pub n_step: usize,
+    /// A dueling head (value and advantages; folds into a plain network when saved).
+    pub dueling: bool,
+    /// The loss on the TD error.
+    pub loss: Loss,
+    /// Largest norm of the gradient over all weights; larger ones are scaled down. `None`: no
+    /// clipping.
+    pub grad_clip: Option<f64>,
+    /// The learning rate at the end, as a fraction of `learning_rate`: it falls linearly over
+    /// training (1: constant).
+    pub lr_end_fraction: f64,
+    /// Prioritised replay, when set.
+    pub prioritized: Option<Priorities>,
+    /// Evaluation on held-out seeds during training, keeping the best network; `None`: the
+    /// network at the end is the result.
+    pub validation: Option<Validation>,
     /// Seed of the initial weights and the replay sampling.
     pub seed: u64,
     /// Episode seeds are `seed_start`, `seed_start + 1`, ...: keep them apart from evaluation seeds.
     pub seed_start: u64,
+}
+
+/// Evaluation during training (as Stable-Baselines3's `EvalCallback` keeps its best model):
+/// every `every` environment steps the current network, with the decision rule it will be saved
+/// with, runs `seeds` (apart from the training seeds and from the seeds it will be tested on);
+/// the network with the highest success rate there (then SPL) is the one returned.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Validation {
+    /// Environment steps between evaluations.
+    pub every: u64,
+    /// The validation seeds.
+    pub seeds: Seeds,
+    /// How outputs become actions in the evaluation (the saved file's rule).
+    pub decision: DecisionRule,
+}
+
+/// The loss on the TD error `d = Q(s, a) - y`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Loss {
+    /// `d^2` (Algorithm 1's).
+    Mse,
+    /// `d^2 / 2` within 1 of 0, `|d| - 1/2` beyond: large errors do not swamp the update.
+    Huber,
+}
+
+/// Proportional prioritised replay: transition `i` is drawn with probability `p_i^alpha / sum`,
+/// `p_i = |d_i| + 1e-3` (new ones at the largest priority so far), and its loss weighted by
+/// `(N P(i))^-beta` over the batch's largest, beta rising linearly to 1 over training.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Priorities {
+    /// How strongly priorities skew sampling (0: uniform).
+    pub alpha: f64,
+    /// Importance-weight exponent at the start.
+    pub beta_start: f64,
+}
+
+impl Default for Priorities {
+    fn default() -> Self {
+        Self {
+            alpha: 0.6,
+            beta_start: 0.4,
+        }
+    }
 }
 
 impl Default for DqnOptions {
@@ -80,6 +149,13 @@ impl Default for DqnOptions {
             updates_per_round: 1,
             warmup: 5_000,
             double: true,
+            n_step: 3,
+            dueling: true,
+            loss: Loss::Huber,
+            grad_clip: Some(10.0),
+            lr_end_fraction: 1.0,
+            prioritized: None,
+            validation: None,
             seed: 0,
             seed_start: 1_000_000,
         }
@@ -101,93 +177,64 @@ pub struct DqnReport {
     pub epsilon: f64,
     /// Mean loss since the last report (NaN before updates start).
     pub loss: f64,
+    /// Current learning rate.
+    pub learning_rate: f64,
+    /// Success rate of the latest validation (NaN before the first, or without validation).
+    pub validation_success: f64,
+    /// The best validation success rate so far (NaN likewise).
+    pub best_validation_success: f64,
 }
 
-/// The replay memory: a ring of transitions.
-struct Replay {
-    width: usize,
-    capacity: usize,
-    observations: Vec<f32>,
-    next_observations: Vec<f32>,
-    actions: Vec<u32>,
-    rewards: Vec<f32>,
-    terminal: Vec<f32>,
-    next: usize,
+/// Runs `v.seeds` with `online`'s current network under `v.decision`: its success rate, mean
+/// SPL and the network.
+fn validate(
+    evaluator: &Evaluator,
+    online: &Net,
+    v: &Validation,
+    threads: usize,
+) -> Result<(f64, f64, Mlp), LearnError> {
+    let mlp = online.to_mlp(HashMap::from([("decision".to_string(), v.decision.name())]))?;
+    let factory = MlpFactory::new(mlp.clone(), "validation");
+    let options = EvalOptions {
+        seeds: v.seeds.clone(),
+        threads,
+        recording: Recording::default(),
+    };
+    let run = evaluator
+        .run(&factory, &options, &AtomicBool::new(false), &|_| {})
+        .map_err(|e| LearnError::Network(format!("validation: {e}")))?;
+    if let Some(e) = run.error {
+        return Err(LearnError::Run(e));
+    }
+    let n = run.records.len().max(1) as f64;
+    let success = run
+        .records
+        .iter()
+        .filter(|r| r.outcome == Outcome::Success)
+        .count() as f64
+        / n;
+    let spl = run.records.iter().map(|r| r.spl).sum::<f64>() / n;
+    Ok((success, spl, mlp))
 }
 
-impl Replay {
-    fn new(width: usize, capacity: usize) -> Self {
-        Self {
-            width,
-            capacity,
-            observations: Vec::new(),
-            next_observations: Vec::new(),
-            actions: Vec::new(),
-            rewards: Vec::new(),
-            terminal: Vec::new(),
-            next: 0,
+/// Scales the gradients in `grads` of `vars` down so that their joint norm is at most `max`.
+fn clip_norm(grads: &mut GradStore, vars: &[Var], max: f64) -> Result<(), LearnError> {
+    let mut squares = 0.0f64;
+    for v in vars {
+        if let Some(g) = grads.get(v) {
+            squares += f64::from(g.sqr()?.sum_all()?.to_scalar::<f32>()?);
         }
     }
-
-    fn len(&self) -> usize {
-        self.actions.len()
-    }
-
-    fn push(&mut self, t: &Transition) {
-        let w = self.width;
-        if self.len() < self.capacity {
-            self.observations.extend_from_slice(&t.observation);
-            self.next_observations
-                .extend_from_slice(&t.next_observation);
-            self.actions.push(t.action);
-            self.rewards.push(t.reward);
-            self.terminal.push(f32::from(u8::from(t.terminal)));
-        } else {
-            let i = self.next;
-            self.observations[i * w..(i + 1) * w].copy_from_slice(&t.observation);
-            self.next_observations[i * w..(i + 1) * w].copy_from_slice(&t.next_observation);
-            self.actions[i] = t.action;
-            self.rewards[i] = t.reward;
-            self.terminal[i] = f32::from(u8::from(t.terminal));
+    let norm = squares.sqrt();
+    if norm > max {
+        let scale = max / norm;
+        for v in vars {
+            if let Some(g) = grads.remove(v) {
+                grads.insert(v, (g * scale)?);
+            }
         }
-        self.next = (self.next + 1) % self.capacity;
     }
-
-    /// A random mini-batch: observations, actions, rewards, next observations, terminal flags.
-    fn sample(
-        &self,
-        n: usize,
-        rng: &mut ChaCha8Rng,
-    ) -> Result<(Tensor, Tensor, Tensor, Tensor, Tensor), LearnError> {
-        let w = self.width;
-        let mut o = Vec::with_capacity(n * w);
-        let mut o2 = Vec::with_capacity(n * w);
-        let (mut a, mut r, mut t) = (Vec::new(), Vec::new(), Vec::new());
-        for _ in 0..n {
-            let i = rng.random_range(0..self.len());
-            o.extend_from_slice(&self.observations[i * w..(i + 1) * w]);
-            o2.extend_from_slice(&self.next_observations[i * w..(i + 1) * w]);
-            a.push(self.actions[i]);
-            r.push(self.rewards[i]);
-            t.push(self.terminal[i]);
-        }
-        let cpu = &Device::Cpu;
-        Ok((
-            batch(o, w)?,
-            Tensor::from_vec(a, (n, 1), cpu)?,
-            Tensor::from_vec(r, n, cpu)?,
-            batch(o2, w)?,
-            Tensor::from_vec(t, n, cpu)?,
-        ))
-    }
-}
-
-struct Transition {
-    observation: Vec<f32>,
-    action: u32,
-    reward: f32,
-    next_observation: Vec<f32>,
-    terminal: bool,
+    Ok(())
 }
 
 /// The mean of `count` losses summing to `sum`; NaN for none.
@@ -222,22 +269,50 @@ pub fn train(
     batch.reset(options.seed_start)?;
     let width = batch.observation_size();
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
-    let online = Net::policy(width, &options.hidden, options.activation, &mut rng)?;
-    let target = Net::policy(width, &options.hidden, options.activation, &mut rng)?;
+    let make = |rng: &mut ChaCha8Rng| {
+        if options.dueling {
+            Net::dueling_policy(width, &options.hidden, options.activation, rng)
+        } else {
+            Net::policy(width, &options.hidden, options.activation, rng)
+        }
+    };
+    let online = make(&mut rng)?;
+    let target = make(&mut rng)?;
     target.copy_from(&online)?;
     let mut optimiser = online.adam(options.learning_rate)?;
+    let vars = online.vars();
     let mut acting = online.to_mlp(HashMap::new())?;
-    let mut replay = Replay::new(width, options.replay_capacity.max(options.batch));
+    let mut replay = Replay::new(
+        width,
+        options.replay_capacity.max(options.batch),
+        options.prioritized.map(|p| p.alpha),
+    );
+    let mut pending: Vec<NStep> = (0..batch.len()).map(|_| NStep::default()).collect();
     let mut recent: VecDeque<(f64, bool)> = VecDeque::with_capacity(100);
     let (mut steps, mut episodes, mut updates) = (0u64, 0u64, 0usize);
     let (mut loss_sum, mut loss_count) = (0.0, 0usize);
     let mut next_report = report_every.max(1);
     let gamma = options.gamma;
+    let progress = |steps: u64| (steps as f64 / options.steps.max(1) as f64).min(1.0);
     let epsilon_at = |steps: u64| {
         let f = (steps as f64 / options.epsilon_decay_steps.max(1) as f64).min(1.0);
         options.epsilon_start + f * (options.epsilon_end - options.epsilon_start)
     };
-    let report = |steps, episodes, recent: &VecDeque<(f64, bool)>, loss: f64| {
+    let lr_at = |steps: u64| {
+        options.learning_rate * (1.0 + progress(steps) * (options.lr_end_fraction - 1.0))
+    };
+    let mut best: Option<(f64, f64, Mlp)> = None;
+    let mut latest_validation = f64::NAN;
+    let mut next_validation = options
+        .validation
+        .as_ref()
+        .map_or(u64::MAX, |v| v.every.max(1));
+    let report = |steps,
+                  episodes,
+                  recent: &VecDeque<(f64, bool)>,
+                  loss: f64,
+                  latest: f64,
+                  best: &Option<(f64, f64, Mlp)>| {
         let n = recent.len().max(1) as f64;
         DqnReport {
             steps,
@@ -246,6 +321,9 @@ pub fn train(
             success_rate: recent.iter().filter(|r| r.1).count() as f64 / n,
             epsilon: epsilon_at(steps),
             loss,
+            learning_rate: lr_at(steps),
+            validation_success: latest,
+            best_validation_success: best.as_ref().map_or(f64::NAN, |b| b.0),
         }
     };
     while steps < options.steps {
@@ -268,13 +346,18 @@ pub fn train(
                 batch.observations()
             };
             let row = i * width..(i + 1) * width;
-            replay.push(&Transition {
-                observation: before[row.clone()].to_vec(),
-                action: s.action.and_then(Action::discrete).map_or(0, |a| a as u32),
-                reward: s.reward as f32,
-                next_observation: next[row].to_vec(),
-                terminal: s.status.is_terminated(),
-            });
+            for t in pending[i].add(
+                &before[row.clone()],
+                s.action.and_then(Action::discrete).map_or(0, |a| a as u32),
+                s.reward as f32,
+                &next[row],
+                done,
+                s.status.is_terminated(),
+                options.n_step,
+                gamma,
+            ) {
+                replay.push(&t);
+            }
             steps += 1;
             if done {
                 episodes += 1;
@@ -285,30 +368,50 @@ pub fn train(
             }
         }
         if replay.len() >= options.warmup.max(options.batch) {
+            optimiser.set_learning_rate(lr_at(steps));
+            let beta = options.prioritized.map_or(1.0, |p| {
+                p.beta_start + progress(steps) * (1.0 - p.beta_start)
+            });
             for _ in 0..options.updates_per_round {
-                let (o, a, r, o2, terminal) = replay.sample(options.batch, &mut rng)?;
-                let next_q = target.forward(&o2, None)?.detach();
+                let b = replay.sample(options.batch, beta, &mut rng)?;
+                let next_q = target.forward(&b.next_observations, None)?.detach();
                 let best_next = if options.double {
                     let choice = online
-                        .forward(&o2, None)?
+                        .forward(&b.next_observations, None)?
                         .detach()
                         .argmax_keepdim(D::Minus1)?;
                     next_q.gather(&choice, D::Minus1)?.squeeze(D::Minus1)?
                 } else {
                     next_q.max(D::Minus1)?
                 };
-                let y = (r + (best_next * terminal.affine(-gamma, gamma)?)?)?.detach();
+                let y = (b.rewards + (best_next * b.bootstrap)?)?.detach();
                 let q = online
-                    .forward(&o, None)?
-                    .gather(&a, D::Minus1)?
+                    .forward(&b.observations, None)?
+                    .gather(&b.actions, D::Minus1)?
                     .squeeze(D::Minus1)?;
-                let loss = candle_nn::loss::mse(&q, &y)?;
-                optimiser.backward_step(&loss)?;
+                let error = (q - y)?;
+                let per_sample = match options.loss {
+                    Loss::Mse => error.sqr()?,
+                    Loss::Huber => {
+                        let size = error.abs()?;
+                        let small = size.minimum(1f32)?;
+                        ((small.sqr()? * 0.5)? + (size - small)?)?
+                    }
+                };
+                let loss = (per_sample * &b.weights)?.mean_all()?;
+                let mut grads = loss.backward()?;
+                if let Some(max) = options.grad_clip {
+                    clip_norm(&mut grads, &vars, max)?;
+                }
+                optimiser.step(&grads)?;
                 let l = f64::from(loss.to_scalar::<f32>()?);
                 if !l.is_finite() {
                     return Err(LearnError::Diverged(format!(
                         "the loss became {l} after {updates} updates; lower the learning rate"
                     )));
+                }
+                if options.prioritized.is_some() {
+                    replay.update_priorities(&b.slots, &error.detach().to_vec1::<f32>()?);
                 }
                 loss_sum += l;
                 loss_count += 1;
@@ -319,11 +422,24 @@ pub fn train(
             }
             acting = online.to_mlp(HashMap::new())?;
         }
+        if let Some(v) = options
+            .validation
+            .as_ref()
+            .filter(|_| steps >= next_validation)
+        {
+            next_validation += v.every.max(1);
+            let (success, spl, mlp) = validate(evaluator, &online, v, threads)?;
+            latest_validation = success;
+            if best.as_ref().is_none_or(|b| (success, spl) > (b.0, b.1)) {
+                best = Some((success, spl, mlp));
+            }
+        }
         if steps >= next_report {
             next_report += report_every.max(1);
             let loss = mean_loss(loss_sum, loss_count);
             (loss_sum, loss_count) = (0.0, 0);
-            if !on_report(&report(steps, episodes, &recent, loss)) {
+            let r = report(steps, episodes, &recent, loss, latest_validation, &best);
+            if !on_report(&r) {
                 break;
             }
         }
@@ -331,7 +447,20 @@ pub fn train(
     // The last stretch, unless a report just covered it.
     if next_report - report_every.max(1) < steps {
         let loss = mean_loss(loss_sum, loss_count);
-        on_report(&report(steps, episodes, &recent, loss));
+        on_report(&report(
+            steps,
+            episodes,
+            &recent,
+            loss,
+            latest_validation,
+            &best,
+        ));
+    }
+    if let Some((_, _, mlp)) = best {
+        return Ok(Mlp {
+            metadata: metadata.into_iter().chain(mlp.metadata.clone()).collect(),
+            ..mlp
+        });
     }
     online.to_mlp(metadata)
 }
@@ -377,5 +506,71 @@ mod tests {
         };
         // Bit for bit: the layers' f32 weights compare exactly.
         assert_eq!(run(1), run(2));
+    }
+
+    #[test]
+    fn every_option_on_is_still_the_same_on_any_thread_count() {
+        // Shaping, prioritised replay, Algorithm 1's one-step MSE without a dueling head, a
+        // learning-rate decay, and validation keeping the best network.
+        let mut c = SimConfig::default();
+        c.maze.cols = 2;
+        c.maze.rows = 2;
+        c.maze.loops = 1.0;
+        c.episode.min_goal_distance_px = 60.0;
+        c.episode.max_steps = 200;
+        c.reward.shaping = ronap_core::config::Shaping::Geodesic;
+        let evaluator = Evaluator::new(c.validate().unwrap(), Scenes::MazePerSeed);
+        let options = DqnOptions {
+            hidden: vec![16],
+            steps: 3_000,
+            warmup: 256,
+            batch: 32,
+            envs: 8,
+            n_step: 1,
+            dueling: false,
+            loss: Loss::Mse,
+            grad_clip: Some(1.0),
+            lr_end_fraction: 0.1,
+            prioritized: Some(Priorities::default()),
+            validation: Some(Validation {
+                every: 1000,
+                seeds: Seeds::Range {
+                    start: 500,
+                    count: 10,
+                },
+                decision: DecisionRule::Sample { temperature: 0.3 },
+            }),
+            ..DqnOptions::default()
+        };
+        let mut reports = Vec::new();
+        let mut run = |threads| {
+            let mut seen = Vec::new();
+            let mlp = train(
+                &evaluator,
+                &options,
+                threads,
+                HashMap::new(),
+                1000,
+                &mut |r| {
+                    seen.push(*r);
+                    true
+                },
+            )
+            .unwrap();
+            reports.push(seen);
+            mlp
+        };
+        let (one, two) = (run(1), run(2));
+        assert_eq!(one.layers, two.layers);
+        assert_eq!(one.metadata, two.metadata);
+        assert_eq!(reports[0], reports[1]);
+        // Validation ran at every report, and the best network's rule is the one saved.
+        assert!(reports[0].iter().all(|r| r.validation_success.is_finite()));
+        assert_eq!(
+            one.metadata.get("decision").map(String::as_str),
+            Some("sample:0.3")
+        );
+        let last = reports[0].last().unwrap();
+        assert!((last.learning_rate - 0.1 * options.learning_rate).abs() < 1e-12);
     }
 }

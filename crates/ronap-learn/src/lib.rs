@@ -8,6 +8,7 @@
 pub mod bc;
 pub mod dqn;
 pub mod net;
+pub mod replay;
 
 /// Training that could not go on.
 #[derive(Debug, thiserror::Error)]

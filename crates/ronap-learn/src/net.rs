@@ -52,11 +52,16 @@ impl TrainActivation {
     }
 }
 
-/// A multilayer perceptron of candle variables.
+/// A multilayer perceptron of candle variables, optionally with a dueling head (Wang et al.
+/// 2016): a value output `V` beside the last layer's advantages `A`, giving
+/// `Q = V + A - mean(A)`. Both heads are linear in the last hidden layer, so a dueling network
+/// folds into a plain one ([`Net::layers`]) and runs as the core's [`Mlp`].
 #[derive(Debug)]
 pub struct Net {
     weights: Vec<Var>,
     biases: Vec<Var>,
+    /// The dueling head's value layer (weight `1 x hidden`, bias), if any.
+    value: Option<(Var, Var)>,
     activation: TrainActivation,
 }
 
@@ -93,6 +98,25 @@ impl Net {
         Self::new(&sizes, activation, rng)
     }
 
+    /// [`Net::policy`] with a dueling head: the value layer is drawn after the others.
+    pub fn dueling_policy(
+        width: usize,
+        hidden: &[usize],
+        activation: TrainActivation,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Self, LearnError> {
+        let mut net = Self::policy(width, hidden, activation, rng)?;
+        let n_in = hidden.last().copied().unwrap_or(width);
+        let k = 1.0 / (n_in as f32).sqrt();
+        let w: Vec<f32> = (0..n_in).map(|_| rng.random_range(-k..k)).collect();
+        let b = vec![rng.random_range(-k..k)];
+        net.value = Some((
+            Var::from_tensor(&Tensor::from_vec(w, (1, n_in), &Device::Cpu)?)?,
+            Var::from_tensor(&Tensor::from_vec(b, 1, &Device::Cpu)?)?,
+        ));
+        Ok(net)
+    }
+
     /// Adam (no weight decay) over every variable, at `learning_rate`.
     pub fn adam(&self, learning_rate: f64) -> Result<AdamW, LearnError> {
         Ok(AdamW::new(
@@ -119,6 +143,7 @@ impl Net {
         Ok(Self {
             weights,
             biases,
+            value: None,
             activation,
         })
     }
@@ -128,6 +153,7 @@ impl Net {
         self.weights
             .iter()
             .zip(&self.biases)
+            .chain(self.value.as_ref().map(|(w, b)| (w, b)))
             .flat_map(|(w, b)| [w.clone(), b.clone()])
             .collect()
     }
@@ -143,10 +169,17 @@ impl Net {
         let last = self.weights.len() - 1;
         let mut noise = noise;
         for (i, (w, b)) in self.weights.iter().zip(&self.biases).enumerate() {
-            x = x
+            let hidden = x;
+            x = hidden
                 .matmul(&w.as_tensor().t()?)?
                 .broadcast_add(b.as_tensor())?;
             if i == last {
+                if let Some((vw, vb)) = &self.value {
+                    let v = hidden
+                        .matmul(&vw.as_tensor().t()?)?
+                        .broadcast_add(vb.as_tensor())?;
+                    x = x.broadcast_sub(&x.mean_keepdim(1)?)?.broadcast_add(&v)?;
+                }
                 break;
             }
             x = match (self.activation, noise.as_deref_mut()) {
@@ -181,16 +214,22 @@ impl Net {
     }
 
     /// The layers as the core's nalgebra layers.
+    /// A dueling head is folded into the last layer: row `i` becomes
+    /// `w_V + w_A,i - mean_j w_A,j` (and the bias alike), which gives the same Q-values.
     pub fn layers(&self) -> Result<Vec<Layer>, LearnError> {
         let mut out = Vec::new();
         for (w, b) in self.weights.iter().zip(&self.biases) {
-            let (rows, cols) = w.as_tensor().dims2()?;
-            let values: Vec<f32> = w.as_tensor().flatten_all()?.to_vec1()?;
-            let bias: Vec<f32> = b.as_tensor().to_vec1()?;
-            out.push(Layer {
-                weight: DMatrix::from_row_slice(rows, cols, &values),
-                bias: DVector::from_vec(bias),
-            });
+            out.push(layer(w, b)?);
+        }
+        if let (Some((vw, vb)), Some(last)) = (&self.value, out.last_mut()) {
+            let value = layer(vw, vb)?;
+            let mean_w = last.weight.row_mean();
+            let mean_b = last.bias.mean();
+            for i in 0..last.weight.nrows() {
+                let row = value.weight.row(0) + last.weight.row(i) - &mean_w;
+                last.weight.set_row(i, &row);
+                last.bias[i] += value.bias[0] - mean_b;
+            }
         }
         Ok(out)
     }
@@ -199,6 +238,17 @@ impl Net {
     pub fn to_mlp(&self, metadata: HashMap<String, String>) -> Result<Mlp, LearnError> {
         Mlp::new(self.layers()?, self.activation.inference(), metadata).map_err(LearnError::Network)
     }
+}
+
+/// The nalgebra layer of weight `w` (`out x in`) and bias `b`.
+fn layer(w: &Var, b: &Var) -> Result<Layer, LearnError> {
+    let (rows, cols) = w.as_tensor().dims2()?;
+    let values: Vec<f32> = w.as_tensor().flatten_all()?.to_vec1()?;
+    let bias: Vec<f32> = b.as_tensor().to_vec1()?;
+    Ok(Layer {
+        weight: DMatrix::from_row_slice(rows, cols, &values),
+        bias: DVector::from_vec(bias),
+    })
 }
 
 /// A `rows x width` batch tensor from row-major values.
@@ -241,5 +291,28 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_dueling_network_folds_into_a_plain_one() {
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        let net = Net::dueling_policy(18, &[16, 8], TrainActivation::Relu, &mut rng).unwrap();
+        let mlp = net.to_mlp(HashMap::new()).unwrap();
+        assert_eq!(mlp.layers.len(), 3);
+        let x: Vec<f32> = (0..54).map(|i| (i as f32 * 0.3).cos()).collect();
+        let out: Vec<Vec<f32>> = net
+            .forward(&batch(x.clone(), 18).unwrap(), None)
+            .unwrap()
+            .to_vec2()
+            .unwrap();
+        for (row, o) in out.iter().enumerate() {
+            // Q = V + A - mean(A): the advantages average to V.
+            let expect = mlp.forward(&x[row * 18..(row + 1) * 18]);
+            for (a, b) in o.iter().zip(expect.iter()) {
+                assert!((a - b).abs() < 1e-5, "{a} vs {b}");
+            }
+        }
+        // The value head is trained: its variables are among the network's.
+        assert_eq!(net.vars().len(), 8);
     }
 }

@@ -5,6 +5,7 @@ use crate::errors::{self, ActionError};
 use numpy::{PyArray1, PyArray3};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use ronap_core::run::shaping::Shaper;
 use ronap_core::sim::world::Worlds;
 use ronap_core::{Episode, Point};
 
@@ -13,6 +14,8 @@ use ronap_core::{Episode, Point};
 pub struct Env {
     worlds: Worlds,
     episode: Option<Episode>,
+    /// The shaping of the episode's reward, under `reward.shaping`.
+    shaper: Option<Shaper>,
     path: Vec<Point>,
     continuous: bool,
 }
@@ -33,6 +36,7 @@ impl Env {
         Ok(Self {
             worlds: Worlds::new(config.valid().clone(), scenes),
             episode: None,
+            shaper: None,
             path: Vec::new(),
             continuous,
         })
@@ -44,7 +48,9 @@ impl Env {
         py: Python<'py>,
         seed: u64,
     ) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyDict>)> {
-        let episode = self.worlds.episode(seed).map_err(errors::scene)?;
+        let world = self.worlds.world(seed);
+        let episode = world.episode(seed).map_err(errors::scene)?;
+        self.shaper = Shaper::start(world, &episode);
         self.path = vec![episode.pose().position()];
         let obs = PyArray1::from_slice(py, episode.observation());
         let info = conv::info(py, &episode, false)?;
@@ -72,7 +78,10 @@ impl Env {
             .as_mut()
             .ok_or_else(|| errors::RonapError::new_err("step() before reset()"))?;
         let r = episode.step(action);
-        let (reward, collided, status) = (r.reward, r.collided, r.status);
+        let (mut reward, collided, status) = (r.reward, r.collided, r.status);
+        if let Some(shaper) = self.shaper.as_mut() {
+            reward = shaper.step(episode, reward);
+        }
         self.path.push(episode.pose().position());
         let (terminated, truncated) = conv::ends(status);
         Ok((

@@ -22,6 +22,16 @@ pub fn positive(s: &str) -> Result<f64, String> {
     }
 }
 
+/// Parses a finite number of at least 0.
+pub fn non_negative(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err("must be zero or a positive number".into())
+    }
+}
+
 /// Parses a whole number of at least 1.
 pub fn count(s: &str) -> Result<u64, String> {
     match s.parse::<u64>() {

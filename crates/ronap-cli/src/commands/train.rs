@@ -4,12 +4,15 @@ use crate::args::{count, fraction, seed, SceneArgs, SimArgs, ThreadArgs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use indicatif::ProgressBar;
+use ronap_core::config::Shaping;
 use ronap_core::eval::Evaluator;
+use ronap_core::eval::Seeds;
 use ronap_core::io::atomic::save_network;
 use ronap_core::io::datalog;
+use ronap_core::io::training::{Curves, TrainingLog};
 use ronap_core::policy::mlp::{DecisionRule, Mlp};
 use ronap_learn::bc::{self, BcOptions};
-use ronap_learn::dqn::{self, DqnOptions};
+use ronap_learn::dqn::{self, DqnOptions, Loss, Priorities, Validation};
 use ronap_learn::net::TrainActivation;
 use std::collections::HashMap;
 use std::io::Write;
@@ -31,7 +34,7 @@ enum Algorithm {
     Bc(BcArgs),
     /// Deep Q-learning (the paper's Algorithm 1) on the SPEC reward, episodes on every core;
     /// prints returns and success rate as it trains.
-    Dqn(DqnArgs),
+    Dqn(Box<DqnArgs>),
 }
 
 /// Flags both algorithms share.
@@ -53,10 +56,10 @@ struct NetArgs {
     seed: u64,
     /// How `ronap run` turns the outputs into an action, saved in the file: argmax, or
     /// sample:TEMPERATURE (draw from softmax(outputs / TEMPERATURE)). A reactive policy that
-    /// samples does not loop for ever where argmax would: the shipped networks reach 89% and 59%
-    /// with sample:2, 6% and 16% with argmax.
-    #[arg(long, value_name = "RULE", default_value = "sample:2", value_parser = decision)]
-    decision: DecisionRule,
+    /// samples does not loop for ever where argmax would [default: bc sample:2 (class
+    /// scores), dqn sample:0.3 (Q-values, on a larger scale)].
+    #[arg(long, value_name = "RULE", value_parser = decision)]
+    decision: Option<DecisionRule>,
     /// Weights file to write (safetensors).
     #[arg(long, value_name = "FILE")]
     out: PathBuf,
@@ -118,6 +121,58 @@ struct DqnArgs {
     /// Updates after each round of --envs steps.
     #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 1, value_parser = count)]
     updates_per_round: u64,
+    /// How progress is paid: none (the paper's straight-line term) or geodesic (potential-based
+    /// shaping along the geodesic distance, with the discount --gamma; keeps the optimal policy)
+    /// [default: the configuration's reward.shaping, none].
+    #[arg(long, value_name = "KIND", value_parser = shaping)]
+    shaping: Option<Shaping>,
+    /// The discount of the shaping term, gamma in F = gamma Phi(s') - Phi(s): at --gamma the
+    /// optimal policy is exactly kept; 1 pays plain geodesic progress, which adds a small cost for
+    /// every step away from the goal [default: --gamma].
+    #[arg(long, allow_negative_numbers = true, value_name = "G", value_parser = fraction)]
+    shaping_gamma: Option<f64>,
+    /// Steps summed in a target before bootstrapping (n-step returns; 1: Algorithm 1's).
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..=100))]
+    n_step: u64,
+    /// A dueling head (value + advantages); the saved file is a plain network all the same.
+    #[arg(long, value_name = "BOOL", default_value_t = true, action = clap::ArgAction::Set)]
+    dueling: bool,
+    /// Double-DQN targets (the online network picks the next action, the target network values it).
+    #[arg(long, value_name = "BOOL", default_value_t = true, action = clap::ArgAction::Set)]
+    double: bool,
+    /// Loss on the TD error: huber or mse (Algorithm 1's).
+    #[arg(long, value_name = "KIND", default_value = "huber", value_parser = loss)]
+    loss: Loss,
+    /// Largest norm of the gradient; larger ones are scaled down (0: no clipping).
+    #[arg(long, allow_negative_numbers = true, value_name = "X", default_value_t = 10.0, value_parser = crate::args::non_negative)]
+    grad_clip: f64,
+    /// Learning rate at the end of training as a fraction of --lr, reached linearly (1: constant).
+    #[arg(long, allow_negative_numbers = true, value_name = "F", default_value_t = 1.0, value_parser = fraction)]
+    lr_end: f64,
+    /// Prioritised replay (proportional, importance-weighted; beta rises to 1 over training).
+    #[arg(long, value_name = "BOOL", default_value_t = false, action = clap::ArgAction::Set)]
+    prioritized: bool,
+    /// Prioritised replay: how strongly priorities skew sampling.
+    #[arg(long, allow_negative_numbers = true, value_name = "A", default_value_t = 0.6, value_parser = fraction)]
+    priority_alpha: f64,
+    /// Prioritised replay: the importance-weight exponent at the start.
+    #[arg(long, allow_negative_numbers = true, value_name = "B", default_value_t = 0.4, value_parser = fraction)]
+    priority_beta: f64,
+    /// Evaluate the network every N environment steps on the validation seeds and keep the
+    /// best one (0: keep the last).
+    #[arg(
+        long,
+        allow_negative_numbers = true,
+        value_name = "N",
+        default_value_t = 100_000
+    )]
+    eval_every: u64,
+    /// Validation episodes per evaluation.
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 200, value_parser = count)]
+    eval_seeds: u64,
+    /// First validation seed: keep the range apart from training and test seeds.
+    #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 500_000, value_parser = seed)]
+    eval_seed_start: u64,
     /// First training episode seed (episodes use seed-start, seed-start + 1, ...); keep the range
     /// apart from evaluation seeds.
     #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 1_000_000, value_parser = seed)]
@@ -157,6 +212,22 @@ fn decision(s: &str) -> Result<DecisionRule, String> {
     DecisionRule::parse(s).ok_or_else(|| format!("{s:?}: expected argmax or sample:TEMPERATURE"))
 }
 
+fn shaping(s: &str) -> Result<Shaping, String> {
+    match s {
+        "none" => Ok(Shaping::None),
+        "geodesic" => Ok(Shaping::Geodesic),
+        _ => Err(format!("{s:?}: expected none or geodesic")),
+    }
+}
+
+fn loss(s: &str) -> Result<Loss, String> {
+    match s {
+        "huber" => Ok(Loss::Huber),
+        "mse" => Ok(Loss::Mse),
+        _ => Err(format!("{s:?}: expected huber or mse")),
+    }
+}
+
 fn activation(s: &str) -> Result<TrainActivation, String> {
     TrainActivation::parse(s)
         .ok_or_else(|| format!("{s:?}: expected relu, tanh, rrelu or leaky_relu:SLOPE"))
@@ -166,7 +237,7 @@ fn activation(s: &str) -> Result<TrainActivation, String> {
 pub fn run(args: TrainArgs) -> Result<ExitCode> {
     match args.algorithm {
         Algorithm::Bc(a) => train_bc(a),
-        Algorithm::Dqn(a) => train_dqn(a),
+        Algorithm::Dqn(a) => train_dqn(*a),
     }
 }
 
@@ -305,9 +376,32 @@ fn train_bc(args: BcArgs) -> Result<ExitCode> {
         crate::output::cancel_on_ctrl_c("stopping after this batch and saving the network");
     let metadata = metadata(
         "logits",
-        args.net.decision,
+        args.net
+            .decision
+            .unwrap_or(DecisionRule::Sample { temperature: 2.0 }),
         format!("behaviour cloning on {}", described.join(", ")),
     );
+    let mut log = TrainingLog::new(
+        &args.net.out,
+        format!("ronap train bc: {}", args.net.out.display()),
+        &["epoch", "loss", "train_accuracy", "test_accuracy"],
+        &[
+            Curves {
+                label: "accuracy",
+                columns: &[
+                    ("test_accuracy", "test accuracy"),
+                    ("train_accuracy", "training accuracy"),
+                ],
+                range: Some((0.0, 1.0)),
+            },
+            Curves {
+                label: "loss",
+                columns: &[("loss", "training loss (cross-entropy)")],
+                range: None,
+            },
+        ],
+    );
+    let mut log_error = None;
     let (mlp, reports) = bc::train(
         &data,
         &options,
@@ -325,10 +419,22 @@ fn train_bc(args: BcArgs) -> Result<ExitCode> {
                 100.0 * r.test_accuracy
             );
             show(&progress, &mut stdout, &line);
+            if let Err(e) = log.push(vec![
+                r.epoch as f64,
+                r.loss,
+                r.train_accuracy,
+                r.test_accuracy,
+            ]) {
+                log_error = Some(e);
+                return false;
+            }
             true
         },
     )?;
     progress.finish_and_clear();
+    if let Some(e) = log_error {
+        return Err(anyhow::Error::new(e).context("writing the training log; training stopped"));
+    }
     save(&mlp, &args.net.out)?;
     if let Some(last) = reports.last() {
         writeln!(
@@ -338,7 +444,13 @@ fn train_bc(args: BcArgs) -> Result<ExitCode> {
             100.0 * last.test_accuracy
         )?;
     }
-    writeln!(stdout, "wrote {}", args.net.out.display())?;
+    writeln!(
+        stdout,
+        "wrote {} (curves: {}, {})",
+        args.net.out.display(),
+        log.csv_path().display(),
+        log.png_path().display()
+    )?;
     if cancel.load(Ordering::Relaxed) {
         return Ok(ExitCode::from(130));
     }
@@ -351,6 +463,11 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
         if let Some(n) = args.max_steps {
             sim.episode.max_steps = n;
         }
+        if let Some(kind) = args.shaping {
+            sim.reward.shaping = kind;
+        }
+        // Shaping keeps the optimal policy exactly at the learner's own discount.
+        sim.reward.shaping_gamma = args.shaping_gamma.unwrap_or(args.gamma);
     })?;
     let (scenes, _) = args.scenes.scenes(&config)?;
     let evaluator = Evaluator::new(config, scenes);
@@ -364,6 +481,10 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
             )
         })?;
     let defaults = DqnOptions::default();
+    let decision = args
+        .net
+        .decision
+        .unwrap_or(DecisionRule::Sample { temperature: 0.3 });
     let options = DqnOptions {
         hidden: args.net.hidden.map_or(defaults.hidden, |w| w.0),
         activation: args.net.activation.unwrap_or(defaults.activation),
@@ -379,7 +500,24 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
         steps: args.steps,
         updates_per_round: args.updates_per_round as usize,
         warmup: defaults.warmup,
-        double: true,
+        double: args.double,
+        n_step: args.n_step as usize,
+        dueling: args.dueling,
+        loss: args.loss,
+        grad_clip: (args.grad_clip > 0.0).then_some(args.grad_clip),
+        lr_end_fraction: args.lr_end,
+        prioritized: args.prioritized.then_some(Priorities {
+            alpha: args.priority_alpha,
+            beta_start: args.priority_beta,
+        }),
+        validation: (args.eval_every > 0).then_some(Validation {
+            every: args.eval_every,
+            seeds: Seeds::Range {
+                start: args.eval_seed_start,
+                count: args.eval_seeds,
+            },
+            decision,
+        }),
         seed: args.net.seed,
         seed_start: args.seed_start,
     };
@@ -400,8 +538,8 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
     )?;
     writeln!(
         stdout,
-        "{:>10} {:>9} {:>12} {:>9} {:>8} {:>10}",
-        "steps", "episodes", "mean return", "success", "epsilon", "loss"
+        "{:>10} {:>9} {:>12} {:>9} {:>8} {:>10} {:>10}",
+        "steps", "episodes", "mean return", "success", "epsilon", "loss", "validation"
     )?;
     let progress = crate::output::progress_bar(
         args.steps,
@@ -411,12 +549,43 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
     let cancel = crate::output::cancel_on_ctrl_c("stopping and saving the network");
     let metadata = metadata(
         "q_values",
-        args.net.decision,
+        decision,
         format!(
             "DQN, {} environment steps, episode seeds from {}",
             args.steps, args.seed_start
         ),
     );
+    let mut log = TrainingLog::new(
+        &args.net.out,
+        format!("ronap train dqn: {}", args.net.out.display()),
+        &[
+            "steps",
+            "episodes",
+            "mean_return",
+            "success_rate",
+            "epsilon",
+            "loss",
+            "learning_rate",
+            "validation_success",
+        ],
+        &[
+            Curves {
+                label: "mean return",
+                columns: &[("mean_return", "training return (last 100 episodes)")],
+                range: None,
+            },
+            Curves {
+                label: "success rate",
+                columns: &[
+                    ("validation_success", "validation success (the saved rule)"),
+                    ("success_rate", "training success (last 100 episodes)"),
+                    ("epsilon", "epsilon"),
+                ],
+                range: Some((0.0, 1.0)),
+            },
+        ],
+    );
+    let mut log_error = None;
     let mut last_steps = 0;
     let mlp = dqn::train(
         &evaluator,
@@ -441,17 +610,45 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
             } else {
                 format!("{:.4}", r.loss)
             };
+            let validation = if r.validation_success.is_nan() {
+                "-".to_string()
+            } else {
+                format!("{:.1}%", 100.0 * r.validation_success)
+            };
             let line = format!(
-                "{:>10} {:>9} {mean_return:>12} {success:>9} {:>8.3} {loss:>10}",
+                "{:>10} {:>9} {mean_return:>12} {success:>9} {:>8.3} {loss:>10} {validation:>10}",
                 r.steps, r.episodes, r.epsilon,
             );
             show(&progress, &mut stdout, &line);
+            let nan_before_first = |v: f64| if r.episodes == 0 { f64::NAN } else { v };
+            if let Err(e) = log.push(vec![
+                r.steps as f64,
+                r.episodes as f64,
+                nan_before_first(r.mean_return),
+                nan_before_first(r.success_rate),
+                r.epsilon,
+                r.loss,
+                r.learning_rate,
+                r.validation_success,
+            ]) {
+                log_error = Some(e);
+                return false;
+            }
             !cancel.load(Ordering::Relaxed)
         },
     )?;
     progress.finish_and_clear();
+    if let Some(e) = log_error {
+        return Err(anyhow::Error::new(e).context("writing the training log; training stopped"));
+    }
     save(&mlp, &args.net.out)?;
-    writeln!(stdout, "wrote {}", args.net.out.display())?;
+    writeln!(
+        stdout,
+        "wrote {} (curves: {}, {})",
+        args.net.out.display(),
+        log.csv_path().display(),
+        log.png_path().display()
+    )?;
     if cancel.load(Ordering::Relaxed) {
         return Ok(ExitCode::from(130));
     }

@@ -9,3 +9,4 @@ pub mod manifest;
 pub mod partial;
 pub mod run_dir;
 pub mod steplog;
+pub mod training;

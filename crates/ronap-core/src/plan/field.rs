@@ -69,6 +69,28 @@ impl DistanceField {
         self.cost[r as usize * self.cols + c as usize]
     }
 
+    /// The geodesic distance from `p` to the goal: the least, over the cell holding `p` and its
+    /// eight neighbours, of the cell's cost plus the straight line from `p` to its centre, so it
+    /// changes smoothly as `p` moves within a cell. `None` when none of them reaches the goal.
+    pub fn distance_at(&self, p: Point) -> Option<f64> {
+        let (c, r) = ((p.x / self.cell_px).floor(), (p.y / self.cell_px).floor());
+        let mut best = f64::INFINITY;
+        for dr in -1..=1 {
+            for dc in -1..=1 {
+                let (cc, rr) = (c + f64::from(dc), r + f64::from(dr));
+                if cc < 0.0 || rr < 0.0 || cc >= self.cols as f64 || rr >= self.rows as f64 {
+                    continue;
+                }
+                let i = rr as usize * self.cols + cc as usize;
+                let cost = self.cost[i];
+                if cost.is_finite() {
+                    best = best.min(cost + (p - self.center(i)).norm());
+                }
+            }
+        }
+        best.is_finite().then_some(best)
+    }
+
     fn center(&self, i: usize) -> Point {
         Point::new(
             ((i % self.cols) as f64 + 0.5) * self.cell_px,

@@ -14,6 +14,10 @@
 //! Policy `i` (its index in the slice passed in) has colour [`policy_colour`]`(i)` in every chart,
 //! and each outcome has colour [`outcome_colour`].
 
+mod line;
+
+pub use line::{line_chart, Line, Panel};
+
 use crate::eval::Outcome;
 use image::imageops::{self, FilterType};
 use image::{Rgb, RgbImage};

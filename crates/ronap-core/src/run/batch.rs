@@ -7,6 +7,7 @@
 //! out in environment order, so a batch steps the same bits on any number of threads.
 
 use crate::geometry::Point;
+use crate::run::shaping::Shaper;
 use crate::run::RunError;
 use crate::sim::episode::{Episode, Status};
 use crate::sim::rng::{stream, Rng, Stream};
@@ -81,7 +82,7 @@ pub struct EnvStep {
     /// Steps of the episode so far with contact between the robot and a moving obstacle (`None`
     /// when the scene has none).
     pub dynamic_collisions: Option<u32>,
-    /// Summed reward of the episode so far.
+    /// Summed reward of the episode so far, as given (with `reward.shaping`, the shaped one).
     pub total_reward: f64,
     /// Whether this was a reset: the environment started a new episode and did not step.
     pub reset: bool,
@@ -115,11 +116,13 @@ impl EnvStep {
     }
 }
 
-/// One environment: its episode and the random stream a policy may draw from.
+/// One environment: its episode, the random stream a policy may draw from, and the shaping of
+/// its reward when the configuration asks for it.
 struct Env {
     episode: Option<Episode>,
     rng: Rng,
     next_seed: u64,
+    shaper: Option<Shaper>,
 }
 
 /// N environments stepped together.
@@ -165,6 +168,7 @@ impl Batch {
                         episode: None,
                         rng: stream(0, Stream::Policy),
                         next_seed: 0,
+                        shaper: None,
                     })
                     .collect(),
                 observation_size,
@@ -275,7 +279,16 @@ impl Batch {
             let r = episode.step(action);
             let (reward, collided) = (r.reward, r.collided);
             obs.copy_from_slice(r.observation);
-            *out = EnvStep::of(episode, Some(action), reward, collided);
+            *out = match env.shaper.as_mut() {
+                Some(shaper) => {
+                    let shaped = shaper.step(episode, reward);
+                    EnvStep {
+                        total_reward: shaper.total(),
+                        ..EnvStep::of(episode, Some(action), shaped, collided)
+                    }
+                }
+                None => EnvStep::of(episode, Some(action), reward, collided),
+            };
             if autoreset == Autoreset::SameStep && out.status.is_done() {
                 last.copy_from_slice(obs);
                 if stride.is_some() {
@@ -334,11 +347,13 @@ impl Batch {
         out: &mut EnvStep,
     ) -> Result<(), RunError> {
         let seed = env.next_seed;
-        let episode = worlds
+        let world = worlds.world(seed);
+        let episode = world
             .episode(seed)
             .map_err(|source| RunError::Episode { seed, source })?;
         obs.copy_from_slice(episode.observation());
         *out = EnvStep::start(&episode);
+        env.shaper = Shaper::start(world, &episode);
         env.rng = stream(seed, Stream::Policy);
         env.episode = Some(episode);
         if let Some(n) = stride {

@@ -5,6 +5,7 @@
 
 pub mod batch;
 pub mod rollout;
+pub mod shaping;
 pub mod team;
 pub mod team_batch;
 

@@ -3,7 +3,7 @@
 //! Everything random in an episode (maze, start, goal, noise) comes from its seed through separate
 //! streams ([`crate::sim::rng`]), so the same seed gives the same run bit for bit.
 
-use crate::config::{OnCollision, ValidConfig};
+use crate::config::{OnCollision, ValidConfig, ACTION_MEMORY};
 use crate::geometry::{wrap_deg, Point};
 use crate::scene::freespace::FreeGrid;
 use crate::scene::Scene;
@@ -115,6 +115,8 @@ pub struct Episode {
     steps: u32,
     collisions: u32,
     total_reward: f64,
+    /// The progress term r_b of the last step's reward.
+    last_progress: f64,
     path_length_px: f64,
     status: Status,
     /// The moving obstacles, when the configuration has some.
@@ -225,6 +227,7 @@ impl Episode {
             steps: 0,
             collisions: 0,
             total_reward: 0.0,
+            last_progress: 0.0,
             path_length_px: 0.0,
             status: Status::Running,
             scene,
@@ -237,6 +240,7 @@ impl Episode {
             goals_reached: 0,
         };
         episode.sense();
+        episode.fill_history();
         if episode.distance_px < config.episode.goal_tolerance_px {
             episode.status = Status::Success;
         }
@@ -362,15 +366,60 @@ impl Episode {
             None => false,
         };
         let collided = self.apply(&motion, wall, moving, touched, false);
+        self.remember(action);
         self.sense();
         let reward = self.score(before, &motion, collided);
         self.result(reward, collided)
     }
 
-    /// The observation's values after the paper's (a team's neighbour slots), to fill in.
+    /// The current frame's values after the paper's (a team's neighbour slots), to fill in.
     pub(crate) fn neighbour_slots_mut(&mut self) -> &mut [f32] {
         let paper = self.readings.len() + 1;
-        &mut self.observation[paper..]
+        let frame = self.config.frame_size();
+        &mut self.observation[paper..frame]
+    }
+
+    /// With `observation.history` above 1, at the start: every past frame is the first one.
+    fn fill_history(&mut self) {
+        let k = self.config.observation.history as usize;
+        let f = self.config.frame_size();
+        for j in 1..k {
+            self.observation.copy_within(0..f, j * f);
+        }
+    }
+
+    /// With `observation.history` above 1, before a step's sensing: the frames move one back
+    /// (the oldest drops out) and `action` becomes the newest remembered action.
+    fn remember(&mut self, action: Action) {
+        let k = self.config.observation.history as usize;
+        if k < 2 {
+            return;
+        }
+        let f = self.config.frame_size();
+        self.observation.copy_within(0..f * (k - 1), f);
+        let a = f * k;
+        self.observation
+            .copy_within(a..a + ACTION_MEMORY * (k - 2), a + ACTION_MEMORY);
+        let values = match action {
+            Action::Discrete(d) => {
+                let mut v = [0.0; ACTION_MEMORY];
+                v[d as usize] = 1.0;
+                v
+            }
+            Action::Continuous { v, w_deg } => {
+                let (v_max, w_max) = (
+                    self.config.robot.max_linear_speed_px,
+                    self.config.robot.max_angular_speed_deg,
+                );
+                let w = (w_deg / w_max).clamp(-1.0, 1.0);
+                [
+                    w.max(0.0) as f32,
+                    (v / v_max).clamp(0.0, 1.0) as f32,
+                    (-w).max(0.0) as f32,
+                ]
+            }
+        };
+        self.observation[a..a + ACTION_MEMORY].copy_from_slice(&values);
     }
 
     /// Makes `goals` the robot's goals, visited one after the other from the first (a goal
@@ -445,8 +494,9 @@ impl Episode {
     pub(crate) fn score(&mut self, before: f64, motion: &Motion, collided: bool) -> f64 {
         let w = &self.config.reward;
         let success = self.distance_px < self.config.episode.goal_tolerance_px;
-        let mut reward =
-            w.progress_per_px * (before - self.distance_px) + w.turn * motion.turn_fraction;
+        let progress = w.progress_per_px * (before - self.distance_px);
+        self.last_progress = progress;
+        let mut reward = progress + w.turn * motion.turn_fraction;
         if collided {
             reward += w.collision;
         }
@@ -577,6 +627,12 @@ impl Episode {
         self.total_reward
     }
 
+    /// The progress term r_b (`progress_per_px` per px of straight-line progress) in the last
+    /// step's reward; 0 before the first step.
+    pub fn last_progress_reward(&self) -> f64 {
+        self.last_progress
+    }
+
     /// Distance driven, px.
     pub fn path_length_px(&self) -> f64 {
         self.path_length_px
@@ -645,6 +701,35 @@ mod tests {
         assert_eq!(bearing_deg(o, Point::new(0.0, 10.0)), 180.0);
         assert_eq!(bearing_deg(o, Point::new(10.0, 0.0)), 270.0);
         assert!((bearing_deg(o, Point::new(20.0, 0.0)) - 315.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn history_remembers_frames_and_actions_newest_first() {
+        let mut c = SimConfig::default();
+        c.observation.history = 3;
+        let config = c.validate().unwrap();
+        assert_eq!(config.observation_size(), 3 * 18 + 2 * 3);
+        let scene = Arc::new(maze_scene(&config, 1));
+        let mut e = Episode::new(&config, scene.clone(), 1).unwrap();
+        let f = 18;
+        let first = e.observation()[..f].to_vec();
+        // At the start every past frame repeats the first; no action is remembered.
+        assert_eq!(&e.observation()[f..2 * f], &first[..]);
+        assert_eq!(&e.observation()[2 * f..3 * f], &first[..]);
+        assert!(e.observation()[3 * f..].iter().all(|&v| v == 0.0));
+        e.step(DiscreteAction::Left);
+        let second = e.observation()[..f].to_vec();
+        e.step(DiscreteAction::Ahead);
+        let o = e.observation();
+        assert_eq!(&o[f..2 * f], &second[..]);
+        assert_eq!(&o[2 * f..3 * f], &first[..]);
+        assert_eq!(&o[3 * f..], &[0.0, 1.0, 0.0, 1.0, 0.0, 0.0]);
+        // The current frame is the paper's observation of the same episode without memory.
+        let plain = SimConfig::default().validate().unwrap();
+        let mut p = Episode::new(&plain, scene, 1).unwrap();
+        p.step(DiscreteAction::Left);
+        p.step(DiscreteAction::Ahead);
+        assert_eq!(&o[..f], p.observation());
     }
 
     #[test]

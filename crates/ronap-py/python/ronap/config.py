@@ -19,7 +19,7 @@ nested like it (``{"scene": {"kind": "warehouse"}, "moving": [{"count": 5}]}``).
 # Top-level entries of a configuration that are arrays of tables, not sections.
 _ARRAYS = ("obstacles", "moving", "robots")
 # Sections the configuration's JSON leaves out while they hold their defaults.
-_OPTIONAL = ("team",)
+_OPTIONAL = ("team", "observation")
 
 
 def default_config() -> dict[str, Any]:
@@ -124,7 +124,7 @@ def _merged(
                 raise ConfigError(f"configuration key {key!r}: expected a list of entries (dicts), got {value!r}")
             merged[key] = list(value)
         elif isinstance(value, Mapping):
-            if key not in merged:
+            if key not in merged and key not in _OPTIONAL:
                 raise ConfigError(f"unknown configuration section {key!r}")
             for field, v in value.items():
                 _merge(merged, key, field, v)

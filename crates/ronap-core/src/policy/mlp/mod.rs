@@ -61,10 +61,9 @@ impl Policy for MlpPolicy {
         let size = episode.observation().len();
         if size != self.mlp.inputs() {
             return Err(PolicyError::Failed(format!(
-                "the network takes {} inputs but the episode's observation has {size} \
-                 ({} laser beams + direction)",
+                "the network takes {} inputs but the episode's observation has {size} values \
+                 (laser.beams, team.neighbours and observation.history set it)",
                 self.mlp.inputs(),
-                size - 1
             )));
         }
         self.rng = crate::sim::rng::stream(episode.seed(), crate::sim::rng::Stream::Policy);
@@ -115,11 +114,11 @@ impl MlpFactory {
                 path: path.to_path_buf(),
                 message: format!(
                     "the network takes {} inputs (metadata observation: {:?}) but this \
-                     configuration's observation has {observation_size} ({} laser beams + \
-                     direction)",
+                     configuration's observation has {observation_size} values (laser.beams, \
+                     team.neighbours and observation.history set it): run it with the \
+                     configuration it was trained with",
                     mlp.inputs(),
                     mlp.metadata.get("observation").map_or("", String::as_str),
-                    observation_size - 1
                 ),
             });
         }
@@ -127,6 +126,14 @@ impl MlpFactory {
             mlp: Arc::new(mlp),
             name: format!("mlp:{}", path.display()),
         })
+    }
+
+    /// Policies running `mlp` (a network in memory), named `name`.
+    pub fn new(mlp: Mlp, name: impl Into<String>) -> Self {
+        Self {
+            mlp: Arc::new(mlp),
+            name: name.into(),
+        }
     }
 
     /// The same network with `rule` instead of the file's decision rule.
