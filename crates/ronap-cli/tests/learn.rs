@@ -210,6 +210,11 @@ fn a_network_trained_with_history_runs_with_it_and_is_refused_without() {
     ]));
     let mlp = ronap_core::policy::mlp::Mlp::load(&weights).unwrap();
     assert_eq!(mlp.inputs(), 3 * 18 + 2 * 3);
+    assert!(
+        mlp.metadata["observation"].contains("observation.history = 3"),
+        "{}",
+        mlp.metadata["observation"]
+    );
     let policy = format!("mlp:{}", weights.display());
     let run_dir = dir.path().join("run");
     ok(&ronap(&[

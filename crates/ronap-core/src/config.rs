@@ -431,8 +431,9 @@ pub struct RewardConfig {
     /// How progress is paid to a learner. Default `none`: the paper's straight-line term r_b.
     #[serde(skip_serializing_if = "Shaping::is_none")]
     pub shaping: Shaping,
-    /// The discount gamma of the shaping term `F = gamma Phi(s') - Phi(s)`; set it to the
-    /// learner's (`ronap train dqn` sets it to its `--gamma`). Default 0.99.
+    /// The discount gamma of the shaping term `F = gamma Phi(s') - Phi(s)`; the learner's keeps
+    /// its optimal policy exactly (`ronap train dqn` sets it to its `--gamma` unless
+    /// `--shaping-gamma` says otherwise). Default 0.99.
     #[serde(skip_serializing_if = "is_default_shaping_gamma")]
     pub shaping_gamma: f64,
 }
@@ -1358,7 +1359,7 @@ const FIELD_DOCS: &[(&str, &str, &str, Option<&str>)] = &[
     ("reward", "turn", "r_c: added on LEFT and RIGHT (scaled by |w| / w_max for continuous actions).", None),
     ("reward", "success", "r_d: added on reaching the goal.", None),
     ("reward", "shaping", "How progress is paid to a learner: \"none\" (r_b, the paper's) or \"geodesic\" (r_b replaced by F = gamma Phi(s') - Phi(s), Phi = -progress_per_px x geodesic distance to the goal, 0 once an episode ends other than by a time-out: keeps the optimal policy, pays nothing for dead ends; episodes.csv keeps the paper's return).", None),
-    ("reward", "shaping_gamma", "gamma of the geodesic shaping term; the learner's discount (ronap train dqn sets it to its --gamma).", None),
+    ("reward", "shaping_gamma", "gamma of the geodesic shaping term; the learner's discount keeps its optimal policy exactly (ronap train dqn sets it to its --gamma unless --shaping-gamma is given).", None),
     ("apf", "gravity_gain", "APF policy: attraction gain xi, per px^2.", None),
     ("apf", "repulsion_gain", "APF policy: repulsion gain eta, px^2.", None),
     ("apf", "influence_px", "APF policy: distance d0 beyond which obstacles do not repel, px.", None),

@@ -49,6 +49,9 @@ pub struct DqnOptions {
     pub replay_capacity: usize,
     /// Updates between target-network refreshes (F).
     pub target_update: usize,
+    /// Soft target updates instead: after every update the target network moves this fraction
+    /// of the way to the online one (`None`: a full copy every `target_update` updates).
+    pub target_tau: Option<f64>,
     /// Exploration at the start.
     pub epsilon_start: f64,
     /// Exploration at the end of the decay.
@@ -141,6 +144,7 @@ impl Default for DqnOptions {
             batch: 128,
             replay_capacity: 200_000,
             target_update: 1000,
+            target_tau: None,
             epsilon_start: 1.0,
             epsilon_end: 0.05,
             epsilon_decay_steps: 300_000,
@@ -153,7 +157,7 @@ impl Default for DqnOptions {
             dueling: true,
             loss: Loss::Huber,
             grad_clip: Some(10.0),
-            lr_end_fraction: 1.0,
+            lr_end_fraction: 0.1,
             prioritized: None,
             validation: None,
             seed: 0,
@@ -416,8 +420,12 @@ pub fn train(
                 loss_sum += l;
                 loss_count += 1;
                 updates += 1;
-                if updates % options.target_update.max(1) == 0 {
-                    target.copy_from(&online)?;
+                match options.target_tau {
+                    Some(tau) => target.blend_from(&online, tau)?,
+                    None if updates % options.target_update.max(1) == 0 => {
+                        target.copy_from(&online)?;
+                    }
+                    None => {}
                 }
             }
             acting = online.to_mlp(HashMap::new())?;

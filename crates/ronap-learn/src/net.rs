@@ -213,6 +213,16 @@ impl Net {
         Ok(())
     }
 
+    /// Moves this network's weights a fraction `tau` of the way to `other`'s (Polyak averaging,
+    /// a soft target-network update).
+    pub fn blend_from(&self, other: &Net, tau: f64) -> Result<(), LearnError> {
+        for (a, b) in self.vars().iter().zip(other.vars()) {
+            let mixed = ((a.as_tensor() * (1.0 - tau))? + (b.as_tensor() * tau)?)?;
+            a.set(&mixed)?;
+        }
+        Ok(())
+    }
+
     /// The layers as the core's nalgebra layers.
     /// A dueling head is folded into the last layer: row `i` becomes
     /// `w_V + w_A,i - mean_j w_A,j` (and the bias alike), which gives the same Q-values.

@@ -10,7 +10,7 @@ use ronap_core::eval::Seeds;
 use ronap_core::io::atomic::save_network;
 use ronap_core::io::datalog;
 use ronap_core::io::training::{Curves, TrainingLog};
-use ronap_core::policy::mlp::{DecisionRule, Mlp};
+use ronap_core::policy::mlp::{observation_layout, DecisionRule, Mlp};
 use ronap_learn::bc::{self, BcOptions};
 use ronap_learn::dqn::{self, DqnOptions, Loss, Priorities, Validation};
 use ronap_learn::net::TrainActivation;
@@ -109,6 +109,10 @@ struct DqnArgs {
     /// Updates between target-network refreshes (F).
     #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 1000, value_parser = count)]
     target_update: u64,
+    /// Soft target updates: after every update the target network moves this fraction of the
+    /// way to the online one, instead of a full copy every --target-update updates (0: off).
+    #[arg(long, allow_negative_numbers = true, value_name = "TAU", default_value_t = 0.0, value_parser = fraction)]
+    target_tau: f64,
     /// Discount gamma.
     #[arg(long, allow_negative_numbers = true, value_name = "G", default_value_t = 0.99, value_parser = fraction)]
     gamma: f64,
@@ -147,7 +151,7 @@ struct DqnArgs {
     #[arg(long, allow_negative_numbers = true, value_name = "X", default_value_t = 10.0, value_parser = crate::args::non_negative)]
     grad_clip: f64,
     /// Learning rate at the end of training as a fraction of --lr, reached linearly (1: constant).
-    #[arg(long, allow_negative_numbers = true, value_name = "F", default_value_t = 1.0, value_parser = fraction)]
+    #[arg(long, allow_negative_numbers = true, value_name = "F", default_value_t = 0.1, value_parser = fraction)]
     lr_end: f64,
     /// Prioritised replay (proportional, importance-weighted; beta rises to 1 over training).
     #[arg(long, value_name = "BOOL", default_value_t = false, action = clap::ArgAction::Set)]
@@ -158,13 +162,13 @@ struct DqnArgs {
     /// Prioritised replay: the importance-weight exponent at the start.
     #[arg(long, allow_negative_numbers = true, value_name = "B", default_value_t = 0.4, value_parser = fraction)]
     priority_beta: f64,
-    /// Evaluate the network every N environment steps on the validation seeds and keep the
-    /// best one (0: keep the last).
+    /// Evaluate the network every N environment steps on the validation seeds, under the
+    /// training configuration (its --max-steps), and keep the best one (0: keep the last).
     #[arg(
         long,
         allow_negative_numbers = true,
         value_name = "N",
-        default_value_t = 100_000
+        default_value_t = 50_000
     )]
     eval_every: u64,
     /// Validation episodes per evaluation.
@@ -493,6 +497,7 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
         batch: args.batch as usize,
         replay_capacity: args.replay as usize,
         target_update: args.target_update as usize,
+        target_tau: (args.target_tau > 0.0).then_some(args.target_tau),
         epsilon_start: 1.0,
         epsilon_end: args.epsilon_end,
         epsilon_decay_steps: args.epsilon_decay,
@@ -547,7 +552,7 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
         "ronap train dqn".into(),
     );
     let cancel = crate::output::cancel_on_ctrl_c("stopping and saving the network");
-    let metadata = metadata(
+    let mut metadata = metadata(
         "q_values",
         decision,
         format!(
@@ -555,6 +560,18 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
             args.steps, args.seed_start
         ),
     );
+    let history = evaluator.config().observation.history;
+    if history > 1 {
+        let layout = observation_layout(evaluator.config().laser.beams as usize);
+        metadata.insert(
+            "observation".into(),
+            format!(
+                "{history} frames of {layout}, newest first, then the last {} actions as \
+                 LEFT,AHEAD,RIGHT one-hot, newest first (observation.history = {history})",
+                history - 1
+            ),
+        );
+    }
     let mut log = TrainingLog::new(
         &args.net.out,
         format!("ronap train dqn: {}", args.net.out.display()),

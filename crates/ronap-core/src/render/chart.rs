@@ -1661,6 +1661,104 @@ mod tests {
         }
     }
 
+    /// A rising, slightly noisy return over 2 M steps and a success rate climbing to 0.8.
+    fn training_panels() -> Vec<Panel> {
+        let steps = |i: usize| i as f64 * 50_000.0;
+        vec![
+            Panel {
+                y_label: "mean return".to_owned(),
+                y_range: None,
+                lines: vec![Line {
+                    name: "dqn".to_owned(),
+                    points: (0..=40)
+                        .map(|i| {
+                            let t = i as f64 / 40.0;
+                            (steps(i), -180.0 + 420.0 * t + 25.0 * (i as f64 * 1.7).sin())
+                        })
+                        .collect(),
+                }],
+            },
+            Panel {
+                y_label: "success rate".to_owned(),
+                y_range: Some((0.0, 1.0)),
+                lines: vec![Line {
+                    name: "validation".to_owned(),
+                    points: (0..=40)
+                        .map(|i| (steps(i), 0.8 * (1.0 - (-(i as f64) / 12.0).exp())))
+                        .collect(),
+                }],
+            },
+        ]
+    }
+
+    #[test]
+    fn line_charts_are_900_wide_and_grow_by_a_panel_each() {
+        let panels = training_panels();
+        let one = line_chart("DQN", "steps", &panels[..1]);
+        let two = line_chart("DQN", "steps", &panels);
+        // Title 44, then per panel a legend row 22, the plot 200 and a gap 16, then the x axis 46.
+        assert_eq!(one.dimensions(), (900, 44 + 238 + 46));
+        assert_eq!(two.dimensions(), (900, 44 + 2 * 238 + 46));
+    }
+
+    #[test]
+    fn line_charts_without_data_say_so() {
+        let nan = Line {
+            name: "nan".to_owned(),
+            points: vec![(f64::NAN, 1.0), (1.0, f64::NAN), (f64::INFINITY, 0.5)],
+        };
+        for lines in [vec![], vec![nan]] {
+            for y_range in [None, Some((0.0, 1.0))] {
+                let panel = Panel {
+                    y_label: "nothing".to_owned(),
+                    y_range,
+                    lines: lines.clone(),
+                };
+                let img = line_chart("empty", "steps", &[panel]);
+                // "no data" is written in the middle of the plot, 100 px below its top.
+                let rows = lines.len() as i64 * LEGEND_ROW;
+                let (cx, cy) = (96 + (900 - 96 - 30) / 2, 44 + rows + 100);
+                let inked = (cy - 8..cy + 8)
+                    .flat_map(|y| (cx - 30..cx + 30).map(move |x| (x, y)))
+                    .filter(|&p| px(&img, p).0[0] < 200)
+                    .count();
+                assert!(inked > 20, "{inked} dark pixels where the note goes");
+            }
+        }
+        // A lone point, equal values and huge values draw something in the line's colour.
+        for points in [
+            vec![(5.0, 3.0)],
+            vec![(0.0, 2.0), (1.0, 2.0), (2.0, 2.0)],
+            vec![(0.0, -1e300), (1e300, 1e300)],
+        ] {
+            let panel = Panel {
+                y_label: "odd".to_owned(),
+                y_range: None,
+                lines: vec![Line {
+                    name: "odd".to_owned(),
+                    points,
+                }],
+            };
+            let img = line_chart("odd", "x", &[panel]);
+            let drawn = img
+                .enumerate_pixels()
+                .filter(|(_, y, p)| i64::from(*y) > 44 + LEGEND_ROW && **p == policy_colour(0))
+                .count();
+            assert!(drawn >= 4, "{drawn} pixels of the line");
+        }
+        let none = line_chart("", "", &[]);
+        assert_eq!(none.width(), 900);
+    }
+
+    /// Writes the example picture to `/tmp/line_chart_example.png` for a look by eye:
+    /// `cargo test -p ronap-core --release render::chart -- --ignored`.
+    #[test]
+    #[ignore = "writes a file for a look by eye"]
+    fn line_chart_example_png() {
+        let img = line_chart("DQN on corridors", "steps", &training_panels());
+        img.save("/tmp/line_chart_example.png").expect("saved");
+    }
+
     #[test]
     fn empty_inputs_give_small_valid_images() {
         for img in [

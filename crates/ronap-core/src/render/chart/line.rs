@@ -36,7 +36,17 @@ const TITLE_H: i64 = 44;
 const X_AXIS_H: i64 = 46;
 
 /// `panels` stacked top to bottom over one x axis labelled `x_label`, under `title`.
+///
+/// The x axis spans the finite x values of every panel. A panel with `y_range: None` spans its
+/// finite y values with a margin of 5% each side; ticks fall on round values inside the range.
+/// No panels, or a panel without a finite point, draws an empty plot that says "no data".
 pub fn line_chart(title: &str, x_label: &str, panels: &[Panel]) -> RgbImage {
+    let nothing = [Panel {
+        y_label: String::new(),
+        y_range: None,
+        lines: Vec::new(),
+    }];
+    let panels = if panels.is_empty() { &nothing } else { panels };
     let finite = |p: &&(f64, f64)| p.0.is_finite() && p.1.is_finite();
     let xs: Vec<f64> = panels
         .iter()
@@ -46,10 +56,6 @@ pub fn line_chart(title: &str, x_label: &str, panels: &[Panel]) -> RgbImage {
         .collect();
     let (x_lo, x_hi) = span(&xs).unwrap_or((0.0, 1.0));
     let x_ticks = ticks(x_lo, x_hi, 6);
-    let (x_lo, x_hi) = (
-        x_ticks.first().copied().unwrap_or(x_lo).min(x_lo),
-        x_ticks.last().copied().unwrap_or(x_hi).max(x_hi),
-    );
     let plot_w = WIDTH - LEFT - RIGHT_MARGIN;
     let legends: Vec<Vec<(Key, String)>> = panels
         .iter()
@@ -68,10 +74,10 @@ pub fn line_chart(title: &str, x_label: &str, panels: &[Panel]) -> RgbImage {
             .map(|r| r * LEGEND_ROW + PLOT_H + 16)
             .sum::<i64>()
         + X_AXIS_H;
-    let mut img = canvas(WIDTH, height.max(TITLE_H + X_AXIS_H + 20));
+    let mut img = canvas(WIDTH, height);
     let title = fit(title, Font::Title.chars_in(WIDTH - 40));
     text(&mut img, (20, 12), &title, Font::Title, INK, Align::Left);
-    let x_px = |x: f64| LEFT + ((x - x_lo) / (x_hi - x_lo) * plot_w as f64).round() as i64;
+    let x_px = |x: f64| LEFT + (along(x, x_lo, x_hi) * plot_w as f64).round() as i64;
     let mut top = TITLE_H;
     for ((panel, legend), rows) in panels.iter().zip(&legends).zip(&legend_rows) {
         draw_legend(&mut img, (LEFT, top), plot_w, legend);
@@ -86,21 +92,13 @@ pub fn line_chart(title: &str, x_label: &str, panels: &[Panel]) -> RgbImage {
         let percent = panel.y_range == Some((0.0, 1.0));
         let (y_lo, y_hi) = match panel.y_range {
             Some((a, b)) if a.is_finite() && b.is_finite() && b > a => (a, b),
-            _ => span(&ys).unwrap_or((0.0, 1.0)),
+            _ => span(&ys).map_or((0.0, 1.0), |(lo, hi)| {
+                let pad = (hi / 2.0 - lo / 2.0) * 0.1;
+                ((lo - pad).max(f64::MIN), (hi + pad).min(f64::MAX))
+            }),
         };
-        let y_ticks = if panel.y_range.is_some() {
-            ticks(y_lo, y_hi, 4)
-                .into_iter()
-                .filter(|t| (y_lo..=y_hi).contains(t))
-                .collect()
-        } else {
-            ticks(y_lo, y_hi, 4)
-        };
-        let (y_lo, y_hi) = (
-            y_ticks.first().copied().unwrap_or(y_lo).min(y_lo),
-            y_ticks.last().copied().unwrap_or(y_hi).max(y_hi),
-        );
-        let y_px = |y: f64| bottom - ((y - y_lo) / (y_hi - y_lo) * PLOT_H as f64).round() as i64;
+        let y_ticks = ticks(y_lo, y_hi, if percent { 4 } else { 5 });
+        let y_px = |y: f64| bottom - (along(y, y_lo, y_hi) * PLOT_H as f64).round() as i64;
         // Grid, ticks and axes.
         let mut widest = 0;
         for &t in &y_ticks {
@@ -108,9 +106,9 @@ pub fn line_chart(title: &str, x_label: &str, panels: &[Panel]) -> RgbImage {
             fill_rect(&mut img, LEFT + 1, y, LEFT + plot_w, y + 1, GRID);
             fill_rect(&mut img, LEFT - 4, y, LEFT, y + 1, INK);
             let label = if percent {
-                format!("{:.0}%", t * 100.0)
+                format!("{}%", round_sig(t * 100.0))
             } else {
-                tick_label(t)
+                fit(&tick_label(t), TICK_CHARS)
             };
             widest = widest.max(Font::Body.width(&label));
             let at = (LEFT - 7, y - Font::Body.height() / 2);
@@ -156,7 +154,7 @@ pub fn line_chart(title: &str, x_label: &str, panels: &[Panel]) -> RgbImage {
         text(
             &mut img,
             (x, bottom + 8),
-            &tick_label(t),
+            &fit(&tick_label(t), TICK_CHARS),
             Font::Body,
             MUTED,
             Align::Centre,
@@ -174,6 +172,19 @@ pub fn line_chart(title: &str, x_label: &str, panels: &[Panel]) -> RgbImage {
     img
 }
 
+/// The most characters of a tick label (longer ones are cut, ending in "..").
+const TICK_CHARS: usize = 9;
+
+/// Where `v` is from `lo` (0) to `hi` (1), without overflow however far apart they are.
+fn along(v: f64, lo: f64, hi: f64) -> f64 {
+    let width = hi / 2.0 - lo / 2.0;
+    if width > 0.0 {
+        (v / 2.0 - lo / 2.0) / width
+    } else {
+        0.5
+    }
+}
+
 /// The least and greatest of `values`, apart when they are equal; `None` for none.
 fn span(values: &[f64]) -> Option<(f64, f64)> {
     let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
@@ -183,17 +194,17 @@ fn span(values: &[f64]) -> Option<(f64, f64)> {
     }
     if hi - lo < 1e-12 * lo.abs().max(1.0) {
         let pad = (lo.abs() * 0.1).max(1.0);
-        return Some((lo - pad, hi + pad));
+        return Some(((lo - pad).max(f64::MIN), (hi + pad).min(f64::MAX)));
     }
     Some((lo, hi))
 }
 
-/// Round tick values (1, 2, 2.5 or 5 times a power of ten apart) covering `lo..hi` in about `n`
-/// steps.
+/// Round tick values (1, 2, 2.5 or 5 times a power of ten apart) inside `lo..=hi`, about `n`
+/// steps apart.
 fn ticks(lo: f64, hi: f64, n: usize) -> Vec<f64> {
-    let raw = (hi - lo) / n.max(1) as f64;
+    let raw = (hi / 2.0 - lo / 2.0) / n.max(1) as f64 * 2.0;
     if !(raw.is_finite() && raw > 0.0) {
-        return vec![lo];
+        return Vec::new();
     }
     let power = 10f64.powf(raw.log10().floor());
     let step = [1.0, 2.0, 2.5, 5.0, 10.0]
@@ -201,31 +212,39 @@ fn ticks(lo: f64, hi: f64, n: usize) -> Vec<f64> {
         .map(|m| m * power)
         .find(|s| *s >= raw)
         .unwrap_or(10.0 * power);
-    let first = (lo / step).floor() as i64;
-    let last = (hi / step).ceil() as i64;
-    (first..=last.min(first + 50))
+    // A tick a hair outside the range (from rounding) still counts.
+    let first = (lo / step - 1e-9).ceil() as i64;
+    let last = (hi / step + 1e-9).floor() as i64;
+    (first..=last.min(first.saturating_add(50)))
         .map(|k| k as f64 * step)
+        .filter(|t| t.is_finite())
         .collect()
 }
 
-/// A tick value as people write it: 40, 2.5, 250k, 1.5M.
-fn tick_label(v: f64) -> String {
-    let trim = |s: String| {
-        if s.contains('.') {
-            s.trim_end_matches('0').trim_end_matches('.').to_string()
-        } else {
-            s
-        }
-    };
-    let a = v.abs();
-    if a >= 1e6 {
-        format!("{}M", trim(format!("{:.2}", v / 1e6)))
-    } else if a >= 1e4 {
-        format!("{}k", trim(format!("{:.1}", v / 1e3)))
-    } else if a >= 100.0 || v == v.round() {
-        format!("{v:.0}")
+/// `v` to 9 significant digits, so a tick of `3 * 0.1` reads 0.3.
+fn round_sig(v: f64) -> f64 {
+    let r = format!("{v:.8e}").parse().unwrap_or(v);
+    // No "-0".
+    if r == 0.0 {
+        0.0
     } else {
-        trim(format!("{v:.2}"))
+        r
+    }
+}
+
+/// A tick value as people write it: 40, 2.5, 0.025, 250k, 1.5M, and past a billion or under a
+/// thousandth 2.5e9, 1e-4.
+fn tick_label(v: f64) -> String {
+    let v = round_sig(v);
+    let a = v.abs();
+    if a >= 1e9 || (a > 0.0 && a < 1e-3) {
+        format!("{v:e}")
+    } else if a >= 1e6 {
+        format!("{}M", round_sig(v / 1e6))
+    } else if a >= 1e4 {
+        format!("{}k", round_sig(v / 1e3))
+    } else {
+        format!("{v}")
     }
 }
 
@@ -263,6 +282,16 @@ mod tests {
         assert_eq!(tick_label(2_000_000.0), "2M");
         assert_eq!(tick_label(40.0), "40");
         assert_eq!(tick_label(2.5), "2.5");
+        assert_eq!(tick_label(0.025), "0.025");
+        assert_eq!(tick_label(3.0 * 0.1), "0.3");
+        assert_eq!(tick_label(-1e-4), "-1e-4");
+        assert_eq!(tick_label(2.5e13), "2.5e13");
+        assert_eq!(tick_label(-0.0), "0");
+        assert_eq!(
+            ticks(-201.0, 266.0, 5),
+            vec![-200.0, -100.0, 0.0, 100.0, 200.0]
+        );
+        assert_eq!(ticks(0.0, f64::MAX, 6), vec![0.0, 5e307, 1e308, 1.5e308]);
         assert_eq!(
             ticks(0.0, 2_000_000.0, 6),
             vec![0.0, 500_000.0, 1e6, 1.5e6, 2e6]
@@ -335,5 +364,30 @@ mod tests {
             let img = line_chart("odd", "x", &panels);
             assert!(img.width() > 0 && img.height() > 0);
         }
+        // Points as far apart as floats go still draw a line, not a dot in the corner.
+        let far = Panel {
+            y_label: "far".into(),
+            y_range: None,
+            lines: vec![Line {
+                name: "far".into(),
+                points: vec![(0.0, -1e300), (1e300, 1e300), (f64::MAX, f64::MAX)],
+            }],
+        };
+        let img = line_chart("far", "x", &[far]);
+        let top = (TITLE_H + LEGEND_ROW) as u32;
+        let drawn = img
+            .enumerate_pixels()
+            .filter(|(_, y, p)| *y > top && **p == policy_colour(0))
+            .count();
+        assert!(drawn > 400, "{drawn} pixels of the line");
+        // No panels at all: one empty plot that says so, under the title.
+        let none = line_chart("none", "x", &[]);
+        let empty = Panel {
+            y_label: String::new(),
+            y_range: None,
+            lines: vec![],
+        };
+        assert_eq!(none, line_chart("none", "x", &[empty]));
+        assert_eq!(none.height() as i64, TITLE_H + PLOT_H + 16 + X_AXIS_H);
     }
 }
