@@ -480,14 +480,18 @@ mod tests {
     use ronap_core::SimConfig;
 
     /// A small open room where the goal is always in reach: DQN must learn to head for it.
-    fn open_room() -> Evaluator {
+    fn open_room_config() -> SimConfig {
         let mut c = SimConfig::default();
         c.maze.cols = 2;
         c.maze.rows = 2;
         c.maze.loops = 1.0;
         c.episode.min_goal_distance_px = 60.0;
         c.episode.max_steps = 200;
-        Evaluator::new(c.validate().unwrap(), Scenes::MazePerSeed)
+        c
+    }
+
+    fn open_room() -> Evaluator {
+        Evaluator::new(open_room_config().validate().unwrap(), Scenes::MazePerSeed)
     }
 
     #[test]
@@ -520,12 +524,7 @@ mod tests {
     fn every_option_on_is_still_the_same_on_any_thread_count() {
         // Shaping, prioritised replay, Algorithm 1's one-step MSE without a dueling head, a
         // learning-rate decay, and validation keeping the best network.
-        let mut c = SimConfig::default();
-        c.maze.cols = 2;
-        c.maze.rows = 2;
-        c.maze.loops = 1.0;
-        c.episode.min_goal_distance_px = 60.0;
-        c.episode.max_steps = 200;
+        let mut c = open_room_config();
         c.reward.shaping = ronap_core::config::Shaping::Geodesic;
         let evaluator = Evaluator::new(c.validate().unwrap(), Scenes::MazePerSeed);
         let options = DqnOptions {

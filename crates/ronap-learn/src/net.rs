@@ -277,6 +277,21 @@ mod tests {
     use super::*;
     use rand::SeedableRng;
 
+    /// Checks `net`'s candle outputs for the 18-wide rows of `x` against `mlp`'s, to 1e-5.
+    fn assert_agree(net: &Net, mlp: &Mlp, x: &[f32], what: &str) {
+        let out: Vec<Vec<f32>> = net
+            .forward(&batch(x.to_vec(), 18).unwrap(), None)
+            .unwrap()
+            .to_vec2()
+            .unwrap();
+        for (row, o) in out.iter().enumerate() {
+            let expect = mlp.forward(&x[row * 18..(row + 1) * 18]);
+            for (a, b) in o.iter().zip(expect.iter()) {
+                assert!((a - b).abs() < 1e-5, "{what}: {a} vs {b}");
+            }
+        }
+    }
+
     #[test]
     fn candle_and_nalgebra_agree() {
         let mut rng = ChaCha8Rng::seed_from_u64(1);
@@ -289,17 +304,7 @@ mod tests {
             let net = Net::new(&[18, 16, 8, 3], act, &mut rng).unwrap();
             let mlp = net.to_mlp(HashMap::new()).unwrap();
             let x: Vec<f32> = (0..36).map(|i| (i as f32 * 0.7).sin()).collect();
-            let out: Vec<Vec<f32>> = net
-                .forward(&batch(x.clone(), 18).unwrap(), None)
-                .unwrap()
-                .to_vec2()
-                .unwrap();
-            for (row, o) in out.iter().enumerate() {
-                let expect = mlp.forward(&x[row * 18..(row + 1) * 18]);
-                for (a, b) in o.iter().zip(expect.iter()) {
-                    assert!((a - b).abs() < 1e-5, "{act:?}: {a} vs {b}");
-                }
-            }
+            assert_agree(&net, &mlp, &x, &format!("{act:?}"));
         }
     }
 
@@ -309,19 +314,9 @@ mod tests {
         let net = Net::dueling_policy(18, &[16, 8], TrainActivation::Relu, &mut rng).unwrap();
         let mlp = net.to_mlp(HashMap::new()).unwrap();
         assert_eq!(mlp.layers.len(), 3);
+        // Q = V + A - mean(A), folded into the last layer.
         let x: Vec<f32> = (0..54).map(|i| (i as f32 * 0.3).cos()).collect();
-        let out: Vec<Vec<f32>> = net
-            .forward(&batch(x.clone(), 18).unwrap(), None)
-            .unwrap()
-            .to_vec2()
-            .unwrap();
-        for (row, o) in out.iter().enumerate() {
-            // Q = V + A - mean(A): the advantages average to V.
-            let expect = mlp.forward(&x[row * 18..(row + 1) * 18]);
-            for (a, b) in o.iter().zip(expect.iter()) {
-                assert!((a - b).abs() < 1e-5, "{a} vs {b}");
-            }
-        }
+        assert_agree(&net, &mlp, &x, "dueling");
         // The value head is trained: its variables are among the network's.
         assert_eq!(net.vars().len(), 8);
     }

@@ -7,7 +7,7 @@ use indicatif::ProgressBar;
 use ronap_core::config::Shaping;
 use ronap_core::eval::Evaluator;
 use ronap_core::eval::Seeds;
-use ronap_core::io::atomic::save_network;
+use ronap_core::io::atomic::{save_network, OutputError};
 use ronap_core::io::datalog;
 use ronap_core::io::training::{Curves, TrainingLog};
 use ronap_core::policy::mlp::{observation_layout, DecisionRule, Mlp};
@@ -18,7 +18,7 @@ use std::collections::HashMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::Ordering;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Arguments of `ronap train`.
 #[derive(Args, Debug)]
@@ -292,9 +292,43 @@ fn check_out(path: &Path) -> Result<()> {
     Ok(())
 }
 
-fn save(mlp: &Mlp, path: &Path) -> Result<()> {
-    save_network(path, mlp)?;
-    Ok(())
+/// The end of a training run, however it stopped.
+struct Finished<'a> {
+    mlp: &'a Mlp,
+    out: &'a Path,
+    log: &'a TrainingLog,
+    /// Why writing the training log stopped training, if it did.
+    log_error: Option<OutputError>,
+    /// A line to print once the weights are saved.
+    summary: Option<String>,
+    /// Set by Ctrl-C: training stopped early.
+    cancel: &'a AtomicBool,
+}
+
+impl Finished<'_> {
+    /// Saves the network (unless its log could not be written), says what was written, and
+    /// gives the exit code: 130 after Ctrl-C.
+    fn write(self, stdout: &mut impl Write) -> Result<ExitCode> {
+        if let Some(e) = self.log_error {
+            return Err(anyhow::Error::new(e).context("writing the training log; training stopped"));
+        }
+        save_network(self.out, self.mlp)?;
+        if let Some(line) = self.summary {
+            writeln!(stdout, "{line}")?;
+        }
+        writeln!(
+            stdout,
+            "wrote {} (curves: {}, {})",
+            self.out.display(),
+            self.log.csv_path().display(),
+            self.log.png_path().display()
+        )?;
+        Ok(if self.cancel.load(Ordering::Relaxed) {
+            ExitCode::from(130)
+        } else {
+            ExitCode::SUCCESS
+        })
+    }
 }
 
 fn train_bc(args: BcArgs) -> Result<ExitCode> {
@@ -436,29 +470,22 @@ fn train_bc(args: BcArgs) -> Result<ExitCode> {
         },
     )?;
     progress.finish_and_clear();
-    if let Some(e) = log_error {
-        return Err(anyhow::Error::new(e).context("writing the training log; training stopped"));
-    }
-    save(&mlp, &args.net.out)?;
-    if let Some(last) = reports.last() {
-        writeln!(
-            stdout,
+    let last = reports.last().map(|last| {
+        format!(
             "final: train accuracy {:.1}%, test accuracy {:.1}%",
             100.0 * last.train_accuracy,
             100.0 * last.test_accuracy
-        )?;
-    }
-    writeln!(
-        stdout,
-        "wrote {} (curves: {}, {})",
-        args.net.out.display(),
-        log.csv_path().display(),
-        log.png_path().display()
-    )?;
-    if cancel.load(Ordering::Relaxed) {
-        return Ok(ExitCode::from(130));
-    }
-    Ok(ExitCode::SUCCESS)
+        )
+    });
+    let finished = Finished {
+        mlp: &mlp,
+        out: &args.net.out,
+        log: &log,
+        log_error,
+        summary: last,
+        cancel: &cancel,
+    };
+    finished.write(&mut stdout)
 }
 
 fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
@@ -655,19 +682,13 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
         },
     )?;
     progress.finish_and_clear();
-    if let Some(e) = log_error {
-        return Err(anyhow::Error::new(e).context("writing the training log; training stopped"));
-    }
-    save(&mlp, &args.net.out)?;
-    writeln!(
-        stdout,
-        "wrote {} (curves: {}, {})",
-        args.net.out.display(),
-        log.csv_path().display(),
-        log.png_path().display()
-    )?;
-    if cancel.load(Ordering::Relaxed) {
-        return Ok(ExitCode::from(130));
-    }
-    Ok(ExitCode::SUCCESS)
+    let finished = Finished {
+        mlp: &mlp,
+        out: &args.net.out,
+        log: &log,
+        log_error,
+        summary: None,
+        cancel: &cancel,
+    };
+    finished.write(&mut stdout)
 }
