@@ -207,5 +207,22 @@ fn mlp(c: &mut Criterion) {
     group.bench_function("forward", |b| {
         b.iter(|| net.forward(black_box(&observation)))
     });
+    // A whole MLP-policy step: the network chooses from the episode's observation and the
+    // episode steps (long episodes, as in `step/default`, so the figure is the step).
+    let mut sim = ronap_core::SimConfig::default();
+    sim.episode.max_steps = 1_000_000;
+    let config = sim.validate().expect("valid");
+    let scene = Arc::new(maze_scene(&config, 0));
+    let mut seed = 0;
+    let mut episode = Episode::new(&config, scene.clone(), seed).expect("default scene");
+    group.bench_function("policy_step", |b| {
+        b.iter(|| {
+            let action = net.action_into(episode.observation(), &mut scratch);
+            if episode.step(action).status.is_done() {
+                seed += 1;
+                episode = Episode::new(&config, scene.clone(), seed).expect("default scene");
+            }
+        })
+    });
     group.finish();
 }

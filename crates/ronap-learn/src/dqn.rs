@@ -103,6 +103,9 @@ pub struct Validation {
     pub seeds: Seeds,
     /// How outputs become actions in the evaluation (the saved file's rule).
     pub decision: DecisionRule,
+    /// The validation episodes' step limit (`None`: the training configuration's). Validating
+    /// under the limit the policy will be evaluated with picks the network that does best there.
+    pub max_steps: Option<u32>,
 }
 
 /// The loss on the TD error `d = Q(s, a) - y`.
@@ -187,6 +190,23 @@ pub struct DqnReport {
     pub validation_success: f64,
     /// The best validation success rate so far (NaN likewise).
     pub best_validation_success: f64,
+}
+
+/// The evaluator validation runs in when its step limit differs from training's (`None`: the
+/// training evaluator serves).
+fn validation_evaluator(
+    evaluator: &Evaluator,
+    validation: Option<&Validation>,
+) -> Result<Option<Evaluator>, LearnError> {
+    let Some(max_steps) = validation.and_then(|v| v.max_steps) else {
+        return Ok(None);
+    };
+    let mut sim = evaluator.config().as_sim_config().clone();
+    sim.episode.max_steps = max_steps;
+    let config = sim
+        .validate()
+        .map_err(|e| LearnError::Data(format!("validation episodes: {e}")))?;
+    Ok(Some(Evaluator::new(config, evaluator.scenes().clone())))
 }
 
 /// Runs `v.seeds` with `online`'s current network under `v.decision`: its success rate, mean
@@ -305,6 +325,7 @@ pub fn train(
     let lr_at = |steps: u64| {
         options.learning_rate * (1.0 + progress(steps) * (options.lr_end_fraction - 1.0))
     };
+    let validation_evaluator = validation_evaluator(evaluator, options.validation.as_ref())?;
     let mut best: Option<(f64, f64, Mlp)> = None;
     let mut latest_validation = f64::NAN;
     let mut next_validation = options
@@ -436,7 +457,12 @@ pub fn train(
             .filter(|_| steps >= next_validation)
         {
             next_validation += v.every.max(1);
-            let (success, spl, mlp) = validate(evaluator, &online, v, threads)?;
+            let (success, spl, mlp) = validate(
+                validation_evaluator.as_ref().unwrap_or(evaluator),
+                &online,
+                v,
+                threads,
+            )?;
             latest_validation = success;
             if best.as_ref().is_none_or(|b| (success, spl) > (b.0, b.1)) {
                 best = Some((success, spl, mlp));
@@ -546,6 +572,7 @@ mod tests {
                     count: 10,
                 },
                 decision: DecisionRule::Sample { temperature: 0.3 },
+                max_steps: Some(300),
             }),
             ..DqnOptions::default()
         };
@@ -579,5 +606,37 @@ mod tests {
         );
         let last = reports[0].last().unwrap();
         assert!((last.learning_rate - 0.1 * options.learning_rate).abs() < 1e-12);
+    }
+
+    #[test]
+    fn validation_runs_under_its_own_step_limit() {
+        // One step is too few to reach any goal: validation under a one-step limit must find
+        // no success, whatever the network, while the training episodes keep their own limit.
+        let evaluator = Evaluator::new(open_room_config().validate().unwrap(), Scenes::MazePerSeed);
+        let options = DqnOptions {
+            hidden: vec![8],
+            steps: 1_000,
+            warmup: 128,
+            batch: 16,
+            envs: 4,
+            validation: Some(Validation {
+                every: 500,
+                seeds: Seeds::Range {
+                    start: 500,
+                    count: 5,
+                },
+                decision: DecisionRule::Argmax,
+                max_steps: Some(1),
+            }),
+            ..DqnOptions::default()
+        };
+        let mut best = Vec::new();
+        train(&evaluator, &options, 1, HashMap::new(), 500, &mut |r| {
+            best.push(r.best_validation_success);
+            true
+        })
+        .unwrap();
+        assert!(!best.is_empty());
+        assert!(best.iter().all(|&b| b == 0.0), "{best:?}");
     }
 }

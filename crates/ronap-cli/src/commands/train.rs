@@ -174,6 +174,11 @@ struct DqnArgs {
     /// Validation episodes per evaluation.
     #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 200, value_parser = count)]
     eval_seeds: u64,
+    /// Step limit of the validation episodes [default: the training episodes' (--max-steps)];
+    /// give the limit the policy will be evaluated under (2000 for the paper's scene) to keep the
+    /// network that does best there.
+    #[arg(long, allow_negative_numbers = true, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    eval_max_steps: Option<u32>,
     /// First validation seed: keep the range apart from training and test seeds.
     #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 500_000, value_parser = seed)]
     eval_seed_start: u64,
@@ -549,6 +554,7 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
                 count: args.eval_seeds,
             },
             decision,
+            max_steps: args.eval_max_steps,
         }),
         seed: args.net.seed,
         seed_start: args.seed_start,

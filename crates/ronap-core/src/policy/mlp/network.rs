@@ -61,6 +61,7 @@ impl Activation {
     }
 
     /// Applies the activation to every value.
+    #[inline(always)]
     pub(crate) fn apply(self, v: &mut [f32]) {
         match self {
             Self::Relu => v.iter_mut().for_each(|x| *x = x.max(0.0)),
@@ -173,17 +174,7 @@ impl Mlp {
         let Scratch { x, y } = scratch;
         x.clear();
         x.extend_from_slice(observation);
-        let last = self.layers.len() - 1;
-        for (i, l) in self.layers.iter().enumerate() {
-            let outputs = l.weight.nrows();
-            y.clear();
-            y.extend_from_slice(l.bias.as_slice());
-            add_columns(y, x, l.weight.as_slice(), outputs);
-            if i < last {
-                self.activation.apply(y);
-            }
-            std::mem::swap(x, y);
-        }
+        ARCH.dispatch(Forward { mlp: self, x, y });
         x
     }
 
@@ -205,38 +196,89 @@ impl Mlp {
     }
 }
 
-/// `y += W x` for the column-major `weights` (column j holds the weights from input j), adding
-/// the columns in input order. Outputs go in blocks held in registers across all the inputs (32,
-/// then 8, then one at a time), so each weight is loaded once and each output stored once; every
-/// output's sum keeps the same order, so the result is the same bit for bit.
-fn add_columns(y: &mut [f32], x: &[f32], weights: &[f32], outputs: usize) {
-    let mut o = 0;
-    while o + 32 <= outputs {
-        add_block::<32>(y, x, weights, outputs, o);
-        o += 32;
-    }
-    while o + 8 <= outputs {
-        add_block::<8>(y, x, weights, outputs, o);
-        o += 8;
-    }
-    while o < outputs {
-        add_block::<1>(y, x, weights, outputs, o);
-        o += 1;
+/// The instruction sets of this processor, detected once.
+static ARCH: std::sync::LazyLock<pulp::Arch> = std::sync::LazyLock::new(pulp::Arch::new);
+
+/// The layers of [`Mlp::forward_into`], compiled once per instruction set (pulp picks the widest
+/// the processor has, AVX2 where there is one): `x` holds the input and, at the end, the output.
+struct Forward<'a> {
+    mlp: &'a Mlp,
+    x: &'a mut Vec<f32>,
+    y: &'a mut Vec<f32>,
+}
+
+impl pulp::WithSimd for Forward<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) {
+        let Self { mlp, x, y } = self;
+        let last = mlp.layers.len() - 1;
+        for (i, l) in mlp.layers.iter().enumerate() {
+            let outputs = l.weight.nrows();
+            y.clear();
+            y.extend_from_slice(l.bias.as_slice());
+            add_columns(simd, y, x, l.weight.as_slice(), outputs);
+            if i < last {
+                mlp.activation.apply(y);
+            }
+            std::mem::swap(x, y);
+        }
     }
 }
 
-/// [`add_columns`] for outputs `o..o + B`.
+/// `y += W x` for the column-major `weights` (column j holds the weights from input j), adding
+/// the columns in input order. Outputs go in blocks of vectors held in registers across all the
+/// inputs (8 vectors, then 2, then 1, then one output at a time), so each weight is loaded once
+/// and each output stored once. Every output's sum keeps the same order, and multiplies and adds
+/// stay separate (no fused multiply-add), so every instruction set gives the same bits.
 #[inline(always)]
-fn add_block<const B: usize>(y: &mut [f32], x: &[f32], weights: &[f32], outputs: usize, o: usize) {
-    let mut acc = [0.0f32; B];
-    acc.copy_from_slice(&y[o..o + B]);
+fn add_columns<S: pulp::Simd>(simd: S, y: &mut [f32], x: &[f32], weights: &[f32], outputs: usize) {
+    let mut o = 0;
+    while o + 8 * S::F32_LANES <= outputs {
+        add_vectors::<S, 8>(simd, y, x, weights, outputs, o);
+        o += 8 * S::F32_LANES;
+    }
+    while o + 2 * S::F32_LANES <= outputs {
+        add_vectors::<S, 2>(simd, y, x, weights, outputs, o);
+        o += 2 * S::F32_LANES;
+    }
+    while o + S::F32_LANES <= outputs {
+        add_vectors::<S, 1>(simd, y, x, weights, outputs, o);
+        o += S::F32_LANES;
+    }
+    for o in o..outputs {
+        let mut acc = y[o];
+        for (&xj, column) in x.iter().zip(weights.chunks_exact(outputs)) {
+            acc += xj * column[o];
+        }
+        y[o] = acc;
+    }
+}
+
+/// [`add_columns`] for the `K` vectors of outputs from `o`.
+#[inline(always)]
+fn add_vectors<S: pulp::Simd, const K: usize>(
+    simd: S,
+    y: &mut [f32],
+    x: &[f32],
+    weights: &[f32],
+    outputs: usize,
+    o: usize,
+) {
+    let n = K * S::F32_LANES;
+    let mut acc = [simd.splat_f32s(0.0); K];
+    acc.copy_from_slice(S::as_simd_f32s(&y[o..o + n]).0);
     for (&xj, column) in x.iter().zip(weights.chunks_exact(outputs)) {
-        let w = &column[o..o + B];
+        let xj = simd.splat_f32s(xj);
+        let (w, _) = S::as_simd_f32s(&column[o..o + n]);
         for (a, &w) in acc.iter_mut().zip(w) {
-            *a += xj * w;
+            *a = simd.add_f32s(*a, simd.mul_f32s(xj, w));
         }
     }
-    y[o..o + B].copy_from_slice(&acc);
+    S::as_mut_simd_f32s(&mut y[o..o + n])
+        .0
+        .copy_from_slice(&acc);
 }
 
 /// Buffers for [`Mlp::forward_into`], reused from step to step.
