@@ -209,6 +209,17 @@ fn validation_evaluator(
     Ok(Some(Evaluator::new(config, evaluator.scenes().clone())))
 }
 
+/// `seeds` in words: "seeds 500000..=500999" or "12 seeds".
+fn describe_seeds(seeds: &Seeds) -> String {
+    match seeds {
+        Seeds::Range { start, count } if *count > 0 => {
+            format!("seeds {start}..={}", start.saturating_add(count - 1))
+        }
+        Seeds::Range { .. } => "no seeds".to_string(),
+        Seeds::List(list) => format!("{} seeds", list.len()),
+    }
+}
+
 /// Runs `v.seeds` with `online`'s current network under `v.decision`: its success rate, mean
 /// SPL and the network.
 fn validate(
@@ -457,14 +468,20 @@ pub fn train(
             .filter(|_| steps >= next_validation)
         {
             next_validation += v.every.max(1);
-            let (success, spl, mlp) = validate(
-                validation_evaluator.as_ref().unwrap_or(evaluator),
-                &online,
-                v,
-                threads,
-            )?;
+            let within = validation_evaluator.as_ref().unwrap_or(evaluator);
+            let (success, spl, mut mlp) = validate(within, &online, v, threads)?;
             latest_validation = success;
             if best.as_ref().is_none_or(|b| (success, spl) > (b.0, b.1)) {
+                mlp.metadata.insert(
+                    "validation".to_string(),
+                    format!(
+                        "kept the network of step {steps}: {:.1}% success, SPL {spl:.3} on {}, \
+                         step limit {}",
+                        100.0 * success,
+                        describe_seeds(&v.seeds),
+                        within.config().episode.max_steps
+                    ),
+                );
                 best = Some((success, spl, mlp));
             }
         }
@@ -631,11 +648,18 @@ mod tests {
             ..DqnOptions::default()
         };
         let mut best = Vec::new();
-        train(&evaluator, &options, 1, HashMap::new(), 500, &mut |r| {
+        let mlp = train(&evaluator, &options, 1, HashMap::new(), 500, &mut |r| {
             best.push(r.best_validation_success);
             true
         })
         .unwrap();
+        // The weights say which network was kept, and where it was validated.
+        let kept = &mlp.metadata["validation"];
+        assert!(
+            kept.starts_with("kept the network of step 500: 0.0% success"),
+            "{kept}"
+        );
+        assert!(kept.ends_with("on seeds 500..=504, step limit 1"), "{kept}");
         assert!(!best.is_empty());
         assert!(best.iter().all(|&b| b == 0.0), "{best:?}");
     }

@@ -693,7 +693,10 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
         out: &args.net.out,
         log: &log,
         log_error,
-        summary: None,
+        summary: mlp
+            .metadata
+            .get("validation")
+            .map(|v| format!("validation: {v}")),
         cancel: &cancel,
     };
     finished.write(&mut stdout)
