@@ -217,6 +217,40 @@ fn view_shows_the_episode_toggles_the_map_and_restores_the_terminal_on_quit() {
 }
 
 #[test]
+fn view_of_a_team_shows_every_robot_follows_another_on_tab_and_quits() {
+    let Some(tmux) = Tmux::start("view-team") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    tmux.line(&format!(
+        "cd {}; stty -g > before.stty",
+        dir.path().display()
+    ));
+    let scenario = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenarios/warehouse-team.toml"
+    );
+    tmux.line(&format!(
+        "{BIN} view --policy geodesic --scenario {scenario} --seed 3 --speed 50; \
+         echo after-view rc=$?"
+    ));
+    let screen = tmux.wait("the team's whole scene", 30, |s| {
+        s.contains("whole scene · seed 3") && s.contains("at goal 0/8")
+    });
+    assert!(screen.contains("robots     8"), "{screen}");
+    assert!(screen.contains("robot 0"), "{screen}");
+    assert!(screen.contains("robots ● 0 ● 1"), "{screen}");
+    tmux.keys(&["Tab"]);
+    tmux.wait("robot 1 followed", 10, |s| s.contains("robot 1"));
+    tmux.keys(&["M"]);
+    tmux.wait("robot 1's first-person view", 10, |s| {
+        s.contains("first person of robot 1 · seed 3")
+    });
+    tmux.keys(&["q"]);
+    assert_restored(&tmux, "after-view rc=0");
+}
+
+#[test]
 fn view_restores_the_terminal_on_ctrl_c_and_sigterm() {
     let Some(tmux) = Tmux::start("view-signals") else {
         return;

@@ -7,7 +7,7 @@
 pub mod policy;
 pub mod sim;
 
-pub use policy::policy_factory;
+pub use policy::{policy_factory, TeamPolicies};
 pub use sim::{EpisodeArgs, SceneArgs, SimArgs};
 
 use clap::Args;

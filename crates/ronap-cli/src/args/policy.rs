@@ -24,3 +24,57 @@ pub fn policy_factory(name: &str, config: &ValidConfig) -> Result<Box<dyn Policy
         PolicyNameError::Network(e) => anyhow::Error::from(e).context(format!("--policy {name:?}")),
     })
 }
+
+/// A team's policies: each robot's policy name (its `[[robots]]` entry's `policy`, else the
+/// command line's), and one factory per entry that robots of the entry share.
+pub struct TeamPolicies {
+    /// Robot `k`'s policy name.
+    pub names: Vec<String>,
+    factories: Vec<Box<dyn PolicyFactory>>,
+    /// Robot `k`'s factory, as an index into `factories`.
+    of_robot: Vec<usize>,
+}
+
+impl TeamPolicies {
+    /// The policies of `config`'s `[[robots]]`, `default` where an entry names none.
+    pub fn new(config: &ValidConfig, default: &str) -> Result<Self> {
+        let mut team = Self {
+            names: Vec::new(),
+            factories: Vec::new(),
+            of_robot: Vec::new(),
+        };
+        for entry in &config.robots {
+            let k = team.names.len();
+            let name = entry.policy.clone().unwrap_or_else(|| default.to_string());
+            let factory = policy_factory(&name, &config.team_robot(k))
+                .map_err(|e| e.context(format!("[[robots]] entry with robot {k}")))?;
+            team.factories.push(factory);
+            for _ in 0..entry.count {
+                team.names.push(name.clone());
+                team.of_robot.push(team.factories.len() - 1);
+            }
+        }
+        Ok(team)
+    }
+
+    /// One factory per robot.
+    pub fn per_robot(&self) -> Vec<&dyn PolicyFactory> {
+        self.of_robot
+            .iter()
+            .map(|&i| self.factories[i].as_ref())
+            .collect()
+    }
+
+    /// A new policy per robot.
+    pub fn make(&self) -> Result<Vec<Box<dyn ronap_core::policy::Policy>>> {
+        self.of_robot
+            .iter()
+            .zip(&self.names)
+            .map(|(&i, name)| {
+                self.factories[i]
+                    .make()
+                    .map_err(|e| anyhow::anyhow!("cannot start policy {name}: {e}"))
+            })
+            .collect()
+    }
+}

@@ -379,23 +379,9 @@ fn run_team(
              robot's figures, --gif SEED animates an episode)"
         );
     }
-    let mut names = Vec::new();
-    let mut factories: Vec<Box<dyn ronap_core::policy::PolicyFactory>> = Vec::new();
-    let mut of_robot = Vec::new();
-    let mut k = 0;
-    for entry in &config.robots {
-        let name = entry.policy.clone().unwrap_or_else(|| job.policy.clone());
-        let factory = policy_factory(&name, &config.team_robot(k))
-            .with_context(|| format!("[[robots]] entry with robot {k}"))?;
-        factories.push(factory);
-        for _ in 0..entry.count {
-            names.push(name.clone());
-            of_robot.push(factories.len() - 1);
-            k += 1;
-        }
-    }
-    let factories_per_robot: Vec<&dyn ronap_core::policy::PolicyFactory> =
-        of_robot.iter().map(|&i| factories[i].as_ref()).collect();
+    let policies = crate::args::TeamPolicies::new(&config, &job.policy)?;
+    let factories_per_robot = policies.per_robot();
+    let names = policies.names.clone();
     let (first, last) = job.span();
     if let Some(s) = job.gif.iter().find(|&&s| s < first || s > last) {
         bail!("--gif {s}: not one of this run's seeds ({first}..={last})");

@@ -1,19 +1,23 @@
 //! `ronap view`: watch a policy drive one episode live in the terminal ([`crate::tui::view`]).
 
-use crate::args::{policy_factory, seed, EpisodeArgs};
+use crate::args::{policy_factory, seed, EpisodeArgs, TeamPolicies};
 use crate::tui::app;
+use crate::tui::team_view::TeamWatch;
 use crate::tui::terminal::{self, Session};
-use crate::tui::view::{start_episode, Ending, ViewApp, ViewState};
+use crate::tui::view::{start_episode, Ending, Lone, ViewApp, ViewState};
 use anyhow::{Context, Result};
 use clap::Args;
 use ronap_core::eval::Evaluator;
+use ronap_core::sim::world::Scenes;
+use ronap_core::ValidConfig;
 use std::process::ExitCode;
 
 /// Arguments of `ronap view`.
 #[derive(Args, Debug)]
 #[command(
     after_help = "Keys: space pause/resume, + and - faster/slower, m whole scene/first \
-    person, s one step when paused, r restart, n next seed, q or Esc quit (Ctrl-C too)."
+    person, s one step when paused, r restart, n next seed, Tab next robot (scenarios with \
+    [[robots]]), q or Esc quit (Ctrl-C too)."
 )]
 pub struct ViewArgs {
     /// Policy to watch, as for `ronap run`: apf (the paper's potential field, Algorithm 3),
@@ -36,6 +40,9 @@ pub struct ViewArgs {
 /// Runs `ronap view`.
 pub fn run(args: ViewArgs) -> Result<ExitCode> {
     let (config, scenes, _) = args.episodes.resolve()?;
+    if config.team_size() > 0 {
+        return run_team(args, config, scenes);
+    }
     let factory = policy_factory(&args.policy, &config)?;
     let evaluator = Evaluator::new(config, scenes);
     // Before a policy process starts or the terminal changes: a pipe gets an error, not a hang.
@@ -47,11 +54,27 @@ pub fn run(args: ViewArgs) -> Result<ExitCode> {
         start_episode(&evaluator, policy.as_mut(), args.seed).map_err(anyhow::Error::msg)?;
     let state = ViewState::new(rollout, &args.policy, args.speed);
     let mut session = Session::start("view")?;
-    let mut view = ViewApp::new(state, &evaluator, policy.as_mut());
+    let mut view = ViewApp::new(Lone::new(state, &evaluator, policy.as_mut()));
     let code = app::run(&mut session, &mut view)?;
     drop(session);
-    if let Some(Ending::Failed(why)) = &view.state.ending {
-        anyhow::bail!("seed {}: {why}", view.state.episode().seed());
+    if let Some(Ending::Failed(why)) = &view.watched.state.ending {
+        anyhow::bail!("seed {}: {why}", view.watched.state.episode().seed());
+    }
+    Ok(code)
+}
+
+/// `ronap view` of a scenario with `[[robots]]`: the whole team, each robot in its colour.
+fn run_team(args: ViewArgs, config: ValidConfig, scenes: Scenes) -> Result<ExitCode> {
+    let policies = TeamPolicies::new(&config, &args.policy)?;
+    let evaluator = Evaluator::new(config, scenes);
+    terminal::require_terminal("view")?;
+    let watch = TeamWatch::start(&evaluator, &policies, args.seed, args.speed)?;
+    let mut session = Session::start("view")?;
+    let mut view = ViewApp::new(watch);
+    let code = app::run(&mut session, &mut view)?;
+    drop(session);
+    if let Some(Ending::Failed(why)) = &view.watched.state.ending {
+        anyhow::bail!("seed {}: {why}", view.watched.state.seed);
     }
     Ok(code)
 }

@@ -19,7 +19,8 @@ use ratatui::Frame;
 use ronap_core::geometry::{unit, Point};
 use ronap_core::render::{HeadingUp, FIRST_PERSON_HALF_SPAN};
 use ronap_core::sim::lidar::RayClass;
-use ronap_core::sim::moving::Body;
+use ronap_core::sim::moving::{Body, Movers};
+use ronap_core::sim::team::Team;
 use ronap_core::Episode;
 
 /// Walls within the laser's range (first-person) and everywhere (whole scene).
@@ -310,10 +311,10 @@ fn rays(episode: &Episode, to: impl Fn(Point) -> (f64, f64)) -> Vec<((f64, f64),
         .collect()
 }
 
-/// The present moving obstacles of `episode` in the coordinates `to` gives: discs filled (at
-/// least a dot), boxes outlined with their centre filled.
-fn movers(pen: &mut Pen, episode: &Episode, to: impl Fn(Point) -> (f64, f64)) {
-    let Some(movers) = episode.movers() else {
+/// The present moving obstacles in the coordinates `to` gives: discs filled (at least a dot),
+/// boxes outlined with their centre filled.
+fn movers(pen: &mut Pen, movers: Option<&Movers>, to: impl Fn(Point) -> (f64, f64)) {
+    let Some(movers) = movers else {
         return;
     };
     let least = pen.grid.px_per_dot * 0.5;
@@ -351,7 +352,7 @@ fn first_person(area: Rect, episode: &Episode) -> Pen {
             pen.dots.push((i, j, colour));
         }
     }
-    movers(&mut pen, episode, |p| view.to_view(p));
+    movers(&mut pen, episode.movers(), |p| view.to_view(p));
     pen.circle((0.0, 0.0), range, RANGE);
     for (end, colour) in rays(episode, |p| view.to_view(p)) {
         pen.line((0.0, 0.0), end, colour);
@@ -375,6 +376,28 @@ fn first_person(area: Rect, episode: &Episode) -> Pen {
 /// The whole scene: walls, the path so far, the current rays, start, goal and the robot with a
 /// tick along its heading.
 fn whole_scene(area: Rect, episode: &Episode, path: &[Point]) -> Pen {
+    let mut pen = scene_walls(area, episode);
+    let s = pen.grid.px_per_dot;
+    let pose = episode.pose();
+    trail(&mut pen, path, pose.position(), PATH);
+    movers(&mut pen, episode.movers(), |p| (p.x, p.y));
+    for (end, colour) in rays(episode, |p| (p.x, p.y)) {
+        pen.line((pose.x, pose.y), end, colour);
+    }
+    let config = episode.config();
+    let start = episode.start().position();
+    pen.disc((start.x, start.y), config.robot.radius_px, START);
+    let goal = episode.goal();
+    pen.disc((goal.x, goal.y), config.episode.goal_tolerance_px, GOAL);
+    let radius = config.robot.radius_px.max(s);
+    pen.disc((pose.x, pose.y), radius, ROBOT);
+    let tip = pose.position() + unit(pose.z_deg) * radius * 2.5;
+    pen.line((pose.x, pose.y), (tip.x, tip.y), ROBOT);
+    pen
+}
+
+/// The whole scene of `episode` fitted into `area`, its walls drawn.
+fn scene_walls(area: Rect, episode: &Episode) -> Pen {
     let scene = episode.scene();
     let (w, h) = (scene.width(), scene.height());
     let mut pen = Pen::new(DotGrid::fit(area, (w / 2.0, h / 2.0), (w, h)));
@@ -389,32 +412,105 @@ fn whole_scene(area: Rect, episode: &Episode, path: &[Point]) -> Pen {
             pen.dots.push((i, j, WALL));
         }
     }
-    let pose = episode.pose();
-    // Path points closer than a dot draw nothing new.
+    pen
+}
+
+/// The path `path` then `now`, in `colour`; points closer than a dot draw nothing new.
+fn trail(pen: &mut Pen, path: &[Point], now: Point, colour: Color) {
+    let s = pen.grid.px_per_dot;
     let mut trail: Vec<(f64, f64)> = Vec::new();
-    for p in path.iter().chain(std::iter::once(&pose.position())) {
+    for p in path.iter().chain(std::iter::once(&now)) {
         match trail.last() {
             Some(&(x, y)) if (p.x - x).hypot(p.y - y) < s => {}
             _ => trail.push((p.x, p.y)),
         }
     }
     for pair in trail.windows(2) {
-        pen.line(pair[0], pair[1], PATH);
+        pen.line(pair[0], pair[1], colour);
     }
-    movers(&mut pen, episode, |p| (p.x, p.y));
-    for (end, colour) in rays(episode, |p| (p.x, p.y)) {
-        pen.line((pose.x, pose.y), end, colour);
+}
+
+/// Robot `k`'s colour in a team view (six colours, repeating).
+pub fn robot_colour(k: usize) -> Color {
+    const COLOURS: [Color; 6] = [
+        Color::Cyan,
+        Color::Yellow,
+        Color::LightMagenta,
+        Color::LightGreen,
+        Color::LightBlue,
+        Color::Blue,
+    ];
+    COLOURS[k % COLOURS.len()]
+}
+
+/// Draws a team's scene panel in `area`, titled `title`. Whole scene: every present robot with
+/// its heading, its path (`paths[k]`) and a ring round its current goal, each in its colour, and
+/// robot `focus`'s rays. First person: robot `focus`'s view, the others as discs in their colours.
+pub fn team_scene(
+    frame: &mut Frame,
+    area: Rect,
+    team: &Team,
+    paths: &[Vec<Point>],
+    focus: usize,
+    mode: SceneMode,
+    title: &str,
+) {
+    let block = Block::bordered().title(format!(" {title} "));
+    let inner = block.inner(area);
+    frame.render_widget(block, area);
+    if inner.width < 2 || inner.height < 2 || team.robots().is_empty() {
+        return;
     }
-    let config = episode.config();
-    let start = episode.start().position();
-    pen.disc((start.x, start.y), config.robot.radius_px, START);
-    let goal = episode.goal();
-    pen.disc((goal.x, goal.y), config.episode.goal_tolerance_px, GOAL);
-    let radius = config.robot.radius_px.max(s);
-    pen.disc((pose.x, pose.y), radius, ROBOT);
-    let tip = pose.position() + unit(pose.z_deg) * radius * 2.5;
-    pen.line((pose.x, pose.y), (tip.x, tip.y), ROBOT);
-    pen
+    let focus = focus.min(team.robots().len() - 1);
+    let followed = team.robot(focus);
+    let pen = match mode {
+        SceneMode::FirstPerson => {
+            let mut pen = first_person(inner, followed);
+            let view = HeadingUp::new(followed.pose());
+            if followed.movers().is_none() {
+                movers(&mut pen, team.movers(), |p| view.to_view(p));
+            }
+            for (k, r) in team.robots().iter().enumerate() {
+                if k != focus && team.present(k) {
+                    let at = view.to_view(r.pose().position());
+                    pen.disc(at, r.config().robot.radius_px, robot_colour(k));
+                }
+            }
+            pen
+        }
+        SceneMode::WholeScene => {
+            let mut pen = scene_walls(inner, followed);
+            let s = pen.grid.px_per_dot;
+            for (k, r) in team.robots().iter().enumerate() {
+                let path = paths.get(k).map_or(&[][..], Vec::as_slice);
+                trail(&mut pen, path, r.pose().position(), robot_colour(k));
+            }
+            movers(&mut pen, team.movers(), |p| (p.x, p.y));
+            let pose = followed.pose();
+            for (end, colour) in rays(followed, |p| (p.x, p.y)) {
+                pen.line((pose.x, pose.y), end, colour);
+            }
+            for (k, r) in team.robots().iter().enumerate() {
+                let colour = robot_colour(k);
+                if team.running(k) {
+                    let goal = r.goal();
+                    let ring = r.config().episode.goal_tolerance_px.max(s);
+                    pen.circle((goal.x, goal.y), ring, colour);
+                }
+                if team.present(k) {
+                    let pose = r.pose();
+                    let radius = r.config().robot.radius_px.max(s);
+                    pen.disc((pose.x, pose.y), radius, colour);
+                    if k == focus {
+                        let tip = pose.position() + unit(pose.z_deg) * radius * 2.5;
+                        pen.line((pose.x, pose.y), (tip.x, tip.y), colour);
+                    }
+                }
+            }
+            pen
+        }
+    };
+    pen.render(frame, inner);
 }
 
 /// Where the goal is, relative to the heading: `ahead`, `35° left`, `170° right`, `behind`.
@@ -433,12 +529,7 @@ pub fn direction_text(direction_deg: f64) -> String {
 pub fn legend(moving: bool) -> Vec<Line<'static>> {
     let mark = |text: &'static str, colour: Color| Span::styled(text, Style::default().fg(colour));
     let mut lines = vec![
-        Line::from(vec![
-            Span::raw("rays  "),
-            mark("━ far ", Color::Green),
-            mark("━ near ", Color::Yellow),
-            mark("━ close", Color::Red),
-        ]),
+        rays_legend(),
         Line::from(vec![
             mark("━▶ goal  ", ARROW),
             mark("● robot  ", ROBOT),
@@ -449,6 +540,42 @@ pub fn legend(moving: bool) -> Vec<Line<'static>> {
         lines.push(Line::from(mark("● moving obstacle", MOVER)));
     }
     lines
+}
+
+/// The legend of a team view: each robot, its path and the ring round its goal in the robot's
+/// own colour (`robots` of them, the first six named).
+pub fn team_legend(robots: usize, moving: bool) -> Vec<Line<'static>> {
+    let mut marks = vec![Span::raw("robots ")];
+    marks.extend(
+        (0..robots.min(6))
+            .map(|k| Span::styled(format!("● {k} "), Style::default().fg(robot_colour(k)))),
+    );
+    if robots > 6 {
+        marks.push(Span::raw("…"));
+    }
+    let mut lines = vec![
+        rays_legend(),
+        Line::from(marks),
+        Line::raw("━ path  ○ goal: its robot's colour"),
+    ];
+    if moving {
+        lines.push(Line::from(Span::styled(
+            "● moving obstacle",
+            Style::default().fg(MOVER),
+        )));
+    }
+    lines
+}
+
+/// The rays' colour classes.
+fn rays_legend() -> Line<'static> {
+    let mark = |text: &'static str, colour: Color| Span::styled(text, Style::default().fg(colour));
+    Line::from(vec![
+        Span::raw("rays  "),
+        mark("━ far ", Color::Green),
+        mark("━ near ", Color::Yellow),
+        mark("━ close", Color::Red),
+    ])
 }
 
 /// A side-panel line: a label in a fixed column, then `value`.
@@ -473,12 +600,21 @@ pub fn key_help(keys: &str, what: &str) -> Line<'static> {
 /// A side panel: `fields`, the colour legend (`moving`: with moving obstacles), then each key
 /// with what it does.
 pub fn side_panel(
-    mut fields: Vec<Line<'static>>,
+    fields: Vec<Line<'static>>,
     moving: bool,
     keys: &[(&str, &str)],
 ) -> Vec<Line<'static>> {
+    side_panel_with(fields, legend(moving), keys)
+}
+
+/// [`side_panel`] with its own `legend`.
+pub fn side_panel_with(
+    mut fields: Vec<Line<'static>>,
+    legend: Vec<Line<'static>>,
+    keys: &[(&str, &str)],
+) -> Vec<Line<'static>> {
     fields.push(Line::raw(""));
-    fields.extend(legend(moving));
+    fields.extend(legend);
     fields.push(Line::raw(""));
     fields.extend(keys.iter().map(|(k, what)| key_help(k, what)));
     fields

@@ -7,5 +7,6 @@
 pub mod app;
 pub mod collect;
 pub mod draw;
+pub mod team_view;
 pub mod terminal;
 pub mod view;

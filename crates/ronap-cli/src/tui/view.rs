@@ -46,12 +46,8 @@ pub struct ViewState {
     pub path: Vec<Point>,
     /// The policy's name as given.
     pub policy: String,
-    /// First person or whole scene.
-    pub mode: SceneMode,
-    /// Whether stepping is paused.
-    pub paused: bool,
-    /// Steps per second.
-    pub speed: u32,
+    /// The view, pause and speed the keys set.
+    pub controls: Controls,
     /// The step of the latest collision.
     pub last_collision: Option<u32>,
     /// Why the episode stopped, when its status does not say.
@@ -65,9 +61,7 @@ impl ViewState {
             path: vec![rollout.episode().pose().position()],
             rollout,
             policy: policy.to_string(),
-            mode: SceneMode::FirstPerson,
-            paused: false,
-            speed,
+            controls: Controls::new(SceneMode::FirstPerson, speed),
             last_collision: None,
             ending: None,
         }
@@ -81,11 +75,6 @@ impl ViewState {
     /// Whether the episode is over.
     pub fn finished(&self) -> bool {
         self.rollout.finished() || self.ending.is_some()
-    }
-
-    /// Whether the loop should be stepping.
-    pub fn running(&self) -> bool {
-        !self.paused && !self.finished()
     }
 
     /// Asks `policy` for the next action and takes it, keeping the path and the collision record.
@@ -115,22 +104,9 @@ impl ViewState {
     /// Whether to show "CollisionWarning": the latest step collided, or one within the last
     /// half second at the current speed, so a warning stays long enough to read.
     pub fn warning(&self) -> bool {
-        let linger = (self.speed / 2).max(1);
+        let linger = (self.controls.speed / 2).max(1);
         self.last_collision
             .is_some_and(|k| self.episode().steps().saturating_sub(k) < linger)
-    }
-
-    /// The next speed up (`faster`) or down.
-    fn change_speed(&mut self, faster: bool) {
-        self.speed = if faster {
-            SPEEDS.into_iter().find(|&s| s > self.speed).unwrap_or(1000)
-        } else {
-            SPEEDS
-                .into_iter()
-                .rev()
-                .find(|&s| s < self.speed)
-                .unwrap_or(1)
-        };
     }
 }
 
@@ -145,39 +121,77 @@ pub enum KeyAction {
     Restart,
     /// Go on to the next seed.
     Next,
+    /// Follow the next robot (team view).
+    NextRobot,
     /// Quit.
     Quit,
     /// Quit as interrupted (Ctrl-C).
     Interrupt,
 }
 
-/// Applies `key` to `state`; what is left for the loop to do comes back.
-pub fn handle_key(state: &mut ViewState, key: &KeyEvent) -> KeyAction {
-    if terminal::is_ctrl_c(key) {
-        return KeyAction::Interrupt;
+/// What the keys set, in the lone and the team view alike.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Controls {
+    /// First person or whole scene.
+    pub mode: SceneMode,
+    /// Whether stepping is paused.
+    pub paused: bool,
+    /// Steps per second.
+    pub speed: u32,
+}
+
+impl Controls {
+    /// Running at `speed` steps per second in `mode`.
+    pub fn new(mode: SceneMode, speed: u32) -> Self {
+        Self {
+            mode,
+            paused: false,
+            speed,
+        }
     }
-    match key.code {
-        KeyCode::Char('q') | KeyCode::Char('Q') | KeyCode::Esc => KeyAction::Quit,
-        KeyCode::Char(' ') => {
-            state.paused = !state.paused;
-            KeyAction::None
+
+    /// The next speed up (`faster`) or down.
+    fn change_speed(&mut self, faster: bool) {
+        self.speed = if faster {
+            SPEEDS.into_iter().find(|&s| s > self.speed).unwrap_or(1000)
+        } else {
+            SPEEDS
+                .into_iter()
+                .rev()
+                .find(|&s| s < self.speed)
+                .unwrap_or(1)
+        };
+    }
+
+    /// Applies `key`; what is left for the loop to do comes back.
+    pub fn handle_key(&mut self, key: &KeyEvent) -> KeyAction {
+        if terminal::is_ctrl_c(key) {
+            return KeyAction::Interrupt;
         }
-        KeyCode::Char('+') | KeyCode::Char('=') => {
-            state.change_speed(true);
-            KeyAction::None
+        match key.code {
+            KeyCode::Char('q') | KeyCode::Char('Q') | KeyCode::Esc => KeyAction::Quit,
+            KeyCode::Char(' ') => {
+                self.paused = !self.paused;
+                KeyAction::None
+            }
+            KeyCode::Char('+') | KeyCode::Char('=') => {
+                self.change_speed(true);
+                KeyAction::None
+            }
+            KeyCode::Char('-') | KeyCode::Char('_') => {
+                self.change_speed(false);
+                KeyAction::None
+            }
+            KeyCode::Char('m') | KeyCode::Char('M') => {
+                self.mode = self.mode.toggled();
+                KeyAction::None
+            }
+            KeyCode::Char('s') | KeyCode::Char('.') if self.paused => KeyAction::Step,
+            KeyCode::Char('r') | KeyCode::Char('R') => KeyAction::Restart,
+            KeyCode::Char('n') | KeyCode::Char('N') => KeyAction::Next,
+            KeyCode::Tab => KeyAction::NextRobot,
+            _ => KeyAction::None,
         }
-        KeyCode::Char('-') | KeyCode::Char('_') => {
-            state.change_speed(false);
-            KeyAction::None
-        }
-        KeyCode::Char('m') | KeyCode::Char('M') => {
-            state.mode = state.mode.toggled();
-            KeyAction::None
-        }
-        KeyCode::Char('s') | KeyCode::Char('.') if state.paused => KeyAction::Step,
-        KeyCode::Char('r') | KeyCode::Char('R') => KeyAction::Restart,
-        KeyCode::Char('n') | KeyCode::Char('N') => KeyAction::Next,
-        _ => KeyAction::None,
     }
 }
 
@@ -186,7 +200,7 @@ pub fn status_line(state: &ViewState) -> Line<'static> {
     let e = state.episode();
     let (mark, mark_style) = if state.finished() {
         ("■ ended", Style::default().add_modifier(Modifier::BOLD))
-    } else if state.paused {
+    } else if state.controls.paused {
         ("❚❚ paused", Style::default().fg(Color::Yellow))
     } else {
         ("▶ running", Style::default().fg(Color::Green))
@@ -198,7 +212,7 @@ pub fn status_line(state: &ViewState) -> Line<'static> {
             " · step {} · collisions {} · {} steps/s",
             e.steps(),
             e.collisions(),
-            state.speed
+            state.controls.speed
         )),
     ];
     if let Some((text, colour)) = message(state) {
@@ -249,7 +263,7 @@ fn side_lines(state: &ViewState) -> Vec<Line<'static>> {
         draw::field("heading", format!("{:.1}°", e.pose().z_deg)),
         draw::field("collisions", e.collisions().to_string()),
         draw::field("path", format!("{:.1} px", e.path_length_px())),
-        draw::field("speed", format!("{} steps/s", state.speed)),
+        draw::field("speed", format!("{} steps/s", state.controls.speed)),
     ];
     draw::side_panel(
         lines,
@@ -271,7 +285,7 @@ pub fn draw(frame: &mut Frame, state: &ViewState) {
         frame,
         state.episode(),
         &state.path,
-        state.mode,
+        state.controls.mode,
         "ronap view",
         side_lines(state),
         status_line(state),
@@ -291,38 +305,117 @@ pub fn start_episode(
     })
 }
 
-/// `ronap view`'s screen as an [`App`]: the policy steps at the chosen speed between keys.
-pub struct ViewApp<'a> {
+/// What a view steps and draws: one robot's episode ([`Lone`]) or a team's
+/// ([`crate::tui::team_view::TeamWatch`]).
+pub trait Watched {
+    /// The keys' settings.
+    fn controls(&self) -> &Controls;
+    /// The keys' settings, to change.
+    fn controls_mut(&mut self) -> &mut Controls;
+    /// Whether the episode is over (or failed).
+    fn finished(&self) -> bool;
+    /// One step of the policies.
+    fn advance(&mut self);
+    /// The episode's seed.
+    fn seed(&self) -> u64;
+    /// Starts the episode of `seed` in place, keeping the controls (a failure is shown).
+    fn restart(&mut self, seed: u64);
+    /// Follows the next robot, if there are several.
+    fn next_robot(&mut self) {}
+    /// Draws the whole screen.
+    fn draw(&self, frame: &mut Frame);
+
+    /// Whether the loop should be stepping.
+    fn running(&self) -> bool {
+        !self.controls().paused && !self.finished()
+    }
+}
+
+/// One robot's episode under its policy, for [`ViewApp`].
+pub struct Lone<'a> {
     /// What is on screen.
     pub state: ViewState,
     evaluator: &'a Evaluator,
     policy: &'a mut dyn Policy,
-    owed: f64,
-    last_tick: Instant,
 }
 
-impl<'a> ViewApp<'a> {
-    /// The app over `state`, stepping `policy` in episodes from `evaluator`.
+impl<'a> Lone<'a> {
+    /// `state` stepped by `policy`, new seeds from `evaluator`.
     pub fn new(state: ViewState, evaluator: &'a Evaluator, policy: &'a mut dyn Policy) -> Self {
         Self {
             state,
             evaluator,
             policy,
+        }
+    }
+}
+
+impl Watched for Lone<'_> {
+    fn controls(&self) -> &Controls {
+        &self.state.controls
+    }
+
+    fn controls_mut(&mut self) -> &mut Controls {
+        &mut self.state.controls
+    }
+
+    fn finished(&self) -> bool {
+        self.state.finished()
+    }
+
+    fn advance(&mut self) {
+        self.state.advance(self.policy);
+    }
+
+    fn seed(&self) -> u64 {
+        self.state.episode().seed()
+    }
+
+    fn restart(&mut self, seed: u64) {
+        let state = &mut self.state;
+        match start_episode(self.evaluator, self.policy, seed) {
+            Ok(rollout) => {
+                let controls = state.controls;
+                *state = ViewState::new(rollout, &state.policy, controls.speed);
+                state.controls = controls;
+            }
+            Err(why) => state.ending = Some(Ending::Failed(why)),
+        }
+    }
+
+    fn draw(&self, frame: &mut Frame) {
+        draw(frame, &self.state)
+    }
+}
+
+/// A view as an [`App`]: the policies step at the chosen speed between keys.
+pub struct ViewApp<W> {
+    /// What is on screen.
+    pub watched: W,
+    owed: f64,
+    last_tick: Instant,
+}
+
+impl<W: Watched> ViewApp<W> {
+    /// The app over `watched`.
+    pub fn new(watched: W) -> Self {
+        Self {
+            watched,
             owed: 0.0,
             last_tick: Instant::now(),
         }
     }
 }
 
-impl App for ViewApp<'_> {
+impl<W: Watched> App for ViewApp<W> {
     fn draw(&self, frame: &mut Frame) {
-        draw(frame, &self.state)
+        self.watched.draw(frame)
     }
 
     fn wait(&self) -> Duration {
-        if self.state.running() {
-            let next =
-                ((1.0 - self.owed).max(0.0) / f64::from(self.state.speed)).min(POLL.as_secs_f64());
+        if self.watched.running() {
+            let speed = f64::from(self.watched.controls().speed);
+            let next = ((1.0 - self.owed).max(0.0) / speed).min(POLL.as_secs_f64());
             Duration::from_secs_f64(next)
         } else {
             POLL
@@ -330,31 +423,26 @@ impl App for ViewApp<'_> {
     }
 
     fn key(&mut self, key: &KeyEvent) -> Result<Option<ExitCode>> {
-        let state = &mut self.state;
-        let next_seed = match handle_key(state, key) {
+        let w = &mut self.watched;
+        let next_seed = match w.controls_mut().handle_key(key) {
             KeyAction::None => None,
             KeyAction::Quit => return Ok(Some(ExitCode::SUCCESS)),
             KeyAction::Interrupt => return Ok(Some(ExitCode::from(130))),
             KeyAction::Step => {
-                if !state.finished() {
-                    state.advance(self.policy);
+                if !w.finished() {
+                    w.advance();
                 }
                 None
             }
-            KeyAction::Restart => Some(state.episode().seed()),
-            KeyAction::Next => Some(state.episode().seed().wrapping_add(1)),
+            KeyAction::NextRobot => {
+                w.next_robot();
+                None
+            }
+            KeyAction::Restart => Some(w.seed()),
+            KeyAction::Next => Some(w.seed().wrapping_add(1)),
         };
         if let Some(seed) = next_seed {
-            let (mode, speed, paused) = (state.mode, state.speed, state.paused);
-            let name = state.policy.clone();
-            match start_episode(self.evaluator, self.policy, seed) {
-                Ok(rollout) => {
-                    *state = ViewState::new(rollout, &name, speed);
-                    state.mode = mode;
-                    state.paused = paused;
-                }
-                Err(why) => state.ending = Some(Ending::Failed(why)),
-            }
+            w.restart(seed);
             self.owed = 0.0;
         }
         Ok(None)
@@ -363,13 +451,13 @@ impl App for ViewApp<'_> {
     fn tick(&mut self) -> Result<bool> {
         let now = Instant::now();
         let mut changed = false;
-        if self.state.running() {
+        if self.watched.running() {
             // Never more than a quarter second of catching up after a slow frame.
-            let speed = f64::from(self.state.speed);
+            let speed = f64::from(self.watched.controls().speed);
             self.owed =
                 (self.owed + (now - self.last_tick).as_secs_f64() * speed).min(speed / 4.0 + 1.0);
-            while self.owed >= 1.0 && self.state.running() {
-                self.state.advance(self.policy);
+            while self.owed >= 1.0 && self.watched.running() {
+                self.watched.advance();
                 self.owed -= 1.0;
                 changed = true;
             }
@@ -552,8 +640,8 @@ mod tests {
     fn m_shows_the_whole_scene_with_the_path_in_blue() {
         let mut state = state_of(Builtin::Geodesic, |s| s.episode().steps() >= 60);
         let m = KeyEvent::new(KeyCode::Char('m'), KeyModifiers::NONE);
-        assert_eq!(handle_key(&mut state, &m), KeyAction::None);
-        assert_eq!(state.mode, SceneMode::WholeScene);
+        assert_eq!(state.controls.handle_key(&m), KeyAction::None);
+        assert_eq!(state.controls.mode, SceneMode::WholeScene);
         let buf = render(&state, 80, 24);
         let scene = inner(draw::layout(buf.area).scene);
         assert!(row(&buf, 0).contains("whole scene · seed 7"));
@@ -562,8 +650,8 @@ mod tests {
         assert!(!dots(&buf, scene, draw::GOAL).is_empty());
         assert!(dots(&buf, scene, draw::WALL).len() > 200);
         insta::assert_snapshot!("view_whole_scene_seed_7", TestBackendView(&buf));
-        handle_key(&mut state, &m);
-        assert_eq!(state.mode, SceneMode::FirstPerson);
+        state.controls.handle_key(&m);
+        assert_eq!(state.controls.mode, SceneMode::FirstPerson);
     }
 
     #[test]
@@ -588,7 +676,7 @@ mod tests {
         // legend says what the colour means.
         assert!((0..24).any(|y| row(&buf, y).contains("moving obstacle")));
         let m = KeyEvent::new(KeyCode::Char('m'), KeyModifiers::NONE);
-        handle_key(&mut state, &m);
+        state.controls.handle_key(&m);
         let before = dots(&render(&state, 80, 24), scene, draw::MOVER);
         assert!(before.len() >= 15, "{} moving-obstacle cells", before.len());
         for _ in 0..20 {
@@ -644,26 +732,26 @@ mod tests {
     fn keys_pause_change_speed_and_quit() {
         let mut state = state_of(Builtin::Random, |s| s.episode().steps() >= 1);
         let key = |c| KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE);
-        handle_key(&mut state, &key(' '));
-        assert!(state.paused && !state.running());
+        state.controls.handle_key(&key(' '));
+        assert!(state.controls.paused && !state.finished());
         assert!(row(&render(&state, 80, 24), 23).contains("paused"));
-        assert_eq!(handle_key(&mut state, &key('s')), KeyAction::Step);
-        handle_key(&mut state, &key(' '));
-        assert!(state.running());
-        assert_eq!(handle_key(&mut state, &key('s')), KeyAction::None);
-        handle_key(&mut state, &key('+'));
-        assert_eq!(state.speed, 50);
-        handle_key(&mut state, &key('-'));
-        handle_key(&mut state, &key('-'));
-        assert_eq!(state.speed, 10);
+        assert_eq!(state.controls.handle_key(&key('s')), KeyAction::Step);
+        state.controls.handle_key(&key(' '));
+        assert!(!state.controls.paused && !state.finished());
+        assert_eq!(state.controls.handle_key(&key('s')), KeyAction::None);
+        state.controls.handle_key(&key('+'));
+        assert_eq!(state.controls.speed, 50);
+        state.controls.handle_key(&key('-'));
+        state.controls.handle_key(&key('-'));
+        assert_eq!(state.controls.speed, 10);
         for _ in 0..20 {
-            handle_key(&mut state, &key('-'));
+            state.controls.handle_key(&key('-'));
         }
-        assert_eq!(state.speed, 1);
-        assert_eq!(handle_key(&mut state, &key('q')), KeyAction::Quit);
+        assert_eq!(state.controls.speed, 1);
+        assert_eq!(state.controls.handle_key(&key('q')), KeyAction::Quit);
         let ctrl_c = KeyEvent::new(KeyCode::Char('c'), KeyModifiers::CONTROL);
-        assert_eq!(handle_key(&mut state, &ctrl_c), KeyAction::Interrupt);
-        assert_eq!(handle_key(&mut state, &key('n')), KeyAction::Next);
+        assert_eq!(state.controls.handle_key(&ctrl_c), KeyAction::Interrupt);
+        assert_eq!(state.controls.handle_key(&key('n')), KeyAction::Next);
     }
 
     #[test]

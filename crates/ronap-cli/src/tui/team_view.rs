@@ -1,0 +1,481 @@
+//! `ronap view` of a scenario with `[[robots]]`: the whole team live in the terminal, each robot
+//! with its path and goal in its own colour, one robot followed (Tab for the next) whose rays are
+//! drawn and whose first-person view `M` shows; a side panel of team figures and a status line
+//! with the step, the robots at their goals, the collisions and how the episode ended.
+//!
+//! [`TeamViewState`] is everything on screen and [`draw`] a pure function of it; [`TeamWatch`]
+//! steps the policies for [`crate::tui::view::ViewApp`], the loop the lone view runs too.
+
+use crate::args::TeamPolicies;
+use crate::tui::draw::{self, SceneMode};
+use crate::tui::view::{Controls, Ending, Watched};
+use anyhow::Result;
+use ratatui::style::{Color, Modifier, Style};
+use ratatui::text::{Line, Span};
+use ratatui::Frame;
+use ronap_core::eval::Evaluator;
+use ronap_core::geometry::Point;
+use ronap_core::policy::Policy;
+use ronap_core::run::team::TeamRollout;
+use ronap_core::run::RunError;
+use ronap_core::sim::team::Team;
+use ronap_core::Status;
+
+/// Everything the team view shows.
+pub struct TeamViewState {
+    /// The team episode.
+    pub rollout: TeamRollout,
+    /// The episode's seed.
+    pub seed: u64,
+    /// Each robot's positions so far, start first.
+    pub paths: Vec<Vec<Point>>,
+    /// Each robot's policy name.
+    pub names: Vec<String>,
+    /// The robot whose rays and first-person view are shown.
+    pub focus: usize,
+    /// The view, pause and speed the keys set.
+    pub controls: Controls,
+    /// Why the episode stopped, when the robots' statuses do not say.
+    pub ending: Option<Ending>,
+}
+
+impl TeamViewState {
+    /// The view of `rollout` (seed `seed`), just started, with robot `k` under `names[k]`.
+    pub fn new(rollout: TeamRollout, seed: u64, names: Vec<String>, speed: u32) -> Self {
+        let team = rollout.team();
+        let paths = (0..team.robots().len())
+            .map(|k| vec![team.robot(k).pose().position()])
+            .collect();
+        Self {
+            rollout,
+            seed,
+            paths,
+            names,
+            focus: 0,
+            controls: Controls::new(SceneMode::WholeScene, speed),
+            ending: None,
+        }
+    }
+
+    /// The team.
+    pub fn team(&self) -> &Team {
+        self.rollout.team()
+    }
+
+    /// Whether the episode is over.
+    pub fn finished(&self) -> bool {
+        self.rollout.finished() || self.ending.is_some()
+    }
+
+    /// One step of every running robot's policy, keeping the paths.
+    pub fn advance(&mut self, policies: &mut [Box<dyn Policy>]) {
+        match self.rollout.advance(policies) {
+            Ok(true) => {
+                let team = self.rollout.team();
+                for (k, path) in self.paths.iter_mut().enumerate() {
+                    if team.present(k) {
+                        path.push(team.robot(k).pose().position());
+                    }
+                }
+            }
+            Ok(false) => {}
+            Err(RunError::Policy { step, source, .. }) => {
+                self.ending = Some(Ending::Failed(format!(
+                    "step {step}: policy failed: {source}"
+                )))
+            }
+            Err(e) => self.ending = Some(Ending::Failed(e.to_string())),
+        }
+    }
+
+    /// Robots at their (last) goal.
+    fn arrived(&self) -> usize {
+        let team = self.team();
+        (0..team.robots().len())
+            .filter(|&k| team.robot(k).status() == Status::Success)
+            .count()
+    }
+}
+
+/// The status line: state, step, robots at their goals, collisions, speed and how it ended.
+pub fn status_line(state: &TeamViewState) -> Line<'static> {
+    let team = state.team();
+    let (mark, mark_style) = if state.finished() {
+        ("■ ended", Style::default().add_modifier(Modifier::BOLD))
+    } else if state.controls.paused {
+        ("❚❚ paused", Style::default().fg(Color::Yellow))
+    } else {
+        ("▶ running", Style::default().fg(Color::Green))
+    };
+    let collisions: u32 = team.robots().iter().map(|r| r.collisions()).sum();
+    let mut spans = vec![
+        Span::raw(" "),
+        Span::styled(mark, mark_style),
+        Span::raw(format!(
+            " · step {} · at goal {}/{} · collisions {} · {} steps/s",
+            team.steps(),
+            state.arrived(),
+            team.robots().len(),
+            collisions,
+            state.controls.speed
+        )),
+    ];
+    if let Some((text, colour)) = message(state) {
+        spans.push(Span::raw(" · "));
+        spans.push(Span::styled(
+            text,
+            Style::default().fg(colour).add_modifier(Modifier::BOLD),
+        ));
+    }
+    Line::from(spans)
+}
+
+/// How the episode ended, in its colour (nothing while it runs).
+fn message(state: &TeamViewState) -> Option<(String, Color)> {
+    if let Some(Ending::Failed(why)) = &state.ending {
+        return Some((why.clone(), Color::Red));
+    }
+    if !state.rollout.finished() {
+        return None;
+    }
+    let team = state.team();
+    let n = team.robots().len();
+    Some(if team.deadlocked() {
+        ("deadlock: no robot moved".to_string(), Color::Yellow)
+    } else if state.arrived() == n {
+        (
+            "TaskComplete: every robot at its goal".to_string(),
+            Color::Green,
+        )
+    } else {
+        (
+            format!(
+                "ended with {} of {n} robots at their goals",
+                state.arrived()
+            ),
+            Color::Yellow,
+        )
+    })
+}
+
+/// The side panel's lines: the team, then the followed robot.
+fn side_lines(state: &TeamViewState) -> Vec<Line<'static>> {
+    let team = state.team();
+    let k = state.focus;
+    let r = team.robot(k);
+    let collisions: u32 = team.robots().iter().map(|r| r.collisions()).sum();
+    let lines = vec![
+        draw::field("seed", state.seed.to_string()),
+        draw::field("robots", team.robots().len().to_string()),
+        draw::field(
+            "step",
+            format!("{} / {}", team.steps(), r.config().episode.max_steps),
+        ),
+        draw::field(
+            "at goal",
+            format!("{} / {}", state.arrived(), team.robots().len()),
+        ),
+        draw::field("collisions", collisions.to_string()),
+        draw::field("speed", format!("{} steps/s", state.controls.speed)),
+        Line::raw(""),
+        Line::from(Span::styled(
+            format!("robot {k}"),
+            Style::default()
+                .fg(draw::robot_colour(k))
+                .add_modifier(Modifier::BOLD),
+        )),
+        draw::field("policy", state.names.get(k).cloned().unwrap_or_default()),
+        draw::field("status", status_word(team, k)),
+        draw::field(
+            "goals",
+            format!("{} / {}", r.goals_reached(), team.goals(k).len().max(1)),
+        ),
+        draw::field("distance", format!("{:.1} px", r.distance_px())),
+        draw::field("collisions", r.collisions().to_string()),
+        draw::field("path", format!("{:.1} px", r.path_length_px())),
+    ];
+    draw::side_panel_with(
+        lines,
+        draw::team_legend(team.robots().len(), team.movers().is_some()),
+        &[
+            ("space", "pause / resume"),
+            ("+ -", "faster / slower"),
+            ("tab", "follow the next robot"),
+            ("m", "whole scene / first person"),
+            ("s", "one step, when paused"),
+            ("r n", "restart / next seed"),
+            ("q", "quit"),
+        ],
+    )
+}
+
+/// Robot `k`'s state in a word.
+fn status_word(team: &Team, k: usize) -> String {
+    if team.retired(k) {
+        return "gave up".to_string();
+    }
+    match team.robot(k).status() {
+        Status::Running => "running",
+        Status::Success => "at goal",
+        Status::TimeOut => "time-out",
+        Status::RewardMin => "R_min",
+        Status::Deadlock => "deadlock",
+        Status::Collision => "collision",
+    }
+    .to_string()
+}
+
+/// Draws the whole screen for `state`.
+pub fn draw(frame: &mut Frame, state: &TeamViewState) {
+    if draw::too_small(frame) {
+        return;
+    }
+    let areas = draw::layout(frame.area());
+    let mode = state.controls.mode;
+    let title = match mode {
+        SceneMode::WholeScene => format!("{} · seed {}", mode.title(), state.seed),
+        SceneMode::FirstPerson => format!(
+            "{} of robot {} · seed {}",
+            mode.title(),
+            state.focus,
+            state.seed
+        ),
+    };
+    draw::team_scene(
+        frame,
+        areas.scene,
+        state.team(),
+        &state.paths,
+        state.focus,
+        mode,
+        &title,
+    );
+    if let Some(area) = areas.side {
+        frame.render_widget(
+            ratatui::widgets::Paragraph::new(side_lines(state))
+                .block(ratatui::widgets::Block::bordered().title(" ronap view ")),
+            area,
+        );
+    }
+    frame.render_widget(
+        ratatui::widgets::Paragraph::new(status_line(state)),
+        areas.status,
+    );
+}
+
+/// A team episode under its policies, for [`crate::tui::view::ViewApp`].
+pub struct TeamWatch<'a> {
+    /// What is on screen.
+    pub state: TeamViewState,
+    evaluator: &'a Evaluator,
+    policies: Vec<Box<dyn Policy>>,
+}
+
+/// The team episode of `seed` with `policies` reset for it.
+fn start_team(
+    evaluator: &Evaluator,
+    policies: &mut [Box<dyn Policy>],
+    seed: u64,
+) -> Result<TeamRollout, String> {
+    TeamRollout::start(
+        evaluator.config(),
+        evaluator.worlds().team(seed),
+        seed,
+        policies,
+    )
+    .map_err(|e| match e {
+        RunError::Episode { source, .. } => format!("cannot start seed {seed}: {source}"),
+        RunError::Policy { source, .. } => format!("seed {seed}: policy failed: {source}"),
+        other => other.to_string(),
+    })
+}
+
+impl<'a> TeamWatch<'a> {
+    /// The team episode of `seed` from `evaluator` under `policies`, at `speed` steps a second.
+    pub fn start(
+        evaluator: &'a Evaluator,
+        policies: &TeamPolicies,
+        seed: u64,
+        speed: u32,
+    ) -> Result<Self> {
+        let mut made = policies.make()?;
+        let rollout = start_team(evaluator, &mut made, seed).map_err(anyhow::Error::msg)?;
+        Ok(Self {
+            state: TeamViewState::new(rollout, seed, policies.names.clone(), speed),
+            evaluator,
+            policies: made,
+        })
+    }
+}
+
+impl Watched for TeamWatch<'_> {
+    fn controls(&self) -> &Controls {
+        &self.state.controls
+    }
+
+    fn controls_mut(&mut self) -> &mut Controls {
+        &mut self.state.controls
+    }
+
+    fn finished(&self) -> bool {
+        self.state.finished()
+    }
+
+    fn advance(&mut self) {
+        self.state.advance(&mut self.policies);
+    }
+
+    fn seed(&self) -> u64 {
+        self.state.seed
+    }
+
+    fn restart(&mut self, seed: u64) {
+        match start_team(self.evaluator, &mut self.policies, seed) {
+            Ok(rollout) => {
+                let (controls, focus) = (self.state.controls, self.state.focus);
+                let names = std::mem::take(&mut self.state.names);
+                self.state = TeamViewState::new(rollout, seed, names, controls.speed);
+                self.state.controls = controls;
+                self.state.focus = focus.min(self.state.team().robots().len() - 1);
+            }
+            Err(why) => self.state.ending = Some(Ending::Failed(why)),
+        }
+    }
+
+    fn next_robot(&mut self) {
+        let n = self.state.team().robots().len().max(1);
+        self.state.focus = (self.state.focus + 1) % n;
+    }
+
+    fn draw(&self, frame: &mut Frame) {
+        draw(frame, &self.state)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tui::view::{KeyAction, ViewApp};
+    use ratatui::backend::TestBackend;
+    use ratatui::buffer::Buffer;
+    use ratatui::crossterm::event::{KeyCode, KeyEvent, KeyModifiers};
+    use ratatui::Terminal;
+
+    /// The evaluator `ronap view --scenario scenarios/NAME` runs.
+    fn evaluator(scenario: &str) -> Evaluator {
+        let mut args = crate::args::EpisodeArgs::default();
+        args.sim.scenario =
+            Some(format!("{}/../../scenarios/{scenario}", env!("CARGO_MANIFEST_DIR")).into());
+        let (config, scenes, _) = args.resolve().unwrap();
+        Evaluator::new(config, scenes)
+    }
+
+    fn render(state: &TeamViewState, w: u16, h: u16) -> Buffer {
+        let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
+        terminal.draw(|f| draw(f, state)).unwrap();
+        terminal.backend().buffer().clone()
+    }
+
+    fn text(buf: &Buffer) -> String {
+        (0..buf.area.height)
+            .map(|y| {
+                (0..buf.area.width)
+                    .map(|x| buf[(x, y)].symbol())
+                    .collect::<String>()
+                    + "\n"
+            })
+            .collect()
+    }
+
+    /// Cells of the scene panel drawn in `colour`.
+    fn cells_in(buf: &Buffer, colour: Color) -> usize {
+        let scene = draw::layout(buf.area).scene;
+        (scene.y + 1..scene.y + scene.height - 1)
+            .flat_map(|y| (scene.x + 1..scene.x + scene.width - 1).map(move |x| (x, y)))
+            .filter(|&(x, y)| buf[(x, y)].fg == colour && buf[(x, y)].symbol() != " ")
+            .count()
+    }
+
+    #[test]
+    fn every_robot_is_drawn_in_its_colour_with_its_path_and_tab_follows_the_next() {
+        let evaluator = evaluator("warehouse-team.toml");
+        let policies = TeamPolicies::new(evaluator.config(), "geodesic").unwrap();
+        let mut app = ViewApp::new(TeamWatch::start(&evaluator, &policies, 3, 20).unwrap());
+        let n = app.watched.state.team().robots().len();
+        assert!(n >= 2);
+        for _ in 0..40 {
+            app.watched.advance();
+        }
+        let state = &app.watched.state;
+        assert!(state.paths.iter().all(|p| p.len() > 1));
+        let buf = render(state, 120, 40);
+        let screen = text(&buf);
+        assert!(screen.contains("whole scene · seed 3"), "{screen}");
+        assert!(screen.contains("step 40"), "{screen}");
+        assert!(screen.contains(&format!("at goal 0/{n}")) || screen.contains("at goal"));
+        assert!(screen.contains("robot 0"), "{screen}");
+        for k in 0..n.min(6) {
+            assert!(
+                cells_in(&buf, draw::robot_colour(k)) > 0,
+                "robot {k} not drawn"
+            );
+        }
+        // Tab follows robot 1; M shows its first-person view.
+        let key = |c| KeyEvent::new(c, KeyModifiers::NONE);
+        assert_eq!(
+            app.watched.state.controls.handle_key(&key(KeyCode::Tab)),
+            KeyAction::NextRobot
+        );
+        app.watched.next_robot();
+        assert_eq!(app.watched.state.focus, 1);
+        app.watched
+            .state
+            .controls
+            .handle_key(&key(KeyCode::Char('m')));
+        let screen = text(&render(&app.watched.state, 120, 40));
+        assert!(screen.contains("first person of robot 1"), "{screen}");
+        assert!(screen.contains("robot 1"), "{screen}");
+    }
+
+    #[test]
+    fn the_corridor_swap_ends_in_a_deadlock_the_status_line_names() {
+        let evaluator = evaluator("corridor-swap.toml");
+        let policies = TeamPolicies::new(evaluator.config(), "geodesic").unwrap();
+        let mut watch = TeamWatch::start(&evaluator, &policies, 0, 20).unwrap();
+        let mut steps = 0;
+        while !watch.finished() && steps < 100_000 {
+            watch.advance();
+            steps += 1;
+        }
+        assert!(watch.finished());
+        let status = text(&render(&watch.state, 100, 30));
+        assert!(
+            status.contains("deadlock") || status.contains("TaskComplete"),
+            "{status}"
+        );
+        assert!(status.contains("■ ended"), "{status}");
+        // Restart keeps the controls and starts the seed again.
+        watch.state.controls.speed = 100;
+        watch.restart(0);
+        assert_eq!(watch.state.team().steps(), 0);
+        assert_eq!(watch.state.controls.speed, 100);
+        assert!(!watch.finished());
+    }
+
+    #[test]
+    fn every_size_draws_without_panicking() {
+        let evaluator = evaluator("warehouse-team.toml");
+        let policies = TeamPolicies::new(evaluator.config(), "apf").unwrap();
+        let mut watch = TeamWatch::start(&evaluator, &policies, 0, 20).unwrap();
+        watch.advance();
+        for mode in [SceneMode::WholeScene, SceneMode::FirstPerson] {
+            watch.state.controls.mode = mode;
+            for (w, h) in [(20, 5), (40, 12), (80, 24), (200, 60)] {
+                let screen = text(&render(&watch.state, w, h));
+                if w >= 40 && h >= 12 {
+                    assert!(screen.contains("step 1"), "{w}x{h}");
+                }
+            }
+        }
+    }
+}
