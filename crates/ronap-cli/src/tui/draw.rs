@@ -631,12 +631,26 @@ pub fn screen(
     side: Vec<Line<'static>>,
     status: Line<'static>,
 ) {
+    let title = format!("{} · seed {}", mode.title(), episode.seed());
+    screen_with(frame, name, side, status, |frame, area| {
+        scene(frame, area, episode, path, mode, &title)
+    });
+}
+
+/// A whole screen whose scene panel `draw_scene` draws into the area it is given: the side panel
+/// titled `name` when there is room, and the status line.
+pub fn screen_with(
+    frame: &mut Frame,
+    name: &str,
+    side: Vec<Line<'static>>,
+    status: Line<'static>,
+    draw_scene: impl FnOnce(&mut Frame, Rect),
+) {
     if too_small(frame) {
         return;
     }
     let areas = layout(frame.area());
-    let title = format!("{} · seed {}", mode.title(), episode.seed());
-    scene(frame, areas.scene, episode, path, mode, &title);
+    draw_scene(frame, areas.scene);
     if let Some(area) = areas.side {
         frame.render_widget(
             Paragraph::new(side).block(Block::bordered().title(format!(" {name} "))),
@@ -644,6 +658,35 @@ pub fn screen(
         );
     }
     frame.render_widget(Paragraph::new(status), areas.status);
+}
+
+/// A status line: ended, paused or running, then `figures`, then `message` in its colour.
+pub fn status_line(
+    finished: bool,
+    paused: bool,
+    figures: String,
+    message: Option<(String, Color)>,
+) -> Line<'static> {
+    let (mark, mark_style) = if finished {
+        ("■ ended", Style::default().add_modifier(Modifier::BOLD))
+    } else if paused {
+        ("❚❚ paused", Style::default().fg(Color::Yellow))
+    } else {
+        ("▶ running", Style::default().fg(Color::Green))
+    };
+    let mut spans = vec![
+        Span::raw(" "),
+        Span::styled(mark, mark_style),
+        Span::raw(figures),
+    ];
+    if let Some((text, colour)) = message {
+        spans.push(Span::raw(" · "));
+        spans.push(Span::styled(
+            text,
+            Style::default().fg(colour).add_modifier(Modifier::BOLD),
+        ));
+    }
+    Line::from(spans)
 }
 
 /// The message shown when the terminal is too small for anything useful.

@@ -100,34 +100,20 @@ impl TeamViewState {
 /// The status line: state, step, robots at their goals, collisions, speed and how it ended.
 pub fn status_line(state: &TeamViewState) -> Line<'static> {
     let team = state.team();
-    let (mark, mark_style) = if state.finished() {
-        ("■ ended", Style::default().add_modifier(Modifier::BOLD))
-    } else if state.controls.paused {
-        ("❚❚ paused", Style::default().fg(Color::Yellow))
-    } else {
-        ("▶ running", Style::default().fg(Color::Green))
-    };
     let collisions: u32 = team.robots().iter().map(|r| r.collisions()).sum();
-    let mut spans = vec![
-        Span::raw(" "),
-        Span::styled(mark, mark_style),
-        Span::raw(format!(
+    draw::status_line(
+        state.finished(),
+        state.controls.paused,
+        format!(
             " · step {} · at goal {}/{} · collisions {} · {} steps/s",
             team.steps(),
             state.arrived(),
             team.robots().len(),
             collisions,
             state.controls.speed
-        )),
-    ];
-    if let Some((text, colour)) = message(state) {
-        spans.push(Span::raw(" · "));
-        spans.push(Span::styled(
-            text,
-            Style::default().fg(colour).add_modifier(Modifier::BOLD),
-        ));
-    }
-    Line::from(spans)
+        ),
+        message(state),
+    )
 }
 
 /// How the episode ended, in its colour (nothing while it runs).
@@ -227,10 +213,6 @@ fn status_word(team: &Team, k: usize) -> String {
 
 /// Draws the whole screen for `state`.
 pub fn draw(frame: &mut Frame, state: &TeamViewState) {
-    if draw::too_small(frame) {
-        return;
-    }
-    let areas = draw::layout(frame.area());
     let mode = state.controls.mode;
     let title = match mode {
         SceneMode::WholeScene => format!("{} · seed {}", mode.title(), state.seed),
@@ -241,25 +223,22 @@ pub fn draw(frame: &mut Frame, state: &TeamViewState) {
             state.seed
         ),
     };
-    draw::team_scene(
+    draw::screen_with(
         frame,
-        areas.scene,
-        state.team(),
-        &state.paths,
-        state.focus,
-        mode,
-        &title,
-    );
-    if let Some(area) = areas.side {
-        frame.render_widget(
-            ratatui::widgets::Paragraph::new(side_lines(state))
-                .block(ratatui::widgets::Block::bordered().title(" ronap view ")),
-            area,
-        );
-    }
-    frame.render_widget(
-        ratatui::widgets::Paragraph::new(status_line(state)),
-        areas.status,
+        "ronap view",
+        side_lines(state),
+        status_line(state),
+        |frame, area| {
+            draw::team_scene(
+                frame,
+                area,
+                state.team(),
+                &state.paths,
+                state.focus,
+                mode,
+                &title,
+            )
+        },
     );
 }
 

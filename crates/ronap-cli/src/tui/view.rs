@@ -11,8 +11,8 @@ use crate::tui::draw::{self, SceneMode};
 use crate::tui::terminal;
 use anyhow::Result;
 use ratatui::crossterm::event::{KeyCode, KeyEvent};
-use ratatui::style::{Color, Modifier, Style};
-use ratatui::text::{Line, Span};
+use ratatui::style::Color;
+use ratatui::text::Line;
 use ratatui::Frame;
 use ronap_core::eval::Evaluator;
 use ronap_core::geometry::Point;
@@ -198,31 +198,17 @@ impl Controls {
 /// The status line: state, step, collisions, speed and the latest message.
 pub fn status_line(state: &ViewState) -> Line<'static> {
     let e = state.episode();
-    let (mark, mark_style) = if state.finished() {
-        ("■ ended", Style::default().add_modifier(Modifier::BOLD))
-    } else if state.controls.paused {
-        ("❚❚ paused", Style::default().fg(Color::Yellow))
-    } else {
-        ("▶ running", Style::default().fg(Color::Green))
-    };
-    let mut spans = vec![
-        Span::raw(" "),
-        Span::styled(mark, mark_style),
-        Span::raw(format!(
+    draw::status_line(
+        state.finished(),
+        state.controls.paused,
+        format!(
             " · step {} · collisions {} · {} steps/s",
             e.steps(),
             e.collisions(),
             state.controls.speed
-        )),
-    ];
-    if let Some((text, colour)) = message(state) {
-        spans.push(Span::raw(" · "));
-        spans.push(Span::styled(
-            text,
-            Style::default().fg(colour).add_modifier(Modifier::BOLD),
-        ));
-    }
-    Line::from(spans)
+        ),
+        message(state),
+    )
 }
 
 /// The message of the moment, in its colour: the paper's "TaskComplete" and "CollisionWarning",
