@@ -24,9 +24,12 @@ use crate::scene::maze_rays::MazeRays;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-/// Bin side of the query index, px: small enough that a bin's list is close to the boxes really
-/// within reach, large enough that building it per episode stays well under a millisecond.
-const BIN_PX: f64 = 10.0;
+/// Bin side of the query index, px. A bin lists every box within reach of any of its points, so
+/// its list grows only slowly with the side (the laser's 50 px reach dominates), while the index's
+/// size and build time fall with its square: at 30 px a maze's index is a fifth of its size at
+/// 10 px, a reset costs 18 us instead of 50 us, and 1024 environments' indices stay nearer the
+/// cache, with the same instruction count per step (callgrind).
+const BIN_PX: f64 = 30.0;
 
 /// A scene that could not be built.
 #[derive(Debug, thiserror::Error)]
