@@ -563,9 +563,10 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
     let mut stdout = std::io::stdout().lock();
     writeln!(
         stdout,
-        "ronap train dqn: {} steps, {} episodes side by side on {threads} threads, network {}-{}-3",
+        "ronap train dqn: {} steps, {} episodes side by side on {threads} thread{}, network {}-{}-3",
         options.steps,
         options.envs,
+        if threads == 1 { "" } else { "s" },
         args.sim.config()?.observation_size(),
         options
             .hidden
