@@ -27,12 +27,11 @@ pub struct FreeGrid {
     free: Vec<bool>,
     /// Free cells whose centre is within `margin_px` of touching an obstacle.
     close: Vec<bool>,
-    /// Region label of each free cell (`u32::MAX` for blocked cells).
-    region: Vec<u32>,
+    /// Region label of each free cell (`u32::MAX` for blocked cells) and the number of regions,
+    /// labelled on first use: planners need only the moves, and placement in a maze no regions.
+    labels: std::sync::OnceLock<(Vec<u32>, usize)>,
     /// Cells of each region, largest region first.
     regions: std::sync::OnceLock<Vec<Vec<u32>>>,
-    /// Number of regions.
-    region_count: usize,
     /// The 8-neighbour moves open from each cell, as bits (see [`FreeGrid::moves`]).
     moves: Vec<u8>,
 }
@@ -138,7 +137,6 @@ impl FreeGrid {
                 }
             }
         }
-        let (region, region_count) = label_regions(cols, rows, &free, &unlinked);
         let moves = open_moves(cols, rows, &free, &unlinked);
         Self {
             cell_px,
@@ -146,9 +144,8 @@ impl FreeGrid {
             rows,
             free,
             close,
-            region,
+            labels: std::sync::OnceLock::new(),
             regions: std::sync::OnceLock::new(),
-            region_count,
             moves,
         }
     }
@@ -209,20 +206,27 @@ impl FreeGrid {
     /// Region label of the cell holding `p` (0 is the largest region), if it is free.
     pub fn region_at(&self, p: Point) -> Option<u32> {
         let (c, r) = self.cell_of(p)?;
-        let l = self.region[r * self.cols + c];
+        let l = self.labels().0[r * self.cols + c];
         (l != u32::MAX).then_some(l)
     }
 
     /// Number of connected regions.
     pub fn region_count(&self) -> usize {
-        self.region_count
+        self.labels().1
+    }
+
+    /// Region labels and their number, labelled on first use.
+    fn labels(&self) -> &(Vec<u32>, usize) {
+        self.labels
+            .get_or_init(|| label_regions(self.cols, self.rows, &self.free, &self.moves))
     }
 
     /// Cells `row * cols + col` of region `label`, in increasing order (listed on first use).
     pub fn region_cells(&self, label: u32) -> &[u32] {
         let regions = self.regions.get_or_init(|| {
-            let mut regions = vec![Vec::new(); self.region_count];
-            for (i, &l) in self.region.iter().enumerate() {
+            let (labels, count) = self.labels();
+            let mut regions = vec![Vec::new(); *count];
+            for (i, &l) in labels.iter().enumerate() {
                 if l != u32::MAX {
                     regions[l as usize].push(i as u32);
                 }
@@ -243,8 +247,10 @@ impl FreeGrid {
 /// of regions.
 ///
 /// Union-find over runs: each row splits into runs of free cells linked east-west; a run joins
-/// the runs below it that it is linked to; every set's root is its lowest cell.
-fn label_regions(cols: usize, rows: usize, free: &[bool], unlinked: &[u8]) -> (Vec<u32>, usize) {
+/// the runs below it that it is linked to; every set's root is its lowest cell. Links are read
+/// from the cells' open [moves](open_moves): between two free cells, the east (bit 0) and north
+/// (bit 2) moves are open exactly where the link is.
+fn label_regions(cols: usize, rows: usize, free: &[bool], moves: &[u8]) -> (Vec<u32>, usize) {
     fn root(parent: &mut [u32], mut i: u32) -> u32 {
         while parent[i as usize] != i {
             let up = parent[parent[i as usize] as usize];
@@ -266,13 +272,13 @@ fn label_regions(cols: usize, rows: usize, free: &[bool], unlinked: &[u8]) -> (V
                 start = u32::MAX;
                 continue;
             }
-            if start == u32::MAX || unlinked[i - 1] & 1 != 0 {
+            if start == u32::MAX || moves[i - 1] & 1 == 0 {
                 start = i as u32;
                 parent[i] = start;
                 below_last = u32::MAX;
             }
             run[i] = start;
-            if r > 0 && free[i - cols] && unlinked[i - cols] & 2 == 0 {
+            if r > 0 && moves[i - cols] & 4 != 0 {
                 let below = run[i - cols];
                 if below != below_last {
                     below_last = below;
@@ -477,12 +483,12 @@ mod tests {
                     }
                 })
                 .collect();
-            let (region, count) = label_regions(cols, rows, &free, &unlinked);
+            let moves = open_moves(cols, rows, &free, &unlinked);
+            let (region, count) = label_regions(cols, rows, &free, &moves);
             let flood = flood_labels(cols, rows, &free, &unlinked);
             assert_eq!(region, flood, "case {case}");
             let labels = flood.iter().filter(|&&l| l != u32::MAX);
             assert_eq!(count, labels.max().map_or(0, |&l| l as usize + 1));
-            let moves = open_moves(cols, rows, &free, &unlinked);
             for i in 0..cols * rows {
                 let (c, r) = ((i % cols) as isize, (i / cols) as isize);
                 let steps = [
