@@ -71,18 +71,17 @@ fn scan(c: &mut Criterion) {
     let crowded = Episode::new(&crowd, Arc::new(maze_scene(&crowd, 0)), 0).expect("places");
     let movers = crowded.movers().expect("a crowd").clone();
     let mut group = c.benchmark_group("scan");
+    // As an episode senses: the heading's sine and cosine once, the still scene, then the discs.
+    let radius = config.robot.radius_px;
     group.bench_function("100_discs", |b| {
         b.iter(|| {
-            laser.scan(
-                &scene,
-                black_box(pose.position()),
-                black_box(pose.z_deg),
-                &mut out,
-            );
-            movers.sense(
+            let heading = unit(black_box(pose.z_deg));
+            laser.scan_toward(&scene, black_box(pose.position()), heading, &mut out);
+            movers.sense_toward(
                 &laser,
                 black_box(pose.position()),
-                black_box(pose.z_deg),
+                radius,
+                heading,
                 &mut out,
             )
         })

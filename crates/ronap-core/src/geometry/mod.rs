@@ -15,6 +15,11 @@ pub mod shape;
 
 use nalgebra::{Point2, Vector2};
 
+/// The instruction sets of this processor, detected once: loops written to vectorise run under
+/// `ARCH.dispatch`, compiled for the widest set the processor has (AVX2 where there is one).
+/// Multiplies and adds stay separate (Rust never fuses them), so every set gives the same bits.
+pub(crate) static ARCH: std::sync::LazyLock<pulp::Arch> = std::sync::LazyLock::new(pulp::Arch::new);
+
 /// A point in the scene, px.
 pub type Point = Point2<f64>;
 /// A displacement or direction in the scene, px.

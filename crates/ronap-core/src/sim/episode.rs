@@ -259,10 +259,11 @@ impl Episode {
     pub(crate) fn sense_among(&mut self, movers: Option<&Movers>, others: &[Disc]) {
         let p = self.pose.position();
         let radius = self.config.robot.radius_px;
+        let heading = crate::geometry::unit(self.pose.z_deg);
         self.laser
-            .scan(&self.scene, p, self.pose.z_deg, &mut self.readings);
+            .scan_toward(&self.scene, p, heading, &mut self.readings);
         if let Some(movers) = movers {
-            let gap = movers.sense_as(&self.laser, p, radius, self.pose.z_deg, &mut self.readings);
+            let gap = movers.sense_toward(&self.laser, p, radius, heading, &mut self.readings);
             self.note_gap(gap);
         }
         let reach = self.laser.range_px() + radius;

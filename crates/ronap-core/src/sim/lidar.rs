@@ -107,9 +107,14 @@ impl Laser {
 
     /// Noise-free readings from `position` at `heading_deg` into `out` (one per beam), px.
     pub fn scan(&self, scene: &Scene, position: Point, heading_deg: f64, out: &mut [f64]) {
+        self.scan_toward(scene, position, unit(heading_deg), out);
+    }
+
+    /// [`Laser::scan`] for the unit heading `heading` (`unit(heading_deg)`), which a caller that
+    /// also refines the readings works out once.
+    pub fn scan_toward(&self, scene: &Scene, position: Point, heading: Vector, out: &mut [f64]) {
         debug_assert_eq!(out.len(), self.offsets.len());
         let range = self.range_px;
-        let heading = unit(heading_deg);
         let r2 = range * range;
         let near = scene.boxes_near(position, range);
         // The boxes within range, when the bin lists few enough to look through and there are
@@ -158,7 +163,7 @@ impl Laser {
                 .filter(|s| s.aabb().distance_squared(position) <= r2)
                 .collect();
             if !near.is_empty() {
-                self.refine(position, heading_deg, out, |origin, dir, best| {
+                self.refine_toward(position, heading, out, |origin, dir, best| {
                     near.iter()
                         .filter_map(|s| s.cast_ray(origin, dir, best))
                         .fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.min(t))))
@@ -176,9 +181,20 @@ impl Laser {
         position: Point,
         heading_deg: f64,
         out: &mut [f64],
+        hit: impl FnMut(Point, Vector, f64) -> Option<f64>,
+    ) {
+        self.refine_toward(position, unit(heading_deg), out, hit);
+    }
+
+    /// [`Laser::refine`] for the unit heading `heading` (`unit(heading_deg)`).
+    #[inline]
+    pub fn refine_toward(
+        &self,
+        position: Point,
+        heading: Vector,
+        out: &mut [f64],
         mut hit: impl FnMut(Point, Vector, f64) -> Option<f64>,
     ) {
-        let heading = unit(heading_deg);
         for (reading, offset) in out.iter_mut().zip(&self.offsets) {
             let dir = turn(heading, *offset);
             if let Some(t) = hit(position, dir, *reading) {
@@ -237,6 +253,40 @@ impl Laser {
                     for i in lo as usize..=hi as usize {
                         beam(i, j, out);
                     }
+                }
+            }
+        }
+    }
+
+    /// Shortens each reading in `out` (taken at the unit heading `heading`) to the nearest of
+    /// a few discs it meets, each given as `(centre - position, |centre - position|^2, radius^2)`:
+    /// the readings [`Laser::refine_toward`] gives with a `hit` that reports the nearest disc by
+    /// [`Body::ray`](crate::sim::moving::Body::ray)'s arithmetic (the same operations, so the same
+    /// bits). The beams go through in blocks as plain arithmetic with no branch, which vectorises.
+    pub(crate) fn refine_discs(
+        &self,
+        heading: Vector,
+        out: &mut [f64],
+        discs: &[(Vector, f64, f64)],
+    ) {
+        const BLOCK: usize = 32;
+        let (mut dx, mut dy) = ([0.0; BLOCK], [0.0; BLOCK]);
+        for (offsets, out) in self.offsets.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+            let m = offsets.len();
+            for (k, offset) in offsets.iter().enumerate() {
+                let dir = turn(heading, *offset);
+                (dx[k], dy[k]) = (dir.x, dir.y);
+            }
+            for &(oc, oc2, r2) in discs {
+                let inside = oc2 <= r2;
+                for k in 0..m {
+                    // `oc.dot(&dir)` as nalgebra works it out for two components.
+                    let along = oc.x * dx[k] + oc.y * dy[k];
+                    let d2 = oc2 - along * along;
+                    let t = along - (r2 - d2).sqrt();
+                    let t = if inside { 0.0 } else { t };
+                    let hit = (d2 <= r2) & (t >= 0.0) & (t < out[k]);
+                    out[k] = if hit { t } else { out[k] };
                 }
             }
         }

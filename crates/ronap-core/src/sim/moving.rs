@@ -172,6 +172,8 @@ struct State {
     bound: Vec<f64>,
     /// Squared distance from the robot's centre within which a move must be checked against it.
     near_robot2: Vec<f64>,
+    /// Whether it is present (has appeared and is not held back).
+    present: Vec<bool>,
     /// Whether it moves along its heading this step (present, `linear` or `random_walk`).
     walks: Vec<bool>,
     /// This step's turn, rad (0 for the obstacles not turning), and its sine and cosine.
@@ -186,6 +188,41 @@ struct State {
     moved: Vec<bool>,
     /// This step's turns beyond 1 rad, as `(obstacle, sin, cos)`, applied after the pass.
     wide: Vec<(usize, f64, f64)>,
+    /// The obstacles by band of [`BAND_PX`] in y, then by x (`by_key`), with their bands and x
+    /// (`key_band`, `key_x`) and where each band starts in that order (`band_start`, one past
+    /// the last band at the end), as of the end of the last step: a scan looks only at the
+    /// obstacles of the bands within its reach whose x is within its reach too. Obstacles move a
+    /// few px a step, so the order barely changes and an insertion sort keeps it in a pass.
+    by_key: Vec<u32>,
+    key_band: Vec<u32>,
+    key_x: Vec<f64>,
+    band_start: Vec<u32>,
+    /// The largest bounding radius, px.
+    max_bound: f64,
+}
+
+/// Height of the bands of y by which [`State`] orders the obstacles for scans, px.
+const BAND_PX: f64 = 64.0;
+
+/// The band of y (below 0: band 0).
+fn band(y: f64) -> u32 {
+    // A float cast saturates (and takes NaN to 0), so every y has a band, in order.
+    (y.max(0.0) / BAND_PX) as u32
+}
+
+/// [`State::pass`] as pulp runs it, compiled once per instruction set.
+struct Pass<'a> {
+    state: &'a mut State,
+    robots: &'a [Point],
+}
+
+impl pulp::WithSimd for Pass<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _: S) {
+        self.state.pass(self.robots);
+    }
 }
 
 /// Margin by which a centre must lie inside its free box, px: the fast test never accepts what
@@ -196,6 +233,7 @@ impl State {
     fn push(&mut self, entry: &Entry, position: Point, dir: Vector, speed: f64, near_robot: f64) {
         self.bound.push(entry.body.bounding_radius());
         self.near_robot2.push(near_robot * near_robot);
+        self.present.push(entry.present());
         self.walks.push(false);
         self.moved.push(false);
         self.x.push(position.x);
@@ -219,16 +257,88 @@ impl State {
         Point::new(self.x[i], self.y[i])
     }
 
+    /// Brings the order by band and x ([`State::by_key`]) up to date with where the obstacles are.
+    fn sort_keys(&mut self) {
+        let n = self.x.len();
+        if self.by_key.len() != n {
+            self.by_key = (0..n as u32).collect();
+            self.key_band.resize(n, 0);
+            self.key_x.resize(n, 0.0);
+            self.max_bound = self.bound.iter().copied().fold(0.0, f64::max);
+        }
+        for k in 0..n {
+            let i = self.by_key[k] as usize;
+            self.key_x[k] = self.x[i];
+            self.key_band[k] = band(self.y[i]);
+        }
+        for k in 1..n {
+            let (b, x, i) = (self.key_band[k], self.key_x[k], self.by_key[k]);
+            let mut j = k;
+            while j > 0 && (self.key_band[j - 1], self.key_x[j - 1]) > (b, x) {
+                self.key_band[j] = self.key_band[j - 1];
+                self.key_x[j] = self.key_x[j - 1];
+                self.by_key[j] = self.by_key[j - 1];
+                j -= 1;
+            }
+            (self.key_band[j], self.key_x[j], self.by_key[j]) = (b, x, i);
+        }
+        let bands = self.key_band.last().map_or(0, |&b| b as usize + 1);
+        self.band_start.clear();
+        let mut k = 0;
+        for b in 0..=bands {
+            while k < n && (self.key_band[k] as usize) < b {
+                k += 1;
+            }
+            self.band_start.push(k as u32);
+        }
+    }
+
+    /// The obstacles whose centre may lie within `slab` px of `p` on both axes, as
+    /// `(x, obstacle)` runs of the order by band and x (every one that does is in them).
+    fn near(&self, p: Point, slab: f64) -> impl Iterator<Item = (f64, usize)> + '_ {
+        let bands = self.band_start.len().saturating_sub(1) as u32;
+        let (lo, hi) = (
+            band(p.y - slab),
+            band(p.y + slab).min(bands.saturating_sub(1)),
+        );
+        let (left, right) = (p.x - slab, p.x + slab);
+        (lo..=hi.max(lo))
+            .filter(move |&b| b < bands)
+            .flat_map(move |b| {
+                let (s, e) = (
+                    self.band_start[b as usize] as usize,
+                    self.band_start[b as usize + 1] as usize,
+                );
+                let xs = &self.key_x[s..e];
+                let first = xs.partition_point(|&x| x < left);
+                xs[first..]
+                    .iter()
+                    .zip(&self.by_key[s + first..e])
+                    .take_while(move |(&x, _)| x <= right)
+                    .map(|(&x, &i)| (x, i as usize))
+            })
+    }
+
     /// Turns every heading by this step's turn and moves it `speed` ahead into `ahead`, marking
     /// in `fits` those whose move stays in their free box; moves there, and marks `moved`, the
-    /// walks that fit and are not near any robot at `robots`. Plain arithmetic over the arrays,
-    /// so it vectorises; turns beyond 1 rad are applied one by one first.
+    /// walks that fit and are not near any robot at `robots`. Turns beyond 1 rad are applied one
+    /// by one first; the rest is plain arithmetic over the arrays in loops with no branch, which
+    /// vectorise (compiled for the processor's widest instruction set, the same bits on each).
     fn turn_and_look_ahead(&mut self, robots: &[Point]) {
         for &(i, s, c) in &self.wide {
             let (dx, dy) = (self.dx[i], self.dy[i]);
             self.dx[i] = dx * c - dy * s;
             self.dy[i] = dx * s + dy * c;
         }
+        crate::geometry::ARCH.dispatch(Pass {
+            state: self,
+            robots,
+        });
+    }
+
+    /// The vectorised part of [`State::turn_and_look_ahead`].
+    #[inline(always)]
+    fn pass(&mut self, robots: &[Point]) {
         let n = self.x.len();
         let (x, y, speed) = (&mut self.x[..n], &mut self.y[..n], &self.speed[..n]);
         let (dx, dy, turn) = (&mut self.dx[..n], &mut self.dy[..n], &self.turn[..n]);
@@ -238,6 +348,14 @@ impl State {
         let (fits, moved) = (&mut self.fits[..n], &mut self.moved[..n]);
         let (walks, near2) = (&self.walks[..n], &self.near_robot2[..n]);
         let (sin, cos) = (&mut self.sin[..n], &mut self.cos[..n]);
+        // Which walks are far from every robot (from where they are now), robot by robot.
+        moved.copy_from_slice(walks);
+        for robot in robots {
+            for i in 0..n {
+                let (rx, ry) = (x[i] - robot.x, y[i] - robot.y);
+                moved[i] &= rx * rx + ry * ry >= near2[i];
+            }
+        }
         // The series alone first: a short loop the compiler interleaves, hiding the latency of
         // the long chains of multiplications.
         for i in 0..n {
@@ -249,27 +367,27 @@ impl State {
             // A rotation keeps the length to within rounding; one Newton step towards length 1
             // stops the drift without a square root or a division.
             let k = 1.5 - 0.5 * (tx * tx + ty * ty);
-            dx[i] = tx * k;
-            dy[i] = ty * k;
-            ax[i] = x[i] + dx[i] * speed[i];
-            ay[i] = y[i] + dy[i] * speed[i];
+            let (ux, uy) = (tx * k, ty * k);
+            dx[i] = ux;
+            dy[i] = uy;
+            let (px, py) = (x[i], y[i]);
+            let (qx, qy) = (px + ux * speed[i], py + uy * speed[i]);
+            ax[i] = qx;
+            ay[i] = qy;
             // The move is clear when both ends lie in the box (it is convex).
-            fits[i] = (ax[i] > lo_x[i])
-                & (ax[i] < hi_x[i])
-                & (ay[i] > lo_y[i])
-                & (ay[i] < hi_y[i])
-                & (x[i] > lo_x[i])
-                & (x[i] < hi_x[i])
-                & (y[i] > lo_y[i])
-                & (y[i] < hi_y[i]);
-            let mut far = true;
-            for robot in robots {
-                let (rx, ry) = (x[i] - robot.x, y[i] - robot.y);
-                far &= rx * rx + ry * ry >= near2[i];
-            }
-            moved[i] = walks[i] & fits[i] & far;
-            x[i] = if moved[i] { ax[i] } else { x[i] };
-            y[i] = if moved[i] { ay[i] } else { y[i] };
+            let fit = (qx > lo_x[i])
+                & (qx < hi_x[i])
+                & (qy > lo_y[i])
+                & (qy < hi_y[i])
+                & (px > lo_x[i])
+                & (px < hi_x[i])
+                & (py > lo_y[i])
+                & (py < hi_y[i]);
+            fits[i] = fit;
+            let go = moved[i] & fit;
+            moved[i] = go;
+            x[i] = if go { qx } else { px };
+            y[i] = if go { qy } else { py };
         }
     }
 
@@ -498,6 +616,7 @@ impl Movers {
                 entries.push(e);
             }
         }
+        state.sort_keys();
         Ok(Some(Self {
             entries,
             state,
@@ -658,6 +777,7 @@ impl Movers {
         }
         state.wide.clear();
         for (i, e) in self.entries.iter().enumerate() {
+            state.present[i] = e.present();
             let (walks, sigma) = match e.motion {
                 Motion::Heading { sigma_rad } if e.present() => (true, sigma_rad),
                 _ => (false, 0.0),
@@ -727,6 +847,7 @@ impl Movers {
             state.x[i] = to.x;
             state.y[i] = to.y;
         }
+        state.sort_keys();
     }
 
     /// Where heading obstacle `i` at `from` goes when its move ahead is not known clear: ahead
@@ -802,6 +923,20 @@ impl Movers {
         heading_deg: f64,
         out: &mut [f64],
     ) -> f64 {
+        self.sense_toward(laser, position, radius, unit(heading_deg), out)
+    }
+
+    /// [`Movers::sense_as`] for the unit heading `heading` (`unit(heading_deg)`), which a caller
+    /// that scans the still scene first works out once
+    /// ([`Laser::scan_toward`](crate::sim::lidar::Laser::scan_toward)).
+    pub fn sense_toward(
+        &self,
+        laser: &crate::sim::lidar::Laser,
+        position: Point,
+        radius: f64,
+        heading: Vector,
+        out: &mut [f64],
+    ) -> f64 {
         let mut near = [0u32; 64];
         let mut count = 0;
         let mut overflow = false;
@@ -809,17 +944,20 @@ impl Movers {
         let range = laser.range_px();
         let st = &self.state;
         let reach = range + radius;
-        for (i, e) in self.entries.iter().enumerate() {
+        // Only obstacles whose centre lies within reach of the laser on both axes (widened by a
+        // px, far above any rounding) can be; of those, the ones within reach.
+        let slab = reach + st.max_bound + 1.0;
+        for (_, i) in st.near(position, slab) {
             let (px, py) = (st.x[i] - position.x, st.y[i] - position.y);
             let d2 = px * px + py * py;
             let far = reach + st.bound[i];
-            if d2 > far * far || !e.present() {
+            if d2 > far * far || !st.present[i] {
                 continue;
             }
             let (p, bound) = (st.position(i), st.bound[i]);
             let d = d2.sqrt();
             if d - bound <= range + radius {
-                least_gap = least_gap.min(e.body.gap(p, position, radius));
+                least_gap = least_gap.min(self.entries[i].body.gap(p, position, radius));
                 if d - bound <= range {
                     if count < near.len() {
                         near[count] = i as u32;
@@ -843,7 +981,28 @@ impl Movers {
         } else {
             &near[..count]
         };
-        laser.refine(position, heading_deg, out, |origin, dir, best| {
+        // Discs only (the common case): what each disc's ray test shares across beams is worked
+        // out once, and the beams test them side by side.
+        const DISCS: usize = 16;
+        if !overflow && count <= DISCS {
+            let mut discs = [(Vector::zeros(), 0.0, 0.0); DISCS];
+            let mut all_discs = true;
+            for (slot, &i) in discs.iter_mut().zip(list) {
+                let i = i as usize;
+                match self.entries[i].body {
+                    Body::Disc(r) => {
+                        let oc = st.position(i) - position;
+                        *slot = (oc, oc.norm_squared(), r * r);
+                    }
+                    Body::Box(_) => all_discs = false,
+                }
+            }
+            if all_discs {
+                laser.refine_discs(heading, out, &discs[..count]);
+                return least_gap;
+            }
+        }
+        laser.refine_toward(position, heading, out, |origin, dir, best| {
             let mut nearest: Option<f64> = None;
             for &i in list {
                 let e = &self.entries[i as usize];
@@ -898,6 +1057,94 @@ fn free_spot(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::config::LaserConfig;
+    use crate::sim::lidar::Laser;
+    use crate::sim::world::maze_scene;
+
+    /// What [`Movers::sense_as`] reads, worked out the plain way: every present obstacle
+    /// against every beam.
+    fn sense_every(
+        m: &Movers,
+        laser: &Laser,
+        p: Point,
+        radius: f64,
+        z: f64,
+        out: &mut [f64],
+    ) -> f64 {
+        let present: Vec<_> = m.items().filter(|o| o.present()).collect();
+        laser.refine(p, z, out, |origin, dir, best| {
+            present
+                .iter()
+                .filter_map(|o| o.body().ray(o.position(), origin, dir, best))
+                .fold(None, |n: Option<f64>, t| Some(n.map_or(t, |n| n.min(t))))
+        });
+        let range = laser.range_px();
+        present
+            .iter()
+            .filter(|o| (o.position() - p).norm() - o.body().bounding_radius() <= range + radius)
+            .map(|o| o.body().gap(o.position(), p, radius))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    #[test]
+    fn pruned_sensing_reads_what_every_obstacle_gives_bit_for_bit() {
+        // Crowds of discs, of boxes and of both, more than a scan lists at once for the long
+        // laser, stepped so that the order by band and x has to follow them.
+        for (shapes, beams, range) in [
+            (vec![MovingShape::Disc], 17, 50.0),
+            (vec![MovingShape::Disc], 360, 400.0),
+            (vec![MovingShape::Box, MovingShape::Disc], 64, 120.0),
+            (vec![MovingShape::Disc, MovingShape::Disc], 64, 1000.0),
+        ] {
+            let sim = crate::SimConfig {
+                moving: shapes
+                    .iter()
+                    .map(|&shape| MovingConfig {
+                        count: 60,
+                        shape,
+                        speed_px: 6.0,
+                        ..Default::default()
+                    })
+                    .collect(),
+                laser: LaserConfig {
+                    beams,
+                    fov_deg: 360.0,
+                    range_px: range,
+                    ..Default::default()
+                },
+                ..Default::default()
+            };
+            let config = sim.validate().expect("valid");
+            let scene = maze_scene(&config, 3);
+            let laser = Laser::new(&config.laser);
+            let start = Point::new(125.0, 125.0);
+            let mut movers = Movers::new(&config, &scene, start, Point::new(875.0, 875.0), 3)
+                .expect("places")
+                .expect("has movers");
+            let mut rng = crate::sim::rng::stream(9, crate::sim::rng::Stream::Moving);
+            let mut scanned = 0;
+            for step in 0..200 {
+                movers.advance(step, &scene, start);
+                for _ in 0..5 {
+                    let p =
+                        Point::new(rng.random_range(0.0..1000.0), rng.random_range(0.0..1000.0));
+                    let z = rng.random_range(-180.0..180.0);
+                    let mut want = vec![range; beams as usize];
+                    let mut got = want.clone();
+                    let gap_want = sense_every(&movers, &laser, p, 10.0, z, &mut want);
+                    let gap_got = movers.sense_as(&laser, p, 10.0, z, &mut got);
+                    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                    assert_eq!(bits(&got), bits(&want), "step {step} at {p} heading {z}");
+                    assert_eq!(gap_got.to_bits(), gap_want.to_bits(), "step {step} at {p}");
+                    scanned += usize::from(want.iter().any(|&r| r < range));
+                }
+            }
+            assert!(
+                scanned > 50,
+                "the laser met obstacles in only {scanned} scans"
+            );
+        }
+    }
 
     #[test]
     fn sin_cos_matches_the_library() {

@@ -174,7 +174,7 @@ impl Mlp {
         let Scratch { x, y } = scratch;
         x.clear();
         x.extend_from_slice(observation);
-        ARCH.dispatch(Forward { mlp: self, x, y });
+        crate::geometry::ARCH.dispatch(Forward { mlp: self, x, y });
         x
     }
 
@@ -195,9 +195,6 @@ impl Mlp {
         DiscreteAction::ALL[best]
     }
 }
-
-/// The instruction sets of this processor, detected once.
-static ARCH: std::sync::LazyLock<pulp::Arch> = std::sync::LazyLock::new(pulp::Arch::new);
 
 /// The layers of [`Mlp::forward_into`], compiled once per instruction set (pulp picks the widest
 /// the processor has, AVX2 where there is one): `x` holds the input and, at the end, the output.
