@@ -188,17 +188,31 @@ struct State {
     moved: Vec<bool>,
     /// This step's turns beyond 1 rad, as `(obstacle, sin, cos)`, applied after the pass.
     wide: Vec<(usize, f64, f64)>,
-    /// The obstacles by band of [`BAND_PX`] in y, then by x (`by_key`), with their bands and x
-    /// (`key_band`, `key_x`) and where each band starts in that order (`band_start`, one past
-    /// the last band at the end), as of the end of the last step: a scan looks only at the
-    /// obstacles of the bands within its reach whose x is within its reach too. Obstacles move a
-    /// few px a step, so the order barely changes and an insertion sort keeps it in a pass.
-    by_key: Vec<u32>,
-    key_band: Vec<u32>,
-    key_x: Vec<f64>,
+    /// The obstacles by band of [`BAND_PX`] in y, then by x, as of the end of the last step, and
+    /// where each band starts in that order (`band_start`, one past the last band at the end): a
+    /// scan looks only at the obstacles of the bands within its reach whose x is within its reach
+    /// too. Obstacles move a few px a step, so the order barely changes and an insertion sort
+    /// keeps it in a pass.
+    keys: Vec<Key>,
     band_start: Vec<u32>,
     /// The largest bounding radius, px.
     max_bound: f64,
+}
+
+/// An obstacle's place in [`State::keys`].
+#[derive(Clone, Copy, Debug)]
+struct Key {
+    band: u32,
+    obstacle: u32,
+    x: f64,
+}
+
+impl Key {
+    /// Whether `self` comes after `other`: by band, then by x.
+    #[inline]
+    fn after(&self, other: &Key) -> bool {
+        self.band > other.band || (self.band == other.band && self.x > other.x)
+    }
 }
 
 /// Height of the bands of y by which [`State`] orders the obstacles for scans, px.
@@ -257,66 +271,64 @@ impl State {
         Point::new(self.x[i], self.y[i])
     }
 
-    /// Brings the order by band and x ([`State::by_key`]) up to date with where the obstacles are.
+    /// Brings the order by band and x ([`State::keys`]) up to date with where the obstacles are.
     fn sort_keys(&mut self) {
         let n = self.x.len();
-        if self.by_key.len() != n {
-            self.by_key = (0..n as u32).collect();
-            self.key_band.resize(n, 0);
-            self.key_x.resize(n, 0.0);
+        if self.keys.len() != n {
+            self.keys = (0..n as u32)
+                .map(|obstacle| Key {
+                    band: 0,
+                    obstacle,
+                    x: 0.0,
+                })
+                .collect();
             self.max_bound = self.bound.iter().copied().fold(0.0, f64::max);
         }
-        for k in 0..n {
-            let i = self.by_key[k] as usize;
-            self.key_x[k] = self.x[i];
-            self.key_band[k] = band(self.y[i]);
+        let (x, y) = (&self.x[..n], &self.y[..n]);
+        for key in &mut self.keys {
+            let i = key.obstacle as usize;
+            key.x = x[i];
+            key.band = band(y[i]);
         }
-        for k in 1..n {
-            let (b, x, i) = (self.key_band[k], self.key_x[k], self.by_key[k]);
-            let mut j = k;
-            while j > 0 && (self.key_band[j - 1], self.key_x[j - 1]) > (b, x) {
-                self.key_band[j] = self.key_band[j - 1];
-                self.key_x[j] = self.key_x[j - 1];
-                self.by_key[j] = self.by_key[j - 1];
-                j -= 1;
+        let keys = &mut self.keys[..];
+        for k in 1..keys.len() {
+            if keys[k - 1].after(&keys[k]) {
+                let key = keys[k];
+                let mut j = k;
+                while j > 0 && keys[j - 1].after(&key) {
+                    keys[j] = keys[j - 1];
+                    j -= 1;
+                }
+                keys[j] = key;
             }
-            (self.key_band[j], self.key_x[j], self.by_key[j]) = (b, x, i);
         }
-        let bands = self.key_band.last().map_or(0, |&b| b as usize + 1);
         self.band_start.clear();
-        let mut k = 0;
-        for b in 0..=bands {
-            while k < n && (self.key_band[k] as usize) < b {
-                k += 1;
+        for (k, key) in self.keys.iter().enumerate() {
+            while self.band_start.len() <= key.band as usize {
+                self.band_start.push(k as u32);
             }
-            self.band_start.push(k as u32);
         }
+        self.band_start.push(n as u32);
     }
 
-    /// The obstacles whose centre may lie within `slab` px of `p` on both axes, as
-    /// `(x, obstacle)` runs of the order by band and x (every one that does is in them).
-    fn near(&self, p: Point, slab: f64) -> impl Iterator<Item = (f64, usize)> + '_ {
-        let bands = self.band_start.len().saturating_sub(1) as u32;
-        let (lo, hi) = (
-            band(p.y - slab),
-            band(p.y + slab).min(bands.saturating_sub(1)),
-        );
+    /// Calls `f` with every obstacle whose centre may lie within `slab` px of `p` on both axes
+    /// (and some that do not): those of the bands within reach whose x is within reach.
+    #[inline]
+    fn near(&self, p: Point, slab: f64, mut f: impl FnMut(usize)) {
+        let bands = self.band_start.len().saturating_sub(1);
+        let (lo, hi) = (band(p.y - slab) as usize, band(p.y + slab) as usize);
         let (left, right) = (p.x - slab, p.x + slab);
-        (lo..=hi.max(lo))
-            .filter(move |&b| b < bands)
-            .flat_map(move |b| {
-                let (s, e) = (
-                    self.band_start[b as usize] as usize,
-                    self.band_start[b as usize + 1] as usize,
-                );
-                let xs = &self.key_x[s..e];
-                let first = xs.partition_point(|&x| x < left);
-                xs[first..]
-                    .iter()
-                    .zip(&self.by_key[s + first..e])
-                    .take_while(move |(&x, _)| x <= right)
-                    .map(|(&x, &i)| (x, i as usize))
-            })
+        for b in lo..=hi.min(bands.saturating_sub(1)) {
+            let (s, e) = (self.band_start[b] as usize, self.band_start[b + 1] as usize);
+            let run = &self.keys[s..e];
+            let first = run.partition_point(|k| k.x < left);
+            for key in &run[first..] {
+                if key.x > right {
+                    break;
+                }
+                f(key.obstacle as usize);
+            }
+        }
     }
 
     /// Turns every heading by this step's turn and moves it `speed` ahead into `ahead`, marking
@@ -947,12 +959,12 @@ impl Movers {
         // Only obstacles whose centre lies within reach of the laser on both axes (widened by a
         // px, far above any rounding) can be; of those, the ones within reach.
         let slab = reach + st.max_bound + 1.0;
-        for (_, i) in st.near(position, slab) {
+        st.near(position, slab, |i| {
             let (px, py) = (st.x[i] - position.x, st.y[i] - position.y);
             let d2 = px * px + py * py;
             let far = reach + st.bound[i];
             if d2 > far * far || !st.present[i] {
-                continue;
+                return;
             }
             let (p, bound) = (st.position(i), st.bound[i]);
             let d = d2.sqrt();
@@ -967,7 +979,7 @@ impl Movers {
                     }
                 }
             }
-        }
+        });
         if count == 0 {
             return least_gap;
         }
@@ -983,7 +995,7 @@ impl Movers {
         };
         // Discs only (the common case): what each disc's ray test shares across beams is worked
         // out once, and the beams test them side by side.
-        const DISCS: usize = 16;
+        const DISCS: usize = 8;
         if !overflow && count <= DISCS {
             let mut discs = [(Vector::zeros(), 0.0, 0.0); DISCS];
             let mut all_discs = true;
