@@ -1100,20 +1100,31 @@ mod tests {
 
     #[test]
     fn pruned_sensing_reads_what_every_obstacle_gives_bit_for_bit() {
-        // Crowds of discs, of boxes and of both, more than a scan lists at once for the long
-        // laser, stepped so that the order by band and x has to follow them.
-        for (shapes, beams, range) in [
-            (vec![MovingShape::Disc], 17, 50.0),
-            (vec![MovingShape::Disc], 360, 400.0),
-            (vec![MovingShape::Box, MovingShape::Disc], 64, 120.0),
-            (vec![MovingShape::Disc, MovingShape::Disc], 64, 1000.0),
+        // Crowds of discs, of boxes and of both, some of them appearing mid-run, more than a
+        // scan lists at once for the long laser, stepped so that the order by band and x has to
+        // follow them.
+        use MotionKind::{Appear, RandomWalk};
+        use MovingShape::{Box, Disc};
+        for (kinds, beams, range) in [
+            (vec![(Disc, RandomWalk)], 17, 50.0),
+            (vec![(Disc, RandomWalk), (Disc, Appear)], 360, 400.0),
+            (
+                vec![(Box, RandomWalk), (Disc, RandomWalk), (Box, Appear)],
+                64,
+                120.0,
+            ),
+            (vec![(Disc, RandomWalk), (Disc, RandomWalk)], 64, 1000.0),
         ] {
             let sim = crate::SimConfig {
-                moving: shapes
+                moving: kinds
                     .iter()
-                    .map(|&shape| MovingConfig {
+                    .map(|&(shape, motion)| MovingConfig {
                         count: 60,
                         shape,
+                        motion,
+                        then: RandomWalk,
+                        from_step: 10,
+                        to_step: 150,
                         speed_px: 6.0,
                         ..Default::default()
                     })
