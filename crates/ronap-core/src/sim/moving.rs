@@ -172,8 +172,6 @@ struct State {
     bound: Vec<f64>,
     /// Squared distance from the robot's centre within which a move must be checked against it.
     near_robot2: Vec<f64>,
-    /// Whether it is present (has appeared and is not held back).
-    present: Vec<bool>,
     /// Whether it moves along its heading this step (present, `linear` or `random_walk`).
     walks: Vec<bool>,
     /// This step's turn, rad (0 for the obstacles not turning), and its sine and cosine.
@@ -195,8 +193,6 @@ struct State {
     /// keeps it in a pass.
     keys: Vec<Key>,
     band_start: Vec<u32>,
-    /// The largest bounding radius, px.
-    max_bound: f64,
 }
 
 /// An obstacle's place in [`State::keys`].
@@ -247,7 +243,6 @@ impl State {
     fn push(&mut self, entry: &Entry, position: Point, dir: Vector, speed: f64, near_robot: f64) {
         self.bound.push(entry.body.bounding_radius());
         self.near_robot2.push(near_robot * near_robot);
-        self.present.push(entry.present());
         self.walks.push(false);
         self.moved.push(false);
         self.x.push(position.x);
@@ -282,7 +277,6 @@ impl State {
                     x: 0.0,
                 })
                 .collect();
-            self.max_bound = self.bound.iter().copied().fold(0.0, f64::max);
         }
         let (x, y) = (&self.x[..n], &self.y[..n]);
         for key in &mut self.keys {
@@ -789,7 +783,6 @@ impl Movers {
         }
         state.wide.clear();
         for (i, e) in self.entries.iter().enumerate() {
-            state.present[i] = e.present();
             let (walks, sigma) = match e.motion {
                 Motion::Heading { sigma_rad } if e.present() => (true, sigma_rad),
                 _ => (false, 0.0),
@@ -956,14 +949,15 @@ impl Movers {
         let range = laser.range_px();
         let st = &self.state;
         let reach = range + radius;
-        // Only obstacles whose centre lies within reach of the laser on both axes (widened by a
-        // px, far above any rounding) can be; of those, the ones within reach.
-        let slab = reach + st.max_bound + 1.0;
+        // Only obstacles whose centre lies within reach of the laser on both axes (the largest
+        // bounding radius, and a px far above any rounding, added) can be; of those, the ones
+        // within reach.
+        let slab = reach + self.reach + 1.0;
         st.near(position, slab, |i| {
             let (px, py) = (st.x[i] - position.x, st.y[i] - position.y);
             let d2 = px * px + py * py;
             let far = reach + st.bound[i];
-            if d2 > far * far || !st.present[i] {
+            if d2 > far * far || !self.entries[i].present() {
                 return;
             }
             let (p, bound) = (st.position(i), st.bound[i]);
