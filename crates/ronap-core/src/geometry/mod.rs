@@ -93,6 +93,44 @@ impl Aabb {
         (enter <= exit).then_some(enter)
     }
 
+    /// Whether the segment `a`–`b` stays at least `radius` from the box: the same answer as
+    /// `segment_distance_squared(a, b) >= radius * radius`, bit for bit, but settled without a
+    /// division where the segment's bounding box keeps clear of the box grown by `radius` (with
+    /// a hair to spare, so rounding cannot tell the two apart), and otherwise stopping at the
+    /// first point found too close.
+    #[inline]
+    pub fn segment_clear(&self, a: Point, b: Point, radius: f64) -> bool {
+        let grow = radius + SEGMENT_CLEAR_HAIR;
+        if a.x.max(b.x) < self.min.x - grow
+            || a.x.min(b.x) > self.max.x + grow
+            || a.y.max(b.y) < self.min.y - grow
+            || a.y.min(b.y) > self.max.y + grow
+        {
+            return true;
+        }
+        let r2 = radius * radius;
+        let d = b - a;
+        let len = d.norm();
+        if len > 0.0 {
+            let inv = Vector::new(1.0 / (d.x / len), 1.0 / (d.y / len));
+            if self.ray_hit(a, inv, len).is_some() {
+                return 0.0 >= r2;
+            }
+        } else if self.contains(a) {
+            return 0.0 >= r2;
+        }
+        self.distance_squared(a) >= r2
+            && self.distance_squared(b) >= r2
+            && [
+                self.min,
+                Point::new(self.max.x, self.min.y),
+                self.max,
+                Point::new(self.min.x, self.max.y),
+            ]
+            .iter()
+            .all(|&c| point_segment_distance_squared(c, a, b) >= r2)
+    }
+
     /// Squared distance between the segment `a`–`b` and the box (0 when they meet).
     pub fn segment_distance_squared(&self, a: Point, b: Point) -> f64 {
         let d = b - a;
@@ -121,6 +159,11 @@ impl Aabb {
             )
     }
 }
+
+/// How much further than asked [`Aabb::segment_clear`]'s division-free test wants a segment to
+/// keep, px: far above the rounding of coordinates up to millions of px, far below anything
+/// that matters.
+const SEGMENT_CLEAR_HAIR: f64 = 1e-6;
 
 /// Squared distance from `p` to the segment `a`–`b`.
 pub fn point_segment_distance_squared(p: Point, a: Point, b: Point) -> f64 {
@@ -205,5 +248,39 @@ mod tests {
         assert_eq!(wrap_deg(360.0), 0.0);
         assert_eq!(wrap_deg(-15.0), 345.0);
         assert!(wrap_deg(-1e-18) < 360.0);
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(4096))]
+
+        /// The division-free test answers as the distance does, including segments that graze
+        /// the grown box, lie along a face, or are a single point.
+        #[test]
+        fn segment_clear_is_segment_distance_at_least_radius(
+            min in (0.0f64..100.0, 0.0f64..100.0),
+            size in (0.0f64..60.0, 0.0f64..60.0),
+            a in (-40.0f64..200.0, -40.0f64..200.0),
+            d in (-80.0f64..80.0, -80.0f64..80.0),
+            snap in 0u8..4,
+            radius in 0.0f64..20.0,
+        ) {
+            let b = Aabb::from_corners(
+                Point::new(min.0, min.1),
+                Point::new(min.0 + size.0, min.1 + size.1),
+            );
+            let a = Point::new(a.0, a.1);
+            // Segments ending on the grown box's edge, running along a face, or of no length.
+            let end = match snap {
+                0 => a + Vector::new(d.0, d.1),
+                1 => Point::new(b.min.x - radius, a.y + d.1),
+                2 => Point::new(a.x, b.max.y + radius),
+                _ => a,
+            };
+            let a = if snap == 2 { Point::new(a.x + d.0, b.max.y + radius) } else { a };
+            proptest::prop_assert_eq!(
+                b.segment_clear(a, end, radius),
+                b.segment_distance_squared(a, end) >= radius * radius
+            );
+        }
     }
 }

@@ -58,13 +58,16 @@ pub fn smooth(scene: &Scene, points: &[Point], radius: f64) -> Vec<Point> {
                         directions.push(d);
                     }
                 }
+                // The corner's own length, kept as it moves (the same value, bit for bit).
+                let mut here = length(out[k]);
                 for d in &directions {
                     let p = out[k] + d * step;
-                    if length(p) < length(out[k]) - 1e-9
+                    if length(p) < here - 1e-9
                         && scene.sweep_clear(a, p, radius)
                         && scene.sweep_clear(p, b, radius)
                     {
                         out[k] = p;
+                        here = length(p);
                         moved = true;
                     }
                 }

@@ -568,7 +568,6 @@ impl Scene {
     /// Whether a disc of `radius` can move in a straight line from `a` to `b` touching nothing:
     /// the whole swept capsule is checked, so no step length passes through an obstacle.
     pub fn sweep_clear(&self, a: Point, b: Point, radius: f64) -> bool {
-        let r2 = radius * radius;
         let piece_clear = |a: Point, b: Point| {
             let reach = (b - a).norm() + radius;
             // A box at least `reach` from `a` is at least `radius` from every point of the
@@ -576,7 +575,7 @@ impl Scene {
             let far2 = reach * reach;
             self.index.near(a, reach).iter().all(|&i| {
                 let b_ = &self.boxes[i as usize];
-                b_.distance_squared(a) >= far2 || b_.segment_distance_squared(a, b) >= r2
+                b_.distance_squared(a) >= far2 || b_.segment_clear(a, b, radius)
             })
         };
         if !self
