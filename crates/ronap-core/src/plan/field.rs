@@ -41,17 +41,17 @@ impl DistanceField {
             cell_px: grid.cell_px(),
             goal,
             cost: work
-                .cost
+                .cells
                 .iter()
-                .map(|&c| {
-                    if c == u32::MAX {
+                .map(|c| {
+                    if c.cost == u32::MAX {
                         f64::INFINITY
                     } else {
-                        c as f64 * px_per_unit
+                        c.cost as f64 * px_per_unit
                     }
                 })
                 .collect(),
-            parent: work.parent,
+            parent: work.cells.iter().map(|c| c.parent).collect(),
         }
     }
 
@@ -108,9 +108,13 @@ impl DistanceField {
         radius: f64,
     ) -> Option<Vec<Point>> {
         let first = best_entry(&attach(scene, grid, start, radius), |i| self.cost[i])?;
-        Some(walk(start, first, self.goal, &self.parent, |i| {
-            self.center(i)
-        }))
+        Some(walk(
+            start,
+            first,
+            self.goal,
+            |i| self.parent[i],
+            |i| self.center(i),
+        ))
     }
 }
 
@@ -133,13 +137,13 @@ pub fn grid_path(
     WORK.with_borrow_mut(|work| {
         work.run(scene, grid, goal, radius, close_cost, Some(&entries));
         let px_per_unit = grid.cell_px() / AXIS as f64;
-        let cost = |i: usize| match work.cost[i] {
+        let cost = |i: usize| match work.cells[i].cost {
             u32::MAX => f64::INFINITY,
             c => c as f64 * px_per_unit,
         };
         // Entries the search stopped short of are provably no better than the best settled one,
         // so leaving them out picks the same entry as the whole field does.
-        let settled = |i: usize| work.cost[i] <= work.reached;
+        let settled = |i: usize| work.cells[i].cost <= work.reached;
         let first = best_entry(
             &entries,
             |i| if settled(i) { cost(i) } else { f64::INFINITY },
@@ -151,7 +155,7 @@ pub fn grid_path(
                 ((i / cols) as f64 + 0.5) * cell_px,
             )
         };
-        Some(walk(start, first, goal, &work.parent, center))
+        Some(walk(start, first, goal, |i| work.cells[i].parent, center))
     })
 }
 
@@ -169,13 +173,20 @@ thread_local! {
     static WORK: std::cell::RefCell<Work> = std::cell::RefCell::default();
 }
 
+/// A cell of the search: its cost to the goal in units ([`AXIS`] per cell side; `u32::MAX` where
+/// not reached) and the next cell towards the goal (or [`ROOT`]).
+#[derive(Clone, Copy, Debug)]
+struct Node {
+    cost: u32,
+    parent: u32,
+}
+
 /// The search's buffers, reusable between searches over grids of any size.
 #[derive(Default)]
 struct Work {
-    /// Cost to the goal per cell, in units ([`AXIS`] per cell side); `u32::MAX` where not reached.
-    cost: Vec<u32>,
-    /// Next cell towards the goal, or [`ROOT`].
-    parent: Vec<u32>,
+    /// Per cell, its cost and parent side by side: a step reads and writes both, and the
+    /// search's front spreads over the whole grid, so one cache line a cell rather than two.
+    cells: Vec<Node>,
     /// Dial's ring of buckets: cells by cost modulo the ring's length.
     buckets: Vec<Vec<u32>>,
     /// Cells of the current bucket being settled.
@@ -207,27 +218,31 @@ impl Work {
         let cell_px = grid.cell_px();
         let close = close_cost.max(1.0).round() as u32;
         let ring = (DIAGONAL * close + 1) as usize;
-        self.cost.clear();
-        self.cost.resize(n, u32::MAX);
-        self.parent.clear();
-        self.parent.resize(n, ROOT);
+        self.cells.clear();
+        self.cells.resize(
+            n,
+            Node {
+                cost: u32::MAX,
+                parent: ROOT,
+            },
+        );
         self.buckets.resize_with(ring, Vec::new);
         self.buckets.truncate(ring);
         self.buckets.iter_mut().for_each(Vec::clear);
         self.reached = 0;
-        let (cost, parent, buckets) = (&mut self.cost, &mut self.parent, &mut self.buckets);
+        let (cells, buckets) = (&mut self.cells, &mut self.buckets);
         let mut pending = 0usize;
         let units_per_px = AXIS as f64 / cell_px;
         let px_per_unit = cell_px / AXIS as f64;
         for (i, d) in attach(scene, grid, goal, radius) {
             let c = (d * units_per_px).round() as u32;
-            if c < cost[i] {
-                cost[i] = c;
+            if c < cells[i].cost {
+                cells[i].cost = c;
                 buckets[c as usize % ring].push(i as u32);
                 pending += 1;
             }
         }
-        let (moves, near) = (grid.moves(), grid.close_cells());
+        let (moves, slow) = (grid.moves(), grid.close_moves());
         let w = cols as isize;
         let offsets: [isize; 8] = [1, -1, w, -w, w + 1, 1 - w, w - 1, -w - 1];
         // Targets lie in a small block: a range check spares looking them up for most cells.
@@ -239,35 +254,47 @@ impl Work {
         // cell's cost).
         let mut best = f64::INFINITY;
         let mut current = 0u32;
+        // `current % ring`, kept by hand: a step lands less than a ring ahead, so its bucket is
+        // an addition and at most one wrap away.
+        let mut slot = 0usize;
+        // Step costs by move, plain and from or into a close cell.
+        let steps = [STEP, STEP.map(|s| s * close)];
         let mut bucket = std::mem::take(&mut self.bucket);
         while pending > 0 {
-            std::mem::swap(&mut bucket, &mut buckets[current as usize % ring]);
+            std::mem::swap(&mut bucket, &mut buckets[slot]);
             for &i in &bucket {
                 let i = i as usize;
-                if cost[i] > current {
+                if cells[i].cost > current {
                     // A start cost a ring or more ahead (the goal's attachments spread wider than
                     // one step): keep it for a later turn of the ring.
-                    buckets[current as usize % ring].push(i as u32);
+                    buckets[slot].push(i as u32);
                     continue;
                 }
                 pending -= 1;
-                if cost[i] < current {
+                if cells[i].cost < current {
                     continue;
                 }
                 // Open moves as bits in the order E, W, N, S, NE, SE, NW, SW: the order decides
                 // which of two equal-cost parents a cell keeps.
                 let mut open = moves[i] as u32;
-                let here_close = near[i];
+                let slow = slow[i] as u32;
                 while open != 0 {
                     let k = open.trailing_zeros() as usize;
                     open &= open - 1;
                     let j = i.wrapping_add(offsets[k] as usize);
-                    let weight = if here_close || near[j] { close } else { 1 };
-                    let nd = current + STEP[k] * weight;
-                    if nd < cost[j] {
-                        cost[j] = nd;
-                        parent[j] = i as u32;
-                        buckets[nd as usize % ring].push(j as u32);
+                    let step = steps[(slow >> k & 1) as usize][k];
+                    let nd = current + step;
+                    let to = &mut cells[j];
+                    if nd < to.cost {
+                        *to = Node {
+                            cost: nd,
+                            parent: i as u32,
+                        };
+                        let mut to = slot + step as usize;
+                        if to >= ring {
+                            to -= ring;
+                        }
+                        buckets[to].push(j as u32);
                         pending += 1;
                     }
                 }
@@ -287,12 +314,16 @@ impl Work {
                 if best.is_finite()
                     && targets
                         .iter()
-                        .all(|&(t, d)| cost[t] <= current || d + floor > best)
+                        .all(|&(t, d)| cells[t].cost <= current || d + floor > best)
                 {
                     break;
                 }
             }
             current += 1;
+            slot += 1;
+            if slot == ring {
+                slot = 0;
+            }
         }
         self.bucket = bucket;
     }
@@ -313,17 +344,17 @@ fn walk(
     start: Point,
     first: usize,
     goal: Point,
-    parent: &[u32],
+    parent: impl Fn(usize) -> u32,
     center: impl Fn(usize) -> Point,
 ) -> Vec<Point> {
     let mut points = vec![start];
     let mut i = first;
     loop {
         points.push(center(i));
-        if parent[i] == ROOT {
+        if parent(i) == ROOT {
             break;
         }
-        i = parent[i] as usize;
+        i = parent(i) as usize;
     }
     points.push(goal);
     points

@@ -34,6 +34,8 @@ pub struct FreeGrid {
     regions: std::sync::OnceLock<Vec<Vec<u32>>>,
     /// The 8-neighbour moves open from each cell, as bits (see [`FreeGrid::moves`]).
     moves: Vec<u8>,
+    /// Of those, the moves from or into a close cell, worked out on first use (a planner's).
+    close_moves: std::sync::OnceLock<Vec<u8>>,
 }
 
 impl FreeGrid {
@@ -147,6 +149,7 @@ impl FreeGrid {
             labels: std::sync::OnceLock::new(),
             regions: std::sync::OnceLock::new(),
             moves,
+            close_moves: std::sync::OnceLock::new(),
         }
     }
 
@@ -167,9 +170,37 @@ impl FreeGrid {
         &self.moves
     }
 
-    /// Close flags of every cell (meaningful for free cells only).
-    pub(crate) fn close_cells(&self) -> &[bool] {
-        &self.close
+    /// Of the [moves](FreeGrid::moves) from each cell, those that start or end in a
+    /// [close](FreeGrid::is_close) cell, as bits in the same order: what a planner charging for
+    /// closeness needs, read from the cell it stands on rather than from each neighbour.
+    pub(crate) fn close_moves(&self) -> &[u8] {
+        self.close_moves.get_or_init(|| {
+            let n = self.moves.len();
+            let w = self.cols as isize;
+            let mut out = vec![0u8; n];
+            for (k, off) in [1, -1, w, -w, w + 1, 1 - w, w - 1, -w - 1]
+                .into_iter()
+                .enumerate()
+            {
+                // Cells `i` in `lo..hi` have their move's target `i + off` in the grid; a move
+                // off the grid (or across its edge) is never open, so its bit stays clear.
+                let lo = off.min(0).unsigned_abs();
+                let hi = n.saturating_sub(off.max(0) as usize);
+                if hi <= lo {
+                    continue;
+                }
+                let there = &self.close[(lo as isize + off) as usize..(hi as isize + off) as usize];
+                for (((o, &m), &here), &there) in out[lo..hi]
+                    .iter_mut()
+                    .zip(&self.moves[lo..hi])
+                    .zip(&self.close[lo..hi])
+                    .zip(there)
+                {
+                    *o |= (m >> k & 1 & u8::from(here | there)) << k;
+                }
+            }
+            out
+        })
     }
 
     /// Cell side, px.
@@ -580,5 +611,28 @@ mod tests {
         ));
         let scene = Scene::from_boxes(100.0, 100.0, boxes, 50.0);
         assert_eq!(FreeGrid::new(&scene, 5.0, 5.0, 5.0).region_count(), 1);
+    }
+
+    #[test]
+    fn close_moves_are_the_open_moves_from_or_into_a_close_cell() {
+        for seed in 0..4u64 {
+            let mut config = crate::config::SimConfig::default();
+            config.maze.cols = 5 + seed as u32;
+            let config = config.validate().expect("valid");
+            let scene = crate::sim::world::maze_scene(&config, seed);
+            let grid = FreeGrid::new(&scene, 5.0, 5.0, 8.0);
+            let cols = grid.size().0 as isize;
+            // E, W, N, S, NE, SE, NW, SW.
+            let offsets = [1, -1, cols, -cols, cols + 1, 1 - cols, cols - 1, -cols - 1];
+            assert!(grid.close_moves().iter().any(|&c| c != 0));
+            assert!(grid.close_moves() != grid.moves());
+            for (i, (&m, &c)) in grid.moves().iter().zip(grid.close_moves()).enumerate() {
+                for (k, off) in offsets.into_iter().enumerate() {
+                    let expect = m >> k & 1 == 1
+                        && (grid.is_close(i) || grid.is_close((i as isize + off) as usize));
+                    assert_eq!(c >> k & 1 == 1, expect, "seed {seed}, cell {i}, move {k}");
+                }
+            }
+        }
     }
 }
