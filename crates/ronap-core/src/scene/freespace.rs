@@ -363,26 +363,38 @@ fn label_regions(cols: usize, rows: usize, free: &[bool], moves: &[u8]) -> (Vec<
 fn open_moves(cols: usize, rows: usize, free: &[bool], unlinked: &[u8]) -> Vec<u8> {
     let mut moves = vec![0u8; cols * rows];
     // A move's bit: its target free, its link open, and for a diagonal both side cells free.
-    // Interior cells, row by row over slices (no bounds left to check, so the loop vectorises),
-    // in arithmetic rather than branches.
+    // Interior cells, row by row, in arithmetic rather than branches over slices cut to the
+    // row's interior (`x_w`, `x_h`, `x_e`: the cells west of, at and east of each), so no bound
+    // is left to check and the loop vectorises.
     let row = |r: usize| r * cols..(r + 1) * cols;
-    let f = |s: &[bool], k: usize| s[k] as u8;
-    let open = |s: &[u8], k: usize, bit: u8| !s[k] >> bit & 1;
-    for r in 1..rows.saturating_sub(1) {
-        let (fs_, fh, fn_) = (&free[row(r - 1)], &free[row(r)], &free[row(r + 1)]);
-        let (us, uh) = (&unlinked[row(r - 1)], &unlinked[row(r)]);
-        let out = &mut moves[row(r)];
-        for (c, out) in out.iter_mut().enumerate().take(cols - 1).skip(1) {
-            let (fe, fw, fno, fs) = (f(fh, c + 1), f(fh, c - 1), f(fn_, c), f(fs_, c));
-            let bits = (fe & open(uh, c, 0))
-                | (fw & open(uh, c - 1, 0)) << 1
-                | (fno & open(uh, c, 1)) << 2
-                | (fs & open(us, c, 1)) << 3
-                | (fe & fno & f(fn_, c + 1) & open(uh, c, 2)) << 4
-                | (fe & fs & f(fs_, c + 1) & open(us, c + 1, 3)) << 5
-                | (fw & fno & f(fn_, c - 1) & open(uh, c, 3)) << 6
-                | (fw & fs & f(fs_, c - 1) & open(us, c - 1, 2)) << 7;
-            *out = bits * f(fh, c);
+    let m = cols.saturating_sub(2);
+    fn shifted<T>(s: &[T], m: usize) -> (&[T], &[T], &[T]) {
+        (&s[..m], &s[1..=m], &s[2..m + 2])
+    }
+    let interior_rows = if cols >= 3 {
+        1..rows.saturating_sub(1)
+    } else {
+        0..0
+    };
+    for r in interior_rows {
+        let (s_w, s_h, s_e) = shifted(&free[row(r - 1)], m);
+        let (h_w, h_h, h_e) = shifted(&free[row(r)], m);
+        let (n_w, n_h, n_e) = shifted(&free[row(r + 1)], m);
+        let (us_w, us_h, us_e) = shifted(&unlinked[row(r - 1)], m);
+        let (uh_w, uh_h, _) = shifted(&unlinked[row(r)], m);
+        let out = &mut moves[row(r)][1..=m];
+        for c in 0..m {
+            let (fe, fw, fno, fs) = (h_e[c] as u8, h_w[c] as u8, n_h[c] as u8, s_h[c] as u8);
+            let (uh, uw, us) = (!uh_h[c], !uh_w[c], !us_h[c]);
+            let bits = (fe & uh & 1)
+                | (fw & uw & 1) << 1
+                | (fno & uh >> 1 & 1) << 2
+                | (fs & us >> 1 & 1) << 3
+                | (fe & fno & n_e[c] as u8 & uh >> 2 & 1) << 4
+                | (fe & fs & s_e[c] as u8 & !us_e[c] >> 3 & 1) << 5
+                | (fw & fno & n_w[c] as u8 & uh >> 3 & 1) << 6
+                | (fw & fs & s_w[c] as u8 & !us_w[c] >> 2 & 1) << 7;
+            out[c] = bits * h_h[c] as u8;
         }
     }
     // The border, checking bounds: the first and last rows, the first and last columns.
