@@ -62,10 +62,21 @@ pub fn smooth(scene: &Scene, points: &[Point], radius: f64) -> Vec<Point> {
                 let mut here = length(out[k]);
                 for d in &directions {
                     let p = out[k] + d * step;
-                    if length(p) < here - 1e-9
-                        && scene.sweep_clear(a, p, radius)
-                        && scene.sweep_clear(p, b, radius)
-                    {
+                    // Both legs clear (the disc at `p` first: both legs end there, and a quarter
+                    // of the tries fail on it; then the shorter, cheaper leg).
+                    let clear = || {
+                        let legs = [(a, p), (p, b)];
+                        let order = if (p - a).norm_squared() <= (b - p).norm_squared() {
+                            [0, 1]
+                        } else {
+                            [1, 0]
+                        };
+                        scene.disc_clear(p, radius)
+                            && order
+                                .iter()
+                                .all(|&l| scene.sweep_clear(legs[l].0, legs[l].1, radius))
+                    };
+                    if length(p) < here - 1e-9 && clear() {
                         out[k] = p;
                         here = length(p);
                         moved = true;
