@@ -226,7 +226,7 @@ impl pulp::WithSimd for Forward<'_> {
 
 /// `y += W x` for the column-major `weights` (column j holds the weights from input j), adding
 /// the columns in input order. Outputs go in blocks of vectors held in registers across all the
-/// inputs (8 vectors, then 2, then 1, then one output at a time), so each weight is loaded once
+/// inputs (8 vectors, then 4, 2, 1, then one output at a time), so each weight is loaded once
 /// and each output stored once. Every output's sum keeps the same order, and multiplies and adds
 /// stay separate (no fused multiply-add), so every instruction set gives the same bits.
 #[inline(always)]
@@ -235,6 +235,12 @@ fn add_columns<S: pulp::Simd>(simd: S, y: &mut [f32], x: &[f32], weights: &[f32]
     while o + 8 * S::F32_LANES <= outputs {
         add_vectors::<S, 8>(simd, y, x, weights, outputs, o);
         o += 8 * S::F32_LANES;
+    }
+    // Four at once where they fit: each output's sum is a chain of dependent adds, so fewer
+    // than about four vectors side by side wait on the adder's latency.
+    while o + 4 * S::F32_LANES <= outputs {
+        add_vectors::<S, 4>(simd, y, x, weights, outputs, o);
+        o += 4 * S::F32_LANES;
     }
     while o + 2 * S::F32_LANES <= outputs {
         add_vectors::<S, 2>(simd, y, x, weights, outputs, o);
