@@ -9,7 +9,7 @@
 //! the same reading to the bit.
 
 use crate::config::LaserConfig;
-use crate::geometry::{unit, Aabb, Point, Vector};
+use crate::geometry::{larger, smaller, unit, Aabb, Point, Vector};
 use crate::scene::Scene;
 use rand_distr::{Distribution, Normal};
 
@@ -137,19 +137,7 @@ impl Laser {
             }
         }
         if count <= MAX_LOCAL_BOXES {
-            for (reading, offset) in out.iter_mut().zip(&self.offsets) {
-                let dir = turn(heading, *offset);
-                let inv = Vector::new(1.0 / dir.x, 1.0 / dir.y);
-                // Each box against the whole beam, so the tests do not wait on each other: the
-                // least hit is the same as shortening the beam box by box.
-                let mut best = range;
-                for b in &local[..count] {
-                    if let Some(t) = b.ray_hit(position, inv, range) {
-                        best = if t < best { t } else { best };
-                    }
-                }
-                *reading = best;
-            }
+            self.local_hits(position, heading, &local[..count], out);
         } else {
             let beams = self.offsets.iter().map(|offset| turn(heading, *offset));
             scene
@@ -168,6 +156,58 @@ impl Laser {
                         .filter_map(|s| s.cast_ray(origin, dir, best))
                         .fold(None, |m: Option<f64>, t| Some(m.map_or(t, |m| m.min(t))))
                 });
+            }
+        }
+    }
+
+    /// Every beam's least [`Aabb::ray_hit`] over `boxes` (a few boxes within range) into `out`,
+    /// `range_px` where none is hit. The beams go through in blocks, each box against a block's
+    /// beams as plain arithmetic that vectorises: the same operations as `ray_hit` on the box's
+    /// sides less the position (worked out once a scan), so the same bits. A beam along an axis
+    /// (an infinite inverse component, where `ray_hit` must look for NaN) is asked of `ray_hit`.
+    fn local_hits(&self, position: Point, heading: Vector, boxes: &[Aabb], out: &mut [f64]) {
+        const BLOCK: usize = 32;
+        let range = self.range_px;
+        let mut sides = [[0.0; 4]; MAX_LOCAL_BOXES];
+        for (s, b) in sides.iter_mut().zip(boxes) {
+            *s = [
+                b.min.x - position.x,
+                b.max.x - position.x,
+                b.min.y - position.y,
+                b.max.y - position.y,
+            ];
+        }
+        let sides = &sides[..boxes.len()];
+        let (mut ix, mut iy) = ([0.0; BLOCK], [0.0; BLOCK]);
+        for (offsets, out) in self.offsets.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
+            let m = offsets.len();
+            let mut along_axis = false;
+            for (k, offset) in offsets.iter().enumerate() {
+                let dir = turn(heading, *offset);
+                (ix[k], iy[k]) = (1.0 / dir.x, 1.0 / dir.y);
+                along_axis |= !(ix[k].is_finite() && iy[k].is_finite());
+            }
+            out.fill(range);
+            for &[lx, hx, ly, hy] in sides {
+                for k in 0..m {
+                    let (nx, fx) = if ix[k] > 0.0 { (lx, hx) } else { (hx, lx) };
+                    let (ny, fy) = if iy[k] > 0.0 { (ly, hy) } else { (hy, ly) };
+                    let enter = larger(larger(nx * ix[k], ny * iy[k]), 0.0);
+                    let exit = smaller(smaller(fx * ix[k], fy * iy[k]), range);
+                    let hit = if enter <= exit { enter } else { f64::INFINITY };
+                    out[k] = smaller(hit, out[k]);
+                }
+            }
+            if along_axis {
+                for k in 0..m {
+                    if !(ix[k].is_finite() && iy[k].is_finite()) {
+                        let inv = Vector::new(ix[k], iy[k]);
+                        out[k] = boxes
+                            .iter()
+                            .filter_map(|b| b.ray_hit(position, inv, range))
+                            .fold(range, smaller);
+                    }
+                }
             }
         }
     }
