@@ -481,22 +481,25 @@ impl Team {
         let slot = self.comm.slot_size();
         let k_near = self.comm.neighbours as usize;
         // `sent` is in robot order, and the grid holds where the senders were.
-        let of = |k: usize| sent.binary_search_by_key(&k, |b| b.from).ok();
+        let of = sent_by_robot(sent.iter().map(|b| b.from), self.robots.len());
         let mut found = Vec::new();
+        let mut near: Vec<(f64, &Broadcast)> = Vec::new();
         for (i, inbox) in self.inbox.iter_mut().enumerate() {
             inbox.clear();
-            let Some(me) = of(i).map(|m| &sent[m]) else {
+            let Some(me) = of[i].map(|m| &sent[m as usize]) else {
                 continue;
             };
             let at = me.pose.position();
             self.grid_before.near(at, range, &mut found);
-            let mut near: Vec<(f64, &Broadcast)> = found
-                .iter()
-                .filter_map(|&j| of(j as usize).map(|m| &sent[m]))
-                .filter(|b| b.from != i)
-                .map(|b| ((b.pose.position() - at).norm(), b))
-                .filter(|(d, _)| *d <= range)
-                .collect();
+            near.clear();
+            near.extend(
+                found
+                    .iter()
+                    .filter_map(|&j| of[j as usize].map(|m| &sent[m as usize]))
+                    .filter(|b| b.from != i)
+                    .map(|b| ((b.pose.position() - at).norm(), b))
+                    .filter(|(d, _)| *d <= range),
+            );
             near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.from.cmp(&b.1.from)));
             inbox.extend(near.iter().map(|(_, b)| (*b).clone()));
             if k_near == 0 {
@@ -526,6 +529,7 @@ impl Team {
             .filter(|&k| self.present(k))
             .map(|k| (k, disc(&self.robots[k])))
             .collect();
+        let of = sent_by_robot(discs.iter().map(|(k, _)| *k), n);
         let movers = self.movers.take();
         self.grid_after.fill(discs.iter().map(|(k, d)| (*k, d.at)));
         let mut others = Vec::with_capacity(discs.len());
@@ -539,16 +543,26 @@ impl Team {
             let reach = r.laser().range_px() + r.config().robot.radius_px + self.max_radius;
             self.grid_after.near(r.pose().position(), reach, &mut found);
             others.clear();
-            others.extend(found.iter().filter(|&&j| j as usize != k).filter_map(|&j| {
-                discs
-                    .binary_search_by_key(&(j as usize), |(i, _)| *i)
-                    .ok()
-                    .map(|m| discs[m].1)
-            }));
+            others.extend(
+                found
+                    .iter()
+                    .filter(|&&j| j as usize != k)
+                    .filter_map(|&j| of[j as usize].map(|m| discs[m as usize].1)),
+            );
             self.robots[k].sense_among(movers.as_deref(), &others);
         }
         self.movers = movers;
     }
+}
+
+/// For each of `n` robots, where it stands in a list of robots given in increasing order
+/// (`robots`), if it is there.
+fn sent_by_robot(robots: impl Iterator<Item = usize>, n: usize) -> Vec<Option<u32>> {
+    let mut at = vec![None; n];
+    for (m, k) in robots.enumerate() {
+        at[k] = Some(m as u32);
+    }
+    at
 }
 
 /// Robot `r` as a disc.
