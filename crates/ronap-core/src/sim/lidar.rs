@@ -49,6 +49,24 @@ impl pulp::WithSimd for LocalHits<'_> {
     }
 }
 
+/// [`Laser::refine_discs_with`] compiled for the processor's widest instruction set.
+struct RefineDiscs<'a> {
+    laser: &'a Laser,
+    heading: Vector,
+    out: &'a mut [f64],
+    discs: &'a [(Vector, f64, f64)],
+}
+
+impl pulp::WithSimd for RefineDiscs<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, _: S) {
+        self.laser
+            .refine_discs_with(self.heading, self.out, self.discs)
+    }
+}
+
 /// How much wider than the target a beam window of [`Laser::refine_round`] is on each side,
 /// degrees: ten times the most [`atan2_deg_near`] can be off, and far above any rounding.
 const WINDOW_MARGIN_DEG: f64 = 1e-2;
@@ -378,13 +396,24 @@ impl Laser {
     /// a few discs it meets, each given as `(centre - position, |centre - position|^2, radius^2)`:
     /// the readings [`Laser::refine_toward`] gives with a `hit` that reports the nearest disc by
     /// [`Body::ray`](crate::sim::moving::Body::ray)'s arithmetic (the same operations, so the same
-    /// bits). The beams go through in blocks as plain arithmetic with no branch, which vectorises.
+    /// bits). The beams go through in blocks, their distances from each centre side by side.
     pub(crate) fn refine_discs(
         &self,
         heading: Vector,
         out: &mut [f64],
         discs: &[(Vector, f64, f64)],
     ) {
+        crate::geometry::ARCH.dispatch(RefineDiscs {
+            laser: self,
+            heading,
+            out,
+            discs,
+        });
+    }
+
+    /// [`Laser::refine_discs`]' loops, compiled for the instruction set [`RefineDiscs`] picks.
+    #[inline(always)]
+    fn refine_discs_with(&self, heading: Vector, out: &mut [f64], discs: &[(Vector, f64, f64)]) {
         const BLOCK: usize = 32;
         let (mut dx, mut dy) = ([0.0; BLOCK], [0.0; BLOCK]);
         for (offsets, out) in self.offsets.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
@@ -393,16 +422,25 @@ impl Laser {
                 let dir = turn(heading, *offset);
                 (dx[k], dy[k]) = (dir.x, dir.y);
             }
+            let (mut alongs, mut d2s) = ([0.0; BLOCK], [0.0; BLOCK]);
             for &(oc, oc2, r2) in discs {
                 let inside = oc2 <= r2;
+                // Where each beam passes the centre, side by side; then the square root only
+                // for the few beams that pass within the radius (no other can hit).
                 for k in 0..m {
                     // `oc.dot(&dir)` as nalgebra works it out for two components.
-                    let along = oc.x * dx[k] + oc.y * dy[k];
-                    let d2 = oc2 - along * along;
-                    let t = along - (r2 - d2).sqrt();
-                    let t = if inside { 0.0 } else { t };
-                    let hit = (d2 <= r2) & (t >= 0.0) & (t < out[k]);
-                    out[k] = if hit { t } else { out[k] };
+                    alongs[k] = oc.x * dx[k] + oc.y * dy[k];
+                    d2s[k] = oc2 - alongs[k] * alongs[k];
+                }
+                for k in 0..m {
+                    let (along, d2) = (alongs[k], d2s[k]);
+                    if d2 <= r2 {
+                        let t = along - (r2 - d2).sqrt();
+                        let t = if inside { 0.0 } else { t };
+                        if t >= 0.0 && t < out[k] {
+                            out[k] = t;
+                        }
+                    }
                 }
             }
         }

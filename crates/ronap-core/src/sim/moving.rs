@@ -315,8 +315,11 @@ impl State {
         for b in lo..=hi.min(bands.saturating_sub(1)) {
             let (s, e) = (self.band_start[b] as usize, self.band_start[b + 1] as usize);
             let run = &self.keys[s..e];
-            let first = run.partition_point(|k| k.x < left);
-            for key in &run[first..] {
+            // A band holds a few obstacles: a plain walk beats a binary search to the first.
+            for key in run {
+                if key.x < left {
+                    continue;
+                }
                 if key.x > right {
                     break;
                 }
@@ -963,7 +966,12 @@ impl Movers {
             let (p, bound) = (st.position(i), st.bound[i]);
             let d = d2.sqrt();
             if d - bound <= range + radius {
-                least_gap = least_gap.min(self.entries[i].body.gap(p, position, radius));
+                // A disc's gap is `Body::gap`'s, whose norm is `d` to the bit.
+                let gap = match self.entries[i].body {
+                    Body::Disc(r) => d - r - radius,
+                    body => body.gap(p, position, radius),
+                };
+                least_gap = least_gap.min(gap);
                 if d - bound <= range {
                     if count < near.len() {
                         near[count] = i as u32;
