@@ -80,6 +80,13 @@ impl PointGrid {
     /// Into `out` (cleared first): every point in the cells the box of the circle `(centre,
     /// radius)` touches, in increasing index order. A superset of the points within `radius`.
     pub fn near(&self, centre: Point, radius: f64, out: &mut Vec<u32>) {
+        self.near_any_order(centre, radius, out);
+        out.sort_unstable();
+    }
+
+    /// [`PointGrid::near`] in no particular order (cell by cell), for a caller that orders
+    /// what it keeps itself.
+    pub fn near_any_order(&self, centre: Point, radius: f64, out: &mut Vec<u32>) {
         out.clear();
         let radius = radius.max(0.0);
         let (c0, r0) = self.cell_of(centre.x - radius, centre.y - radius);
@@ -89,7 +96,6 @@ impl PointGrid {
             let (a, b) = (self.starts[row + c0], self.starts[row + c1 + 1]);
             out.extend_from_slice(&self.items[a as usize..b as usize]);
         }
-        out.sort_unstable();
     }
 }
 

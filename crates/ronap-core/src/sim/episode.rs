@@ -276,9 +276,10 @@ impl Episode {
                 .map(|d| (d.at, d.radius)),
         );
         if !near.is_empty() {
-            self.laser.refine_round(
+            self.laser.refine_round_toward(
                 p,
                 self.pose.z_deg,
+                heading,
                 &mut self.readings,
                 &near,
                 |j, origin, dir, best| Body::Disc(near[j].1).ray(near[j].0, origin, dir, best),

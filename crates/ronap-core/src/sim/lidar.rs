@@ -341,10 +341,24 @@ impl Laser {
         heading_deg: f64,
         out: &mut [f64],
         targets: &[(Point, f64)],
+        hit: impl FnMut(usize, Point, Vector, f64) -> Option<f64>,
+    ) {
+        self.refine_round_toward(position, heading_deg, unit(heading_deg), out, targets, hit);
+    }
+
+    /// [`Laser::refine_round`] for the heading `heading_deg` whose unit vector `heading` the
+    /// caller has already worked out.
+    pub(crate) fn refine_round_toward(
+        &self,
+        position: Point,
+        heading_deg: f64,
+        heading: Vector,
+        out: &mut [f64],
+        targets: &[(Point, f64)],
         mut hit: impl FnMut(usize, Point, Vector, f64) -> Option<f64>,
     ) {
-        let heading = unit(heading_deg);
         let m = self.offsets.len();
+        let per_step = 1.0 / self.step_deg;
         let mut beam = |i: usize, j: usize, out: &mut [f64]| {
             let dir = turn(heading, self.offsets[i]);
             if let Some(t) = hit(j, position, dir, out[i]) {
@@ -368,13 +382,18 @@ impl Laser {
             // the target's, so every beam that can touch it is asked (the others miss it).
             let x = radius / d;
             let half = (x / (1.0 - x * x).sqrt()).to_degrees() + WINDOW_MARGIN_DEG;
-            let from_first = crate::geometry::wrap_deg(
-                atan2_deg_near(oc.y, oc.x) - heading_deg - self.first_offset_deg,
-            );
+            // Brought into [0, 360) to within a rounding, which the margin covers.
+            let mut from_first = atan2_deg_near(oc.y, oc.x) - heading_deg - self.first_offset_deg;
+            while from_first < 0.0 {
+                from_first += 360.0;
+            }
+            while from_first >= 360.0 {
+                from_first -= 360.0;
+            }
             let last = m - 1;
             for shift in [-360.0, 0.0, 360.0] {
                 let c = from_first + shift;
-                let (lo, hi) = ((c - half) / self.step_deg, (c + half) / self.step_deg);
+                let (lo, hi) = ((c - half) * per_step, (c + half) * per_step);
                 // Beams lo..=hi, each end rounded inwards (a float cast truncates, which is the
                 // floor of a number >= 0).
                 if hi >= 0.0 {

@@ -490,7 +490,8 @@ impl Team {
                 continue;
             };
             let at = me.pose.position();
-            self.grid_before.near(at, range, &mut found);
+            // Any order: what is kept is sorted by distance, then sender.
+            self.grid_before.near_any_order(at, range, &mut found);
             near.clear();
             near.extend(
                 found
