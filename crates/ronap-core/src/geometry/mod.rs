@@ -43,7 +43,7 @@ pub struct Aabb {
 /// touching: that slab spans the whole line, so NaN reads as -inf where the slab is entered and
 /// +inf where it is left.
 #[inline(always)]
-pub(crate) fn slab(lo: f64, hi: f64, o: f64, inv: f64) -> (f64, f64) {
+fn slab(lo: f64, hi: f64, o: f64, inv: f64) -> (f64, f64) {
     let (t1, t2) = ((lo - o) * inv, (hi - o) * inv);
     let ordered = if inv > 0.0 { (t1, t2) } else { (t2, t1) };
     if !inv.is_finite() && (t1.is_nan() || t2.is_nan()) {

@@ -481,7 +481,7 @@ impl Team {
         let slot = self.comm.slot_size();
         let k_near = self.comm.neighbours as usize;
         // `sent` is in robot order, and the grid holds where the senders were.
-        let of = sent_by_robot(sent.iter().map(|b| b.from), self.robots.len());
+        let of = places_of(sent.iter().map(|b| b.from), self.robots.len());
         let mut found = Vec::new();
         let mut near: Vec<(f64, &Broadcast)> = Vec::new();
         for (i, inbox) in self.inbox.iter_mut().enumerate() {
@@ -530,7 +530,7 @@ impl Team {
             .filter(|&k| self.present(k))
             .map(|k| (k, disc(&self.robots[k])))
             .collect();
-        let of = sent_by_robot(discs.iter().map(|(k, _)| *k), n);
+        let of = places_of(discs.iter().map(|(k, _)| *k), n);
         let movers = self.movers.take();
         self.grid_after.fill(discs.iter().map(|(k, d)| (*k, d.at)));
         let mut others = Vec::with_capacity(discs.len());
@@ -556,9 +556,9 @@ impl Team {
     }
 }
 
-/// For each of `n` robots, where it stands in a list of robots given in increasing order
-/// (`robots`), if it is there.
-fn sent_by_robot(robots: impl Iterator<Item = usize>, n: usize) -> Vec<Option<u32>> {
+/// For each of `n` robots, its place in the list `robots` (of robot indices), if listed: a
+/// look-up for lists that leave some robots out (those no longer in the scene).
+fn places_of(robots: impl Iterator<Item = usize>, n: usize) -> Vec<Option<u32>> {
     let mut at = vec![None; n];
     for (m, k) in robots.enumerate() {
         at[k] = Some(m as u32);
