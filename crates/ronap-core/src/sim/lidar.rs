@@ -9,7 +9,7 @@
 //! the same reading to the bit.
 
 use crate::config::LaserConfig;
-use crate::geometry::{larger, smaller, unit, Aabb, Point, Vector};
+use crate::geometry::{least_box_hits, smaller, unit, Aabb, Point, Vector};
 use crate::scene::Scene;
 use rand_distr::{Distribution, Normal};
 
@@ -31,22 +31,21 @@ fn turn(heading: Vector, offset: Vector) -> Vector {
     )
 }
 
-/// [`Laser::local_block_hits`] compiled for the processor's widest instruction set.
-struct LocalHits<'a> {
-    laser: &'a Laser,
-    heading: Vector,
-    sides: &'a [[f64; 4]],
-    out: &'a mut [f64],
-}
+/// Beams go through the vectorised loops in blocks of this many.
+const BLOCK: usize = 32;
 
-impl pulp::WithSimd for LocalHits<'_> {
-    type Output = bool;
-
-    #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _: S) -> bool {
-        self.laser
-            .local_block_hits(self.heading, self.sides, self.out)
+/// The inverse directions `1 / dir` of the beams at `offsets` for the unit heading `heading`,
+/// into `ix` and `iy` (as many as there are offsets); whether one runs along an axis (an
+/// infinite component).
+#[inline]
+fn inverse_directions(heading: Vector, offsets: &[Vector], ix: &mut [f64], iy: &mut [f64]) -> bool {
+    let mut along_axis = false;
+    for (k, offset) in offsets.iter().enumerate() {
+        let dir = turn(heading, *offset);
+        (ix[k], iy[k]) = (1.0 / dir.x, 1.0 / dir.y);
+        along_axis |= !(ix[k].is_finite() && iy[k].is_finite());
     }
+    along_axis
 }
 
 /// [`Laser::refine_discs_with`] compiled for the processor's widest instruction set.
@@ -229,71 +228,32 @@ impl Laser {
     }
 
     /// Every beam's least [`Aabb::ray_hit`] over `boxes` (a few boxes within range) into `out`,
-    /// `range_px` where none is hit. The beams go through in blocks, each box against a block's
-    /// beams as plain arithmetic that vectorises: the same operations as `ray_hit` on the box's
-    /// sides less the position (worked out once a scan), so the same bits. A beam along an axis
-    /// (an infinite inverse component, where `ray_hit` must look for NaN) is asked of `ray_hit`.
+    /// `range_px` where none is hit: the beams in blocks, each box against a block's beams side
+    /// by side ([`least_box_hits`], the same bits as `ray_hit`). A beam along an axis (an
+    /// infinite inverse component, where `ray_hit` must look for NaN) is asked of `ray_hit`.
     fn local_hits(&self, position: Point, heading: Vector, boxes: &[Aabb], out: &mut [f64]) {
         let range = self.range_px;
         let mut sides = [[0.0; 4]; MAX_LOCAL_BOXES];
         for (s, b) in sides.iter_mut().zip(boxes) {
-            *s = [
-                b.min.x - position.x,
-                b.max.x - position.x,
-                b.min.y - position.y,
-                b.max.y - position.y,
-            ];
+            *s = b.sides_from(position);
         }
         let sides = &sides[..boxes.len()];
-        let along_axis = crate::geometry::ARCH.dispatch(LocalHits {
-            laser: self,
-            heading,
-            sides,
-            out,
-        });
-        if along_axis {
-            for (offset, reading) in self.offsets.iter().zip(out.iter_mut()) {
-                let dir = turn(heading, *offset);
-                let inv = Vector::new(1.0 / dir.x, 1.0 / dir.y);
-                if !(inv.x.is_finite() && inv.y.is_finite()) {
-                    *reading = boxes
-                        .iter()
-                        .filter_map(|b| b.ray_hit(position, inv, range))
-                        .fold(range, smaller);
-                }
-            }
-        }
-    }
-
-    /// The vectorised part of [`Laser::local_hits`]: every beam against every box's `sides`
-    /// (less the position), into `out`; whether some beam runs along an axis (its readings are
-    /// left to the caller).
-    #[inline(always)]
-    fn local_block_hits(&self, heading: Vector, sides: &[[f64; 4]], out: &mut [f64]) -> bool {
-        const BLOCK: usize = 32;
-        let range = self.range_px;
         let (mut ix, mut iy) = ([0.0; BLOCK], [0.0; BLOCK]);
-        let mut along_axis = false;
         for (offsets, out) in self.offsets.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
-            let m = offsets.len();
-            for (k, offset) in offsets.iter().enumerate() {
-                let dir = turn(heading, *offset);
-                (ix[k], iy[k]) = (1.0 / dir.x, 1.0 / dir.y);
-                along_axis |= !(ix[k].is_finite() && iy[k].is_finite());
-            }
-            out.fill(range);
-            for &[lx, hx, ly, hy] in sides {
-                for k in 0..m {
-                    let (nx, fx) = if ix[k] > 0.0 { (lx, hx) } else { (hx, lx) };
-                    let (ny, fy) = if iy[k] > 0.0 { (ly, hy) } else { (hy, ly) };
-                    let enter = larger(larger(nx * ix[k], ny * iy[k]), 0.0);
-                    let exit = smaller(smaller(fx * ix[k], fy * iy[k]), range);
-                    let hit = if enter <= exit { enter } else { f64::INFINITY };
-                    out[k] = smaller(hit, out[k]);
+            let along_axis = inverse_directions(heading, offsets, &mut ix, &mut iy);
+            least_box_hits(sides, &ix, &iy, range, out);
+            if along_axis {
+                for k in 0..offsets.len() {
+                    if !(ix[k].is_finite() && iy[k].is_finite()) {
+                        let inv = Vector::new(ix[k], iy[k]);
+                        out[k] = boxes
+                            .iter()
+                            .filter_map(|b| b.ray_hit(position, inv, range))
+                            .fold(range, smaller);
+                    }
                 }
             }
         }
-        along_axis
     }
 
     /// Shortens each reading in `out` (taken from `position` at `heading_deg`) to the nearer hit
@@ -441,7 +401,6 @@ impl Laser {
     /// [`Laser::refine_discs`]' loops, compiled for the instruction set [`RefineDiscs`] picks.
     #[inline(always)]
     fn refine_discs_with(&self, heading: Vector, out: &mut [f64], discs: &[(Vector, f64, f64)]) {
-        const BLOCK: usize = 32;
         let (mut dx, mut dy) = ([0.0; BLOCK], [0.0; BLOCK]);
         for (offsets, out) in self.offsets.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
             let m = offsets.len();
