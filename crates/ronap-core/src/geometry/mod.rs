@@ -34,7 +34,8 @@ pub struct Aabb {
     pub max: Point,
 }
 
-/// Where the ray `o + t / inv` enters and leaves the slab `[lo, hi]` of one axis, in `t`.
+/// Where the ray `o + t / inv` enters and leaves the slab `[lo, hi]` (`lo <= hi`) of one axis,
+/// in `t`.
 ///
 /// The slab's near side is `lo` when the ray runs up the axis (`inv > 0`) and `hi` when it runs
 /// down: rounding keeps `lo - o <= hi - o`, so this is the least and greatest of the two crossings
@@ -174,7 +175,8 @@ impl Aabb {
     }
 
     /// Distance along the ray `origin + t * dir` to the box's boundary, for `t` in `[0, max_t]`,
-    /// given `inv_dir = 1 / dir` per component. `Some(0.0)` when the origin is inside.
+    /// given `inv_dir = 1 / dir` per component. `Some(0.0)` when the origin is inside. For a box
+    /// with `min <= max` and an origin with no NaN (as every box and scan of a scene).
     #[inline]
     pub fn ray_hit(&self, origin: Point, inv_dir: Vector, max_t: f64) -> Option<f64> {
         let (ex, xx) = slab(self.min.x, self.max.x, origin.x, inv_dir.x);

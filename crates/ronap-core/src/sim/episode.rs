@@ -278,7 +278,6 @@ impl Episode {
         if !near.is_empty() {
             self.laser.refine_round_toward(
                 p,
-                self.pose.z_deg,
                 heading,
                 &mut self.readings,
                 &near,
