@@ -243,8 +243,7 @@ impl Work {
             }
         }
         let (moves, slow) = (grid.moves(), grid.close_moves());
-        let w = cols as isize;
-        let offsets: [isize; 8] = [1, -1, w, -w, w + 1, 1 - w, w - 1, -w - 1];
+        let offsets = grid.move_offsets();
         // Targets lie in a small block: a range check spares looking them up for most cells.
         let (lowest, highest) = targets
             .into_iter()

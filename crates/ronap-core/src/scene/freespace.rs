@@ -170,18 +170,20 @@ impl FreeGrid {
         &self.moves
     }
 
+    /// What each [move](FreeGrid::moves) adds to a cell's index, in the moves' bit order.
+    pub(crate) fn move_offsets(&self) -> [isize; 8] {
+        let w = self.cols as isize;
+        [1, -1, w, -w, w + 1, 1 - w, w - 1, -w - 1]
+    }
+
     /// Of the [moves](FreeGrid::moves) from each cell, those that start or end in a
     /// [close](FreeGrid::is_close) cell, as bits in the same order: what a planner charging for
     /// closeness needs, read from the cell it stands on rather than from each neighbour.
     pub(crate) fn close_moves(&self) -> &[u8] {
         self.close_moves.get_or_init(|| {
             let n = self.moves.len();
-            let w = self.cols as isize;
             let mut out = vec![0u8; n];
-            for (k, off) in [1, -1, w, -w, w + 1, 1 - w, w - 1, -w - 1]
-                .into_iter()
-                .enumerate()
-            {
+            for (k, off) in self.move_offsets().into_iter().enumerate() {
                 // Cells `i` in `lo..hi` have their move's target `i + off` in the grid; a move
                 // off the grid (or across its edge) is never open, so its bit stays clear.
                 let lo = off.min(0).unsigned_abs();
