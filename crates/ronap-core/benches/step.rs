@@ -214,6 +214,13 @@ fn mlp(c: &mut Criterion) {
     let scene = Arc::new(maze_scene(&config, 0));
     let mut seed = 0;
     let mut episode = Episode::new(&config, scene.clone(), seed).expect("default scene");
+    // Sixteen observations at once (a worker stepping sixteen episodes side by side), per row.
+    let rows: Vec<f32> = (0..16).flat_map(|_| observation.iter().copied()).collect();
+    group.throughput(Throughput::Elements(16));
+    group.bench_function("forward_rows_16", |b| {
+        b.iter(|| net.forward_rows_into(black_box(&rows), &mut scratch).len())
+    });
+    group.throughput(Throughput::Elements(1));
     group.bench_function("policy_step", |b| {
         b.iter(|| {
             let action = net.action_into(episode.observation(), &mut scratch);

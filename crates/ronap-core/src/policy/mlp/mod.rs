@@ -233,6 +233,47 @@ mod tests {
     }
 
     #[test]
+    fn rows_together_give_each_rows_own_bits() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2);
+        // The shipped shape, and shapes whose widths leave every kind of remainder (lanes of
+        // 4 and 8, a part of a vector, a single output).
+        let shapes: [&[usize]; 3] = [
+            &[18, 64, 128, 64, 32, 8, 3],
+            &[5, 17, 1, 23, 3],
+            &[33, 40, 9, 16, 3],
+        ];
+        for sizes in shapes {
+            let layers = sizes
+                .windows(2)
+                .map(|w| Layer {
+                    weight: DMatrix::from_fn(w[1], w[0], |_, _| rng.random_range(-0.5..0.5)),
+                    bias: DVector::from_fn(w[1], |_, _| rng.random_range(-0.1..0.1)),
+                })
+                .collect();
+            let m = Mlp::new(layers, Activation::LeakyRelu(RRELU_SLOPE), HashMap::new()).unwrap();
+            let (ins, outs) = (sizes[0], *sizes.last().unwrap());
+            let (mut one, mut many) = (Scratch::default(), Scratch::default());
+            for rows in [0, 1, 2, 3, 4, 5, 7, 8, 13] {
+                let x: Vec<f32> = (0..rows * ins)
+                    .map(|_| rng.random_range(-1.0..1.0))
+                    .collect();
+                let got = m.forward_rows_into(&x, &mut many).to_vec();
+                assert_eq!(got.len(), rows * outs);
+                for (r, row) in x.chunks_exact(ins).enumerate() {
+                    let want = m.forward_into(row, &mut one);
+                    let bits = |v: &[f32]| v.iter().map(|f| f.to_bits()).collect::<Vec<_>>();
+                    assert_eq!(
+                        bits(&got[r * outs..(r + 1) * outs]),
+                        bits(want),
+                        "{sizes:?}, {rows} rows, row {r}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
     fn round_trips_and_computes_by_hand() {
         let m = tiny();
         let back = Mlp::from_bytes(&m.to_bytes().unwrap()).unwrap();

@@ -178,6 +178,29 @@ impl Mlp {
         x
     }
 
+    /// The network's outputs for many observations at once: `observations` holds
+    /// `observations.len() / inputs` rows of [`Mlp::inputs`] values, and the result as many rows
+    /// of outputs, each row bit for bit what [`Mlp::forward_into`] gives for it. Rows go through
+    /// in fours, so each weight loaded from memory serves four sums: for a network too large
+    /// for the processor's nearest cache (the shipped one's 79 KB of weights), one observation at
+    /// a time waits on the weights' loads, and four at a time on the arithmetic.
+    pub fn forward_rows_into<'s>(
+        &self,
+        observations: &[f32],
+        scratch: &'s mut Scratch,
+    ) -> &'s [f32] {
+        let Scratch { x, y } = scratch;
+        x.clear();
+        x.extend_from_slice(observations);
+        crate::geometry::ARCH.dispatch(ForwardRows {
+            mlp: self,
+            rows: observations.len() / self.inputs(),
+            x,
+            y,
+        });
+        x
+    }
+
     /// The action with the largest output (the first of equals).
     pub fn action(&self, observation: &[f32]) -> DiscreteAction {
         self.action_into(observation, &mut Scratch::default())
@@ -224,6 +247,98 @@ impl pulp::WithSimd for Forward<'_> {
     }
 }
 
+/// The layers of [`Mlp::forward_rows_into`]: `x` holds `rows` rows of input and, at the end, of
+/// output.
+struct ForwardRows<'a> {
+    mlp: &'a Mlp,
+    rows: usize,
+    x: &'a mut Vec<f32>,
+    y: &'a mut Vec<f32>,
+}
+
+impl pulp::WithSimd for ForwardRows<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) {
+        let Self { mlp, rows, x, y } = self;
+        let last = mlp.layers.len() - 1;
+        for (i, l) in mlp.layers.iter().enumerate() {
+            let (ins, outs) = (l.weight.ncols(), l.weight.nrows());
+            y.clear();
+            for _ in 0..rows {
+                y.extend_from_slice(l.bias.as_slice());
+            }
+            let weights = l.weight.as_slice();
+            let mut r = 0;
+            while r + 4 <= rows {
+                add_rows::<S, 4>(simd, y, x, weights, ins, outs, r);
+                r += 4;
+            }
+            match rows - r {
+                3 => add_rows::<S, 3>(simd, y, x, weights, ins, outs, r),
+                2 => add_rows::<S, 2>(simd, y, x, weights, ins, outs, r),
+                1 => add_columns(simd, &mut y[r * outs..], &x[r * ins..], weights, outs),
+                _ => {}
+            }
+            if i < last {
+                mlp.activation.apply(y);
+            }
+            std::mem::swap(x, y);
+        }
+    }
+}
+
+/// [`add_columns`] for the `R` rows from `r` of the row-major `x` (`ins` values a row) into
+/// those of `y` (`outs` a row): two vectors of outputs of each row at a time, each weight loaded
+/// once for the `R` rows, every output's sum in the same order as [`add_columns`] (so the same
+/// bits).
+#[inline(always)]
+fn add_rows<S: pulp::Simd, const R: usize>(
+    simd: S,
+    y: &mut [f32],
+    x: &[f32],
+    weights: &[f32],
+    ins: usize,
+    outs: usize,
+    r: usize,
+) {
+    let lanes = S::F32_LANES;
+    let xs: [&[f32]; R] = std::array::from_fn(|k| &x[(r + k) * ins..(r + k + 1) * ins]);
+    let mut o = 0;
+    while o + 2 * lanes <= outs {
+        let mut acc = [[simd.splat_f32s(0.0); 2]; R];
+        for (k, a) in acc.iter_mut().enumerate() {
+            let row = (r + k) * outs + o;
+            a.copy_from_slice(S::as_simd_f32s(&y[row..row + 2 * lanes]).0);
+        }
+        // `take(ins)` tells the compiler every `j` is within each row (no bounds check).
+        for (j, column) in weights.chunks_exact(outs).take(ins).enumerate() {
+            let (w, _) = S::as_simd_f32s(&column[o..o + 2 * lanes]);
+            let (w0, w1) = (w[0], w[1]);
+            for (a, xk) in acc.iter_mut().zip(&xs) {
+                let xj = simd.splat_f32s(xk[j]);
+                a[0] = simd.add_f32s(a[0], simd.mul_f32s(xj, w0));
+                a[1] = simd.add_f32s(a[1], simd.mul_f32s(xj, w1));
+            }
+        }
+        for (k, a) in acc.iter().enumerate() {
+            let row = (r + k) * outs + o;
+            S::as_mut_simd_f32s(&mut y[row..row + 2 * lanes])
+                .0
+                .copy_from_slice(a);
+        }
+        o += 2 * lanes;
+    }
+    // What is left of each row (fewer than two vectors), a row at a time.
+    if o < outs {
+        for (k, xk) in xs.iter().enumerate() {
+            let row = (r + k) * outs;
+            add_columns_from(simd, &mut y[row..row + outs], xk, weights, outs, o);
+        }
+    }
+}
+
 /// `y += W x` for the column-major `weights` (column j holds the weights from input j), adding
 /// the columns in input order. Outputs go in blocks of vectors held in registers across all the
 /// inputs (8 vectors, then 4, 2, 1, then one output at a time), so each weight is loaded once
@@ -231,7 +346,19 @@ impl pulp::WithSimd for Forward<'_> {
 /// stay separate (no fused multiply-add), so every instruction set gives the same bits.
 #[inline(always)]
 fn add_columns<S: pulp::Simd>(simd: S, y: &mut [f32], x: &[f32], weights: &[f32], outputs: usize) {
-    let mut o = 0;
+    add_columns_from(simd, y, x, weights, outputs, 0);
+}
+
+/// [`add_columns`] for the outputs from `o` on.
+#[inline(always)]
+fn add_columns_from<S: pulp::Simd>(
+    simd: S,
+    y: &mut [f32],
+    x: &[f32],
+    weights: &[f32],
+    outputs: usize,
+    mut o: usize,
+) {
     while o + 8 * S::F32_LANES <= outputs {
         add_vectors::<S, 8>(simd, y, x, weights, outputs, o);
         o += 8 * S::F32_LANES;
