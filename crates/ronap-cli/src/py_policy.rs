@@ -307,8 +307,8 @@ impl Policy for PyProcess {
         Ok(())
     }
 
-    fn hear(&mut self, inbox: &[ronap_core::sim::team::Broadcast]) {
-        let size = inbox.first().map_or(0, |b| b.message.len());
+    fn hear(&mut self, inbox: ronap_core::sim::team::Inbox<'_>) {
+        let size = inbox.get(0).map_or(0, |b| b.message.len());
         let mut text = format!("{} {size}", inbox.len());
         for b in inbox {
             text.push_str(&format!(

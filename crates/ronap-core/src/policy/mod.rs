@@ -52,7 +52,7 @@ pub trait Policy: Send {
     /// What a robot of a team received at the last step (the broadcasts of the robots within
     /// `team.comm_range_px`, nearest first), told before each [`Policy::act`]; the built-in
     /// policies do not listen.
-    fn hear(&mut self, inbox: &[crate::sim::team::Broadcast]) {
+    fn hear(&mut self, inbox: crate::sim::team::Inbox<'_>) {
         let _ = inbox;
     }
 }

@@ -269,10 +269,12 @@ impl Episode {
         let reach = self.laser.range_px() + radius;
         let mut near = std::mem::take(&mut self.near_discs);
         near.clear();
+        // Squared distances, without a square root: a disc near the edge of `reach` (which is
+        // the range plus the robot's radius) is beyond every beam's range either way.
         near.extend(
             others
                 .iter()
-                .filter(|d| (d.at - p).norm() - d.radius <= reach)
+                .filter(|d| (d.at - p).norm_squared() <= (reach + d.radius) * (reach + d.radius))
                 .map(|d| (d.at, d.radius)),
         );
         if !near.is_empty() {

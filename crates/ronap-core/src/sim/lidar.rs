@@ -326,54 +326,69 @@ impl Laser {
                 }
             }
         };
-        for (j, &(centre, radius)) in targets.iter().enumerate() {
-            let oc = centre - position;
-            let d = oc.norm();
-            // Where the target lies from the first beam: its angle from the heading as the beams
-            // are turned (the heading's own unit vector, so any heading in degrees reads the
-            // same), brought into [0, 360); a rounding is covered by the window's margin.
-            let mut from_first = atan2_deg_near(
-                heading.x * oc.y - heading.y * oc.x,
-                heading.x * oc.x + heading.y * oc.y,
-            ) - self.first_offset_deg;
-            if from_first < 0.0 {
-                from_first += 360.0;
-            }
-            if from_first >= 360.0 {
-                from_first -= 360.0;
-            }
-            if d <= radius * (1.0 + 1e-9)
-                || self.step_deg == 0.0
-                || !d.is_finite()
-                || !from_first.is_finite()
-            {
-                // Overlapping the laser, one beam, or no direction to go by: every beam may touch
-                // it.
-                for i in 0..m {
-                    beam(i, j, out);
+        // The windows of a few targets first, then their beams: each window is a long chain of
+        // dependent operations (a square root, a division, the arctangent), and a loop of windows alone
+        // lets the processor work on several chains at once.
+        const CHUNK: usize = 16;
+        for (c, chunk) in targets.chunks(CHUNK).enumerate() {
+            // Per target: where it lies from the first beam, half the angle its window covers,
+            // and whether every beam has to be asked.
+            let mut windows = [(0.0, 0.0, false); CHUNK];
+            for (w, &(centre, radius)) in windows.iter_mut().zip(chunk) {
+                let oc = centre - position;
+                let d2 = oc.norm_squared();
+                // Where the target lies from the first beam: its angle from the heading as the
+                // beams are turned (the heading's own unit vector, so any heading in degrees
+                // reads the same), brought into [0, 360); a rounding is covered by the window's
+                // margin.
+                let mut from_first = atan2_deg_near(
+                    heading.x * oc.y - heading.y * oc.x,
+                    heading.x * oc.x + heading.y * oc.y,
+                ) - self.first_offset_deg;
+                if from_first < 0.0 {
+                    from_first += 360.0;
                 }
-                continue;
+                if from_first >= 360.0 {
+                    from_first -= 360.0;
+                }
+                // Overlapping the laser, one beam, or no direction to go by: every beam may
+                // touch it.
+                let r2 = radius * radius;
+                let all = d2 <= r2 * (1.0 + 2e-9)
+                    || self.step_deg == 0.0
+                    || !d2.is_finite()
+                    || !from_first.is_finite();
+                // Half the angle the target covers (at most tan of it: asin(r / d) <=
+                // r / sqrt(d^2 - r^2)), and its direction to within WINDOW_MARGIN_DEG / 100: a
+                // window at least as wide as the target's, so every beam that can touch it is
+                // asked (the others miss it). Not used when every beam is asked.
+                let half = (radius / (d2 - r2).sqrt()).to_degrees() + WINDOW_MARGIN_DEG;
+                *w = (from_first, half, all);
             }
-            // Half the angle the target covers (at most tan of it: asin x <= x / sqrt(1 - x^2)),
-            // and its direction to within WINDOW_MARGIN_DEG / 100: a window at least as wide as
-            // the target's, so every beam that can touch it is asked (the others miss it).
-            let x = radius / d;
-            let half = (x / (1.0 - x * x).sqrt()).to_degrees() + WINDOW_MARGIN_DEG;
-            let last = m - 1;
-            for shift in [-360.0, 0.0, 360.0] {
-                let c = from_first + shift;
-                let (lo, hi) = ((c - half) * per_step, (c + half) * per_step);
-                // Beams lo..=hi, each end rounded inwards (a float cast truncates, which is the
-                // floor of a number >= 0).
-                if hi >= 0.0 && lo <= last as f64 {
-                    let first = if lo > 0.0 {
-                        let t = lo as usize;
-                        t + usize::from((t as f64) < lo)
-                    } else {
-                        0
-                    };
-                    for i in first..=(hi as usize).min(last) {
+            for (k, &(from_first, half, all)) in windows[..chunk.len()].iter().enumerate() {
+                let j = c * CHUNK + k;
+                if all {
+                    for i in 0..m {
                         beam(i, j, out);
+                    }
+                    continue;
+                }
+                let last = m - 1;
+                for shift in [-360.0, 0.0, 360.0] {
+                    let c = from_first + shift;
+                    let (lo, hi) = ((c - half) * per_step, (c + half) * per_step);
+                    // Beams lo..=hi, each end rounded inwards (a float cast truncates, which is
+                    // the floor of a number >= 0).
+                    if hi >= 0.0 && lo <= last as f64 {
+                        let first = if lo > 0.0 {
+                            let t = lo as usize;
+                            t + usize::from((t as f64) < lo)
+                        } else {
+                            0
+                        };
+                        for i in first..=(hi as usize).min(last) {
+                            beam(i, j, out);
+                        }
                     }
                 }
             }

@@ -44,6 +44,77 @@ pub struct Broadcast {
     pub message: Vec<f32>,
 }
 
+/// What a robot received at the last step ([`Team::inbox`]): the broadcasts of the robots that
+/// were within range when they sent, nearest first.
+#[derive(Clone, Copy, Debug)]
+pub struct Inbox<'a> {
+    sent: &'a [Broadcast],
+    places: &'a [u32],
+}
+
+impl<'a> Inbox<'a> {
+    /// Number of broadcasts received.
+    pub fn len(&self) -> usize {
+        self.places.len()
+    }
+
+    /// Whether nothing was received.
+    pub fn is_empty(&self) -> bool {
+        self.places.is_empty()
+    }
+
+    /// The `i`-th nearest broadcast.
+    pub fn get(&self, i: usize) -> Option<&'a Broadcast> {
+        self.places.get(i).map(|&m| &self.sent[m as usize])
+    }
+
+    /// The broadcasts, nearest first.
+    pub fn iter(&self) -> InboxIter<'a> {
+        InboxIter {
+            sent: self.sent,
+            places: self.places.iter(),
+        }
+    }
+}
+
+impl<'a> IntoIterator for Inbox<'a> {
+    type Item = &'a Broadcast;
+    type IntoIter = InboxIter<'a>;
+
+    fn into_iter(self) -> InboxIter<'a> {
+        self.iter()
+    }
+}
+
+/// The broadcasts of an [`Inbox`], nearest first.
+#[derive(Clone, Debug)]
+pub struct InboxIter<'a> {
+    sent: &'a [Broadcast],
+    places: std::slice::Iter<'a, u32>,
+}
+
+impl<'a> Iterator for InboxIter<'a> {
+    type Item = &'a Broadcast;
+
+    fn next(&mut self) -> Option<&'a Broadcast> {
+        self.places.next().map(|&m| &self.sent[m as usize])
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        self.places.size_hint()
+    }
+}
+
+impl ExactSizeIterator for InboxIter<'_> {}
+
+impl std::ops::Index<usize> for Inbox<'_> {
+    type Output = Broadcast;
+
+    fn index(&self, i: usize) -> &Broadcast {
+        &self.sent[self.places[i] as usize]
+    }
+}
+
 /// Several robots in one scene.
 #[derive(Clone, Debug)]
 pub struct Team {
@@ -69,8 +140,13 @@ pub struct Team {
     comm: TeamConfig,
     /// Each robot's message for the next broadcast.
     outbox: Vec<Vec<f32>>,
-    /// What each robot received at the last step, nearest sender first.
-    inbox: Vec<Vec<Broadcast>>,
+    /// The last step's broadcasts, in robot order...
+    sent: Vec<Broadcast>,
+    /// ... and what each robot received of them, nearest sender first: robot `k`'s are the
+    /// places in `sent` at `inbox[inbox_starts[k]..inbox_starts[k + 1]]` (places rather than
+    /// copies: a thousand robots hear some ten thousand broadcasts a step).
+    inbox: Vec<u32>,
+    inbox_starts: Vec<u32>,
     /// The robots in the scene by where they were before the step (motions, messages)...
     grid_before: PointGrid,
     /// ... and where they are after it (sensing).
@@ -196,7 +272,9 @@ impl Team {
             goal_lists,
             comm: config.team.clone(),
             outbox: vec![vec![0.0; config.team.message_size as usize]; robots.len()],
-            inbox: vec![Vec::new(); robots.len()],
+            sent: Vec::new(),
+            inbox: Vec::new(),
+            inbox_starts: vec![0; robots.len() + 1],
             robots,
             on_arrival,
             movers,
@@ -283,8 +361,11 @@ impl Team {
 
     /// What robot `k` received at the last step: the broadcasts of the robots that were within
     /// `team.comm_range_px` of it when they sent, nearest first.
-    pub fn inbox(&self, k: usize) -> &[Broadcast] {
-        &self.inbox[k]
+    pub fn inbox(&self, k: usize) -> Inbox<'_> {
+        Inbox {
+            sent: &self.sent,
+            places: &self.inbox[self.inbox_starts[k] as usize..self.inbox_starts[k + 1] as usize],
+        }
     }
 
     /// Robot `k`'s goals as drawn or listed (one, or a goal list).
@@ -452,7 +533,7 @@ impl Team {
             }
         }
         self.sense_all();
-        self.deliver(&sent);
+        self.deliver(sent);
         for k in 0..n {
             self.rewards[k] = 0.0;
             if let Some(m) = &motions[k] {
@@ -474,18 +555,22 @@ impl Team {
     }
 
     /// Hands each robot in the scene the broadcasts `sent` from within range of where it was,
-    /// nearest first, and writes the nearest `team.neighbours` into its observation.
-    fn deliver(&mut self, sent: &[Broadcast]) {
+    /// nearest first, and writes the nearest `team.neighbours` into its observation; `sent` is
+    /// kept until the next step.
+    fn deliver(&mut self, sent: Vec<Broadcast>) {
         let range = self.comm.comm_range_px;
         let scale = range.max(1.0);
         let slot = self.comm.slot_size();
         let k_near = self.comm.neighbours as usize;
+        self.sent = sent;
+        let sent = &self.sent;
         // `sent` is in robot order, and the grid holds where the senders were.
         let of = places_of(sent.iter().map(|b| b.from), self.robots.len());
         let mut found = Vec::new();
-        let mut near: Vec<(f64, &Broadcast)> = Vec::new();
-        for (i, inbox) in self.inbox.iter_mut().enumerate() {
-            inbox.clear();
+        let mut near: Vec<(f64, u32)> = Vec::new();
+        self.inbox.clear();
+        for i in 0..self.robots.len() {
+            self.inbox_starts[i] = self.inbox.len() as u32;
             let Some(me) = of[i].map(|m| &sent[m as usize]) else {
                 continue;
             };
@@ -496,13 +581,14 @@ impl Team {
             near.extend(
                 found
                     .iter()
-                    .filter_map(|&j| of[j as usize].map(|m| &sent[m as usize]))
-                    .filter(|b| b.from != i)
-                    .map(|b| ((b.pose.position() - at).norm(), b))
+                    .filter_map(|&j| of[j as usize])
+                    .filter(|&m| sent[m as usize].from != i)
+                    .map(|m| ((sent[m as usize].pose.position() - at).norm(), m))
                     .filter(|(d, _)| *d <= range),
             );
-            near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.from.cmp(&b.1.from)));
-            inbox.extend(near.iter().map(|(_, b)| (*b).clone()));
+            // Places in `sent` are in sender order.
+            near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            self.inbox.extend(near.iter().map(|&(_, m)| m));
             if k_near == 0 {
                 continue;
             }
@@ -510,7 +596,8 @@ impl Team {
             let (sin, cos) = pose.z_deg.to_radians().sin_cos();
             let slots = self.robots[i].neighbour_slots_mut();
             slots.fill(0.0);
-            for (b, out) in inbox.iter().zip(slots.chunks_mut(slot)).take(k_near) {
+            for (&(_, m), out) in near.iter().zip(slots.chunks_mut(slot)).take(k_near) {
+                let b = &sent[m as usize];
                 let d = b.pose.position() - pose.position();
                 out[0] = ((d.x * cos + d.y * sin) / scale) as f32;
                 out[1] = ((-d.x * sin + d.y * cos) / scale) as f32;
@@ -521,6 +608,7 @@ impl Team {
                 }
             }
         }
+        self.inbox_starts[self.robots.len()] = self.inbox.len() as u32;
     }
 
     /// Every running robot reads its sensors among the others (discs) and the obstacles.
@@ -539,10 +627,13 @@ impl Team {
             if !self.running(k) && self.steps > 0 {
                 continue;
             }
-            // The robots the laser can reach, in robot order (sense_among keeps its exact test).
+            // The robots the laser can reach, in any order (sense_among keeps its exact test,
+            // and a reading is the least of the distances its beam meets, whatever their
+            // order: robots never overlap, so no two robots give a beam the same distance 0).
             let r = &self.robots[k];
             let reach = r.laser().range_px() + r.config().robot.radius_px + self.max_radius;
-            self.grid_after.near(r.pose().position(), reach, &mut found);
+            self.grid_after
+                .near_any_order(r.pose().position(), reach, &mut found);
             others.clear();
             others.extend(
                 found
