@@ -102,10 +102,13 @@ impl VecEnv {
     }
 
     /// Each environment's current state: the step it took, or the start of the episode that
-    /// replaced the one it ended.
-    fn current(&self) -> Vec<EnvStep> {
-        self.batch
-            .steps()
+    /// replaced the one it ended (the step records themselves, uncopied, when none was).
+    fn current(&self) -> std::borrow::Cow<'_, [EnvStep]> {
+        let steps = self.batch.steps();
+        if !steps.iter().any(|s| self.restarted(s)) {
+            return std::borrow::Cow::Borrowed(steps);
+        }
+        steps
             .iter()
             .enumerate()
             .map(|(i, s)| match self.batch.episode(i) {
@@ -117,7 +120,10 @@ impl VecEnv {
 
     /// Adds each selected environment's new position to its path (a new path for a new episode).
     fn track(&mut self, which: Option<&[bool]>) {
-        let current = self.current();
+        if self.paths.is_none() {
+            return;
+        }
+        let current = self.current().into_owned();
         let Some(paths) = self.paths.as_mut() else {
             return;
         };
