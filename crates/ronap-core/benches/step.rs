@@ -218,7 +218,10 @@ fn mlp(c: &mut Criterion) {
     let rows: Vec<f32> = (0..16).flat_map(|_| observation.iter().copied()).collect();
     group.throughput(Throughput::Elements(16));
     group.bench_function("forward_rows_16", |b| {
-        b.iter(|| net.forward_rows_into(black_box(&rows), &mut scratch).len())
+        b.iter(|| {
+            net.forward_rows_into(black_box(&rows), 16, &mut scratch)
+                .len()
+        })
     });
     group.throughput(Throughput::Elements(1));
     group.bench_function("policy_step", |b| {

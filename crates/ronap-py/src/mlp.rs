@@ -75,9 +75,9 @@ pub fn mlp_outputs<'py>(
     }
     // Every row at once (the same bits as one at a time, a few rows sharing each weight).
     let rows: Vec<f32> = obs.iter().copied().collect();
-    let out = mlp
-        .forward_rows_into(&rows, &mut Scratch::default())
-        .to_vec();
     let n = obs.nrows();
+    let out = mlp
+        .forward_rows_into(&rows, n, &mut Scratch::default())
+        .to_vec();
     PyArray1::from_vec(py, out).reshape([n, 3])
 }

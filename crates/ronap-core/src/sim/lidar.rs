@@ -375,8 +375,8 @@ impl Laser {
                 }
                 let last = m - 1;
                 for shift in [-360.0, 0.0, 360.0] {
-                    let c = from_first + shift;
-                    let (lo, hi) = ((c - half) * per_step, (c + half) * per_step);
+                    let at = from_first + shift;
+                    let (lo, hi) = ((at - half) * per_step, (at + half) * per_step);
                     // Beams lo..=hi, each end rounded inwards (a float cast truncates, which is
                     // the floor of a number >= 0).
                     if hi >= 0.0 && lo <= last as f64 {

