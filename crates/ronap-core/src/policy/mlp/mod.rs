@@ -202,6 +202,23 @@ mod tests {
         x.iter().copied().collect()
     }
 
+    /// A network of layer widths `sizes` (inputs first) with random weights and biases.
+    fn random_mlp(
+        rng: &mut rand_chacha::ChaCha8Rng,
+        sizes: &[usize],
+        activation: Activation,
+    ) -> Mlp {
+        use rand::Rng;
+        let layers = sizes
+            .windows(2)
+            .map(|w| Layer {
+                weight: DMatrix::from_fn(w[1], w[0], |_, _| rng.random_range(-0.5..0.5)),
+                bias: DVector::from_fn(w[1], |_, _| rng.random_range(-0.1..0.1)),
+            })
+            .collect();
+        Mlp::new(layers, activation, HashMap::new()).unwrap()
+    }
+
     #[test]
     fn the_allocation_free_pass_gives_gemvs_bits() {
         use rand::{Rng, SeedableRng};
@@ -213,14 +230,7 @@ mod tests {
             Activation::Tanh,
             Activation::LeakyRelu(RRELU_SLOPE),
         ] {
-            let layers = sizes
-                .windows(2)
-                .map(|w| Layer {
-                    weight: DMatrix::from_fn(w[1], w[0], |_, _| rng.random_range(-0.5..0.5)),
-                    bias: DVector::from_fn(w[1], |_, _| rng.random_range(-0.1..0.1)),
-                })
-                .collect();
-            let m = Mlp::new(layers, activation, HashMap::new()).unwrap();
+            let m = random_mlp(&mut rng, &sizes, activation);
             let mut scratch = Scratch::default();
             for _ in 0..200 {
                 let x: Vec<f32> = (0..18).map(|_| rng.random_range(0.0..1.0)).collect();
@@ -246,14 +256,7 @@ mod tests {
             &[0, 20, 3],
         ];
         for sizes in shapes {
-            let layers = sizes
-                .windows(2)
-                .map(|w| Layer {
-                    weight: DMatrix::from_fn(w[1], w[0], |_, _| rng.random_range(-0.5..0.5)),
-                    bias: DVector::from_fn(w[1], |_, _| rng.random_range(-0.1..0.1)),
-                })
-                .collect();
-            let m = Mlp::new(layers, Activation::LeakyRelu(RRELU_SLOPE), HashMap::new()).unwrap();
+            let m = random_mlp(&mut rng, sizes, Activation::LeakyRelu(RRELU_SLOPE));
             let (ins, outs) = (sizes[0], *sizes.last().unwrap());
             let (mut one, mut many) = (Scratch::default(), Scratch::default());
             for rows in [0, 1, 2, 3, 4, 5, 6, 7, 8, 10, 13] {

@@ -174,7 +174,12 @@ impl Mlp {
         let Scratch { x, y } = scratch;
         x.clear();
         x.extend_from_slice(observation);
-        crate::geometry::ARCH.dispatch(Forward { mlp: self, x, y });
+        crate::geometry::ARCH.dispatch(ForwardRows {
+            mlp: self,
+            rows: 1,
+            x,
+            y,
+        });
         x
     }
 
@@ -228,36 +233,10 @@ impl Mlp {
     }
 }
 
-/// The layers of [`Mlp::forward_into`], compiled once per instruction set (pulp picks the widest
-/// the processor has, AVX2 where there is one): `x` holds the input and, at the end, the output.
-struct Forward<'a> {
-    mlp: &'a Mlp,
-    x: &'a mut Vec<f32>,
-    y: &'a mut Vec<f32>,
-}
-
-impl pulp::WithSimd for Forward<'_> {
-    type Output = ();
-
-    #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, simd: S) {
-        let Self { mlp, x, y } = self;
-        let last = mlp.layers.len() - 1;
-        for (i, l) in mlp.layers.iter().enumerate() {
-            let outputs = l.weight.nrows();
-            y.clear();
-            y.extend_from_slice(l.bias.as_slice());
-            add_columns(simd, y, x, l.weight.as_slice(), outputs);
-            if i < last {
-                mlp.activation.apply(y);
-            }
-            std::mem::swap(x, y);
-        }
-    }
-}
-
-/// The layers of [`Mlp::forward_rows_into`]: `x` holds `rows` rows of input and, at the end, of
-/// output.
+/// The layers of [`Mlp::forward_rows_into`] (and of [`Mlp::forward_into`], one row), compiled
+/// once per instruction set (pulp picks the widest the processor has, AVX2 where there is one):
+/// `x` holds `rows` rows of input and, at the end, of output. A single row goes through
+/// [`add_columns`], whose blocks of up to eight vectors suit one row best.
 struct ForwardRows<'a> {
     mlp: &'a Mlp,
     rows: usize,
