@@ -327,8 +327,8 @@ impl Laser {
             }
         };
         // The windows of a few targets first, then their beams: each window is a long chain of
-        // dependent operations (a square root, a division, the arctangent), and a loop of windows alone
-        // lets the processor work on several chains at once.
+        // dependent operations (a square root, a division, the arctangent), and a loop of
+        // windows alone lets the processor work on several chains at once.
         const CHUNK: usize = 16;
         for (c, chunk) in targets.chunks(CHUNK).enumerate() {
             // Per target: where it lies from the first beam, half the angle its window covers,
