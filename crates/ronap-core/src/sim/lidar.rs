@@ -650,7 +650,8 @@ mod tests {
                 8 => rng.random_range(-1e18..1e18),
                 _ => rng.random_range(-720.0..720.0),
             };
-            let discs: Vec<(Point, f64)> = (0..rng.random_range(0..12))
+            // Up to 40 discs: more than the 16 whose windows are worked out at a time.
+            let discs: Vec<(Point, f64)> = (0..rng.random_range(0..40))
                 .map(|_| {
                     let at = p + Vector::new(
                         rng.random_range(-220.0..220.0),

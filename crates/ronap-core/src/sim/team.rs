@@ -581,8 +581,8 @@ impl Team {
             near.extend(
                 found
                     .iter()
+                    .filter(|&&j| j as usize != i)
                     .filter_map(|&j| of[j as usize])
-                    .filter(|&m| sent[m as usize].from != i)
                     .map(|m| ((sent[m as usize].pose.position() - at).norm(), m))
                     .filter(|(d, _)| *d <= range),
             );
