@@ -102,17 +102,44 @@ impl BinIndex {
     /// Indices of every box within `radius` of `p` (and possibly some further away).
     #[inline]
     pub fn near(&self, p: Point, radius: f64) -> &[u32] {
+        match self.bin(p, radius) {
+            Some(b) => self.bin_items(b),
+            None => &self.all,
+        }
+    }
+
+    /// The bin [`BinIndex::near`] reads for `p` and `radius`, or `None` when it reads every box.
+    #[inline]
+    fn bin(&self, p: Point, radius: f64) -> Option<usize> {
         let fx = (p.x - self.origin.x) / self.bin_px;
         let fy = (p.y - self.origin.y) / self.bin_px;
         if radius > self.reach_px || !(fx >= 0.0 && fy >= 0.0) {
-            return &self.all;
+            return None;
         }
         let (c, r) = (fx as usize, fy as usize);
-        if c >= self.cols || r >= self.rows {
-            return &self.all;
-        }
-        let b = r * self.cols + c;
+        (c < self.cols && r < self.rows).then_some(r * self.cols + c)
+    }
+
+    #[inline]
+    fn bin_items(&self, b: usize) -> &[u32] {
         &self.items[self.starts[b] as usize..self.starts[b + 1] as usize]
+    }
+
+    /// Asks for the memory a query about `p` reads, one link of the chain a call: `stage` 0 the
+    /// bin's bounds, 1 the bin's list (which needs the bounds), 2 and on the boxes listed (which
+    /// need the list), each through `item`. Results never change; see [`super::prefetch`].
+    pub(crate) fn prefetch_near(&self, p: Point, stage: usize, item: impl Fn(u32)) {
+        let Some(b) = self.bin(p, self.reach_px) else {
+            return;
+        };
+        match stage {
+            0 => {
+                super::prefetch::line(&self.starts[b]);
+                super::prefetch::line(&self.starts[b + 1]);
+            }
+            1 => super::prefetch::lines(self.bin_items(b)),
+            _ => self.bin_items(b).iter().for_each(|&i| item(i)),
+        }
     }
 }
 

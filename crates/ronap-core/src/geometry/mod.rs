@@ -9,6 +9,7 @@
 
 pub mod index;
 pub mod point_grid;
+pub(crate) mod prefetch;
 pub mod ray_grid;
 pub mod reference;
 pub mod shape;

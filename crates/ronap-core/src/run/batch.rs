@@ -9,7 +9,7 @@
 use crate::geometry::Point;
 use crate::run::shaping::Shaper;
 use crate::run::RunError;
-use crate::sim::episode::{Episode, Status};
+use crate::sim::episode::{Episode, Status, PREFETCH_STAGES};
 use crate::sim::rng::{stream, Rng, Stream};
 use crate::sim::robot::{Action, Pose};
 use crate::sim::world::Worlds;
@@ -17,6 +17,9 @@ use rayon::prelude::*;
 
 /// Environments per parallel task: enough work to outweigh handing it to a thread.
 const MIN_PER_TASK: usize = 16;
+
+/// Most environments in one parallel task (a run stepped in order, see [`Lanes::for_each`]).
+const RUN: usize = 64;
 
 /// When an environment whose episode ended starts the next one.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -133,10 +136,10 @@ pub struct Batch {
     next_seed: u64,
 }
 
-/// One environment with its observation row, final-observation row and step record.
-type Lane<'a> = (
-    ((&'a mut Env, &'a mut [f32]), &'a mut [f32]),
-    &'a mut EnvStep,
+/// A run of environments with their observation rows, final-observation rows and step records.
+type Run<'a> = (
+    ((&'a mut [Env], &'a mut [f32]), &'a mut [f32]),
+    &'a mut [EnvStep],
 );
 
 /// The environments and their rows in the flat buffers, apart from what a step only reads.
@@ -412,37 +415,83 @@ impl Batch {
 impl Lanes {
     /// Runs `f` on every environment with its index, observation row, final-observation row and
     /// step record: on the calling thread for a small batch (too little work to wake another
-    /// thread for), else on the pool. The first error in environment order wins.
+    /// thread for), else on the pool in runs of up to [`RUN`] environments. The first error in
+    /// environment order wins.
     fn for_each(
         &mut self,
         f: impl Fn(usize, &mut Env, &mut [f32], &mut [f32], &mut EnvStep) -> Result<(), RunError> + Sync,
     ) -> Result<(), RunError> {
         let d = self.observation_size;
         let n = self.envs.len();
-        let one = |(i, (((env, obs), last), out)): (usize, Lane<'_>)| f(i, env, obs, last, out);
-        let results: Vec<Result<(), RunError>> = if n <= MIN_PER_TASK {
+        if n <= MIN_PER_TASK {
+            let first = Self::run(
+                0,
+                &mut self.envs,
+                &mut self.observations,
+                &mut self.final_observations,
+                &mut self.steps,
+                d,
+                &f,
+            );
+            return first.map_or(Ok(()), |(_, e)| Err(e));
+        }
+        // Runs short enough that every thread gets a few, long enough that the environments
+        // asked for ahead at a run's start are few.
+        let len = (n / (4 * self.pool.current_num_threads())).clamp(MIN_PER_TASK, RUN);
+        // Each run's first error with its environment's index; the least index wins, and no
+        // vector of results is made.
+        let first = self.pool.install(|| {
             self.envs
-                .iter_mut()
-                .zip(self.observations.chunks_mut(d))
-                .zip(self.final_observations.chunks_mut(d))
-                .zip(self.steps.iter_mut())
+                .par_chunks_mut(len)
+                .zip(self.observations.par_chunks_mut(len * d))
+                .zip(self.final_observations.par_chunks_mut(len * d))
+                .zip(self.steps.par_chunks_mut(len))
                 .enumerate()
-                .map(one)
-                .collect()
-        } else {
-            self.pool.install(|| {
-                self.envs
-                    .par_iter_mut()
-                    .zip(self.observations.par_chunks_mut(d))
-                    .zip(self.final_observations.par_chunks_mut(d))
-                    .zip(self.steps.par_iter_mut())
-                    .enumerate()
-                    .with_min_len(MIN_PER_TASK)
-                    .map(one)
-                    .collect()
-            })
-        };
-        results.into_iter().collect()
+                .filter_map(|(r, (((envs, obs), last), out)): (usize, Run<'_>)| {
+                    Self::run(r * len, envs, obs, last, out, d, &f)
+                })
+                .min_by_key(|(i, _)| *i)
+        });
+        first.map_or(Ok(()), |(_, e)| Err(e))
+    }
+
+    /// [`Lanes::for_each`] over one run of environments from `base`, in order, asking for each
+    /// environment's memory a few environments ahead (see [`Episode::prefetch`]): a thousand
+    /// scenes do not fit the caches, and a step would otherwise wait on each link of the chain
+    /// from the episode to the boxes near its robot in turn.
+    fn run(
+        base: usize,
+        envs: &mut [Env],
+        obs: &mut [f32],
+        last: &mut [f32],
+        out: &mut [EnvStep],
+        d: usize,
+        f: &(impl Fn(usize, &mut Env, &mut [f32], &mut [f32], &mut EnvStep) -> Result<(), RunError>
+              + Sync),
+    ) -> Option<(usize, RunError)> {
+        let mut first = None;
+        for j in 0..envs.len() {
+            for stage in 0..PREFETCH_STAGES {
+                if let Some(e) = envs
+                    .get(j + PREFETCH_STAGES - stage)
+                    .and_then(|e| e.episode.as_ref())
+                {
+                    e.prefetch(stage);
+                }
+            }
+            let row = j * d..(j + 1) * d;
+            let result = f(
+                base + j,
+                &mut envs[j],
+                &mut obs[row.clone()],
+                &mut last[row],
+                &mut out[j],
+            );
+            if let (Err(e), None) = (result, &first) {
+                first = Some((base + j, e));
+            }
+        }
+        first
     }
 }
 

@@ -16,6 +16,7 @@ pub mod warehouse;
 
 use crate::config::{MapConfig, MazeConfig};
 use crate::geometry::index::BinIndex;
+use crate::geometry::prefetch;
 use crate::geometry::ray_grid::{self, RayGrid};
 use crate::geometry::shape::Shape;
 use crate::geometry::{Aabb, Point, Vector};
@@ -553,6 +554,17 @@ impl Scene {
             .filter_map(|s| s.cast_ray(origin, dir, max_px))
             .fold(boxes.unwrap_or(f64::INFINITY), f64::min);
         best.is_finite().then_some(best)
+    }
+
+    /// Asks for the memory the queries about `p` read, one link of the chain a call (`stage`
+    /// 0, 1, then 2: the bin, its list, its boxes). Results never change.
+    pub(crate) fn prefetch_near(&self, p: Point, stage: usize) {
+        self.index.prefetch_near(p, stage, |i| {
+            if let Some(b) = self.boxes.get(i as usize) {
+                prefetch::line(&b.min);
+                prefetch::line(&b.max);
+            }
+        });
     }
 
     /// Whether a disc of `radius` at `p` touches no obstacle (a tangent disc does not touch).

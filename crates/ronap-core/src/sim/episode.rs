@@ -95,6 +95,9 @@ pub fn bearing_deg(from: Point, to: Point) -> f64 {
     wrap_deg(d.y.atan2(d.x).to_degrees())
 }
 
+/// How many calls of [`Episode::prefetch`] bring in what a step reads.
+pub(crate) const PREFETCH_STAGES: usize = 5;
+
 /// One episode in progress.
 #[derive(Clone, Debug)]
 pub struct Episode {
@@ -373,6 +376,34 @@ impl Episode {
         self.sense();
         let reward = self.score(before, &motion, collided);
         self.result(reward, collided)
+    }
+
+    /// Asks for the memory the next step reads, one link of the chain a call, `stage` from 0
+    /// to [`PREFETCH_STAGES`] - 1: the episode's own fields, then what they point to (the
+    /// scene, the readings, the observation, the beams), then the scene's bin around the robot,
+    /// its list and its boxes. A batch calls each stage a few environments ahead of the one it
+    /// steps, so each link has arrived before the next needs it. Results never change.
+    pub(crate) fn prefetch(&self, stage: usize) {
+        use crate::geometry::prefetch::{line, lines};
+        match stage {
+            0 => {
+                line(&self.scene);
+                line(&self.pose);
+                line(&self.readings);
+                line(&self.observation);
+                line(&self.laser);
+                line(&self.robot);
+                line(&self.noise_rng);
+                line(&self.status);
+            }
+            1 => {
+                line(&*self.scene);
+                lines(&self.readings);
+                lines(&self.observation);
+                self.laser.prefetch();
+            }
+            s => self.scene.prefetch_near(self.pose.position(), s - 2),
+        }
     }
 
     /// The current frame's values after the paper's (a team's neighbour slots), to fill in.

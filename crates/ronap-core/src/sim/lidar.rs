@@ -151,6 +151,11 @@ impl Laser {
         self.offsets.len()
     }
 
+    /// Asks for the beams' directions (see [`crate::geometry::prefetch`]).
+    pub(crate) fn prefetch(&self) {
+        crate::geometry::prefetch::lines(&self.offsets);
+    }
+
     /// Largest reading, px.
     pub fn range_px(&self) -> f64 {
         self.range_px
