@@ -13,7 +13,7 @@ use crate::sim::episode::{Episode, Status, PREFETCH_STAGES};
 use crate::sim::rng::{stream, Rng, Stream};
 use crate::sim::robot::{Action, Pose};
 use crate::sim::world::Worlds;
-use rayon::prelude::*;
+use std::sync::{Mutex, PoisonError};
 
 /// Environments per parallel task: enough work to outweigh handing it to a thread.
 const MIN_PER_TASK: usize = 16;
@@ -144,7 +144,8 @@ type Run<'a> = (
 
 /// The environments and their rows in the flat buffers, apart from what a step only reads.
 struct Lanes {
-    pool: rayon::ThreadPool,
+    /// The threads that step beside the calling thread (`None`: it steps alone).
+    pool: Option<rayon::ThreadPool>,
     envs: Vec<Env>,
     observation_size: usize,
     observations: Vec<f32>,
@@ -156,10 +157,19 @@ impl Batch {
     /// A batch of `options.envs` environments in `worlds`, none started yet.
     pub fn new(worlds: Worlds, options: BatchOptions) -> Result<Self, RunError> {
         let n = options.envs.max(1);
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(options.threads)
-            .build()
-            .map_err(|e| RunError::Threads(e.to_string()))?;
+        // The calling thread steps too, so the pool holds one thread fewer than asked for.
+        let threads = match options.threads {
+            0 => std::thread::available_parallelism().map_or(1, usize::from),
+            t => t,
+        };
+        let pool = (threads > 1)
+            .then(|| {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads - 1)
+                    .build()
+                    .map_err(|e| RunError::Threads(e.to_string()))
+            })
+            .transpose()?;
         let observation_size = worlds.config().observation_size();
         Ok(Self {
             worlds,
@@ -414,16 +424,18 @@ impl Batch {
 
 impl Lanes {
     /// Runs `f` on every environment with its index, observation row, final-observation row and
-    /// step record: on the calling thread for a small batch (too little work to wake another
-    /// thread for), else on the pool in runs of up to [`RUN`] environments. The first error in
-    /// environment order wins.
+    /// step record, in runs of up to [`RUN`] environments: the calling thread takes runs one
+    /// after another, and so do the pool's threads once they wake (a small batch, too little
+    /// work to wake another thread for, stays on the calling thread). The calling thread starts
+    /// at once instead of waiting for the pool to wake and then for it to finish. The first
+    /// error in environment order wins.
     fn for_each(
         &mut self,
         f: impl Fn(usize, &mut Env, &mut [f32], &mut [f32], &mut EnvStep) -> Result<(), RunError> + Sync,
     ) -> Result<(), RunError> {
         let d = self.observation_size;
         let n = self.envs.len();
-        if n <= MIN_PER_TASK {
+        let Some(pool) = self.pool.as_ref().filter(|_| n > MIN_PER_TASK) else {
             let first = Self::run(
                 0,
                 &mut self.envs,
@@ -434,24 +446,40 @@ impl Lanes {
                 &f,
             );
             return first.map_or(Ok(()), |(_, e)| Err(e));
-        }
+        };
+        let helpers = pool.current_num_threads();
         // Runs short enough that every thread gets a few, long enough that the environments
         // asked for ahead at a run's start are few.
-        let len = (n / (4 * self.pool.current_num_threads())).clamp(MIN_PER_TASK, RUN);
-        // Each run's first error with its environment's index; the least index wins, and no
-        // vector of results is made.
-        let first = self.pool.install(|| {
-            self.envs
-                .par_chunks_mut(len)
-                .zip(self.observations.par_chunks_mut(len * d))
-                .zip(self.final_observations.par_chunks_mut(len * d))
-                .zip(self.steps.par_chunks_mut(len))
-                .enumerate()
-                .filter_map(|(r, (((envs, obs), last), out)): (usize, Run<'_>)| {
-                    Self::run(r * len, envs, obs, last, out, d, &f)
-                })
-                .min_by_key(|(i, _)| *i)
+        let len = (n / (4 * (helpers + 1))).clamp(MIN_PER_TASK, RUN);
+        let runs: Vec<(usize, Run<'_>)> = self
+            .envs
+            .chunks_mut(len)
+            .zip(self.observations.chunks_mut(len * d))
+            .zip(self.final_observations.chunks_mut(len * d))
+            .zip(self.steps.chunks_mut(len))
+            .enumerate()
+            .collect();
+        let queue = Mutex::new(runs.into_iter());
+        let first: Mutex<Option<(usize, RunError)>> = Mutex::new(None);
+        let work = || loop {
+            let next = queue.lock().unwrap_or_else(PoisonError::into_inner).next();
+            let Some((r, (((envs, obs), last), out))) = next else {
+                return;
+            };
+            if let Some((i, e)) = Self::run(r * len, envs, obs, last, out, d, &f) {
+                let mut slot = first.lock().unwrap_or_else(PoisonError::into_inner);
+                if slot.as_ref().is_none_or(|(j, _)| i < *j) {
+                    *slot = Some((i, e));
+                }
+            }
+        };
+        pool.in_place_scope(|s| {
+            for _ in 0..helpers {
+                s.spawn(|_| work());
+            }
+            work();
         });
+        let first = first.into_inner().unwrap_or_else(PoisonError::into_inner);
         first.map_or(Ok(()), |(_, e)| Err(e))
     }
 
@@ -593,6 +621,32 @@ mod tests {
                 envs: 4
             })
         );
+    }
+
+    #[test]
+    fn every_environment_is_visited_once_and_the_least_failing_index_wins() {
+        for threads in [1, 2, 3] {
+            let mut b = batch(300, threads, Autoreset::NextStep);
+            let visits: Vec<std::sync::atomic::AtomicUsize> =
+                (0..300).map(|_| Default::default()).collect();
+            let result = b.lanes.for_each(|i, _, obs, last, _| {
+                assert_eq!((obs.len(), last.len()), (18, 18));
+                visits[i].fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                // Failures in several runs, the least of them not in the first run.
+                match i % 37 == 5 && i > 50 {
+                    true => Err(RunError::Ended { env: i }),
+                    false => Ok(()),
+                }
+            });
+            assert_eq!(
+                result,
+                Err(RunError::Ended { env: 79 }),
+                "{threads} threads"
+            );
+            assert!(visits
+                .iter()
+                .all(|v| v.load(std::sync::atomic::Ordering::Relaxed) == 1));
+        }
     }
 
     #[test]
