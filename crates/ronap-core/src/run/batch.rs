@@ -51,7 +51,7 @@ pub enum SeedOrder {
 pub struct BatchOptions {
     /// Number of environments (at least 1).
     pub envs: usize,
-    /// Worker threads (0: all cores).
+    /// Threads that step the environments, the calling thread among them (0: all cores).
     pub threads: usize,
     /// When finished episodes restart.
     pub autoreset: Autoreset,
