@@ -13,13 +13,19 @@ use crate::sim::episode::{Episode, Status, PREFETCH_STAGES};
 use crate::sim::rng::{stream, Rng, Stream};
 use crate::sim::robot::{Action, Pose};
 use crate::sim::world::Worlds;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Mutex, PoisonError};
+use std::time::Duration;
 
 /// Environments per parallel task: enough work to outweigh handing it to a thread.
 const MIN_PER_TASK: usize = 16;
 
 /// Most environments in one parallel task (a run stepped in order, see [`Lanes::for_each`]).
 const RUN: usize = 64;
+
+/// Longest the calling thread waits awake for the pool's last runs (a run of [`RUN`]
+/// environments takes about 20 us).
+const SPIN: Duration = Duration::from_micros(100);
 
 /// When an environment whose episode ended starts the next one.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -459,25 +465,36 @@ impl Lanes {
             .zip(self.steps.chunks_mut(len))
             .enumerate()
             .collect();
+        let total = runs.len();
         let queue = Mutex::new(runs.into_iter());
+        let done = AtomicUsize::new(0);
         let first: Mutex<Option<(usize, RunError)>> = Mutex::new(None);
         let work = || loop {
             let next = queue.lock().unwrap_or_else(PoisonError::into_inner).next();
             let Some((r, (((envs, obs), last), out))) = next else {
                 return;
             };
-            if let Some((i, e)) = Self::run(r * len, envs, obs, last, out, d, &f) {
+            let failed = Self::run(r * len, envs, obs, last, out, d, &f);
+            if let Some((i, e)) = failed {
                 let mut slot = first.lock().unwrap_or_else(PoisonError::into_inner);
                 if slot.as_ref().is_none_or(|(j, _)| i < *j) {
                     *slot = Some((i, e));
                 }
             }
+            done.fetch_add(1, Ordering::Release);
         };
         pool.in_place_scope(|s| {
             for _ in 0..helpers {
                 s.spawn(|_| work());
             }
             work();
+            // The runs left are under way on the pool: wait for them awake, for at most about
+            // as long as a run takes, rather than sleep and be woken (tens of microseconds on a
+            // virtual machine).
+            let clock = std::time::Instant::now();
+            while done.load(Ordering::Acquire) < total && clock.elapsed() < SPIN {
+                std::hint::spin_loop();
+            }
         });
         let first = first.into_inner().unwrap_or_else(PoisonError::into_inner);
         first.map_or(Ok(()), |(_, e)| Err(e))
