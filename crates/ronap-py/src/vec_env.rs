@@ -282,8 +282,7 @@ impl VecEnv {
         Option<Finals<'py>>,
     )> {
         let n = self.batch.len();
-        let mut buffer = std::mem::take(&mut self.actions);
-        buffer.clear();
+        self.actions.clear();
         if self.continuous {
             let a: PyReadonlyArray2<'py, f64> = actions.extract()?;
             let a = a.as_array();
@@ -296,7 +295,7 @@ impl VecEnv {
             for (i, r) in a.rows().into_iter().enumerate() {
                 match (r[0], r[1]) {
                     (v, w_deg) if v.is_finite() && w_deg.is_finite() => {
-                        buffer.push(Action::Continuous { v, w_deg });
+                        self.actions.push(Action::Continuous { v, w_deg });
                     }
                     (v, w) => {
                         return Err(errors::ActionError::new_err(format!(
@@ -325,10 +324,11 @@ impl VecEnv {
                     "action {a} for environment {i}: expected 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)"
                 )));
             }
-            buffer.extend(a.iter().filter_map(|&a| conv::discrete(a)));
+            self.actions
+                .extend(a.iter().filter_map(|&a| conv::discrete(a)));
         }
-        let stepped = py.allow_threads(|| self.batch.step_actions(&buffer));
-        self.actions = buffer;
+        let (batch, chosen) = (&mut self.batch, &self.actions);
+        let stepped = py.allow_threads(|| batch.step_actions(chosen));
         stepped.map_err(|e| run_error(&e))?;
         self.track(None);
         let steps = self.batch.steps();

@@ -57,7 +57,8 @@ pub enum SeedOrder {
 pub struct BatchOptions {
     /// Number of environments (at least 1).
     pub envs: usize,
-    /// Threads that step the environments, the calling thread among them (0: all cores).
+    /// Threads that step the environments, the calling thread among them (0: `RAYON_NUM_THREADS`
+    /// where set, else all cores).
     pub threads: usize,
     /// When finished episodes restart.
     pub autoreset: Autoreset,
@@ -152,6 +153,9 @@ type Run<'a> = (
 struct Lanes {
     /// The threads that step beside the calling thread (`None`: it steps alone).
     pool: Option<rayon::ThreadPool>,
+    /// Whether the calling thread may wait awake for the pool's last runs: not when there are
+    /// more threads than cores, where the thread it waits for may not be running.
+    spin: bool,
     envs: Vec<Env>,
     observation_size: usize,
     observations: Vec<f32>,
@@ -163,9 +167,15 @@ impl Batch {
     /// A batch of `options.envs` environments in `worlds`, none started yet.
     pub fn new(worlds: Worlds, options: BatchOptions) -> Result<Self, RunError> {
         let n = options.envs.max(1);
-        // The calling thread steps too, so the pool holds one thread fewer than asked for.
+        // The calling thread steps too, so the pool holds one thread fewer than asked for. All
+        // cores means rayon's own default: `RAYON_NUM_THREADS` where set, else every core.
+        let cores = std::thread::available_parallelism().map_or(1, usize::from);
         let threads = match options.threads {
-            0 => std::thread::available_parallelism().map_or(1, usize::from),
+            0 => std::env::var("RAYON_NUM_THREADS")
+                .ok()
+                .and_then(|v| v.trim().parse::<usize>().ok())
+                .filter(|&t| t > 0)
+                .unwrap_or(cores),
             t => t,
         };
         let pool = (threads > 1)
@@ -182,6 +192,7 @@ impl Batch {
             options: BatchOptions { envs: n, ..options },
             lanes: Lanes {
                 pool,
+                spin: threads <= cores,
                 envs: (0..n)
                     .map(|_| Env {
                         episode: None,
@@ -430,9 +441,10 @@ impl Batch {
 
 impl Lanes {
     /// Runs `f` on every environment with its index, observation row, final-observation row and
-    /// step record, in runs of up to [`RUN`] environments: the calling thread takes runs one
-    /// after another, and so do the pool's threads once they wake (a small batch, too little
-    /// work to wake another thread for, stays on the calling thread). The calling thread starts
+    /// step record, in runs of [`MIN_PER_TASK`] to [`RUN`] environments: the calling thread
+    /// takes runs one after another, and so do the pool's threads once they wake (without a
+    /// pool, or for a small batch, too little work to wake another thread for, the calling
+    /// thread steps every environment as one run). The calling thread starts
     /// at once instead of waiting for the pool to wake and then for it to finish. The first
     /// error in environment order wins.
     fn for_each(
@@ -483,11 +495,16 @@ impl Lanes {
             }
             done.fetch_add(1, Ordering::Release);
         };
+        let spin = self.spin;
         pool.in_place_scope(|s| {
-            for _ in 0..helpers {
+            // No more helpers than runs beyond the caller's first: the scope waits for each.
+            for _ in 0..helpers.min(total.saturating_sub(1)) {
                 s.spawn(|_| work());
             }
             work();
+            if !spin {
+                return;
+            }
             // The runs left are under way on the pool: wait for them awake, for at most about
             // as long as a run takes, rather than sleep and be woken (tens of microseconds on a
             // virtual machine).
@@ -642,10 +659,11 @@ mod tests {
 
     #[test]
     fn every_environment_is_visited_once_and_the_least_failing_index_wins() {
-        for threads in [1, 2, 3] {
-            let mut b = batch(300, threads, Autoreset::NextStep);
+        // Threads 0 (all cores) to 3; 40 environments make three runs, fewer than the threads.
+        for (envs, threads) in [(300, 1), (300, 2), (300, 3), (300, 0), (40, 3)] {
+            let mut b = batch(envs, threads, Autoreset::NextStep);
             let visits: Vec<std::sync::atomic::AtomicUsize> =
-                (0..300).map(|_| Default::default()).collect();
+                (0..envs).map(|_| Default::default()).collect();
             let result = b.lanes.for_each(|i, _, obs, last, _| {
                 assert_eq!((obs.len(), last.len()), (18, 18));
                 visits[i].fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -655,11 +673,12 @@ mod tests {
                     false => Ok(()),
                 }
             });
-            assert_eq!(
-                result,
-                Err(RunError::Ended { env: 79 }),
-                "{threads} threads"
-            );
+            let expected = if envs > 79 {
+                Err(RunError::Ended { env: 79 })
+            } else {
+                Ok(())
+            };
+            assert_eq!(result, expected, "{envs} environments, {threads} threads");
             assert!(visits
                 .iter()
                 .all(|v| v.load(std::sync::atomic::Ordering::Relaxed) == 1));
