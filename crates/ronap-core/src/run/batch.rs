@@ -505,9 +505,9 @@ impl Lanes {
             if !spin {
                 return;
             }
-            // The runs left are under way on the pool: wait for them awake, for at most about
-            // as long as a run takes, rather than sleep and be woken (tens of microseconds on a
-            // virtual machine).
+            // The runs left are under way on the pool: wait for them awake, for at most
+            // [`SPIN`] (a few runs' time), rather than sleep and be woken (tens of microseconds
+            // on a virtual machine).
             let clock = std::time::Instant::now();
             while done.load(Ordering::Acquire) < total && clock.elapsed() < SPIN {
                 std::hint::spin_loop();
