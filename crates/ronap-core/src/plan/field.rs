@@ -17,10 +17,8 @@ pub struct DistanceField {
     rows: usize,
     cell_px: f64,
     goal: Point,
-    /// Cost to the goal per cell; infinite where unreachable.
-    cost: Vec<f64>,
-    /// Next cell towards the goal, or [`ROOT`].
-    parent: Vec<u32>,
+    /// Per cell, its cost to the goal in the search's units and the next cell towards the goal.
+    cells: Vec<Node>,
 }
 
 /// Cells around a point searched to attach it to the grid (a 5 x 5 block).
@@ -29,29 +27,27 @@ const ATTACH_CELLS: isize = 2;
 impl DistanceField {
     /// The field towards `goal` for a disc of `radius`. Steps into or out of a
     /// [close](FreeGrid::is_close) cell cost `close_cost` times their length (1 gives plain
-    /// shortest paths; more keeps paths away from walls).
+    /// shortest paths; more keeps paths away from walls). The search runs in buffers kept per
+    /// thread; the field keeps a copy of its cells.
     pub fn new(scene: &Scene, grid: &FreeGrid, goal: Point, radius: f64, close_cost: f64) -> Self {
         let (cols, rows) = grid.size();
-        let mut work = Work::default();
-        work.run(scene, grid, goal, radius, close_cost, None);
-        let px_per_unit = grid.cell_px() / AXIS as f64;
-        Self {
-            cols,
-            rows,
-            cell_px: grid.cell_px(),
-            goal,
-            cost: work
-                .cells
-                .iter()
-                .map(|c| {
-                    if c.cost == u32::MAX {
-                        f64::INFINITY
-                    } else {
-                        c.cost as f64 * px_per_unit
-                    }
-                })
-                .collect(),
-            parent: work.cells.iter().map(|c| c.parent).collect(),
+        WORK.with_borrow_mut(|work| {
+            work.run(scene, grid, goal, radius, close_cost, None);
+            Self {
+                cols,
+                rows,
+                cell_px: grid.cell_px(),
+                goal,
+                cells: work.cells.clone(),
+            }
+        })
+    }
+
+    /// The cost of cell `i`, px (infinite where unreachable).
+    fn cost(&self, i: usize) -> f64 {
+        match self.cells[i].cost {
+            u32::MAX => f64::INFINITY,
+            c => c as f64 * (self.cell_px / AXIS as f64),
         }
     }
 
@@ -66,7 +62,7 @@ impl DistanceField {
         if c < 0.0 || r < 0.0 || c >= self.cols as f64 || r >= self.rows as f64 {
             return f64::INFINITY;
         }
-        self.cost[r as usize * self.cols + c as usize]
+        self.cost(r as usize * self.cols + c as usize)
     }
 
     /// The geodesic distance from `p` to the goal: the least, over the cell holding `p` and its
@@ -82,7 +78,7 @@ impl DistanceField {
                     continue;
                 }
                 let i = rr as usize * self.cols + cc as usize;
-                let cost = self.cost[i];
+                let cost = self.cost(i);
                 if cost.is_finite() {
                     best = best.min(cost + (p - self.center(i)).norm());
                 }
@@ -107,12 +103,12 @@ impl DistanceField {
         start: Point,
         radius: f64,
     ) -> Option<Vec<Point>> {
-        let first = best_entry(&attach(scene, grid, start, radius), |i| self.cost[i])?;
+        let first = best_entry(&attach(scene, grid, start, radius), |i| self.cost(i))?;
         Some(walk(
             start,
             first,
             self.goal,
-            |i| self.parent[i],
+            |i| self.cells[i].parent,
             |i| self.center(i),
         ))
     }
