@@ -271,27 +271,35 @@ impl Work {
                 }
                 // Open moves as bits in the order E, W, N, S, NE, SE, NW, SW: the order decides
                 // which of two equal-cost parents a cell keeps.
-                let mut open = moves[i] as u32;
+                let open = moves[i] as u32;
                 let slow = slow[i] as u32;
-                while open != 0 {
-                    let k = open.trailing_zeros() as usize;
-                    open &= open - 1;
+                // Which open moves improve their cell, found for all eight before any is
+                // taken (they reach eight different cells), without a branch on each: whether
+                // a neighbour improves is a coin toss to the branch predictor. A closed move
+                // looks at the cell itself, which never improves (every step costs more than
+                // nothing).
+                let mut better = 0u32;
+                for k in 0..8 {
+                    let mask = ((open as usize >> k) & 1).wrapping_neg();
+                    let j = i.wrapping_add(offsets[k] as usize & mask);
+                    let nd = current + steps[(slow >> k & 1) as usize][k];
+                    better |= u32::from(nd < cells[j].cost) << k;
+                }
+                while better != 0 {
+                    let k = better.trailing_zeros() as usize;
+                    better &= better - 1;
                     let j = i.wrapping_add(offsets[k] as usize);
                     let step = steps[(slow >> k & 1) as usize][k];
-                    let nd = current + step;
-                    let to = &mut cells[j];
-                    if nd < to.cost {
-                        *to = Node {
-                            cost: nd,
-                            parent: i as u32,
-                        };
-                        let mut to = slot + step as usize;
-                        if to >= ring {
-                            to -= ring;
-                        }
-                        buckets[to].push(j as u32);
-                        pending += 1;
+                    cells[j] = Node {
+                        cost: current + step,
+                        parent: i as u32,
+                    };
+                    let mut to = slot + step as usize;
+                    if to >= ring {
+                        to -= ring;
                     }
+                    buckets[to].push(j as u32);
+                    pending += 1;
                 }
                 if (lowest..=highest).contains(&i) {
                     for &(t, d) in targets.unwrap_or_default() {
