@@ -8,6 +8,7 @@
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use ronap_core::geometry::reference::ParryScene;
 use ronap_core::geometry::unit;
+use ronap_core::policy::{Decision, Policy};
 use ronap_core::scene::freespace::FreeGrid;
 use ronap_core::sim::world::maze_scene;
 use ronap_core::{Episode, Laser, ValidConfig};
@@ -230,6 +231,38 @@ fn mlp(c: &mut Criterion) {
             if episode.step(action).status.is_done() {
                 seed += 1;
                 episode = Episode::new(&config, scene.clone(), seed).expect("default scene");
+            }
+        })
+    });
+    // The same steps as the evaluator takes them for a network's policy: sixteen episodes side
+    // by side on one thread, the policy deciding for all sixteen at once (`Policy::act_lanes`),
+    // then each episode stepping; per episode step.
+    let lanes = ronap_core::policy::mlp::SIDE_BY_SIDE;
+    let mut policy = ronap_core::policy::mlp::MlpPolicy::new(Arc::new(net.clone()));
+    let world = ronap_core::World::maze(config.clone(), 0);
+    let mut episodes: Vec<Episode> = (0..lanes as u64)
+        .map(|s| Episode::new(&config, scene.clone(), s).expect("default scene"))
+        .collect();
+    for (lane, e) in episodes.iter().enumerate() {
+        policy.reset_lane(lane, &world, e).expect("fits");
+    }
+    let mut decisions = Vec::with_capacity(lanes);
+    let mut next_seed = lanes as u64;
+    group.throughput(Throughput::Elements(lanes as u64));
+    group.bench_function("policy_step_side_by_side", |b| {
+        b.iter(|| {
+            decisions.clear();
+            let asked: Vec<(usize, &Episode)> = episodes.iter().enumerate().collect();
+            policy.act_lanes(&asked, &mut decisions).expect("decides");
+            for (lane, (e, d)) in episodes.iter_mut().zip(&decisions).enumerate() {
+                let Decision::Act(action) = d else {
+                    unreachable!("an MLP never gives up")
+                };
+                if e.step(*action).status.is_done() {
+                    next_seed += 1;
+                    *e = Episode::new(&config, scene.clone(), next_seed).expect("default scene");
+                    policy.reset_lane(lane, &world, e).expect("fits");
+                }
             }
         })
     });

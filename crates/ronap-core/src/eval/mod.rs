@@ -7,6 +7,7 @@
 
 pub mod ordered;
 pub mod record;
+pub mod side_by_side;
 pub mod summary;
 pub mod team;
 
@@ -21,6 +22,9 @@ use crate::plan::shortest_path_px;
 use crate::policy::{Policy, PolicyError, PolicyFactory};
 use crate::run::rollout::Rollout;
 use crate::run::RunError;
+use crate::sim::episode::Episode;
+use crate::sim::moving::Track;
+use crate::sim::robot::{Action, Pose};
 use crate::sim::world::{Scenes, World, Worlds};
 use ordered::{run_in_order, Ordered, Window};
 use std::sync::atomic::AtomicBool;
@@ -170,49 +174,24 @@ impl Evaluator {
     ) -> Result<EpisodeRecord, RunError> {
         let clock = Instant::now();
         let mut rollout = Rollout::start(self.world(seed), seed, policy)?;
-        let mut trajectory = Vec::new();
-        let mut step_log = Vec::new();
-        let mut tracks = Vec::new();
-        let record_tracks = |e: &crate::sim::episode::Episode, tracks: &mut Vec<_>| {
-            if let Some(movers) = e.movers() {
-                movers.record(tracks);
-            }
-        };
-        if recording.trajectory {
-            trajectory.push(rollout.episode().pose());
-            record_tracks(rollout.episode(), &mut tracks);
-        }
+        let mut recorder = Recorder::start(recording, clock, &rollout);
         while let Some(action) = rollout.decide(policy)? {
-            let before = recording.steps.then(|| {
-                let e = rollout.episode();
-                (
-                    e.pose(),
-                    e.readings().to_vec(),
-                    e.bearing_deg(),
-                    e.distance_px(),
-                    e.direction_deg(),
-                )
-            });
-            let s = rollout.take(action);
-            if let Some((pose, readings, bearing_deg, distance_px, direction_deg)) = before {
-                step_log.push(StepLog {
-                    step: s.step,
-                    pose,
-                    readings,
-                    bearing_deg,
-                    distance_px,
-                    direction_deg,
-                    action,
-                    collided: s.collided,
-                    reward: s.reward,
-                });
-            }
-            if recording.trajectory {
-                trajectory.push(s.pose);
-                record_tracks(rollout.episode(), &mut tracks);
-            }
+            recorder.take(&mut rollout, action);
         }
+        Ok(self.record(rollout, recorder))
+    }
+
+    /// The record of a finished rollout.
+    pub(crate) fn record(&self, rollout: Rollout, recorder: Recorder) -> EpisodeRecord {
+        let Recorder {
+            clock,
+            trajectory,
+            step_log,
+            tracks,
+            ..
+        } = recorder;
         let (world, episode, reason) = rollout.into_parts();
+        let seed = episode.seed();
         let outcome = Outcome::of(episode.status());
         // The shortest path is only needed to score a success, and costs more than a random
         // policy's whole episode, so failures are not charged for it.
@@ -232,7 +211,7 @@ impl Evaluator {
             }
             _ => 0.0,
         };
-        Ok(EpisodeRecord {
+        EpisodeRecord {
             seed,
             outcome,
             reason,
@@ -252,7 +231,7 @@ impl Evaluator {
             dynamic: episode.dynamic_metrics(),
             step_log,
             world: Some(world),
-        })
+        }
     }
 
     /// Runs `options.seeds` with policies from `factory`, keeping every record (stripped of its
@@ -283,7 +262,10 @@ impl Evaluator {
     /// `false` stops the run. Memory stays flat however many seeds: workers run at most a
     /// [`Window`] of episodes ahead of the next record `sink` is waiting for. Setting `cancel`
     /// stops the run between episodes; the episodes under way finish and are handed on, so what
-    /// `sink` saw is always the first seeds of `options.seeds`.
+    /// `sink` saw is always the first seeds of `options.seeds`. A factory whose policies decide for
+    /// several episodes at once ([`PolicyFactory::side_by_side`]) has each worker step that many
+    /// side by side, in blocks of seeds ([`side_by_side`]): the same records, and the cancel flag
+    /// then stops the run between blocks.
     pub fn stream(
         &self,
         factory: &dyn PolicyFactory,
@@ -292,6 +274,10 @@ impl Evaluator {
         on_finish: &(dyn Fn(&EpisodeRecord) + Sync),
         sink: &mut dyn FnMut(EpisodeRecord) -> bool,
     ) -> Result<RunEnd, PolicyError> {
+        let lanes = factory.side_by_side();
+        if lanes > 1 {
+            return self.stream_side_by_side(factory, options, lanes, cancel, on_finish, sink);
+        }
         let clock = Instant::now();
         let pool = worker_pool(options.threads)?;
         // Policies are made at most once per worker and handed from episode to episode, so a
@@ -320,6 +306,72 @@ impl Evaluator {
             sink,
         );
         RunEnd::of(ended, options.seeds.len(), clock)
+    }
+}
+
+/// What an evaluation keeps of an episode as it runs: its clock, and the trajectory, obstacle
+/// tracks and step log its [`Recording`] asks for.
+pub(crate) struct Recorder {
+    clock: Instant,
+    recording: Recording,
+    trajectory: Vec<Pose>,
+    step_log: Vec<StepLog>,
+    tracks: Vec<Track>,
+}
+
+impl Recorder {
+    /// Starts recording `rollout`'s episode (begun at `clock`) as `recording` asks.
+    pub(crate) fn start(recording: Recording, clock: Instant, rollout: &Rollout) -> Self {
+        let mut recorder = Self {
+            clock,
+            recording,
+            trajectory: Vec::new(),
+            step_log: Vec::new(),
+            tracks: Vec::new(),
+        };
+        if recording.trajectory {
+            recorder.trajectory.push(rollout.episode().pose());
+            recorder.track(rollout.episode());
+        }
+        recorder
+    }
+
+    fn track(&mut self, episode: &Episode) {
+        if let Some(movers) = episode.movers() {
+            movers.record(&mut self.tracks);
+        }
+    }
+
+    /// Takes `action` in `rollout`, keeping what the recording asks for.
+    pub(crate) fn take(&mut self, rollout: &mut Rollout, action: Action) {
+        let before = self.recording.steps.then(|| {
+            let e = rollout.episode();
+            (
+                e.pose(),
+                e.readings().to_vec(),
+                e.bearing_deg(),
+                e.distance_px(),
+                e.direction_deg(),
+            )
+        });
+        let s = rollout.take(action);
+        if let Some((pose, readings, bearing_deg, distance_px, direction_deg)) = before {
+            self.step_log.push(StepLog {
+                step: s.step,
+                pose,
+                readings,
+                bearing_deg,
+                distance_px,
+                direction_deg,
+                action,
+                collided: s.collided,
+                reward: s.reward,
+            });
+        }
+        if self.recording.trajectory {
+            self.trajectory.push(s.pose);
+            self.track(rollout.episode());
+        }
     }
 }
 

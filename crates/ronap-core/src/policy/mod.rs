@@ -55,6 +55,34 @@ pub trait Policy: Send {
     fn hear(&mut self, inbox: crate::sim::team::Inbox<'_>) {
         let _ = inbox;
     }
+
+    /// Prepares lane `lane` for a new episode, for a policy whose factory runs episodes
+    /// [side by side](PolicyFactory::side_by_side): each lane keeps its own episode's state, as
+    /// [`Policy::reset`] prepares the one episode of a policy run alone (the default).
+    fn reset_lane(
+        &mut self,
+        lane: usize,
+        world: &World,
+        episode: &Episode,
+    ) -> Result<(), PolicyError> {
+        let _ = lane;
+        self.reset(world, episode)
+    }
+
+    /// The decisions for several episodes at once, each given with its lane, pushed onto
+    /// `decisions` in the same order: what [`Policy::act`] decides for each, but sharing the
+    /// work between them (a network evaluating its rows together). On an error, the index in
+    /// `episodes` of the episode it belongs to. The default asks [`Policy::act`] in turn.
+    fn act_lanes(
+        &mut self,
+        episodes: &[(usize, &Episode)],
+        decisions: &mut Vec<Decision>,
+    ) -> Result<(), (usize, PolicyError)> {
+        for (k, (_, episode)) in episodes.iter().enumerate() {
+            decisions.push(self.act(episode).map_err(|e| (k, e))?);
+        }
+        Ok(())
+    }
 }
 
 /// Makes policies: one per worker thread of an evaluation.
@@ -64,4 +92,12 @@ pub trait PolicyFactory: Sync {
 
     /// The policy's name, for reports.
     fn name(&self) -> String;
+
+    /// How many episodes each policy it makes decides for together, through
+    /// [`Policy::reset_lane`] and [`Policy::act_lanes`]: more than 1 only when deciding together
+    /// is cheaper and every lane keeps its own state. The evaluator then steps that many episodes
+    /// of a worker side by side; their records are the same as one at a time, bit for bit.
+    fn side_by_side(&self) -> usize {
+        1
+    }
 }

@@ -47,6 +47,25 @@ impl Rollout {
         Ok(rollout)
     }
 
+    /// The episode of `seed` in `world`, with lane `lane` of `policy` reset for it (episodes run
+    /// [side by side](crate::policy::PolicyFactory::side_by_side)).
+    pub fn start_lane(
+        world: Arc<World>,
+        seed: u64,
+        policy: &mut dyn Policy,
+        lane: usize,
+    ) -> Result<Self, RunError> {
+        let rollout = Self::new(world, seed)?;
+        policy
+            .reset_lane(lane, &rollout.world, &rollout.episode)
+            .map_err(|source| RunError::Policy {
+                seed,
+                step: 0,
+                source,
+            })?;
+        Ok(rollout)
+    }
+
     /// The episode of `seed` in `world`, for a caller that chooses every action itself.
     pub fn new(world: Arc<World>, seed: u64) -> Result<Self, RunError> {
         let episode = world
@@ -70,12 +89,26 @@ impl Rollout {
         if self.finished() {
             return Ok(None);
         }
-        let seed = self.episode.seed();
-        let step = self.episode.steps() + 1;
-        let action = match policy
-            .act(&self.episode)
-            .map_err(|source| RunError::Policy { seed, step, source })?
-        {
+        let decision = policy.act(&self.episode);
+        self.decided(decision.map_err(|source| self.policy_error(source)))
+    }
+
+    /// The error of the policy failing to decide this step.
+    pub fn policy_error(&self, source: crate::policy::PolicyError) -> RunError {
+        RunError::Policy {
+            seed: self.episode.seed(),
+            step: self.episode.steps() + 1,
+            source,
+        }
+    }
+
+    /// [`Rollout::decide`] for a decision already made (with the others of episodes side by
+    /// side): the action, checked; `None` when the policy gave up.
+    pub fn decided(
+        &mut self,
+        decision: Result<Decision, RunError>,
+    ) -> Result<Option<Action>, RunError> {
+        let action = match decision? {
             Decision::Act(action) => action,
             Decision::GiveUp(why) => {
                 self.gave_up = Some(why);
@@ -84,7 +117,11 @@ impl Rollout {
         };
         if let Action::Continuous { v, w_deg } = action {
             if !v.is_finite() || !w_deg.is_finite() {
-                return Err(RunError::InvalidAction { seed, step, action });
+                return Err(RunError::InvalidAction {
+                    seed: self.episode.seed(),
+                    step: self.episode.steps() + 1,
+                    action,
+                });
             }
         }
         Ok(Some(action))

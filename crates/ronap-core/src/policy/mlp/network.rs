@@ -318,7 +318,26 @@ fn add_rows<S: pulp::Simd, const R: usize>(
         }
         o += 2 * lanes;
     }
-    // What is left of each row (fewer than two vectors), a row at a time.
+    // One vector of each row: the rows' sums side by side, so each waits less on the adder.
+    while o + lanes <= outs {
+        let mut acc = [simd.splat_f32s(0.0); R];
+        for (k, a) in acc.iter_mut().enumerate() {
+            let row = (r + k) * outs + o;
+            *a = S::as_simd_f32s(&y[row..row + lanes]).0[0];
+        }
+        for (j, column) in weights.chunks_exact(outs).take(ins).enumerate() {
+            let w = S::as_simd_f32s(&column[o..o + lanes]).0[0];
+            for (a, xk) in acc.iter_mut().zip(&xs) {
+                *a = simd.add_f32s(*a, simd.mul_f32s(simd.splat_f32s(xk[j]), w));
+            }
+        }
+        for (k, a) in acc.iter().enumerate() {
+            let row = (r + k) * outs + o;
+            S::as_mut_simd_f32s(&mut y[row..row + lanes]).0[0] = *a;
+        }
+        o += lanes;
+    }
+    // What is left of each row (less than a vector), a row at a time.
     if o < outs {
         for (k, xk) in xs.iter().enumerate() {
             let row = (r + k) * outs;

@@ -1,0 +1,456 @@
+//! Episodes side by side: a worker steps several episodes at once on its thread, asking the
+//! policy for all their actions in one call ([`PolicyFactory::side_by_side`]), so a network
+//! evaluates its rows together and loads each weight once for several of them. Records are the
+//! same, bit for bit, as one episode after another.
+
+use crate::eval::ordered::{run_in_order, Ordered, Window};
+use crate::eval::{
+    worker_pool, EpisodeRecord, EvalOptions, Evaluator, Failure, Recorder, Recording, RunEnd,
+};
+use crate::policy::{Policy, PolicyError, PolicyFactory};
+use crate::run::rollout::Rollout;
+use crate::run::RunError;
+use crate::sim::episode::Episode;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+/// Lane-fuls of seeds in each job of a side-by-side evaluation: lanes whose episodes end take the
+/// block's next seeds, so only the block's last episodes run with lanes idle.
+pub const SIDE_BY_SIDE_BLOCK: usize = 8;
+
+/// An episode under way in a lane.
+struct Live {
+    /// Its place in the seeds.
+    index: usize,
+    lane: usize,
+    rollout: Rollout,
+    recorder: Recorder,
+}
+
+/// Keeps `index`'s error if it is the first failed episode in seed order so far.
+fn fail(failed: &mut Option<(usize, RunError)>, index: usize, e: RunError) {
+    if failed.as_ref().is_none_or(|(f, _)| index < *f) {
+        *failed = Some((index, e));
+    }
+}
+
+impl Evaluator {
+    /// Runs the episodes of `seeds` side by side, `lanes` at a time on this thread, `policy`
+    /// deciding for all of them at once at each step ([`PolicyFactory::side_by_side`]); a lane
+    /// whose episode ends takes the next seed. Each record goes to `on_finish` as its episode
+    /// ends. Gives the records in seed order and the error of the first failed episode in seed
+    /// order: every record before it, none from it on (as [`Evaluator::run_episode`] one seed
+    /// after another would). Every record is the one [`Evaluator::run_episode`] gives, bit for
+    /// bit, but for its wall time, which counts the steps of the episodes beside it.
+    pub fn run_side_by_side(
+        &self,
+        policy: &mut dyn Policy,
+        seeds: &[u64],
+        lanes: usize,
+        recording: Recording,
+        on_finish: &dyn Fn(&EpisodeRecord),
+    ) -> (Vec<EpisodeRecord>, Option<RunError>) {
+        let lanes = lanes.max(1);
+        let mut records: Vec<Option<EpisodeRecord>> = seeds.iter().map(|_| None).collect();
+        // The first failed episode in seed order so far.
+        let mut failed: Option<(usize, RunError)> = None;
+        let mut live: Vec<Live> = Vec::with_capacity(lanes);
+        let mut free: Vec<usize> = (0..lanes).rev().collect();
+        let mut next = 0;
+        let mut decisions = Vec::with_capacity(lanes);
+        loop {
+            // Episodes after a failed one are neither started nor kept going.
+            let stop = failed.as_ref().map_or(seeds.len(), |(f, _)| *f);
+            live.retain(|l| {
+                if l.index >= stop {
+                    free.push(l.lane);
+                }
+                l.index < stop
+            });
+            while next < stop {
+                let Some(lane) = free.pop() else {
+                    break;
+                };
+                let (index, seed) = (next, seeds[next]);
+                next += 1;
+                let clock = Instant::now();
+                match Rollout::start_lane(self.world(seed), seed, policy, lane) {
+                    Ok(rollout) => {
+                        let recorder = Recorder::start(recording, clock, &rollout);
+                        live.push(Live {
+                            index,
+                            lane,
+                            rollout,
+                            recorder,
+                        });
+                    }
+                    Err(e) => {
+                        free.push(lane);
+                        fail(&mut failed, index, e);
+                    }
+                }
+            }
+            // Episodes over (or given up) end here.
+            let mut k = 0;
+            while k < live.len() {
+                if live[k].rollout.finished() {
+                    let l = live.remove(k);
+                    free.push(l.lane);
+                    let record = self.record(l.rollout, l.recorder);
+                    on_finish(&record);
+                    records[l.index] = Some(record);
+                } else {
+                    k += 1;
+                }
+            }
+            if live.is_empty() {
+                if next >= failed.as_ref().map_or(seeds.len(), |(f, _)| *f) {
+                    break;
+                }
+                continue;
+            }
+            decisions.clear();
+            let asked: Vec<(usize, &Episode)> =
+                live.iter().map(|l| (l.lane, l.rollout.episode())).collect();
+            let mut refused = policy.act_lanes(&asked, &mut decisions).err();
+            drop(asked);
+            let mut decided = decisions.drain(..);
+            for (k, l) in live.iter_mut().enumerate() {
+                let decision = if let Some(d) = decided.next() {
+                    Ok(d)
+                } else if let Some((_, e)) = refused.take_if(|(at, _)| *at == k) {
+                    Err(l.rollout.policy_error(e))
+                } else {
+                    // Not asked (the policy stopped at an earlier episode's error): asked again.
+                    continue;
+                };
+                match l.rollout.decided(decision) {
+                    Ok(Some(action)) => l.recorder.take(&mut l.rollout, action),
+                    Ok(None) => {}
+                    Err(e) => fail(&mut failed, l.index, e),
+                }
+            }
+        }
+        let error = failed.map(|(_, e)| e);
+        (records.into_iter().map_while(|r| r).collect(), error)
+    }
+
+    /// [`Evaluator::stream`] for a policy deciding for `lanes` episodes at once: each job is a
+    /// block of [`SIDE_BY_SIDE_BLOCK`] lane-fuls of seeds, run side by side on one worker
+    /// ([`Evaluator::run_side_by_side`]), so the cancel flag stops the run between blocks.
+    pub(crate) fn stream_side_by_side(
+        &self,
+        factory: &dyn PolicyFactory,
+        options: &EvalOptions,
+        lanes: usize,
+        cancel: &AtomicBool,
+        on_finish: &(dyn Fn(&EpisodeRecord) + Sync),
+        sink: &mut dyn FnMut(EpisodeRecord) -> bool,
+    ) -> Result<RunEnd, PolicyError> {
+        let clock = Instant::now();
+        let pool = worker_pool(options.threads)?;
+        let count = options.seeds.len();
+        let block = lanes * SIDE_BY_SIDE_BLOCK;
+        // A failed block gives the records before its failed episode with the failure.
+        type Failed = (Vec<EpisodeRecord>, Failure);
+        let work = |policy: &mut Option<Box<dyn Policy>>, b: usize| -> Result<_, Failed> {
+            let policy = match policy {
+                Some(p) => p,
+                None => policy.insert(
+                    factory
+                        .make()
+                        .map_err(|e| (Vec::new(), Failure::Policy(e)))?,
+                ),
+            };
+            let seeds: Vec<u64> = (b * block..count.min((b + 1) * block))
+                .filter_map(|i| options.seeds.get(i))
+                .collect();
+            let (mut records, error) =
+                self.run_side_by_side(policy.as_mut(), &seeds, lanes, options.recording, on_finish);
+            records.iter_mut().for_each(EpisodeRecord::strip);
+            match error {
+                Some(e) => Err((records, Failure::Run(e))),
+                None => Ok(records),
+            }
+        };
+        let mut handed = 0;
+        let mut hand = |records: Vec<EpisodeRecord>| {
+            for record in records {
+                if !sink(record) {
+                    return false;
+                }
+                handed += 1;
+            }
+            true
+        };
+        let ended = run_in_order(
+            &pool,
+            count.div_ceil(block),
+            // Blocks each worker may run ahead: enough to keep every worker busy.
+            Window(4 * pool.current_num_threads()),
+            cancel,
+            &work,
+            &mut hand,
+        );
+        let mut refused = ended.refused;
+        let failed = match ended.failed {
+            Some((b, (records, failure))) => {
+                // The records before the failed episode come after every earlier block's.
+                if !refused {
+                    refused = !hand(records);
+                }
+                Some((b, failure))
+            }
+            None => None,
+        };
+        RunEnd::of(
+            Ordered {
+                handed,
+                failed,
+                refused,
+            },
+            count,
+            clock,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::SimConfig;
+    use crate::policy::mlp::MlpFactory;
+    use crate::policy::Decision;
+    use crate::sim::robot::DiscreteAction;
+    use crate::sim::world::{Scenes, World};
+    use std::path::Path;
+    use std::sync::atomic::Ordering;
+
+    fn evaluator() -> Evaluator {
+        let config = SimConfig::default().validate().expect("valid");
+        Evaluator::new(config, Scenes::MazePerSeed)
+    }
+
+    fn shipped(name: &str) -> MlpFactory {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../policies")
+            .join(name);
+        MlpFactory::load(&path, 18).expect("shipped")
+    }
+
+    /// Another factory's policies, one episode at a time.
+    struct Alone<'a>(&'a dyn PolicyFactory);
+
+    impl PolicyFactory for Alone<'_> {
+        fn make(&self) -> Result<Box<dyn Policy>, PolicyError> {
+            self.0.make()
+        }
+        fn name(&self) -> String {
+            self.0.name()
+        }
+    }
+
+    /// A record as text, but for its wall time and its world.
+    fn key(r: &EpisodeRecord) -> String {
+        let mut r = r.clone();
+        r.wall_time_s = 0.0;
+        r.world = None;
+        format!("{r:?}")
+    }
+
+    fn stream(
+        factory: &dyn PolicyFactory,
+        seeds: u64,
+        threads: usize,
+    ) -> (Vec<EpisodeRecord>, RunEnd) {
+        let options = EvalOptions {
+            seeds: crate::eval::Seeds::Range {
+                start: 0,
+                count: seeds,
+            },
+            threads,
+            ..EvalOptions::default()
+        };
+        let mut records = Vec::new();
+        let end = evaluator()
+            .stream(
+                factory,
+                &options,
+                &AtomicBool::new(false),
+                &|_| {},
+                &mut |r| {
+                    records.push(r);
+                    true
+                },
+            )
+            .expect("policies made");
+        (records, end)
+    }
+
+    /// The shipped networks (bc samples from its stream, dqn takes the argmax) give the same
+    /// records side by side as one at a time, on one and two threads.
+    #[test]
+    fn side_by_side_records_are_the_records_one_at_a_time() {
+        for name in ["bc.safetensors", "dqn.safetensors"] {
+            let factory = shipped(name);
+            assert!(factory.side_by_side() > 1);
+            let (alone, _) = stream(&Alone(&factory), 150, 1);
+            assert_eq!(alone.len(), 150);
+            for threads in [1, 2] {
+                let (together, end) = stream(&factory, 150, threads);
+                assert_eq!(end.episodes, 150);
+                assert!(end.error.is_none() && !end.cancelled);
+                let (a, b): (Vec<_>, Vec<_>) = alone
+                    .iter()
+                    .zip(&together)
+                    .map(|(a, b)| (key(a), key(b)))
+                    .unzip();
+                assert_eq!(a, b, "{name} on {threads} threads");
+            }
+        }
+    }
+
+    /// Trajectories and step logs too, with lanes fewer than the seeds and more.
+    #[test]
+    fn side_by_side_records_trajectories_and_steps_as_one_at_a_time() {
+        let evaluator = evaluator();
+        let factory = shipped("bc.safetensors");
+        let recording = Recording {
+            trajectory: true,
+            steps: true,
+        };
+        let seeds: Vec<u64> = (100..112).collect();
+        let mut policy = factory.make().expect("made");
+        let alone: Vec<String> = seeds
+            .iter()
+            .map(|&s| {
+                key(&evaluator
+                    .run_episode(policy.as_mut(), s, recording)
+                    .expect("runs"))
+            })
+            .collect();
+        for lanes in [1, 3, 16] {
+            let finished = std::sync::Mutex::new(0);
+            let (records, error) =
+                evaluator.run_side_by_side(policy.as_mut(), &seeds, lanes, recording, &|_| {
+                    *finished.lock().expect("lock") += 1
+                });
+            assert!(error.is_none());
+            assert_eq!(*finished.lock().expect("lock"), seeds.len());
+            assert!(records
+                .iter()
+                .all(|r| !r.trajectory.is_empty() && !r.step_log.is_empty()));
+            let together: Vec<String> = records.iter().map(key).collect();
+            assert_eq!(alone, together, "{lanes} lanes");
+        }
+    }
+
+    /// Drives ahead; fails at `seed` when resetting (`step` 0) or at step `step`; decides for
+    /// four lanes at once.
+    struct Failing {
+        seed: u64,
+        step: u32,
+    }
+
+    impl PolicyFactory for Failing {
+        fn make(&self) -> Result<Box<dyn Policy>, PolicyError> {
+            Ok(Box::new(FailingPolicy {
+                seed: self.seed,
+                step: self.step,
+            }))
+        }
+        fn name(&self) -> String {
+            "failing".into()
+        }
+        fn side_by_side(&self) -> usize {
+            4
+        }
+    }
+
+    struct FailingPolicy {
+        seed: u64,
+        step: u32,
+    }
+
+    impl Policy for FailingPolicy {
+        fn reset(&mut self, _: &World, episode: &Episode) -> Result<(), PolicyError> {
+            if self.step == 0 && episode.seed() == self.seed {
+                return Err(PolicyError::Failed("no reset".into()));
+            }
+            Ok(())
+        }
+        fn act(&mut self, episode: &Episode) -> Result<Decision, PolicyError> {
+            if episode.seed() == self.seed && episode.steps() + 1 == self.step {
+                return Err(PolicyError::Failed("no act".into()));
+            }
+            Ok(Decision::Act(DiscreteAction::Ahead.into()))
+        }
+    }
+
+    /// A failed episode ends the run at it, side by side as one at a time: every record before
+    /// it is handed on, none from it on, and the error is its own.
+    #[test]
+    fn a_failed_episode_ends_the_run_at_it_with_every_record_before() {
+        for (seed, step) in [(37, 0), (37, 5), (0, 1), (40, 2)] {
+            let factory = Failing { seed, step };
+            let (alone, alone_end) = stream(&Alone(&factory), 100, 1);
+            for threads in [1, 2] {
+                let (together, end) = stream(&factory, 100, threads);
+                assert_eq!(together.len(), seed as usize, "seed {seed} step {step}");
+                assert_eq!(end.episodes, seed as usize);
+                assert_eq!(end.error, alone_end.error);
+                let expected = format!("seed {seed}, step {step}: policy failed");
+                assert!(
+                    end.error
+                        .as_ref()
+                        .expect("failed")
+                        .to_string()
+                        .starts_with(&expected),
+                    "{:?}",
+                    end.error
+                );
+                assert_eq!(
+                    alone.iter().map(key).collect::<Vec<_>>(),
+                    together.iter().map(key).collect::<Vec<_>>()
+                );
+            }
+        }
+    }
+
+    /// A sink that stops after 10 records gets 10, in order; a run cancelled before it starts
+    /// runs nothing.
+    #[test]
+    fn a_sink_stops_and_the_cancel_flag_stops_between_blocks() {
+        let factory = shipped("dqn.safetensors");
+        let options = EvalOptions {
+            seeds: crate::eval::Seeds::Range {
+                start: 5,
+                count: 300,
+            },
+            threads: 2,
+            ..EvalOptions::default()
+        };
+        let mut seen = Vec::new();
+        let end = evaluator()
+            .stream(
+                &factory,
+                &options,
+                &AtomicBool::new(false),
+                &|_| {},
+                &mut |r| {
+                    seen.push(r.seed);
+                    seen.len() < 10
+                },
+            )
+            .expect("made");
+        assert_eq!(seen, (5..15).collect::<Vec<_>>());
+        assert_eq!(end.episodes, 9);
+        let cancel = AtomicBool::new(false);
+        cancel.store(true, Ordering::Relaxed);
+        let end = evaluator()
+            .stream(&factory, &options, &cancel, &|_| {}, &mut |_| true)
+            .expect("made");
+        assert_eq!(end.episodes, 0);
+        assert!(end.cancelled);
+    }
+}
