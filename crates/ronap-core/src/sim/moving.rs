@@ -193,7 +193,18 @@ struct State {
     /// keeps it in a pass.
     keys: Vec<Key>,
     band_start: Vec<u32>,
+    /// Steps since `keys` were put in order: an obstacle may since have moved up to `age *
+    /// drift` px on either axis, so a scan looks that much further in the old order, and the
+    /// order is brought up to date every [`RESORT_EVERY`] steps (or when an obstacle appears).
+    age: u32,
+    /// The furthest an obstacle moves in a step on either axis (its speed), px, with a margin
+    /// for rounding.
+    drift: f64,
 }
+
+/// Steps between bringing the obstacles' order by band and x up to date: sorting costs more
+/// than a step's scan, and in a few steps obstacles barely move.
+const RESORT_EVERY: u32 = 8;
 
 /// An obstacle's place in [`State::keys`].
 #[derive(Clone, Copy, Debug)]
@@ -241,6 +252,7 @@ const FIT_MARGIN: f64 = 1e-9;
 
 impl State {
     fn push(&mut self, entry: &Entry, position: Point, dir: Vector, speed: f64, near_robot: f64) {
+        self.drift = self.drift.max(speed * (1.0 + 1e-9));
         self.bound.push(entry.body.bounding_radius());
         self.near_robot2.push(near_robot * near_robot);
         self.walks.push(false);
@@ -268,6 +280,7 @@ impl State {
 
     /// Brings the order by band and x ([`State::keys`]) up to date with where the obstacles are.
     fn sort_keys(&mut self) {
+        self.age = 0;
         let n = self.x.len();
         if self.keys.len() != n {
             self.keys = (0..n as u32)
@@ -306,9 +319,11 @@ impl State {
     }
 
     /// Calls `f` with every obstacle whose centre may lie within `slab` px of `p` on both axes
-    /// (and some that do not): those of the bands within reach whose x is within reach.
+    /// (and some that do not): those of the bands within reach whose x is within reach, as of
+    /// the last sort, reach grown by how far obstacles may have moved since.
     #[inline]
     fn near(&self, p: Point, slab: f64, mut f: impl FnMut(usize)) {
+        let slab = slab + f64::from(self.age) * self.drift;
         let bands = self.band_start.len().saturating_sub(1);
         let (lo, hi) = (band(p.y - slab) as usize, band(p.y + slab) as usize);
         let (left, right) = (p.x - slab, p.x + slab);
@@ -761,6 +776,7 @@ impl Movers {
         self.centres.clear();
         self.centres.extend(robots.iter().map(|r| r.at));
         let state = &mut self.state;
+        let mut appeared = false;
         for (i, e) in self.entries.iter_mut().enumerate() {
             if let Some(at) = e.appears_at {
                 if step >= at {
@@ -774,6 +790,8 @@ impl Movers {
                         state.x[i] = p.x;
                         state.y[i] = p.y;
                         e.appears_at = None;
+                        // A jump, not a step: the order must be brought up to date.
+                        appeared = true;
                     }
                 }
             } else if e.held
@@ -855,7 +873,10 @@ impl Movers {
             state.x[i] = to.x;
             state.y[i] = to.y;
         }
-        state.sort_keys();
+        state.age += 1;
+        if appeared || state.age >= RESORT_EVERY {
+            state.sort_keys();
+        }
     }
 
     /// Where heading obstacle `i` at `from` goes when its move ahead is not known clear: ahead
