@@ -37,21 +37,21 @@ fn fail(failed: &mut Option<(usize, RunError)>, index: usize, e: RunError) {
 impl Evaluator {
     /// Runs the episodes of `seeds` side by side, `lanes` at a time on this thread, `policy`
     /// deciding for all of them at once at each step ([`PolicyFactory::side_by_side`]); a lane
-    /// whose episode ends takes the next seed. Each record goes to `on_finish` as its episode
-    /// ends. Gives the records in seed order and the error of the first failed episode in seed
-    /// order: every record before it, none from it on (as [`Evaluator::run_episode`] one seed
-    /// after another would). Every record is the one [`Evaluator::run_episode`] gives, bit for
-    /// bit, but for its wall time, which counts the steps of the episodes beside it.
+    /// whose episode ends takes the next seed. Each record goes to `finished`, with its place in
+    /// `seeds`, as its episode ends (so a caller keeps only what it needs of it). Gives the place
+    /// and error of the first failed episode in seed order: every episode before it has finished,
+    /// none from it on is handed on (as [`Evaluator::run_episode`] one seed after another would
+    /// stop). Every record is the one [`Evaluator::run_episode`] gives, bit for bit, but for its
+    /// wall time, which counts the steps of the episodes beside it.
     pub fn run_side_by_side(
         &self,
         policy: &mut dyn Policy,
         seeds: &[u64],
         lanes: usize,
         recording: Recording,
-        on_finish: &dyn Fn(&EpisodeRecord),
-    ) -> (Vec<EpisodeRecord>, Option<RunError>) {
+        finished: &mut dyn FnMut(usize, EpisodeRecord),
+    ) -> Option<(usize, RunError)> {
         let lanes = lanes.max(1);
-        let mut records: Vec<Option<EpisodeRecord>> = seeds.iter().map(|_| None).collect();
         // The first failed episode in seed order so far.
         let mut failed: Option<(usize, RunError)> = None;
         let mut live: Vec<Live> = Vec::with_capacity(lanes);
@@ -96,9 +96,9 @@ impl Evaluator {
                 if live[k].rollout.finished() {
                     let l = live.remove(k);
                     free.push(l.lane);
-                    let record = self.record(l.rollout, l.recorder);
-                    on_finish(&record);
-                    records[l.index] = Some(record);
+                    if failed.as_ref().is_none_or(|(f, _)| l.index < *f) {
+                        finished(l.index, self.record(l.rollout, l.recorder));
+                    }
                 } else {
                     k += 1;
                 }
@@ -131,8 +131,7 @@ impl Evaluator {
                 }
             }
         }
-        let error = failed.map(|(_, e)| e);
-        (records.into_iter().map_while(|r| r).collect(), error)
+        failed
     }
 
     /// [`Evaluator::stream`] for a policy deciding for `lanes` episodes at once: each job is a
@@ -165,11 +164,22 @@ impl Evaluator {
             let seeds: Vec<u64> = (b * block..count.min((b + 1) * block))
                 .filter_map(|i| options.seeds.get(i))
                 .collect();
-            let (mut records, error) =
-                self.run_side_by_side(policy.as_mut(), &seeds, lanes, options.recording, on_finish);
-            records.iter_mut().for_each(EpisodeRecord::strip);
-            match error {
-                Some(e) => Err((records, Failure::Run(e))),
+            let mut records: Vec<Option<EpisodeRecord>> = seeds.iter().map(|_| None).collect();
+            let failed = self.run_side_by_side(
+                policy.as_mut(),
+                &seeds,
+                lanes,
+                options.recording,
+                &mut |i, mut record| {
+                    on_finish(&record);
+                    record.strip();
+                    records[i] = Some(record);
+                },
+            );
+            // Every episode before the first failed one has finished.
+            let records = records.into_iter().map_while(|r| r).collect();
+            match failed {
+                Some((_, e)) => Err((records, Failure::Run(e))),
                 None => Ok(records),
             }
         };
@@ -330,13 +340,20 @@ mod tests {
             })
             .collect();
         for lanes in [1, 3, 16] {
-            let finished = std::sync::Mutex::new(0);
-            let (records, error) =
-                evaluator.run_side_by_side(policy.as_mut(), &seeds, lanes, recording, &|_| {
-                    *finished.lock().expect("lock") += 1
-                });
-            assert!(error.is_none());
-            assert_eq!(*finished.lock().expect("lock"), seeds.len());
+            let mut records: Vec<Option<EpisodeRecord>> = vec![None; seeds.len()];
+            let failed = evaluator.run_side_by_side(
+                policy.as_mut(),
+                &seeds,
+                lanes,
+                recording,
+                &mut |i, r| {
+                    assert!(records[i].is_none(), "seed {i} twice");
+                    records[i] = Some(r);
+                },
+            );
+            assert!(failed.is_none());
+            let records: Vec<EpisodeRecord> = records.into_iter().flatten().collect();
+            assert_eq!(records.len(), seeds.len());
             assert!(records
                 .iter()
                 .all(|r| !r.trajectory.is_empty() && !r.step_log.is_empty()));
