@@ -4,7 +4,7 @@
 //! streams ([`crate::sim::rng`]), so the same seed gives the same run bit for bit.
 
 use crate::config::{OnCollision, ValidConfig, ACTION_MEMORY};
-use crate::geometry::{wrap_deg, Point};
+use crate::geometry::{wrap_deg, Point, Vector};
 use crate::scene::freespace::FreeGrid;
 use crate::scene::Scene;
 use crate::sim::lidar::Laser;
@@ -113,6 +113,9 @@ pub struct Episode {
     readings: Vec<f64>,
     /// The other robots near enough to see, gathered afresh each sensing (a kept buffer).
     near_discs: Vec<(Point, f64)>,
+    /// The heading the last sensing faced, degrees, and its unit vector (`unit(z_deg)`): a step
+    /// ahead from that heading moves along it without working out its sine and cosine again.
+    facing: (f64, Vector),
     observation: Vec<f32>,
     distance_px: f64,
     steps: u32,
@@ -225,6 +228,7 @@ impl Episode {
             noise_rng: stream(seed, Stream::Noise),
             readings: vec![0.0; beams],
             near_discs: Vec::new(),
+            facing: (f64::NAN, Vector::zeros()),
             observation: vec![0.0; config.observation_size()],
             distance_px: 0.0,
             steps: 0,
@@ -263,6 +267,7 @@ impl Episode {
         let p = self.pose.position();
         let radius = self.config.robot.radius_px;
         let heading = crate::geometry::unit(self.pose.z_deg);
+        self.facing = (self.pose.z_deg, heading);
         self.laser
             .scan_toward(&self.scene, p, heading, &mut self.readings);
         if let Some(movers) = movers {
@@ -363,7 +368,10 @@ impl Episode {
                 .advance(self.steps + 1, &self.scene, self.pose.position())
                 .touched_robot;
         }
-        let motion = self.robot.motion(self.pose, action);
+        // The pose may have been set since the last sensing (re-posing in data collection).
+        let facing =
+            (self.facing.0.to_bits() == self.pose.z_deg.to_bits()).then_some(self.facing.1);
+        let motion = self.robot.motion_facing(self.pose, facing, action);
         let wall = !self.robot.motion_clear(&self.scene, self.pose, &motion);
         let moving = match &self.movers {
             Some(movers) => !self

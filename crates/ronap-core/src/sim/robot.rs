@@ -5,7 +5,7 @@
 //! swept against the scene, so no speed carries the disc through a wall.
 
 use crate::config::RobotConfig;
-use crate::geometry::{wrap_deg, Point};
+use crate::geometry::{wrap_deg, Point, Vector};
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -191,6 +191,13 @@ impl Robot {
 
     /// Where `action` takes the robot from `pose` in free space.
     pub fn motion(&self, pose: Pose, action: Action) -> Motion {
+        self.motion_facing(pose, None, action)
+    }
+
+    /// [`Robot::motion`], given `pose`'s unit heading (`unit(pose.z_deg)`) when the caller has it
+    /// already: a move straight ahead goes along it (the same bits: `unit` is the heading's cosine
+    /// and sine, as the move works them out without it).
+    pub fn motion_facing(&self, pose: Pose, facing: Option<Vector>, action: Action) -> Motion {
         let c = &self.config;
         let (v, w_deg, turn_fraction) = match action {
             Action::Discrete(DiscreteAction::Left) => (0.0, c.turn_speed_deg, 1.0),
@@ -210,7 +217,7 @@ impl Robot {
             }
         };
         Motion {
-            end: arc_end(pose, v, w_deg),
+            end: arc_end(pose, v, w_deg, facing),
             turn_fraction,
             v,
             w_deg,
@@ -253,7 +260,7 @@ impl Robot {
         let mut from = pose;
         for k in 1..=chords {
             let part = k as f64 / chords as f64;
-            let to = arc_end(pose, motion.v * part, motion.w_deg * part);
+            let to = arc_end(pose, motion.v * part, motion.w_deg * part, None);
             if !sweep_clear(
                 from.position(),
                 to.position(),
@@ -267,12 +274,18 @@ impl Robot {
     }
 }
 
-/// The pose after moving `v` px along a unicycle arc that turns `w_deg` degrees from `pose`.
-fn arc_end(pose: Pose, v: f64, w_deg: f64) -> Pose {
+/// The pose after moving `v` px along a unicycle arc that turns `w_deg` degrees from `pose`
+/// (whose unit heading `facing` is, when given).
+fn arc_end(pose: Pose, v: f64, w_deg: f64, facing: Option<Vector>) -> Pose {
     let z0 = pose.z_deg.to_radians();
     let w = w_deg.to_radians();
-    let (dx, dy) = if w.abs() < 1e-12 {
-        (v * z0.cos(), v * z0.sin())
+    let (dx, dy) = if v == 0.0 {
+        // Turning on the spot (LEFT and RIGHT): the arc's formula gives a zero times its sines
+        // and cosines, which a position plus zero leaves as it is. Four fewer calls to them.
+        (0.0, 0.0)
+    } else if w.abs() < 1e-12 {
+        let (c, s) = facing.map_or_else(|| (z0.cos(), z0.sin()), |f| (f.x, f.y));
+        (v * c, v * s)
     } else {
         let r = v / w;
         (
