@@ -494,7 +494,11 @@ impl Episode {
 
     /// The first half of a step: where `action` would take the robot (no collision check).
     pub(crate) fn motion(&self, action: Action) -> Motion {
-        self.robot.motion(self.pose, action)
+        // The unit heading of the last sensing, unless the pose was set since (re-posing in data
+        // collection).
+        let facing =
+            (self.facing.0.to_bits() == self.pose.z_deg.to_bits()).then_some(self.facing.1);
+        self.robot.motion_facing(self.pose, facing, action)
     }
 
     /// The robot.
