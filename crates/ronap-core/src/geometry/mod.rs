@@ -279,7 +279,18 @@ pub fn unit(deg: f64) -> Vector {
 
 /// An angle in degrees brought into `[0, 360)`.
 pub fn wrap_deg(deg: f64) -> f64 {
-    let w = deg.rem_euclid(360.0);
+    // The common cases without `rem_euclid`'s `fmod` (a slow software remainder), giving its
+    // bits: within one turn below or above [0, 360) the remainder is exact, so it is `deg`,
+    // `deg + 360` as `rem_euclid` adds it, or `deg - 360` (exact by Sterbenz's lemma).
+    let w = if (0.0..360.0).contains(&deg) {
+        deg
+    } else if -360.0 < deg && deg < 0.0 {
+        deg + 360.0
+    } else if (360.0..720.0).contains(&deg) {
+        deg - 360.0
+    } else {
+        deg.rem_euclid(360.0)
+    };
     // rem_euclid can round up to exactly 360.0 for tiny negative inputs.
     if w >= 360.0 {
         0.0
@@ -291,6 +302,54 @@ pub fn wrap_deg(deg: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The fast cases of `wrap_deg` give `rem_euclid`'s bits, edges, zeros' signs and NaN
+    /// included.
+    #[test]
+    fn wrap_deg_is_rem_euclid_bit_for_bit() {
+        let reference = |d: f64| {
+            let w = d.rem_euclid(360.0);
+            if w >= 360.0 {
+                0.0
+            } else {
+                w
+            }
+        };
+        let mut values = vec![
+            0.0,
+            -0.0,
+            360.0,
+            -360.0,
+            720.0,
+            -720.0,
+            1e-300,
+            -1e-300,
+            359.99999999999994,
+            -359.99999999999994,
+            719.9999999999999,
+            1e20,
+            -1e20,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MIN_POSITIVE,
+            -f64::MIN_POSITIVE,
+            5e-324,
+            -5e-324,
+        ];
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        for _ in 0..200_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let u = (x >> 11) as f64 / (1u64 << 53) as f64;
+            values.push(u * 2200.0 - 1100.0);
+            values.push(f64::from_bits(x));
+        }
+        for d in values {
+            assert_eq!(wrap_deg(d).to_bits(), reference(d).to_bits(), "{d:e}");
+        }
+    }
 
     fn inv(d: Vector) -> Vector {
         Vector::new(1.0 / d.x, 1.0 / d.y)
