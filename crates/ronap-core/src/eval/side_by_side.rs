@@ -38,11 +38,13 @@ impl Evaluator {
     /// Runs the episodes of `seeds` side by side, `lanes` at a time on this thread, `policy`
     /// deciding for all of them at once at each step ([`PolicyFactory::side_by_side`]); a lane
     /// whose episode ends takes the next seed. Each record goes to `finished`, with its place in
-    /// `seeds`, as its episode ends (so a caller keeps only what it needs of it). Gives the place
-    /// and error of the first failed episode in seed order: every episode before it has finished,
-    /// none from it on is handed on (as [`Evaluator::run_episode`] one seed after another would
-    /// stop). Every record is the one [`Evaluator::run_episode`] gives, bit for bit, but for its
-    /// wall time, which counts the steps of the episodes beside it.
+    /// `seeds`, as its episode ends, in the order they end (so a caller keeps only what it needs
+    /// of it). Gives the place and error of the first failed episode in seed order: every episode
+    /// before it has finished; none after it is started once it failed, but some may have ended
+    /// before it failed and gone to `finished`, so a caller keeping a prefix cuts at the failed
+    /// place (as [`Evaluator::run_episode`] one seed after another would have stopped there).
+    /// Every record is the one [`Evaluator::run_episode`] gives, bit for bit, but for its wall
+    /// time, which counts the steps of the episodes beside it.
     pub fn run_side_by_side(
         &self,
         policy: &mut dyn Policy,
@@ -67,7 +69,7 @@ impl Evaluator {
                 }
                 l.index < stop
             });
-            while next < stop {
+            while next < failed.as_ref().map_or(seeds.len(), |(f, _)| *f) {
                 let Some(lane) = free.pop() else {
                     break;
                 };
@@ -113,6 +115,21 @@ impl Evaluator {
             let asked: Vec<(usize, &Episode)> =
                 live.iter().map(|l| (l.lane, l.rollout.episode())).collect();
             let mut refused = policy.act_lanes(&asked, &mut decisions).err();
+            // One decision per episode asked, up to the one whose decision failed: anything
+            // else would hand actions to the wrong episodes (or ask again for ever).
+            let expected = refused.as_ref().map_or(asked.len(), |(k, _)| *k);
+            if decisions.len() != expected || expected > asked.len() {
+                let message = format!(
+                    "the policy gave {} decisions for {} episodes side by side{}",
+                    decisions.len(),
+                    asked.len(),
+                    refused
+                        .as_ref()
+                        .map_or(String::new(), |(k, _)| format!(", failing at episode {k}")),
+                );
+                decisions.clear();
+                refused = Some((0, PolicyError::Failed(message)));
+            }
             drop(asked);
             let mut decided = decisions.drain(..);
             for (k, l) in live.iter_mut().enumerate() {
@@ -205,11 +222,12 @@ impl Evaluator {
         let mut refused = ended.refused;
         let failed = match ended.failed {
             Some((b, (records, failure))) => {
-                // The records before the failed episode come after every earlier block's.
+                // The records before the failed episode come after every earlier block's; a
+                // sink that stops among them stops the run before the failure is reached.
                 if !refused {
                     refused = !hand(records);
                 }
-                Some((b, failure))
+                (!refused).then_some((b, failure))
             }
             None => None,
         };
@@ -432,6 +450,76 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A sink that stops among the records before a failed episode stops the run there: no
+    /// error, as one at a time (the failure is never reached).
+    #[test]
+    fn a_sink_that_stops_before_a_failure_ends_the_run_without_it() {
+        let factory = Failing { seed: 37, step: 5 };
+        for f in [&factory as &dyn PolicyFactory, &Alone(&factory)] {
+            let options = EvalOptions {
+                seeds: crate::eval::Seeds::Range {
+                    start: 0,
+                    count: 100,
+                },
+                threads: 1,
+                ..EvalOptions::default()
+            };
+            let mut seen = 0;
+            let end = evaluator()
+                .stream(f, &options, &AtomicBool::new(false), &|_| {}, &mut |_| {
+                    seen += 1;
+                    seen < 10
+                })
+                .expect("made");
+            assert_eq!(end.episodes, 9);
+            assert!(end.error.is_none() && end.cancelled, "{end:?}");
+        }
+    }
+
+    /// A policy giving too few decisions for the episodes side by side fails the run (naming
+    /// what it gave) rather than asking again for ever.
+    #[test]
+    fn a_policy_short_of_decisions_fails_the_run() {
+        struct Short;
+        impl PolicyFactory for Short {
+            fn make(&self) -> Result<Box<dyn Policy>, PolicyError> {
+                Ok(Box::new(ShortPolicy))
+            }
+            fn name(&self) -> String {
+                "short".into()
+            }
+            fn side_by_side(&self) -> usize {
+                4
+            }
+        }
+        struct ShortPolicy;
+        impl Policy for ShortPolicy {
+            fn reset(&mut self, _: &World, _: &Episode) -> Result<(), PolicyError> {
+                Ok(())
+            }
+            fn act(&mut self, _: &Episode) -> Result<Decision, PolicyError> {
+                Ok(Decision::Act(DiscreteAction::Ahead.into()))
+            }
+            fn act_lanes(
+                &mut self,
+                episodes: &[(usize, &Episode)],
+                decisions: &mut Vec<Decision>,
+            ) -> Result<(), (usize, PolicyError)> {
+                for _ in 1..episodes.len() {
+                    decisions.push(Decision::Act(DiscreteAction::Left.into()));
+                }
+                Ok(())
+            }
+        }
+        let (records, end) = stream(&Short, 10, 1);
+        assert!(records.is_empty());
+        let error = end.error.expect("failed").to_string();
+        assert!(
+            error.starts_with("seed 0, step 1: policy failed: the policy gave 3 decisions for 4"),
+            "{error}"
+        );
     }
 
     /// A sink that stops after 10 records gets 10, in order; a run cancelled before it starts

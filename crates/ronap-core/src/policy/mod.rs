@@ -71,8 +71,10 @@ pub trait Policy: Send {
 
     /// The decisions for several episodes at once, each given with its lane, pushed onto
     /// `decisions` in the same order: what [`Policy::act`] decides for each, but sharing the
-    /// work between them (a network evaluating its rows together). On an error, the index in
-    /// `episodes` of the episode it belongs to. The default asks [`Policy::act`] in turn.
+    /// work between them (a network evaluating its rows together). Exactly one decision per
+    /// episode; on an error, the index in `episodes` of the episode it belongs to, with one
+    /// decision pushed for each episode before it (the evaluator fails the run otherwise). The
+    /// default asks [`Policy::act`] in turn.
     fn act_lanes(
         &mut self,
         episodes: &[(usize, &Episode)],
@@ -96,7 +98,8 @@ pub trait PolicyFactory: Sync {
     /// How many episodes each policy it makes decides for together, through
     /// [`Policy::reset_lane`] and [`Policy::act_lanes`]: more than 1 only when deciding together
     /// is cheaper and every lane keeps its own state. The evaluator then steps that many episodes
-    /// of a worker side by side; their records are the same as one at a time, bit for bit.
+    /// of a worker side by side; their records are the same as one at a time, bit for bit, but
+    /// for the episodes' wall times.
     fn side_by_side(&self) -> usize {
         1
     }

@@ -103,7 +103,8 @@ impl Rollout {
     }
 
     /// [`Rollout::decide`] for a decision already made (with the others of episodes side by
-    /// side): the action, checked; `None` when the policy gave up.
+    /// side) for this episode while not [finished](Rollout::finished): the action, checked;
+    /// `None` when the policy gave up.
     pub fn decided(
         &mut self,
         decision: Result<Decision, RunError>,

@@ -368,10 +368,7 @@ impl Episode {
                 .advance(self.steps + 1, &self.scene, self.pose.position())
                 .touched_robot;
         }
-        // The pose may have been set since the last sensing (re-posing in data collection).
-        let facing =
-            (self.facing.0.to_bits() == self.pose.z_deg.to_bits()).then_some(self.facing.1);
-        let motion = self.robot.motion_facing(self.pose, facing, action);
+        let motion = self.motion(action);
         let wall = !self.robot.motion_clear(&self.scene, self.pose, &motion);
         let moving = match &self.movers {
             Some(movers) => !self

@@ -870,6 +870,12 @@ impl Movers {
                 touched.push(k);
                 continue;
             }
+            // Scans between sorts rely on it (see `State::age`).
+            debug_assert!(
+                (to.x - from.x).abs() <= state.drift && (to.y - from.y).abs() <= state.drift,
+                "obstacle {i} moved from {from} to {to}, more than {} px",
+                state.drift
+            );
             state.x[i] = to.x;
             state.y[i] = to.y;
         }

@@ -84,16 +84,7 @@ impl MlpPolicy {
 /// The action `rule` picks from the network's `outputs`, drawing from `rng` when it samples.
 fn choose(rule: DecisionRule, outputs: &[f32], rng: &mut crate::sim::rng::Rng) -> DiscreteAction {
     match rule {
-        DecisionRule::Argmax => {
-            // The first of equals.
-            let mut best = 0;
-            for i in 1..outputs.len() {
-                if outputs[i] > outputs[best] {
-                    best = i;
-                }
-            }
-            DiscreteAction::ALL[best]
-        }
+        DecisionRule::Argmax => DiscreteAction::ALL[network::argmax(outputs)],
         DecisionRule::Sample { temperature } => {
             let top = outputs.iter().copied().fold(f32::NEG_INFINITY, f32::max);
             // A network has one output per action (checked when it is made).

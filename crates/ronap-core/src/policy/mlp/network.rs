@@ -223,15 +223,19 @@ impl Mlp {
 
     /// [`Mlp::action`], computed in `scratch`.
     pub fn action_into(&self, observation: &[f32], scratch: &mut Scratch) -> DiscreteAction {
-        let out = self.forward_into(observation, scratch);
-        let mut best = 0;
-        for i in 1..out.len() {
-            if out[i] > out[best] {
-                best = i;
-            }
-        }
-        DiscreteAction::ALL[best]
+        DiscreteAction::ALL[argmax(self.forward_into(observation, scratch))]
     }
+}
+
+/// The index of the largest of `outputs` (the first of equals; 0 for none).
+pub(crate) fn argmax(outputs: &[f32]) -> usize {
+    let mut best = 0;
+    for i in 1..outputs.len() {
+        if outputs[i] > outputs[best] {
+            best = i;
+        }
+    }
+    best
 }
 
 /// The layers of [`Mlp::forward_rows_into`] (and of [`Mlp::forward_into`], one row), compiled
