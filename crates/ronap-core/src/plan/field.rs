@@ -165,7 +165,7 @@ const STEP: [u32; 8] = [
 ];
 
 thread_local! {
-    /// Each thread's search buffers for [`grid_path`].
+    /// Each thread's search buffers for [`grid_path`] and [`DistanceField::new`].
     static WORK: std::cell::RefCell<Work> = std::cell::RefCell::default();
 }
 
@@ -180,8 +180,9 @@ struct Node {
 /// The search's buffers, reusable between searches over grids of any size.
 #[derive(Default)]
 struct Work {
-    /// Per cell, its cost and parent side by side: a step reads and writes both, and the
-    /// search's front spreads over the whole grid, so one cache line a cell rather than two.
+    /// Per cell, its cost and parent side by side: a settled cell reads its neighbours' costs
+    /// and writes cost and parent of those it improves, over a front spread across the whole
+    /// grid, so one cache line a cell rather than two (apart, they measured slower).
     cells: Vec<Node>,
     /// Dial's ring of buckets: cells by cost modulo the ring's length.
     buckets: Vec<Vec<u32>>,

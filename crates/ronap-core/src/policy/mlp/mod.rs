@@ -152,9 +152,8 @@ impl Policy for MlpPolicy {
         let outputs = self
             .mlp
             .forward_rows_into(&self.rows, episodes.len(), &mut self.scratch);
-        for ((lane, _), row) in episodes.iter().zip(outputs.chunks_exact(width)) {
+        for (k, ((lane, _), row)) in episodes.iter().zip(outputs.chunks_exact(width)).enumerate() {
             let rng = self.lane_rngs.get_mut(*lane).ok_or_else(|| {
-                let k = decisions.len();
                 (
                     k,
                     PolicyError::Failed(format!("lane {lane} was never reset")),
