@@ -286,19 +286,21 @@ mod tests {
         format!("{r:?}")
     }
 
+    /// `count` seeds from `start` on `threads` threads.
+    fn options(start: u64, count: u64, threads: usize) -> EvalOptions {
+        EvalOptions {
+            seeds: crate::eval::Seeds::Range { start, count },
+            threads,
+            ..EvalOptions::default()
+        }
+    }
+
     fn stream(
         factory: &dyn PolicyFactory,
         seeds: u64,
         threads: usize,
     ) -> (Vec<EpisodeRecord>, RunEnd) {
-        let options = EvalOptions {
-            seeds: crate::eval::Seeds::Range {
-                start: 0,
-                count: seeds,
-            },
-            threads,
-            ..EvalOptions::default()
-        };
+        let options = options(0, seeds, threads);
         let mut records = Vec::new();
         let end = evaluator()
             .stream(
@@ -458,14 +460,7 @@ mod tests {
     fn a_sink_that_stops_before_a_failure_ends_the_run_without_it() {
         let factory = Failing { seed: 37, step: 5 };
         for f in [&factory as &dyn PolicyFactory, &Alone(&factory)] {
-            let options = EvalOptions {
-                seeds: crate::eval::Seeds::Range {
-                    start: 0,
-                    count: 100,
-                },
-                threads: 1,
-                ..EvalOptions::default()
-            };
+            let options = options(0, 100, 1);
             let mut seen = 0;
             let end = evaluator()
                 .stream(f, &options, &AtomicBool::new(false), &|_| {}, &mut |_| {
@@ -527,14 +522,7 @@ mod tests {
     #[test]
     fn a_sink_stops_and_the_cancel_flag_stops_between_blocks() {
         let factory = shipped("dqn.safetensors");
-        let options = EvalOptions {
-            seeds: crate::eval::Seeds::Range {
-                start: 5,
-                count: 300,
-            },
-            threads: 2,
-            ..EvalOptions::default()
-        };
+        let options = options(5, 300, 2);
         let mut seen = Vec::new();
         let end = evaluator()
             .stream(

@@ -72,3 +72,14 @@ pub enum RunError {
     #[error("cannot start worker threads: {0}")]
     Threads(String),
 }
+
+impl RunError {
+    /// The policy failing to prepare for the episode of `seed` (step 0).
+    pub(crate) fn reset(seed: u64, source: PolicyError) -> Self {
+        Self::Policy {
+            seed,
+            step: 0,
+            source,
+        }
+    }
+}

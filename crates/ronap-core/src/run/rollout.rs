@@ -3,7 +3,7 @@
 //! means: an action is taken (a non-finite continuous one is an error), giving up ends the episode
 //! as a failure with the policy's reason.
 
-use crate::policy::{Decision, Policy};
+use crate::policy::{Decision, Policy, PolicyError};
 use crate::run::RunError;
 use crate::sim::episode::Episode;
 use crate::sim::robot::{Action, Pose};
@@ -36,15 +36,7 @@ pub struct Rollout {
 impl Rollout {
     /// The episode of `seed` in `world`, with `policy` reset for it.
     pub fn start(world: Arc<World>, seed: u64, policy: &mut dyn Policy) -> Result<Self, RunError> {
-        let rollout = Self::new(world, seed)?;
-        policy
-            .reset(&rollout.world, &rollout.episode)
-            .map_err(|source| RunError::Policy {
-                seed,
-                step: 0,
-                source,
-            })?;
-        Ok(rollout)
+        Self::reset_by(world, seed, |world, episode| policy.reset(world, episode))
     }
 
     /// The episode of `seed` in `world`, with lane `lane` of `policy` reset for it (episodes run
@@ -55,14 +47,19 @@ impl Rollout {
         policy: &mut dyn Policy,
         lane: usize,
     ) -> Result<Self, RunError> {
+        Self::reset_by(world, seed, |world, episode| {
+            policy.reset_lane(lane, world, episode)
+        })
+    }
+
+    /// The episode of `seed` in `world`, with `reset` (a policy's) called for it.
+    fn reset_by(
+        world: Arc<World>,
+        seed: u64,
+        reset: impl FnOnce(&World, &Episode) -> Result<(), PolicyError>,
+    ) -> Result<Self, RunError> {
         let rollout = Self::new(world, seed)?;
-        policy
-            .reset_lane(lane, &rollout.world, &rollout.episode)
-            .map_err(|source| RunError::Policy {
-                seed,
-                step: 0,
-                source,
-            })?;
+        reset(&rollout.world, &rollout.episode).map_err(|e| RunError::reset(seed, e))?;
         Ok(rollout)
     }
 
@@ -94,7 +91,7 @@ impl Rollout {
     }
 
     /// The error of the policy failing to decide this step.
-    pub fn policy_error(&self, source: crate::policy::PolicyError) -> RunError {
+    pub fn policy_error(&self, source: PolicyError) -> RunError {
         RunError::Policy {
             seed: self.episode.seed(),
             step: self.episode.steps() + 1,

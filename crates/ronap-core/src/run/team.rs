@@ -130,11 +130,7 @@ impl TeamRollout {
         for (k, policy) in policies.iter_mut().enumerate() {
             policy
                 .reset(&rollout.worlds[k], rollout.team.robot(k))
-                .map_err(|source| RunError::Policy {
-                    seed,
-                    step: 0,
-                    source,
-                })?;
+                .map_err(|e| RunError::reset(seed, e))?;
         }
         Ok(rollout)
     }

@@ -396,22 +396,27 @@ fn add_columns_from<S: pulp::Simd>(
     outputs: usize,
     mut o: usize,
 ) {
+    // One row: `x` is its inputs and `y` its outputs.
+    let shape = Shape {
+        ins: x.len(),
+        outs: outputs,
+    };
     while o + 8 * S::F32_LANES <= outputs {
-        add_vectors::<S, 8>(simd, y, x, weights, outputs, o);
+        add_block::<S, 1, 8>(simd, y, x, weights, shape, 0, o);
         o += 8 * S::F32_LANES;
     }
     // Four at once where they fit: each output's sum is a chain of dependent adds, so fewer
     // than about four vectors side by side wait on the adder's latency.
     while o + 4 * S::F32_LANES <= outputs {
-        add_vectors::<S, 4>(simd, y, x, weights, outputs, o);
+        add_block::<S, 1, 4>(simd, y, x, weights, shape, 0, o);
         o += 4 * S::F32_LANES;
     }
     while o + 2 * S::F32_LANES <= outputs {
-        add_vectors::<S, 2>(simd, y, x, weights, outputs, o);
+        add_block::<S, 1, 2>(simd, y, x, weights, shape, 0, o);
         o += 2 * S::F32_LANES;
     }
     while o + S::F32_LANES <= outputs {
-        add_vectors::<S, 1>(simd, y, x, weights, outputs, o);
+        add_block::<S, 1, 1>(simd, y, x, weights, shape, 0, o);
         o += S::F32_LANES;
     }
     for o in o..outputs {
@@ -421,31 +426,6 @@ fn add_columns_from<S: pulp::Simd>(
         }
         y[o] = acc;
     }
-}
-
-/// [`add_columns`] for the `K` vectors of outputs from `o`.
-#[inline(always)]
-fn add_vectors<S: pulp::Simd, const K: usize>(
-    simd: S,
-    y: &mut [f32],
-    x: &[f32],
-    weights: &[f32],
-    outputs: usize,
-    o: usize,
-) {
-    let n = K * S::F32_LANES;
-    let mut acc = [simd.splat_f32s(0.0); K];
-    acc.copy_from_slice(S::as_simd_f32s(&y[o..o + n]).0);
-    for (&xj, column) in x.iter().zip(weights.chunks_exact(outputs)) {
-        let xj = simd.splat_f32s(xj);
-        let (w, _) = S::as_simd_f32s(&column[o..o + n]);
-        for (a, &w) in acc.iter_mut().zip(w) {
-            *a = simd.add_f32s(*a, simd.mul_f32s(xj, w));
-        }
-    }
-    S::as_mut_simd_f32s(&mut y[o..o + n])
-        .0
-        .copy_from_slice(&acc);
 }
 
 /// Buffers for [`Mlp::forward_into`], reused from step to step.
