@@ -248,7 +248,7 @@ impl RayGrid {
     /// The nearest [`Aabb::ray_hit`] of the ray `start.origin + t * dir`, `t` in `[0, max_t]`,
     /// given `inv_dir = 1 / dir` per component, over every box of the grid: `Some(0.0)` when the
     /// origin is inside a box, `None` when no box lies within `max_t`.
-    #[inline]
+    #[inline(always)]
     pub fn cast(&self, start: &GridStart, dir: Vector, inv_dir: Vector, max_t: f64) -> Option<f64> {
         let o = start.origin;
         let (mut col, mut row) = match start.cell {
