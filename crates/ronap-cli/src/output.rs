@@ -30,7 +30,8 @@ pub fn progress_bar(len: u64, template: &str, prefix: String) -> indicatif::Prog
 }
 
 /// A flag the first Ctrl-C sets (after saying `what` happens now); a second Ctrl-C exits at once
-/// with code 130.
+/// with code 130. A termination request (SIGTERM, as `timeout`, schedulers and service managers
+/// send, or SIGHUP) counts as a Ctrl-C, so what is done is kept then too.
 pub fn cancel_on_ctrl_c(what: &'static str) -> Arc<AtomicBool> {
     let cancel = Arc::new(AtomicBool::new(false));
     let flag = cancel.clone();
@@ -41,6 +42,14 @@ pub fn cancel_on_ctrl_c(what: &'static str) -> Arc<AtomicBool> {
         eprintln!("\nronap: interrupted; {what} (Ctrl-C again to quit now)");
     });
     cancel
+}
+
+/// `n` and `noun`, plural but for one: "1 thread", "2 threads".
+pub fn counted(n: impl Into<u64>, noun: &str) -> String {
+    match n.into() {
+        1 => format!("1 {noun}"),
+        n => format!("{n} {noun}s"),
+    }
 }
 
 /// `2026-11-21T10:31:05Z` style UTC parts from the system clock.

@@ -128,6 +128,8 @@ fn maze_flags_shape_the_picture() {
         out.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
+    // A binary PGM (P5), as map servers read it, not the PAM (P7) `image` writes by default.
+    assert_eq!(&std::fs::read(&out).unwrap()[..3], b"P5\n");
     let img = image::open(&out).unwrap().to_luma8();
     assert_eq!(img.dimensions(), (400, 300));
     // The bottom-left corner of the frame: 4 px walls, half inside the scene, at 2 pixels a px.

@@ -1,7 +1,7 @@
 //! The learning loop from the command line: collect, train, run; weights-file errors; the shipped
 //! policies against their reported figures.
 
-use crate::util::{ok, repo_root, ronap, summary, text};
+use crate::util::{assert_rejected, ok, repo_root, ronap, summary, text};
 
 #[test]
 fn collect_train_run_loop() {
@@ -406,4 +406,40 @@ fn shipped_policies_reach_their_reported_success() {
             "{name}: {got:.2} on seeds 0..99 vs {reported:.3} reported on 0..999"
         );
     }
+}
+
+/// A train fraction of 0 leaves nothing to train on: refused before any data is read. At 1 there
+/// is no test split, and the test accuracy shows as `-`, not NaN.
+#[test]
+fn train_fractions_at_the_ends() {
+    assert_rejected(
+        &["train", "bc", "--data", "x.csv", "--train-fraction", "0"],
+        &["--train-fraction", "0"],
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let data = dir.path().join("expert.csv");
+    ok(&ronap(&[
+        "collect",
+        "--expert",
+        "geodesic",
+        "--samples",
+        "200",
+        "--out",
+        data.to_str().unwrap(),
+    ]));
+    let net = dir.path().join("net.safetensors");
+    let out = ok(&ronap(&[
+        "train",
+        "bc",
+        "--data",
+        data.to_str().unwrap(),
+        "--train-fraction",
+        "1",
+        "--epochs",
+        "1",
+        "--out",
+        net.to_str().unwrap(),
+    ]));
+    assert!(out.contains("test accuracy -"), "{out}");
+    assert!(!out.contains("NaN"), "{out}");
 }

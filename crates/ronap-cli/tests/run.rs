@@ -442,6 +442,61 @@ fn ctrl_c_keeps_the_finished_episodes() {
     assert_eq!(summary["interrupted"], true);
     assert_eq!(summary["summary"]["episodes"], finished);
     assert!(text(&o.stdout).contains("interrupted"));
+    // Starting afresh there would lose them: refused until resumed (or removed).
+    let o = ronap(&["run", "--policy", "random", "--seeds", "2", "--out", out.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("was interrupted"), "{}", text(&o.stderr));
+    assert_eq!(rows(&out.join("episodes.csv")).len() - 1, finished);
+}
+
+/// `timeout`, job schedulers and service managers stop a program with SIGTERM: a collection so
+/// stopped keeps its rows, as after Ctrl-C, and leaves no temporary file.
+#[cfg(unix)]
+#[test]
+fn sigterm_keeps_the_rows_collected() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("rows.csv");
+    let child = Command::new(env!("CARGO_BIN_EXE_ronap"))
+        .args(["collect", "--expert", "geodesic", "--samples", "1000000000", "--threads", "1"])
+        .args(["--out", out.to_str().unwrap()])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let kill = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(130), "{}", text(&o.stderr));
+    let saved = rows(&out).len() - 1;
+    assert!(saved > 0, "{saved}");
+    assert!(text(&o.stdout).contains(&format!("interrupted: {saved} of")), "{}", text(&o.stdout));
+    let files: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(files.len(), 1, "{files:?}");
+}
+
+/// Seeds end at 2^64 - 1: a collection that runs out of them says so and keeps its rows.
+#[test]
+fn collect_says_when_the_seeds_run_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("rows.csv");
+    let o = ronap(&[
+        "collect",
+        "--expert",
+        "geodesic",
+        "--samples",
+        "300",
+        "--seed-start",
+        "18446744073709551614",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("the seeds ran out"), "{}", text(&o.stderr));
+    assert_eq!(rows(&out).len() - 1, 100);
 }
 
 #[test]

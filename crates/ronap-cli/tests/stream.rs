@@ -78,6 +78,13 @@ fn kill_and_resume(args: &[&str], files: &[&str]) {
     for (k, row) in reader.records().enumerate() {
         assert_eq!(row.unwrap()[0], k.to_string(), "row {k} of {text}");
     }
+    // A new run there would throw the finished episodes away: refused, pointing at --resume.
+    let a: Vec<String> = with_out(&killed);
+    let o = ronap(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("stopped short"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("ronap run --resume"), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(&partial).unwrap(), text);
 
     let o = ronap(&["run", "--resume", killed.to_str().unwrap()]);
     ok(&o);
@@ -224,7 +231,20 @@ fn a_second_run_into_a_directory_in_use_is_refused() {
     for (k, row) in reader.records().enumerate() {
         assert_eq!(row.unwrap()[0], k.to_string());
     }
-    // Once the holder is gone, the directory is free again.
+    // Once the holder is gone, the directory is free again: no longer in use, only holding a
+    // run stopped short (which a new run must not throw away)...
+    let err = crate::util::assert_rejected(
+        &["run", "--policy", "apf", "--seeds", "3", "--out", o],
+        &[o, "stopped short", "--resume"],
+    );
+    assert!(!err.contains("in use"), "{err}");
+    // ...and once that is cleared, a new run goes ahead.
+    for entry in std::fs::read_dir(&out).unwrap() {
+        let path = entry.unwrap().path();
+        if path.to_string_lossy().ends_with(".partial") {
+            std::fs::remove_file(path).unwrap();
+        }
+    }
     ok(&ronap(&[
         "run", "--policy", "apf", "--seeds", "3", "--out", o,
     ]));

@@ -110,8 +110,14 @@ pub fn train(
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
     let mut rows: Vec<usize> = (0..data.len()).collect();
     rows.shuffle(&mut rng);
-    let n_train =
-        ((data.len() as f64 * options.train_fraction).round() as usize).clamp(1, data.len());
+    let n_train = ((data.len() as f64 * options.train_fraction).round() as usize).min(data.len());
+    if n_train == 0 {
+        return Err(LearnError::Data(format!(
+            "train_fraction {} of {} rows leaves no row to train on",
+            options.train_fraction,
+            data.len()
+        )));
+    }
     let (train_rows, test_rows) = rows.split_at(n_train);
     let mut train_rows = train_rows.to_vec();
 

@@ -7,7 +7,7 @@
 pub mod policy;
 pub mod sim;
 
-pub use policy::{policy_factory, TeamPolicies};
+pub use policy::{named_policy, policy_factory, TeamPolicies};
 pub use sim::{EpisodeArgs, SceneArgs, SimArgs};
 
 use clap::Args;
@@ -44,6 +44,14 @@ pub fn count(s: &str) -> Result<u64, String> {
 pub fn seed(s: &str) -> Result<u64, String> {
     s.parse::<u64>()
         .map_err(|_| "a seed must be a whole number from 0 to 18446744073709551615".into())
+}
+
+/// Parses a fraction in (0, 1].
+pub fn share(s: &str) -> Result<f64, String> {
+    match fraction(s)? {
+        0.0 => Err("must be above 0 and at most 1".into()),
+        v => Ok(v),
+    }
 }
 
 /// Parses a fraction in [0, 1].

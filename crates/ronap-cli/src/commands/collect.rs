@@ -2,7 +2,7 @@
 //! planner or by a person at the keys (`--human`, the paper's Collect Data screen), in the
 //! data-log format.
 
-use crate::args::policy_factory;
+use crate::args::named_policy;
 use crate::args::{count, seed, SceneArgs, SimArgs, ThreadArgs};
 use crate::output::cancel_on_ctrl_c;
 use anyhow::{bail, Context, Result};
@@ -49,7 +49,7 @@ pub struct CollectArgs {
     mode: Mode,
     /// With --mode drive: the policy that drives while the expert labels (DAgger: a learned
     /// policy visits its own mistakes), e.g. mlp:policies/bc.safetensors [default: the expert].
-    #[arg(long, value_name = "POLICY", requires = "mode")]
+    #[arg(long, value_name = "POLICY")]
     driver: Option<String>,
     /// First seed; episode i has seed seed-start + i.
     #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 1_000_000, value_parser = seed)]
@@ -88,7 +88,7 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
     let (scenes, _) = args.scenes.scenes(&config)?;
     let driver = match (&args.driver, args.mode) {
         (Some(_), Mode::Repose) => bail!("--driver needs --mode drive"),
-        (Some(name), Mode::Drive) => Some(policy_factory(name, &config)?),
+        (Some(name), Mode::Drive) => Some(named_policy("driver", name, &config)?),
         (None, _) => None,
     };
     let evaluator = Evaluator::new(config.clone(), scenes);
@@ -155,7 +155,9 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
     let mut stdout = std::io::stdout().lock();
     writeln!(
         stdout,
-        "ronap collect: {rows} rows from {episodes} episodes (seeds {first}..{}), expert {}, mode {}, {:.1} s",
+        "ronap collect: {} from {} (seeds {first}..{}), expert {}, mode {}, {:.1} s",
+        crate::output::counted(rows as u64, "row"),
+        crate::output::counted(episodes as u64, "episode"),
         first + episodes.saturating_sub(1) as u64,
         expert,
         match args.mode {
@@ -171,6 +173,14 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
     if cancel.load(Ordering::Relaxed) {
         writeln!(stdout, "interrupted: {rows} of {} rows saved", args.samples)?;
         return Ok(ExitCode::from(130));
+    }
+    if rows < args.samples as usize {
+        // Only the seeds running out ends a collection short without an error.
+        bail!(
+            "--seed-start {first} --samples {}: the seeds ran out below 2^64 - 1 after {rows} rows \
+             (the rows recorded are saved); start lower",
+            args.samples
+        );
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -25,7 +25,8 @@ pub enum By {
 #[derive(Args, Debug)]
 pub struct CompareArgs {
     /// A policy to compare (repeat for each; at least two in all, counting --run): apf, geodesic,
-    /// random, mlp:FILE.safetensors[@RULE] or py:FILE.py:FUNCTION, as for `ronap run`.
+    /// geodesic-wait, random, mlp:FILE.safetensors[@RULE] or py:FILE.py:FUNCTION, as for `ronap
+    /// run`.
     #[arg(long, value_name = "NAME")]
     policy: Vec<String>,
     /// A finished `ronap run` (or a compare's runs/<policy>) directory to reuse instead of running
@@ -132,9 +133,10 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
     let mut stdout = std::io::stdout().lock();
     writeln!(
         stdout,
-        "ronap compare: {}, seeds {first}..{}, {threads} threads",
+        "ronap compare: {}, seeds {first}..{}, {}",
         names.join(" vs "),
-        end - 1
+        end - 1,
+        crate::output::counted(threads as u64, "thread")
     )?;
     write!(stdout, "{}", comparison.table())?;
     writeln!(

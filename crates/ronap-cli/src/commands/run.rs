@@ -6,6 +6,7 @@ use crate::output::cancel_on_ctrl_c;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use ronap_core::eval::{EpisodeRecord, EvalOptions, Evaluator, Recording, Seeds};
+use ronap_core::io::atomic::OutputError;
 use ronap_core::io::manifest::PLAN_FILE;
 use ronap_core::io::run_dir::{
     evaluate_into, evaluate_team_into, Pictures, ResumeError, RunFiles, RunInfo, RunWriter,
@@ -22,7 +23,8 @@ use std::process::ExitCode;
 #[derive(Args, Debug)]
 pub struct RunArgs {
     /// Policy to evaluate: apf (the paper's potential field, Algorithm 3), geodesic (shortest-path
-    /// follower, no local minima), random, mlp:FILE.safetensors (a trained network, e.g.
+    /// follower, no local minima), geodesic-wait (geodesic that waits for moving obstacles ahead),
+    /// random, mlp:FILE.safetensors (a trained network, e.g.
     /// mlp:policies/bc.safetensors; append @argmax or @sample:T to override its decision rule), or
     /// py:FILE.py:FUNCTION (a Python function: observation in, action 0/1/2 out; run with
     /// $RONAP_PYTHON or python3).
@@ -155,13 +157,18 @@ impl Job {
 
     /// The writer of a new run into `out_dir`.
     fn writer(&self, files: RunFiles) -> Result<RunWriter> {
-        Ok(
-            RunWriter::create(&self.out_dir, files, self.seeds.first().unwrap_or(0))
-                .with_context(|| {
-                    format!("cannot prepare output directory {}", self.out_dir.display())
-                })?
-                .with_front_end(self.front_end()),
-        )
+        let dir = &self.out_dir;
+        let writer = match RunWriter::create(dir, files, self.seeds.first().unwrap_or(0)) {
+            Ok(w) => w,
+            Err(e @ OutputError::StoppedShort { .. }) => {
+                bail!("{e} (ronap run --resume {} finishes it)", dir.display())
+            }
+            Err(e) => {
+                return Err(anyhow::Error::from(e)
+                    .context(format!("cannot prepare output directory {}", dir.display())))
+            }
+        };
+        Ok(writer.with_front_end(self.front_end()))
     }
 }
 
@@ -323,7 +330,7 @@ fn run_lone(
         if job.batch > 0 {
             format!("batches of up to {} episodes", job.batch)
         } else {
-            format!("{} threads", job.threads)
+            crate::output::counted(job.threads as u64, "thread")
         }
     )?;
     write!(stdout, "{}", summary.table())?;
@@ -430,10 +437,10 @@ fn run_team(
     let mut stdout = std::io::stdout().lock();
     writeln!(
         stdout,
-        "ronap run: {} robots ({}), seeds {first}..{last}, {} threads",
-        names.len(),
+        "ronap run: {} ({}), seeds {first}..{last}, {}",
+        crate::output::counted(names.len() as u64, "robot"),
         summary_of_names(&names),
-        job.threads
+        crate::output::counted(job.threads as u64, "thread")
     )?;
     write!(stdout, "{}", evaluation.team.table())?;
     writeln!(stdout, "per robot:")?;

@@ -80,8 +80,8 @@ struct BcArgs {
     /// Rows per mini-batch.
     #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 256, value_parser = count)]
     batch: u64,
-    /// Fraction of rows to train on; the rest are the test split.
-    #[arg(long, allow_negative_numbers = true, value_name = "F", default_value_t = 0.8, value_parser = fraction)]
+    /// Fraction of rows to train on, above 0; the rest are the test split (none at 1).
+    #[arg(long, allow_negative_numbers = true, value_name = "F", default_value_t = 0.8, value_parser = crate::args::share)]
     train_fraction: f64,
     /// Laser range, px: ronap's rows hold readings in px, the network sees them over this range
     /// (SPEC.md's d_max).
@@ -455,11 +455,11 @@ fn train_bc(args: BcArgs) -> Result<ExitCode> {
         },
         &mut |r| {
             let line = format!(
-                "{:>6} {:>10.4} {:>9.1}% {:>9.1}%",
+                "{:>6} {:>10.4} {:>10} {:>10}",
                 r.epoch,
                 r.loss,
-                100.0 * r.train_accuracy,
-                100.0 * r.test_accuracy
+                percent(r.train_accuracy),
+                percent(r.test_accuracy)
             );
             show(&progress, &mut stdout, &line);
             if let Err(e) = log.push(vec![
@@ -477,9 +477,9 @@ fn train_bc(args: BcArgs) -> Result<ExitCode> {
     progress.finish_and_clear();
     let last = reports.last().map(|last| {
         format!(
-            "final: train accuracy {:.1}%, test accuracy {:.1}%",
-            100.0 * last.train_accuracy,
-            100.0 * last.test_accuracy
+            "final: train accuracy {}, test accuracy {}",
+            percent(last.train_accuracy),
+            percent(last.test_accuracy)
         )
     });
     let finished = Finished {
@@ -701,4 +701,13 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
         cancel: &cancel,
     };
     finished.write(&mut stdout)
+}
+
+/// An accuracy as a percentage, `-` where there was nothing to measure it on (no test split).
+fn percent(accuracy: f64) -> String {
+    if accuracy.is_nan() {
+        "-".into()
+    } else {
+        format!("{:.1}%", 100.0 * accuracy)
+    }
 }

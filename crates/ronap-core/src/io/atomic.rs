@@ -43,6 +43,19 @@ pub enum OutputError {
         /// The process holding it, when it said.
         pid: Option<u32>,
     },
+    /// The directory holds a run stopped short (killed or interrupted), whose finished episodes
+    /// starting a new run there would throw away.
+    #[error(
+        "{} holds a run that stopped short ({why}): resume it to finish it, or remove the \
+         directory (or choose another) to start afresh",
+        dir.display()
+    )]
+    StoppedShort {
+        /// The directory.
+        dir: PathBuf,
+        /// How it shows.
+        why: String,
+    },
     /// The file name has an extension no writer knows.
     #[error("cannot write {}: {message}", path.display())]
     Format {
@@ -105,29 +118,34 @@ pub fn save_network(path: &Path, mlp: &crate::policy::mlp::Mlp) -> Result<(), Ou
     write_atomic(path, |w| w.write_all(&bytes))
 }
 
-/// Saves an image as PNG (or PGM/PPM for a `.pgm`/`.ppm` path), atomically.
+/// Saves an image as PNG (or binary PGM/PPM, `P5`/`P6`, for a `.pgm`/`.ppm` path, as map
+/// servers read them), atomically.
 pub fn save_image(path: &Path, image: &image::RgbImage) -> Result<(), OutputError> {
+    use image::codecs::pnm::{PnmEncoder, PnmSubtype, SampleEncoding};
+    use image::{ExtendedColorType, ImageEncoder};
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    let format = match ext.as_deref() {
-        Some("png") => image::ImageFormat::Png,
-        Some("pgm") | Some("ppm") => image::ImageFormat::Pnm,
+    let mut buffer = std::io::Cursor::new(Vec::new());
+    let (w, h) = image.dimensions();
+    let encoded = match ext.as_deref() {
+        Some("png") => image.write_to(&mut buffer, image::ImageFormat::Png),
+        Some("pgm") => {
+            let gray = image::DynamicImage::ImageRgb8(image.clone()).to_luma8();
+            PnmEncoder::new(&mut buffer)
+                .with_subtype(PnmSubtype::Graymap(SampleEncoding::Binary))
+                .write_image(gray.as_raw(), w, h, ExtendedColorType::L8)
+        }
+        Some("ppm") => PnmEncoder::new(&mut buffer)
+            .with_subtype(PnmSubtype::Pixmap(SampleEncoding::Binary))
+            .write_image(image.as_raw(), w, h, ExtendedColorType::Rgb8),
         _ => {
             return Err(OutputError::Format {
                 path: path.to_path_buf(),
                 message: "unknown picture type (use a .png, .pgm or .ppm file name)".into(),
             })
         }
-    };
-    let mut buffer = std::io::Cursor::new(Vec::new());
-    let encoded = if ext.as_deref() == Some("pgm") {
-        image::DynamicImage::ImageRgb8(image.clone())
-            .to_luma8()
-            .write_to(&mut buffer, format)
-    } else {
-        image.write_to(&mut buffer, format)
     };
     encoded.map_err(|e| OutputError::Format {
         path: path.to_path_buf(),

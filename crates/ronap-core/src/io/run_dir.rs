@@ -221,10 +221,29 @@ struct Resumed {
 
 impl RunWriter {
     /// Makes and locks `dir` for a run whose seeds start at `first_seed`, removing the files of
-    /// an earlier run there.
+    /// an earlier run there; refuses ([`OutputError::StoppedShort`]) when that run stopped short
+    /// (killed, with its files still partial, or interrupted), whose episodes are for resuming.
     pub fn create(dir: &Path, files: RunFiles, first_seed: u64) -> Result<Self, OutputError> {
         make_dir(dir)?;
         let lock = RunLock::take(dir)?;
+        let interrupted = RunManifest::read(&dir.join("summary.json")).is_ok_and(|m| m.interrupted);
+        let killed = RUN_FILES
+            .iter()
+            .find(|name| partial_path(&dir.join(name)).exists());
+        let why = match (interrupted, killed) {
+            (true, _) => Some("its summary.json says it was interrupted".to_string()),
+            (false, Some(name)) => Some(format!(
+                "{} is still there",
+                partial_path(Path::new(name)).display()
+            )),
+            (false, None) => None,
+        };
+        if let Some(why) = why {
+            return Err(OutputError::StoppedShort {
+                dir: dir.to_path_buf(),
+                why,
+            });
+        }
         let subs = [
             (files.pictures.is_some(), "png"),
             (files.steps, "steps"),
@@ -1335,6 +1354,12 @@ mod tests {
         // Stopped short (the driver killed): the finished rows stay, partial.
         let stopped = run.finish(1.0).unwrap();
         assert!(stopped.interrupted);
+        // A new run there would throw them away: refused, naming what shows it stopped short.
+        let refused = RunWriter::create(&dir, RunFiles::default(), 5).unwrap_err();
+        assert!(
+            matches!(&refused, OutputError::StoppedShort { why, .. } if why.contains("episodes.csv.partial")),
+            "{refused}"
+        );
         let (writer, plan) = RunWriter::resume(&dir).unwrap();
         assert_eq!(writer.done(), 10);
         let info = RunInfo::of(&plan);
