@@ -49,7 +49,9 @@ impl Env {
         seed: u64,
     ) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyDict>)> {
         let world = self.worlds.world(seed);
-        let episode = world.episode(seed).map_err(errors::scene)?;
+        let episode = world
+            .episode(seed)
+            .map_err(|e| errors::scene(format!("seed {seed}: {e}")))?;
         self.shaper = Shaper::start(world, &episode);
         self.path = vec![episode.pose().position()];
         let obs = PyArray1::from_slice(py, episode.observation());

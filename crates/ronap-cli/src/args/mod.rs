@@ -36,6 +36,9 @@ pub fn non_negative(s: &str) -> Result<f64, String> {
 pub fn count(s: &str) -> Result<u64, String> {
     match s.parse::<u64>() {
         Ok(n) if n >= 1 => Ok(n),
+        Err(e) if *e.kind() == std::num::IntErrorKind::PosOverflow => {
+            Err("must be at most 18446744073709551615".into())
+        }
         _ => Err("must be a whole number of at least 1".into()),
     }
 }

@@ -294,6 +294,10 @@ fn check_out(path: &Path) -> Result<()> {
             dir.display()
         );
     }
+    // The weights and the curves are written through temporary files in that directory: try one.
+    if let Err(e) = ronap_core::io::atomic::check_writable(dir) {
+        bail!("--out {}: {e}", path.display());
+    }
     Ok(())
 }
 

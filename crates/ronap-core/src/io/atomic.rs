@@ -66,6 +66,20 @@ pub enum OutputError {
     },
 }
 
+/// Whether files can be written in `dir` the way [`write_atomic`] writes them (through a
+/// temporary file there), tried with an empty temporary file that is removed at once: for checks
+/// before a long job whose results would otherwise be lost at the end.
+pub fn check_writable(dir: &Path) -> Result<(), OutputError> {
+    tempfile::Builder::new()
+        .prefix(".ronap-")
+        .tempfile_in(dir)
+        .map(drop)
+        .map_err(|source| OutputError::Io {
+            path: dir.to_path_buf(),
+            source,
+        })
+}
+
 /// Writes `path` through `write`, atomically; the file gets mode 0644 on Unix.
 pub fn write_atomic(
     path: &Path,

@@ -483,6 +483,12 @@ impl RunWriter {
 
 /// Makes `dir` and its parents.
 fn make_dir(dir: &Path) -> Result<(), OutputError> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(OutputError::Io {
+            path: dir.to_path_buf(),
+            source: std::io::Error::other("it is a file, not a directory"),
+        });
+    }
     std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
         path: dir.to_path_buf(),
         source,

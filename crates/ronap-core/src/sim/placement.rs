@@ -22,10 +22,11 @@ pub enum EpisodeError {
         /// Robot radius, px.
         radius_px: f64,
     },
-    /// No start and goal at least `min_goal_distance_px` apart were found in one region.
+    /// No start and goal at least `min_goal_distance_px` apart were found in one region (the
+    /// message leaves the seed to its callers, which name it).
     #[error(
-        "seed {seed}: found no start and goal {min_goal_distance_px} px apart in one free region \
-         of the scene ({span_px:.0} px across); lower episode.min_goal_distance_px"
+        "found no start and goal {min_goal_distance_px} px apart in one free region of the scene \
+         (which is {span_px:.0} px corner to corner); lower episode.min_goal_distance_px"
     )]
     NoPlacement {
         /// The episode seed.
