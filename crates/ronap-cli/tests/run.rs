@@ -443,9 +443,21 @@ fn ctrl_c_keeps_the_finished_episodes() {
     assert_eq!(summary["summary"]["episodes"], finished);
     assert!(text(&o.stdout).contains("interrupted"));
     // Starting afresh there would lose them: refused until resumed (or removed).
-    let o = ronap(&["run", "--policy", "random", "--seeds", "2", "--out", out.to_str().unwrap()]);
+    let o = ronap(&[
+        "run",
+        "--policy",
+        "random",
+        "--seeds",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(text(&o.stderr).contains("was interrupted"), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("was interrupted"),
+        "{}",
+        text(&o.stderr)
+    );
     assert_eq!(rows(&out.join("episodes.csv")).len() - 1, finished);
 }
 
@@ -457,7 +469,15 @@ fn sigterm_keeps_the_rows_collected() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("rows.csv");
     let child = Command::new(env!("CARGO_BIN_EXE_ronap"))
-        .args(["collect", "--expert", "geodesic", "--samples", "1000000000", "--threads", "1"])
+        .args([
+            "collect",
+            "--expert",
+            "geodesic",
+            "--samples",
+            "1000000000",
+            "--threads",
+            "1",
+        ])
         .args(["--out", out.to_str().unwrap()])
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
@@ -473,7 +493,11 @@ fn sigterm_keeps_the_rows_collected() {
     assert_eq!(o.status.code(), Some(130), "{}", text(&o.stderr));
     let saved = rows(&out).len() - 1;
     assert!(saved > 0, "{saved}");
-    assert!(text(&o.stdout).contains(&format!("interrupted: {saved} of")), "{}", text(&o.stdout));
+    assert!(
+        text(&o.stdout).contains(&format!("interrupted: {saved} of")),
+        "{}",
+        text(&o.stdout)
+    );
     let files: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
     assert_eq!(files.len(), 1, "{files:?}");
 }
@@ -495,7 +519,11 @@ fn collect_says_when_the_seeds_run_out() {
         out.to_str().unwrap(),
     ]);
     assert_eq!(o.status.code(), Some(2));
-    assert!(text(&o.stderr).contains("the seeds ran out"), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("the seeds ran out"),
+        "{}",
+        text(&o.stderr)
+    );
     assert_eq!(rows(&out).len() - 1, 100);
 }
 

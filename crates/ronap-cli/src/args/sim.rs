@@ -2,7 +2,7 @@
 //! core's validated configuration, and where episodes take place.
 
 use crate::args::{fraction, positive, seed};
-use anyhow::Result;
+use anyhow::{Context, Result};
 use clap::Args;
 use ronap_core::config::ConfigFile;
 use ronap_core::scene::map::MapSource;
@@ -98,7 +98,14 @@ impl SceneArgs {
 
     /// The scenes (reading the map, if any), with what the map file was read as.
     pub fn scenes(&self, config: &ValidConfig) -> Result<(Scenes, Option<MapSource>)> {
-        Ok(self.spec(config).load(config)?)
+        let loaded = self.spec(config).load(config);
+        match (&config.scene.file, &self.map) {
+            // The map the scenario names: say where the name came from.
+            (Some(file), None) => {
+                loaded.with_context(|| format!("the scenario's scene.file = {file:?}"))
+            }
+            _ => Ok(loaded?),
+        }
     }
 }
 

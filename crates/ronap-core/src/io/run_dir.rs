@@ -579,10 +579,15 @@ fn write_episode_files(
 }
 
 /// Removes the per-episode files an earlier run left in `dir` (`png/seed-*.png`,
-/// `steps/seed-*.csv`, `gif/seed-*.gif`), so a reused output directory shows only this run.
-/// Nothing else is touched.
+/// `steps/seed-*.csv`, the GIFs `ronap replay` drew beside them, `steps/seed-*.gif`, and
+/// `gif/seed-*.gif`), so a reused output directory shows only this run. Nothing else is touched.
 fn remove_stale_files(dir: &Path) -> Result<(), OutputError> {
-    for (sub, ext) in [("png", ".png"), ("steps", ".csv"), ("gif", ".gif")] {
+    for (sub, ext) in [
+        ("png", ".png"),
+        ("steps", ".csv"),
+        ("steps", ".gif"),
+        ("gif", ".gif"),
+    ] {
         let Ok(entries) = std::fs::read_dir(dir.join(sub)) else {
             continue;
         };
@@ -1337,6 +1342,31 @@ mod tests {
     }
 
     #[test]
+    fn a_new_run_clears_an_earlier_runs_episode_files_and_nothing_else() {
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().join("run");
+        let stale = [
+            "png/seed-000001-success.png",
+            "steps/seed-000001.csv",
+            "steps/seed-000001-top.gif",
+            "gif/seed-000001-success.gif",
+        ];
+        let kept = ["steps/notes.txt", "png/mine.png", "other.csv"];
+        for f in stale.iter().chain(&kept) {
+            let path = dir.join(f);
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            std::fs::write(path, b"x").unwrap();
+        }
+        drop(RunWriter::create(&dir, RunFiles::default(), 0).unwrap());
+        for f in stale {
+            assert!(!dir.join(f).exists(), "{f} left");
+        }
+        for f in kept {
+            assert!(dir.join(f).exists(), "{f} removed");
+        }
+    }
+
+    #[test]
     fn rows_out_of_order_are_refused_and_a_stopped_block_run_resumes() {
         let (config, evaluator, info) = setting();
         let tmp = tempfile::tempdir().unwrap();
@@ -1363,7 +1393,7 @@ mod tests {
         // A new run there would throw them away: refused, naming what shows it stopped short.
         let refused = RunWriter::create(&dir, RunFiles::default(), 5).unwrap_err();
         assert!(
-            matches!(&refused, OutputError::StoppedShort { why, .. } if why.contains("episodes.csv.partial")),
+            matches!(&refused, OutputError::StoppedShort { why, .. } if why.contains("interrupted")),
             "{refused}"
         );
         let (writer, plan) = RunWriter::resume(&dir).unwrap();

@@ -276,12 +276,16 @@ impl<'b, I: Iterator<Item = (Vector, &'b mut f64)>> pulp::WithSimd for FirstBoxH
         match self.start {
             RayStart::Maze(walls, start) => {
                 for (dir, reading) in self.beams {
-                    *reading = walls.cast(start, dir, inverse(dir), max_px).unwrap_or(max_px);
+                    *reading = walls
+                        .cast(start, dir, inverse(dir), max_px)
+                        .unwrap_or(max_px);
                 }
             }
             RayStart::Grid(grid, start) => {
                 for (dir, reading) in self.beams {
-                    *reading = grid.cast(start, dir, inverse(dir), max_px).unwrap_or(max_px);
+                    *reading = grid
+                        .cast(start, dir, inverse(dir), max_px)
+                        .unwrap_or(max_px);
                 }
             }
         }
