@@ -406,13 +406,31 @@ fn ros_map_yaml_is_read() {
     assert_eq!(summary["summary"]["successes"], 4);
 }
 
+/// Runs `ronap` with `args`, sends it `signal` (as `kill` names it) after 1.5 s and waits for it.
+#[cfg(unix)]
+fn signalled(args: &[&str], signal: &str) -> std::process::Output {
+    let child = Command::new(env!("CARGO_BIN_EXE_ronap"))
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let kill = Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(kill.success());
+    child.wait_with_output().unwrap()
+}
+
 #[cfg(unix)]
 #[test]
 fn ctrl_c_keeps_the_finished_episodes() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("r");
-    let child = Command::new(env!("CARGO_BIN_EXE_ronap"))
-        .args([
+    let o = signalled(
+        &[
             "run",
             "--policy",
             "random",
@@ -422,18 +440,9 @@ fn ctrl_c_keeps_the_finished_episodes() {
             "1",
             "--out",
             out.to_str().unwrap(),
-        ])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(1500));
-    let kill = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(kill.success());
-    let o = child.wait_with_output().unwrap();
+        ],
+        "-INT",
+    );
     assert_eq!(o.status.code(), Some(130), "{}", text(&o.stderr));
     let episodes = rows(&out.join("episodes.csv"));
     let finished = episodes.len() - 1;
@@ -468,8 +477,8 @@ fn ctrl_c_keeps_the_finished_episodes() {
 fn sigterm_keeps_the_rows_collected() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("rows.csv");
-    let child = Command::new(env!("CARGO_BIN_EXE_ronap"))
-        .args([
+    let o = signalled(
+        &[
             "collect",
             "--expert",
             "geodesic",
@@ -477,19 +486,11 @@ fn sigterm_keeps_the_rows_collected() {
             "1000000000",
             "--threads",
             "1",
-        ])
-        .args(["--out", out.to_str().unwrap()])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(1500));
-    let kill = Command::new("kill")
-        .args(["-TERM", &child.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(kill.success());
-    let o = child.wait_with_output().unwrap();
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        "-TERM",
+    );
     assert_eq!(o.status.code(), Some(130), "{}", text(&o.stderr));
     let saved = rows(&out).len() - 1;
     assert!(saved > 0, "{saved}");
