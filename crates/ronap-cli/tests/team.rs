@@ -151,7 +151,15 @@ fn bad_robot_entries_are_named() {
         ),
         (
             "[[robots]]\nstart = [150.0, 150.0, 0.0]\n\n[[robots]]\nstart = [155.0, 150.0, 0.0]\n",
-            vec!["robot 1's start", "overlapping robots cannot start"],
+            vec![
+                "robot 1's start",
+                "5.0 px from robot 0's",
+                "overlapping robots cannot start",
+            ],
+        ),
+        (
+            "[[robots]]\nstart = [5000.0, 5000.0, 0.0]\n",
+            vec!["robots[0].start", "(5000, 5000)", "is not free"],
         ),
     ] {
         let f = dir.path().join("bad.toml");

@@ -194,11 +194,15 @@ impl Team {
                     let p = Point::new(x, y);
                     let hit = taken
                         .iter()
-                        .position(|&(q, _, r)| (p - q).norm() < radius + r + PLACEMENT_GAP_PX);
-                    if let Some(j) = hit {
+                        .enumerate()
+                        .find(|&(_, &(q, _, r))| (p - q).norm() < radius + r + PLACEMENT_GAP_PX);
+                    if let Some((j, &(q, _, r))) = hit {
                         return Err(EpisodeError::Moving(format!(
-                            "robot {k}'s start ({x}, {y}) is within {PLACEMENT_GAP_PX} px of robot \
-                             {j}'s: overlapping robots cannot start"
+                            "robot {k}'s start ({x}, {y}) is {:.1} px from robot {j}'s, whose \
+                             centres must be {} px apart (both radii and a {PLACEMENT_GAP_PX} px \
+                             gap): overlapping robots cannot start",
+                            (p - q).norm(),
+                            radius + r + PLACEMENT_GAP_PX
                         )));
                     }
                 }
@@ -208,13 +212,28 @@ impl Team {
                         (start - s).norm() >= gap && (goal - g).norm() >= gap
                     })
                 };
+                // A fixed start or goal is the entry's, not `[episode]`'s: name it so.
+                let of_entry = |err: EpisodeError| match err {
+                    EpisodeError::Blocked {
+                        which,
+                        x,
+                        y,
+                        radius_px,
+                    } => EpisodeError::Moving(format!(
+                        "robots[{e}].{which} = ({x}, {y}) is not free: a robot of radius \
+                         {radius_px} px there touches an obstacle or leaves the scene"
+                    )),
+                    other => other,
+                };
                 let placement = if k == 0 {
                     let mut first = stream(seed, Stream::Placement);
-                    sample_placement_with(cfg, scene, grid, seed, &mut first, clear)?
+                    sample_placement_with(cfg, scene, grid, seed, &mut first, clear)
                 } else {
-                    sample_placement_with(cfg, scene, grid, seed, &mut others, clear)?
-                };
-                let mut robot = Episode::placed(cfg, scene.clone(), seed, placement, false)?;
+                    sample_placement_with(cfg, scene, grid, seed, &mut others, clear)
+                }
+                .map_err(of_entry)?;
+                let mut robot = Episode::placed(cfg, scene.clone(), seed, placement, false)
+                    .map_err(of_entry)?;
                 let goals: Vec<Point> = if !entry.goals.is_empty() {
                     entry.goals.iter().map(|g| Point::new(g[0], g[1])).collect()
                 } else {
