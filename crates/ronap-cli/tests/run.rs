@@ -1,7 +1,7 @@
 //! End-to-end tests of `ronap run`: every output file read back, determinism across thread
 //! counts, the success gate, bad input, maps, APF's local minima, and Ctrl-C.
 
-use crate::util::{assert_rejected_leaving_nothing, col, json, ronap, rows, text};
+use crate::util::{assert_rejected, assert_rejected_leaving_nothing, col, json, ronap, rows, text};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -452,20 +452,17 @@ fn ctrl_c_keeps_the_finished_episodes() {
     assert_eq!(summary["summary"]["episodes"], finished);
     assert!(text(&o.stdout).contains("interrupted"));
     // Starting afresh there would lose them: refused until resumed (or removed).
-    let o = ronap(&[
-        "run",
-        "--policy",
-        "random",
-        "--seeds",
-        "2",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(
-        text(&o.stderr).contains("was interrupted"),
-        "{}",
-        text(&o.stderr)
+    assert_rejected(
+        &[
+            "run",
+            "--policy",
+            "random",
+            "--seeds",
+            "2",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &["was interrupted", "ronap run --resume"],
     );
     assert_eq!(rows(&out.join("episodes.csv")).len() - 1, finished);
 }
@@ -508,22 +505,19 @@ fn sigterm_keeps_the_rows_collected() {
 fn collect_says_when_the_seeds_run_out() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("rows.csv");
-    let o = ronap(&[
-        "collect",
-        "--expert",
-        "geodesic",
-        "--samples",
-        "300",
-        "--seed-start",
-        "18446744073709551614",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(
-        text(&o.stderr).contains("the seeds ran out"),
-        "{}",
-        text(&o.stderr)
+    assert_rejected(
+        &[
+            "collect",
+            "--expert",
+            "geodesic",
+            "--samples",
+            "300",
+            "--seed-start",
+            "18446744073709551614",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &["--seed-start", "the seeds ran out"],
     );
     assert_eq!(rows(&out).len() - 1, 100);
 }

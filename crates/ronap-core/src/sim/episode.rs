@@ -196,6 +196,7 @@ impl Episode {
             if !inside(p) {
                 return Err(EpisodeError::Blocked {
                     which,
+                    entry: None,
                     x: p.x,
                     y: p.y,
                     radius_px: radius,

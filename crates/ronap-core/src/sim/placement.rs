@@ -49,10 +49,12 @@ pub enum EpisodeError {
         robots: usize,
     },
     /// A fixed start or goal touches an obstacle or lies outside the scene.
-    #[error("episode.{which} = ({x}, {y}) is not free: a robot of radius {radius_px} px there touches an obstacle or leaves the scene")]
+    #[error("{}.{which} = ({x}, {y}) is not free: a robot of radius {radius_px} px there touches an obstacle or leaves the scene", section(*.entry))]
     Blocked {
         /// `start` or `goal`.
         which: &'static str,
+        /// The `[[robots]]` entry it is of, `None` for `[episode]`'s.
+        entry: Option<usize>,
         /// x, px.
         x: f64,
         /// y, px.
@@ -60,6 +62,22 @@ pub enum EpisodeError {
         /// Robot radius, px.
         radius_px: f64,
     },
+}
+
+/// The configuration table a fixed start or goal is in: `[[robots]]` entry `entry`, or
+/// `[episode]`.
+fn section(entry: Option<usize>) -> String {
+    entry.map_or_else(|| "episode".into(), |e| format!("robots[{e}]"))
+}
+
+impl EpisodeError {
+    /// This error with a fixed start or goal named as `[[robots]]` entry `entry`'s.
+    pub(crate) fn of_entry(mut self, entry: usize) -> Self {
+        if let Self::Blocked { entry: of, .. } = &mut self {
+            *of = Some(entry);
+        }
+        self
+    }
 }
 
 /// Where an episode starts and where it must go.
@@ -142,6 +160,7 @@ pub fn sample_placement_with(
     };
     let blocked = |which: &'static str, p: Point| EpisodeError::Blocked {
         which,
+        entry: None,
         x: p.x,
         y: p.y,
         radius_px: radius,

@@ -213,18 +213,7 @@ impl Team {
                     })
                 };
                 // A fixed start or goal is the entry's, not `[episode]`'s: name it so.
-                let of_entry = |err: EpisodeError| match err {
-                    EpisodeError::Blocked {
-                        which,
-                        x,
-                        y,
-                        radius_px,
-                    } => EpisodeError::Moving(format!(
-                        "robots[{e}].{which} = ({x}, {y}) is not free: a robot of radius \
-                         {radius_px} px there touches an obstacle or leaves the scene"
-                    )),
-                    other => other,
-                };
+                let of_entry = |err: EpisodeError| err.of_entry(e);
                 let placement = if k == 0 {
                     let mut first = stream(seed, Stream::Placement);
                     sample_placement_with(cfg, scene, grid, seed, &mut first, clear)
