@@ -204,11 +204,14 @@ impl RayGrid {
     }
 
     /// A grid over `boxes` in a scene spanning `bounds`, with cells sized to the boxes' density:
-    /// about four cells per box over the scene (anchored at its corner), none smaller than 4 px.
+    /// about one cell per box over the scene (anchored at its corner), none smaller than 4 px.
+    /// Larger cells mean fewer steps and more boxes tested in each; one per box measured fastest
+    /// for 1000 px rays in every scene tried (an office plan of 12 boxes, mazes drawn as images,
+    /// warehouses of 134 boxes, 1500 scattered small boxes), from 1.2x to 1.6x faster than four.
     pub fn fitted(boxes: &[Aabb], bounds: Aabb) -> Self {
         let size = bounds.extents();
         let per_box = size.x * size.y / boxes.len().max(1) as f64;
-        let cell_px = (per_box / 4.0).sqrt().max(4.0);
+        let cell_px = per_box.sqrt().max(4.0);
         Self::new(boxes, bounds, bounds.min, cell_px)
     }
 
