@@ -150,6 +150,15 @@ impl Entry {
     fn present(&self) -> bool {
         self.appears_at.is_none() && !self.held
     }
+
+    /// Whether it moves along its heading this step (present, `linear` or `random_walk`), and
+    /// the standard deviation of its turns, rad (0 when it does not turn).
+    fn walk(&self) -> (bool, f64) {
+        match self.motion {
+            Motion::Heading { sigma_rad } if self.present() => (true, sigma_rad),
+            _ => (false, 0.0),
+        }
+    }
 }
 
 /// Where the obstacles are and where they head, one array per quantity, so that the turns, the
@@ -172,8 +181,10 @@ struct State {
     bound: Vec<f64>,
     /// Squared distance from the robot's centre within which a move must be checked against it.
     near_robot2: Vec<f64>,
-    /// Whether it moves along its heading this step (present, `linear` or `random_walk`).
+    /// Whether it moves along its heading this step, and the standard deviation of its turns
+    /// ([`Entry::walk`], kept up to date as obstacles appear).
     walks: Vec<bool>,
+    sigma: Vec<f64>,
     /// This step's turn, rad (0 for the obstacles not turning), and its sine and cosine.
     turn: Vec<f64>,
     sin: Vec<f64>,
@@ -255,7 +266,9 @@ impl State {
         self.drift = self.drift.max(speed * (1.0 + 1e-9));
         self.bound.push(entry.body.bounding_radius());
         self.near_robot2.push(near_robot * near_robot);
-        self.walks.push(false);
+        let (walks, sigma) = entry.walk();
+        self.walks.push(walks);
+        self.sigma.push(sigma);
         self.moved.push(false);
         self.x.push(position.x);
         self.y.push(position.y);
@@ -565,6 +578,8 @@ pub struct Movers {
     robot_radius: f64,
     /// The robots' centres this step (a buffer kept between steps).
     centres: Vec<Point>,
+    /// Obstacles not yet present (to appear, or held back off the robot's start).
+    waiting: usize,
 }
 
 /// A robot as moving obstacles see it: a disc.
@@ -641,6 +656,7 @@ impl Movers {
             }
         }
         state.sort_keys();
+        let waiting = entries.iter().filter(|e| !e.present()).count();
         Ok(Some(Self {
             entries,
             state,
@@ -648,6 +664,7 @@ impl Movers {
             reach,
             robot_radius,
             centres: Vec::new(),
+            waiting,
         }))
     }
 
@@ -777,7 +794,12 @@ impl Movers {
         self.centres.extend(robots.iter().map(|r| r.at));
         let state = &mut self.state;
         let mut appeared = false;
-        for (i, e) in self.entries.iter_mut().enumerate() {
+        let entries = if self.waiting > 0 {
+            &mut self.entries[..]
+        } else {
+            &mut []
+        };
+        for (i, e) in entries.iter_mut().enumerate() {
             if let Some(at) = e.appears_at {
                 if step >= at {
                     let (body, min_gap) = (e.body, e.min_gap);
@@ -790,6 +812,8 @@ impl Movers {
                         state.x[i] = p.x;
                         state.y[i] = p.y;
                         e.appears_at = None;
+                        (state.walks[i], state.sigma[i]) = e.walk();
+                        self.waiting -= 1;
                         // A jump, not a step: the order must be brought up to date.
                         appeared = true;
                     }
@@ -800,15 +824,13 @@ impl Movers {
                     .all(|r| e.body.gap(state.position(i), r.at, r.radius) >= 0.0)
             {
                 e.held = false;
+                (state.walks[i], state.sigma[i]) = e.walk();
+                self.waiting -= 1;
             }
         }
         state.wide.clear();
-        for (i, e) in self.entries.iter().enumerate() {
-            let (walks, sigma) = match e.motion {
-                Motion::Heading { sigma_rad } if e.present() => (true, sigma_rad),
-                _ => (false, 0.0),
-            };
-            state.walks[i] = walks;
+        for i in 0..state.sigma.len() {
+            let sigma = state.sigma[i];
             if sigma > 0.0 {
                 let z: f64 = StandardNormal.sample(&mut self.rng);
                 state.set_turn(i, sigma * z);
@@ -920,9 +942,13 @@ impl Movers {
         let reach = self.reach + radius + (b - a).norm();
         let r2 = reach * reach;
         let st = &self.state;
-        self.entries.iter().enumerate().all(|(i, e)| {
+        let mut clear = true;
+        // Only obstacles whose centre is within `reach` of `a` can touch the sweep: those of
+        // the bands and x within reach, as a scan finds them.
+        st.near(a, reach, |i| {
             let (px, py) = (st.x[i] - a.x, st.y[i] - a.y);
-            px * px + py * py > r2
+            let e = &self.entries[i];
+            clear &= px * px + py * py > r2
                 || !e.present()
                 || match e.body {
                     Body::Disc(r) => {
@@ -932,8 +958,9 @@ impl Movers {
                         e.body.aabb(st.position(i)).segment_distance_squared(a, b)
                             >= radius * radius
                     }
-                }
-        })
+                };
+        });
+        clear
     }
 
     /// Shortens the laser readings `out`, taken from `position` at `heading_deg`, to the present
@@ -1127,6 +1154,18 @@ mod tests {
             .fold(f64::INFINITY, f64::min)
     }
 
+    /// What [`Movers::sweep_clear`] answers, worked out the plain way: every present obstacle.
+    fn sweep_clear_every(m: &Movers, a: Point, b: Point, radius: f64) -> bool {
+        m.items().filter(|o| o.present()).all(|o| match o.body() {
+            Body::Disc(r) => {
+                point_segment_distance_squared(o.position(), a, b) >= (r + radius).powi(2)
+            }
+            body @ Body::Box(_) => {
+                body.aabb(o.position()).segment_distance_squared(a, b) >= radius * radius
+            }
+        })
+    }
+
     #[test]
     fn pruned_sensing_reads_what_every_obstacle_gives_bit_for_bit() {
         // Crowds of discs, of boxes and of both, some of them appearing mid-run, more than a
@@ -1174,7 +1213,7 @@ mod tests {
                 .expect("places")
                 .expect("has movers");
             let mut rng = crate::sim::rng::stream(9, crate::sim::rng::Stream::Moving);
-            let mut scanned = 0;
+            let (mut scanned, mut blocked) = (0, 0);
             for step in 0..200 {
                 movers.advance(step, &scene, start);
                 for _ in 0..5 {
@@ -1189,12 +1228,18 @@ mod tests {
                     assert_eq!(bits(&got), bits(&want), "step {step} at {p} heading {z}");
                     assert_eq!(gap_got.to_bits(), gap_want.to_bits(), "step {step} at {p}");
                     scanned += usize::from(want.iter().any(|&r| r < range));
+                    // The robot's sweep, pruned to the obstacles of the bands within reach.
+                    let to = p + unit(z) * rng.random_range(0.0..40.0);
+                    let clear = sweep_clear_every(&movers, p, to, 10.0);
+                    assert_eq!(movers.sweep_clear(p, to, 10.0), clear, "{p} to {to}");
+                    blocked += usize::from(!clear);
                 }
             }
             assert!(
                 scanned > 50,
                 "the laser met obstacles in only {scanned} scans"
             );
+            assert!(blocked > 20, "only {blocked} sweeps met an obstacle");
         }
     }
 
