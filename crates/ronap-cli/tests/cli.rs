@@ -1,7 +1,8 @@
 //! End-to-end tests of the `ronap` binary: outputs read back and checked, bad input rejected.
 
 use crate::util::{
-    assert_rejected, assert_rejected_in_empty_dir, ok, repo_root, ronap, stderr, stdout,
+    assert_rejected, assert_rejected_in_empty_dir, assert_rejected_leaving_nothing, ok, repo_root,
+    ronap, stderr, stdout,
 };
 
 #[test]
@@ -301,6 +302,58 @@ fn bench_takes_its_laser_and_scene_from_the_flags() {
         &["bench", "--sweep", "--beams", "9"],
         &["--sweep", "--beams"],
     );
+}
+
+/// Maze flags for a scene that is not a maze are refused by name, not silently ignored.
+#[test]
+fn maze_flags_are_refused_for_other_scenes() {
+    let root = repo_root();
+    let office = root.join("scenarios/office.png");
+    let office = office.to_str().unwrap();
+    let warehouse = root.join("scenarios/warehouse-forklifts.toml");
+    let warehouse = warehouse.to_str().unwrap();
+    let map = root.join("scenarios/map-mover.toml");
+    let map = map.to_str().unwrap();
+    let out = tempfile::tempdir().unwrap();
+    let run = out.path().join("run");
+    let run = run.to_str().unwrap();
+    for (args, names) in [
+        (
+            vec![
+                "run", "--policy", "apf", "--map", office, "--cols", "5", "--out", run,
+            ],
+            vec!["--cols", "--map", "office.png"],
+        ),
+        (
+            vec!["bench", "--seconds", "0.01", "--map", office, "--rows", "5"],
+            vec!["--rows", "--map"],
+        ),
+        (
+            vec!["maze", "--scenario", warehouse, "--loops", "0.1"],
+            vec!["--loops", "scene.kind", "warehouse"],
+        ),
+        (
+            vec!["view", "--policy", "apf", "--scenario", map, "--cell", "50"],
+            vec!["--cell", "scene.kind", "map"],
+        ),
+        (
+            vec![
+                "train",
+                "dqn",
+                "--map",
+                office,
+                "--wall-thickness",
+                "3",
+                "--out",
+                run,
+            ],
+            vec!["--wall-thickness", "--map"],
+        ),
+    ] {
+        assert_rejected_leaving_nothing(&args, &names, std::path::Path::new(run));
+    }
+    // A maze flag with a maze still works.
+    ok(&ronap(&["maze", "--cols", "3", "--rows", "2"]));
 }
 
 #[test]

@@ -46,6 +46,44 @@ impl SimArgs {
         self.config_with(|_| {})
     }
 
+    /// The first maze flag given (`--cols`, `--rows`, `--cell`, `--loops`, `--wall-thickness`).
+    fn maze_flag(&self) -> Option<&'static str> {
+        [
+            (self.cols.is_some(), "--cols"),
+            (self.rows.is_some(), "--rows"),
+            (self.cell.is_some(), "--cell"),
+            (self.loops.is_some(), "--loops"),
+            (self.wall_thickness.is_some(), "--wall-thickness"),
+        ]
+        .into_iter()
+        .find_map(|(given, flag)| given.then_some(flag))
+    }
+
+    /// Refuses maze flags for a scene that is not a maze (`map`, the `--map` flag, or the
+    /// scenario's `scene.kind`), which would otherwise be silently ignored.
+    pub fn check_scene(&self, config: &ValidConfig, map: Option<&std::path::Path>) -> Result<()> {
+        let Some(flag) = self.maze_flag() else {
+            return Ok(());
+        };
+        if let Some(map) = map {
+            anyhow::bail!(
+                "{flag} shapes a maze, but --map {} gives the scene (leave {flag} out)",
+                map.display()
+            );
+        }
+        let kind = config.scene.kind;
+        if kind != ronap_core::config::SceneKind::Maze {
+            let name = match kind {
+                ronap_core::config::SceneKind::Warehouse => "warehouse",
+                _ => "map",
+            };
+            anyhow::bail!(
+                "{flag} shapes a maze, but the scenario's scene.kind is \"{name}\" (leave {flag} out)"
+            );
+        }
+        Ok(())
+    }
+
     /// Like [`SimArgs::config`], with a command's own flags applied by `more` before the check.
     pub fn config_with(&self, more: impl FnOnce(&mut SimConfig)) -> Result<ValidConfig> {
         if self.wants_example() {
@@ -96,8 +134,14 @@ impl SceneArgs {
         SceneSpec::resolve(&config.scene, self.maze_seed, self.map.as_deref())
     }
 
-    /// The scenes (reading the map, if any), with what the map file was read as.
-    pub fn scenes(&self, config: &ValidConfig) -> Result<(Scenes, Option<MapSource>)> {
+    /// The scenes (reading the map, if any), with what the map file was read as; maze flags in
+    /// `sim` for a scene that is not a maze are refused.
+    pub fn scenes(
+        &self,
+        sim: &SimArgs,
+        config: &ValidConfig,
+    ) -> Result<(Scenes, Option<MapSource>)> {
+        sim.check_scene(config, self.map.as_deref())?;
         let loaded = self.spec(config).load(config);
         match (&config.scene.file, &self.map) {
             // The map the scenario names: say where the name came from.
@@ -131,7 +175,7 @@ impl EpisodeArgs {
                 sim.episode.max_steps = n;
             }
         })?;
-        let (scenes, map) = self.scenes.scenes(&config)?;
+        let (scenes, map) = self.scenes.scenes(&self.sim, &config)?;
         Ok((config, scenes, map))
     }
 }

@@ -87,6 +87,7 @@ impl Bench {
             laser.range_px = range_px.unwrap_or(laser.range_px);
             laser.fov_deg = args.fov.unwrap_or(laser.fov_deg);
         })?;
+        args.sim.check_scene(&config, args.map.as_deref())?;
         let spec = SceneSpec::resolve(&config.scene, Some(0), args.map.as_deref());
         let (scenes, _) = spec
             .load(&config)

@@ -85,7 +85,7 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
         bail!("--expert {expert:?}: unknown expert (expected geodesic)");
     }
     let config = args.sim.config()?;
-    let (scenes, _) = args.scenes.scenes(&config)?;
+    let (scenes, _) = args.scenes.scenes(&args.sim, &config)?;
     let driver = match (&args.driver, args.mode) {
         (Some(_), Mode::Repose) => bail!("--driver needs --mode drive"),
         (Some(name), Mode::Drive) => Some(named_policy("driver", name, &config)?),
@@ -191,7 +191,7 @@ fn run_human(args: CollectArgs) -> Result<ExitCode> {
         bail!("--human records in the paper's re-posing mode: --mode drive is for --expert");
     }
     let config = args.sim.config()?;
-    let (scenes, _) = args.scenes.scenes(&config)?;
+    let (scenes, _) = args.scenes.scenes(&args.sim, &config)?;
     let user = args
         .user
         .clone()

@@ -41,6 +41,7 @@ pub struct MazeArgs {
 /// Runs `ronap maze`.
 pub fn run(args: MazeArgs) -> Result<ExitCode> {
     let config = args.sim.config()?;
+    args.sim.check_scene(&config, None)?;
     let seed = args.seed.or(config.scene.seed).unwrap_or(0);
     let (scenes, _) = SceneSpec::resolve(&config.scene, Some(seed), None).load(&config)?;
     let worlds = Worlds::new(config.clone(), scenes);

@@ -509,7 +509,7 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
         // Shaping keeps the optimal policy exactly at the learner's own discount.
         sim.reward.shaping_gamma = args.shaping_gamma.unwrap_or(args.gamma);
     })?;
-    let (scenes, _) = args.scenes.scenes(&config)?;
+    let (scenes, _) = args.scenes.scenes(&args.sim, &config)?;
     let evaluator = Evaluator::new(config, scenes);
     evaluator
         .world(args.seed_start)
