@@ -181,9 +181,10 @@ struct State {
     bound: Vec<f64>,
     /// Squared distance from the robot's centre within which a move must be checked against it.
     near_robot2: Vec<f64>,
-    /// Whether it moves along its heading this step, and the standard deviation of its turns
-    /// ([`Entry::walk`], kept up to date as obstacles appear).
+    /// Whether it moves along its heading this step ([`Entry::walk`], kept up to date as
+    /// obstacles appear or are released).
     walks: Vec<bool>,
+    /// The standard deviation of its turns, rad (0 when absent or not turning; the same).
     sigma: Vec<f64>,
     /// This step's turn, rad (0 for the obstacles not turning), and its sine and cosine.
     turn: Vec<f64>,
