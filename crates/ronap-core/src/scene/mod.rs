@@ -708,22 +708,34 @@ impl Scene {
     /// a further query. Grown from `p` along x first, then y (or y first with `y_first`), so a
     /// corridor gives a box as long as the reach allows. A point box when `p` is in an obstacle.
     pub fn free_box(&self, p: Point, y_first: bool) -> Aabb {
+        self.free_box_toward(p, y_first, Vector::zeros())
+    }
+
+    /// [`Scene::free_box`] for something at `p` heading along `dir` (a unit vector, or zero):
+    /// the box is sought within the index's reach of `p + dir * reach / 2` rather than of `p`,
+    /// so it still holds `p` and reaches half as far again ahead (and half as far behind).
+    pub fn free_box_toward(&self, p: Point, y_first: bool, dir: Vector) -> Aabb {
         let reach = self.index.reach_px();
         let point = Aabb { min: p, max: p };
         if !self.bounds().contains(p) {
             return point;
         }
+        let lead = reach / 2.0;
+        let c = Point::new(
+            (p.x + dir.x.clamp(-1.0, 1.0) * lead).clamp(0.0, self.width),
+            (p.y + dir.y.clamp(-1.0, 1.0) * lead).clamp(0.0, self.height),
+        );
         let cap = Aabb {
-            min: Point::new((p.x - reach).max(0.0), (p.y - reach).max(0.0)),
+            min: Point::new((c.x - reach).max(0.0), (c.y - reach).max(0.0)),
             max: Point::new(
-                (p.x + reach).min(self.width),
-                (p.y + reach).min(self.height),
+                (c.x + reach).min(self.width),
+                (c.y + reach).min(self.height),
             ),
         };
         // Shapes by their bounding boxes: the box stays clear, if smaller than it could be.
         let near = self
             .index
-            .near(p, reach)
+            .near(c, reach)
             .iter()
             .map(|&i| self.boxes[i as usize]);
         let obstacles = near.chain(self.shapes.iter().map(Shape::aabb));
@@ -860,7 +872,12 @@ mod tests {
             );
             for _ in 0..200 {
                 let p = Point::new(rng.random_range(0.0..1000.0), rng.random_range(0.0..1000.0));
-                let free = scene.free_box(p, rng.random());
+                let dir = if rng.random() {
+                    Vector::zeros()
+                } else {
+                    crate::geometry::unit(rng.random_range(0.0..360.0))
+                };
+                let free = scene.free_box_toward(p, rng.random(), dir);
                 assert!(free.min.x <= p.x && p.x <= free.max.x, "{p:?} {free:?}");
                 assert!(free.min.y <= p.y && p.y <= free.max.y, "{p:?} {free:?}");
                 if free.extents().x > 0.0 && free.extents().y > 0.0 {

@@ -919,7 +919,8 @@ impl Movers {
         from: Point,
     ) -> Option<Point> {
         let (dx, dy, speed) = (state.dx[i], state.dy[i], state.speed[i]);
-        let free = scene.free_box(from, dy.abs() > dx.abs());
+        // Sought ahead of the obstacle, where it is going: it stays in the box for longer.
+        let free = scene.free_box_toward(from, dy.abs() > dx.abs(), Vector::new(dx, dy));
         state.set_free(i, free, body.half_extents());
         let clear = |state: &State, to: Point| {
             (state.in_free(i, from) && state.in_free(i, to)) || body.sweep_clear(scene, from, to)
