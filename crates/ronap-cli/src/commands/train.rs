@@ -31,24 +31,41 @@ pub struct TrainArgs {
 enum Algorithm {
     /// Behaviour cloning (the paper's Algorithm 2): fit a classifier to logged (observation,
     /// action) rows; prints training and test accuracy per epoch.
+    #[command(
+        mut_arg("hidden", |a| with_default(a, "64,128,64,32,8 (the original's)")),
+        mut_arg("activation", |a| with_default(a, "rrelu")),
+        mut_arg("lr", |a| with_default(a, "0.0008 (the original's)")),
+        mut_arg("decision", |a| with_default(a, "sample:2 (on class scores)")),
+    )]
     Bc(BcArgs),
     /// Deep Q-learning (the paper's Algorithm 1) on the SPEC reward, episodes on every core;
     /// prints returns and success rate as it trains.
+    #[command(
+        mut_arg("hidden", |a| with_default(a, "128,128")),
+        mut_arg("activation", |a| with_default(a, "relu")),
+        mut_arg("lr", |a| with_default(a, "0.0005")),
+        mut_arg("decision", |a| with_default(a, "sample:0.3 (on Q-values, a larger scale)")),
+    )]
     Dqn(Box<DqnArgs>),
+}
+
+/// `arg` with its trainer's `default` added to its help: the flags both trainers share
+/// ([`NetArgs`]) default differently in each.
+fn with_default(arg: clap::Arg, default: &str) -> clap::Arg {
+    let help = arg.get_help().map(ToString::to_string).unwrap_or_default();
+    arg.help(format!("{help} [default: {default}]"))
 }
 
 /// Flags both algorithms share.
 #[derive(Args, Debug)]
 struct NetArgs {
-    /// Hidden layer widths, comma-separated [default: bc 64,128,64,32,8 (the original's); dqn
-    /// 128,128].
+    /// Hidden layer widths, comma-separated.
     #[arg(long, value_name = "N,N,...", value_parser = widths)]
     hidden: Option<Widths>,
-    /// Hidden activation: relu, tanh, rrelu (the paper's) or leaky_relu:SLOPE [default: bc
-    /// rrelu, dqn relu].
+    /// Hidden activation: relu, tanh, rrelu (the paper's) or leaky_relu:SLOPE.
     #[arg(long, value_name = "NAME", value_parser = activation)]
     activation: Option<TrainActivation>,
-    /// Adam's learning rate [default: bc 0.0008 (the original's), dqn 0.0005].
+    /// Adam's learning rate.
     #[arg(long, allow_negative_numbers = true, value_name = "LR", value_parser = crate::args::positive)]
     lr: Option<f64>,
     /// Seed of the initial weights and of every random choice in training.
@@ -56,8 +73,7 @@ struct NetArgs {
     seed: u64,
     /// How `ronap run` turns the outputs into an action, saved in the file: argmax, or
     /// sample:TEMPERATURE (draw from softmax(outputs / TEMPERATURE)). A reactive policy that
-    /// samples does not loop for ever where argmax would [default: bc sample:2 (class
-    /// scores), dqn sample:0.3 (Q-values, on a larger scale)].
+    /// samples does not loop for ever where argmax would.
     #[arg(long, value_name = "RULE", value_parser = decision)]
     decision: Option<DecisionRule>,
     /// Weights file to write (safetensors).
