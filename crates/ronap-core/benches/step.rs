@@ -142,6 +142,29 @@ fn setup(c: &mut Criterion) {
     group.bench_function("grid_path", |b| {
         b.iter(|| ronap_core::plan::grid_path(world.scene(), grid, start, goal, 5.0, 4.0))
     });
+    // What a geodesic episode builds before its first step, averaged over the scenes and starts
+    // of 200 seeds as an evaluation meets them (the other benchmarks here use one seed's): a new
+    // maze and its index, placement, the free-space grid, and the policy's path (its search
+    // stopped early, charging for closeness to walls).
+    let seeds: Vec<u64> = (0..200).collect();
+    let mut next = 0;
+    group.bench_function("geodesic_episode_over_seeds", |b| {
+        b.iter(|| {
+            let seed = seeds[next % seeds.len()];
+            next += 1;
+            let world = ronap_core::World::maze(config.clone(), seed);
+            let episode = world.episode(seed).expect("placement");
+            let path = ronap_core::plan::grid_path(
+                world.scene(),
+                world.grid(),
+                episode.start().position(),
+                episode.goal(),
+                config.robot.radius_px,
+                4.0,
+            );
+            (world, path)
+        })
+    });
     let field = ronap_core::plan::DistanceField::new(world.scene(), grid, goal, 5.0, 1.0);
     let path = field
         .path(world.scene(), grid, start, 5.0)
