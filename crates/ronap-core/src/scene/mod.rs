@@ -704,16 +704,13 @@ impl Scene {
     }
 
     /// A box round `p`, inside the scene, whose interior no obstacle enters (obstacles may touch
-    /// its sides), within the index's reach of `p`: anything strictly inside it is clear, without
-    /// a further query. Grown from `p` along x first, then y (or y first with `y_first`), so a
-    /// corridor gives a box as long as the reach allows. A point box when `p` is in an obstacle.
-    pub fn free_box(&self, p: Point, y_first: bool) -> Aabb {
-        self.free_box_toward(p, y_first, Vector::zeros())
-    }
-
-    /// [`Scene::free_box`] for something at `p` heading along `dir` (a unit vector, or zero):
-    /// the box is sought within the index's reach of `p + dir * reach / 2` rather than of `p`,
-    /// so it still holds `p` and reaches half as far again ahead (and half as far behind).
+    /// its sides): anything strictly inside it is clear, without a further query. Grown from `p`
+    /// along x first, then y (or y first with `y_first`), so a corridor gives a box as long as
+    /// the reach allows. A point box when `p` is in an obstacle.
+    ///
+    /// For something at `p` heading along `dir` (a unit vector, or zero), the box is sought
+    /// within the index's reach of `p + dir * reach / 2` (of `p` itself when `dir` is zero), so
+    /// it still holds `p` and reaches half as far again ahead (and half as far behind).
     pub fn free_box_toward(&self, p: Point, y_first: bool, dir: Vector) -> Aabb {
         let reach = self.index.reach_px();
         let point = Aabb { min: p, max: p };
