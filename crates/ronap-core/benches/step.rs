@@ -144,8 +144,8 @@ fn setup(c: &mut Criterion) {
     });
     // What a geodesic episode builds before its first step, averaged over the scenes and starts
     // of 200 seeds as an evaluation meets them (the other benchmarks here use one seed's): a new
-    // maze and its index, placement, the free-space grid, and the policy's path (its search
-    // stopped early, charging for closeness to walls).
+    // maze and its index, placement, the free-space grid, and the policy's path (searched over
+    // just the cells it could use, charging for closeness to walls).
     let mut next = 0u64;
     group.bench_function("geodesic_episode_over_seeds", |b| {
         b.iter(|| {
