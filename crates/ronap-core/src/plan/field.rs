@@ -157,7 +157,7 @@ pub fn grid_path(
             };
             walk(start, first, goal, |i| work.cells[i].parent, center)
         });
-        work.tidy(grid);
+        work.tidy();
         path
     })
 }
@@ -195,9 +195,11 @@ struct Work {
     buckets: Vec<Vec<u32>>,
     /// Cells of the current bucket being settled.
     bucket: Vec<u32>,
-    /// [`Work::bound`]'s ring of buckets: cells as row and column, by cost plus least distance
-    /// to the start modulo the ring's length.
-    front: Vec<Vec<(u32, u32)>>,
+    /// [`Work::bound`]'s ring of buckets: cells by cost plus least distance to the start
+    /// modulo the ring's length.
+    front: Vec<Vec<u32>>,
+    /// [`Work::bound`]'s cells reached at the sum it is settling.
+    level: Vec<u32>,
     /// The cells [`Work::bound`] settled.
     closed: Vec<u32>,
     /// The cells [`Work::narrow`] keeps.
@@ -372,7 +374,7 @@ impl Work {
             if c < cells[i].cost {
                 cells[i].cost = c;
                 let (col, row) = ((i % cols) as u32, (i / cols) as u32);
-                starts.push(((row, col), c + least(col, row)));
+                starts.push((i as u32, c + least(col, row)));
             }
         }
         let mut current = starts.iter().map(|s| s.1).min().unwrap_or(0);
@@ -398,13 +400,18 @@ impl Work {
         // The best path through a settled target so far, px (a start's straight line plus its
         // cell's cost).
         let mut best = f64::INFINITY;
+        // Cells reached at the sum being settled (a step towards the start often keeps it), kept
+        // apart from the ring: the ring's buffers, kept per thread, then grow only to the cells
+        // put there from a lower sum.
+        let level = &mut self.level;
+        level.clear();
         while pending > 0 {
-            // A step may keep a cell's sum, so the bucket can grow while it is settled.
             let mut n = 0;
-            while let Some(&(r, c)) = front[slot].get(n) {
+            while let Some(i) = front[slot].get(n).copied().or_else(|| level.pop()) {
                 n += 1;
                 pending -= 1;
-                let i = r as usize * cols + c as usize;
+                let (r, c) = (i / cols as u32, i % cols as u32);
+                let i = i as usize;
                 let cost = cells[i].cost;
                 // The ring is wider than any push is ahead, so a bucket holds one sum (or less,
                 // for a cell improved since it was put there).
@@ -430,11 +437,16 @@ impl Work {
                     let nd = cost + steps[(slow >> k & 1) as usize][k];
                     cells[j].cost = nd;
                     let (nc, nr) = (c.wrapping_add(DC[k]), r.wrapping_add(DR[k]));
-                    let mut to = slot + (nd + least(nc, nr) - current) as usize;
-                    if to >= ring {
-                        to -= ring;
+                    let ahead = (nd + least(nc, nr) - current) as usize;
+                    if ahead == 0 {
+                        level.push(j as u32);
+                    } else {
+                        let mut to = slot + ahead;
+                        if to >= ring {
+                            to -= ring;
+                        }
+                        front[to].push(j as u32);
                     }
-                    front[to].push((nr, nc));
                     pending += 1;
                 }
                 if c.abs_diff(fc) <= ATTACH_CELLS as u32 && r.abs_diff(fr) <= ATTACH_CELLS as u32 {
@@ -475,7 +487,6 @@ impl Work {
     /// the whole field does: a cell's parent is one of those neighbours, and which one follows
     /// from how they were reached, in turn, down to the goal.
     fn narrow(&mut self, grid: &FreeGrid, to: usize, close_cost: f64) {
-        let cols = grid.size().0;
         let close = close_cost.max(1.0).round() as u32;
         let steps = [STEP, STEP.map(|s| s * close)];
         let (moves, slow) = (grid.moves(), grid.close_moves());
@@ -510,8 +521,8 @@ impl Work {
         }
         // Settled cells outside the set keep their costs, which no step betters; those reached
         // but not settled (waiting in the ring) cost nothing, so the search stops there.
-        for &(r, c) in self.front.iter().flatten() {
-            cells[r as usize * cols + c as usize].cost = 0;
+        for &i in self.front.iter().flatten() {
+            cells[i as usize].cost = 0;
         }
         for &i in shortest.iter() {
             cells[i as usize] = UNREACHED;
@@ -520,10 +531,9 @@ impl Work {
 
     /// Leaves every cell unreached again after a [`Work::bound`] and [`Work::search`]: only the
     /// cells they reached, which wait in the ring or are settled.
-    fn tidy(&mut self, grid: &FreeGrid) {
-        let cols = grid.size().0;
-        for &(r, c) in self.front.iter().flatten() {
-            self.cells[r as usize * cols + c as usize] = UNREACHED;
+    fn tidy(&mut self) {
+        for &i in self.front.iter().flatten() {
+            self.cells[i as usize] = UNREACHED;
         }
         for &i in &self.closed {
             self.cells[i as usize] = UNREACHED;
