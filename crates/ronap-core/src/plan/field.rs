@@ -119,8 +119,8 @@ impl DistanceField {
 /// `DistanceField::new(..).path(..)`), searching only the cells such a path could use.
 ///
 /// A search from the goal that a lower bound on each cell's remaining distance to `start` steers
-/// (A*) finds which cells could lie on the path, or decide between equal ones: a few thousand of
-/// the default scene's 40 000 instead of every cell nearer the goal than `start`. The field's
+/// (A*) finds the cells that could lie on the path or decide between equal ones: a few thousand
+/// of the default scene's 40 000 instead of every cell nearer the goal than `start`. The field's
 /// own search then runs over just those cells, so that ties between equal paths fall exactly as
 /// in the whole field. Buffers are kept per thread between calls.
 pub fn grid_path(
@@ -162,7 +162,7 @@ pub fn grid_path(
     })
 }
 
-/// Axis step cost, in the integer units of the search (see [`Work::run`]).
+/// Axis step cost, in the integer units of the search (see [`Work::search`]).
 const AXIS: u32 = 12;
 /// Diagonal step cost (within 0.2% of 12 sqrt 2).
 const DIAGONAL: u32 = 17;
@@ -331,8 +331,8 @@ impl Work {
 
     /// Settles the cells that a grid path from `start` (in cell `from`, entering the grid at
     /// `targets`: cells and their straight-line distance in px from `start`) could use, at their
-    /// final costs, into [`Work::closed`]. Returns the targets' costs, in units, where a path
-    /// through them could be the shortest.
+    /// final costs, into [`Work::closed`]. Returns the costs, in units, of the targets it
+    /// settled: those beyond could not begin the shortest path.
     ///
     /// This is A* from the goal's attachments, with [`Work::search`]'s step costs, steered by
     /// the octile distance to `from` less the most the targets allow ([`ENTRY_SLACK`]): never
@@ -406,6 +406,8 @@ impl Work {
         let level = &mut self.level;
         level.clear();
         while pending > 0 {
+            // Nothing is put in this bucket during its turn (a push lands 1 to `ring - 1` sums
+            // ahead, or in `level`), so counting past its end reads `level` only.
             let mut n = 0;
             while let Some(i) = front[slot].get(n).copied().or_else(|| level.pop()) {
                 n += 1;
@@ -483,7 +485,8 @@ impl Work {
     /// Readies [`Work::cells`], after [`Work::bound`], for a [`Work::search`] over just the
     /// cells on the shortest paths from the goal to cell `to` (settled by the bound): `to` and,
     /// in turn, every neighbour that offers a cell in the set its cost. Their costs are left
-    /// unknown, every other cell reached at nothing. The search gives each of them the parent
+    /// unknown; other settled cells keep their final costs, and cells still waiting in the ring
+    /// cost nothing, so the search goes no further. The search gives each of them the parent
     /// the whole field does: a cell's parent is one of those neighbours, and which one follows
     /// from how they were reached, in turn, down to the goal.
     fn narrow(&mut self, grid: &FreeGrid, to: usize, close_cost: f64) {
@@ -519,8 +522,9 @@ impl Work {
                 }
             }
         }
-        // Settled cells outside the set keep their costs, which no step betters; those reached
-        // but not settled (waiting in the ring) cost nothing, so the search stops there.
+        // Settled cells outside the set keep their costs, which no step betters; cells with an
+        // entry still in the ring (those reached but not settled, and settled ones with a stale
+        // entry, reset just after if in the set) cost nothing, so the search stops there.
         for &i in self.front.iter().flatten() {
             cells[i as usize].cost = 0;
         }
