@@ -15,3 +15,10 @@ def ronap_bin() -> str:
             pytest.fail(f"no ronap binary at {path}: build it with `cargo build --release -p ronap-cli`")
         path = found
     return path
+
+
+@pytest.fixture(autouse=True)
+def _sb3_logs_in_tmp_path(tmp_path, monkeypatch):
+    """Stable-Baselines3 makes a log folder for every `learn()`, in the system's temporary folder
+    unless $SB3_LOGDIR says otherwise: keep them in the test's own folder, which pytest clears."""
+    monkeypatch.setenv("SB3_LOGDIR", str(tmp_path / "sb3-logs"))
