@@ -249,8 +249,8 @@ impl Work {
     /// searched cell its cost is searched too.
     fn search(&mut self, grid: &FreeGrid, roots: &[(usize, f64)], close_cost: f64) {
         let cell_px = grid.cell_px();
-        let close = close_cost.max(1.0).round() as u32;
-        let ring = (DIAGONAL * close + 1) as usize;
+        let steps = step_costs(close_cost);
+        let ring = longest(&steps) as usize + 1;
         reset_ring(&mut self.buckets, ring);
         let (cells, buckets) = (&mut self.cells, &mut self.buckets);
         let mut pending = 0usize;
@@ -269,8 +269,6 @@ impl Work {
         // `current % ring`, kept by hand: a step lands less than a ring ahead, so its bucket is
         // an addition and at most one wrap away.
         let mut slot = 0usize;
-        // Step costs by move, plain and from or into a close cell.
-        let steps = [STEP, STEP.map(|s| s * close)];
         let mut bucket = std::mem::take(&mut self.bucket);
         while pending > 0 {
             std::mem::swap(&mut bucket, &mut buckets[slot]);
@@ -290,18 +288,7 @@ impl Work {
                 // which of two equal-cost parents a cell keeps.
                 let open = moves[i] as u32;
                 let slow = slow[i] as u32;
-                // Which open moves improve their cell, found for all eight before any is
-                // taken (they reach eight different cells), without a branch on each: whether
-                // a neighbour improves is a coin toss to the branch predictor. A closed move
-                // looks at the cell itself, which never improves (every step costs more than
-                // nothing).
-                let mut better = 0u32;
-                for k in 0..8 {
-                    let mask = ((open as usize >> k) & 1).wrapping_neg();
-                    let j = i.wrapping_add(offsets[k] as usize & mask);
-                    let nd = current + steps[(slow >> k & 1) as usize][k];
-                    better |= u32::from(nd < cells[j].cost) << k;
-                }
+                let mut better = improving(cells, i, current, open, slow, &offsets, &steps);
                 while better != 0 {
                     let k = better.trailing_zeros() as usize;
                     better &= better - 1;
@@ -352,7 +339,7 @@ impl Work {
     ) -> Vec<Option<u32>> {
         let (cols, rows) = grid.size();
         let cell_px = grid.cell_px();
-        let close = close_cost.max(1.0).round() as u32;
+        let steps = step_costs(close_cost);
         if !self.clean || self.cells.len() != cols * rows {
             self.cells.clear();
             self.cells.resize(cols * rows, UNREACHED);
@@ -381,11 +368,9 @@ impl Work {
         // A step changes a cell's sum by 0 to twice its cost; the goal's attachments may spread
         // wider than that.
         let widest = starts.iter().map(|s| s.1 - current).max().unwrap_or(0);
-        let ring = (2 * DIAGONAL * close).max(widest) as usize + 1;
+        let ring = (2 * longest(&steps)).max(widest) as usize + 1;
+        reset_ring(&mut self.front, ring);
         let front = &mut self.front;
-        front.resize_with(ring, Vec::new);
-        front.truncate(ring);
-        front.iter_mut().for_each(Vec::clear);
         let mut slot = current as usize % ring;
         for &(at, sum) in &starts {
             front[sum as usize % ring].push(at);
@@ -396,7 +381,6 @@ impl Work {
         // Column and row changes of the moves E, W, N, S, NE, SE, NW, SW.
         const DC: [u32; 8] = [1, u32::MAX, 0, 0, 1, 1, u32::MAX, u32::MAX];
         const DR: [u32; 8] = [0, 0, 1, u32::MAX, 1, u32::MAX, 1, u32::MAX];
-        let steps = [STEP, STEP.map(|s| s * close)];
         // The best path through a settled target so far, px (a start's straight line plus its
         // cell's cost).
         let mut best = f64::INFINITY;
@@ -424,14 +408,7 @@ impl Work {
                 closed.push(i as u32);
                 let open = moves[i] as u32;
                 let slow = slow[i] as u32;
-                // As in `search`: which moves improve their cell, without a branch on each.
-                let mut better = 0u32;
-                for k in 0..8 {
-                    let mask = ((open as usize >> k) & 1).wrapping_neg();
-                    let j = i.wrapping_add(offsets[k] as usize & mask);
-                    let nd = cost + steps[(slow >> k & 1) as usize][k];
-                    better |= u32::from(nd < cells[j].cost) << k;
-                }
+                let mut better = improving(cells, i, cost, open, slow, &offsets, &steps);
                 while better != 0 {
                     let k = better.trailing_zeros() as usize;
                     better &= better - 1;
@@ -490,8 +467,7 @@ impl Work {
     /// the whole field does: a cell's parent is one of those neighbours, and which one follows
     /// from how they were reached, in turn, down to the goal.
     fn narrow(&mut self, grid: &FreeGrid, to: usize, close_cost: f64) {
-        let close = close_cost.max(1.0).round() as u32;
-        let steps = [STEP, STEP.map(|s| s * close)];
+        let steps = step_costs(close_cost);
         let (moves, slow) = (grid.moves(), grid.close_moves());
         let offsets = grid.move_offsets();
         let (cells, shortest) = (&mut self.cells, &mut self.shortest);
@@ -544,6 +520,43 @@ impl Work {
         }
         self.clean = true;
     }
+}
+
+/// Step costs by move (E, W, N, S, NE, SE, NW, SW), plain and from or into a close cell: those
+/// cost `close_cost` times as much, rounded, and at least as much as plain ones.
+fn step_costs(close_cost: f64) -> [[u32; 8]; 2] {
+    let close = close_cost.max(1.0).round() as u32;
+    [STEP, STEP.map(|s| s * close)]
+}
+
+/// The longest of [`step_costs`]' steps: a diagonal from or into a close cell.
+fn longest(steps: &[[u32; 8]; 2]) -> u32 {
+    steps[1][7]
+}
+
+/// Which open moves from cell `i` (at `cost`; `open` and `slow` its open and close moves as
+/// bits) improve the cell they reach, as bits. Found for all eight before any is taken (they
+/// reach eight different cells), without a branch on each: whether a neighbour improves is a
+/// coin toss to the branch predictor. A closed move looks at the cell itself, which never
+/// improves (every step costs more than nothing).
+#[inline(always)]
+fn improving(
+    cells: &[Node],
+    i: usize,
+    cost: u32,
+    open: u32,
+    slow: u32,
+    offsets: &[isize; 8],
+    steps: &[[u32; 8]; 2],
+) -> u32 {
+    let mut better = 0u32;
+    for k in 0..8 {
+        let mask = ((open as usize >> k) & 1).wrapping_neg();
+        let j = i.wrapping_add(offsets[k] as usize & mask);
+        let nd = cost + steps[(slow >> k & 1) as usize][k];
+        better |= u32::from(nd < cells[j].cost) << k;
+    }
+    better
 }
 
 /// Empties `buckets` and makes them `ring` long.
