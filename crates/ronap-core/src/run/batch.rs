@@ -13,8 +13,8 @@ use crate::sim::episode::{Episode, Status, PREFETCH_STAGES};
 use crate::sim::rng::{stream, Rng, Stream};
 use crate::sim::robot::{Action, Pose};
 use crate::sim::world::Worlds;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Mutex, PoisonError};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
 
 /// Environments per parallel task: enough work to outweigh handing it to a thread.
@@ -26,6 +26,14 @@ const RUN: usize = 64;
 /// Longest the calling thread waits awake for the pool's last runs (a run of [`RUN`]
 /// environments takes about 20 us).
 const SPIN: Duration = Duration::from_micros(100);
+
+/// Longest the pool's threads stay awake after a step for the next one, before rayon lets them
+/// sleep: a caller stepping in a loop (Python's glue between two steps of 1024 environments is
+/// tens of microseconds) then finds them awake, instead of waking them with a system call and
+/// stepping alone until they run again (tens of microseconds on a virtual machine). They stay
+/// only when the caller came back within this time the last time, so a caller that works longer
+/// between steps (training a network, say) does not have them spin beside it in vain.
+const LINGER: Duration = Duration::from_micros(200);
 
 /// When an environment whose episode ended starts the next one.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -156,6 +164,11 @@ struct Lanes {
     /// Whether the calling thread may wait awake for the pool's last runs: not when there are
     /// more threads than cores, where the thread it waits for may not be running.
     spin: bool,
+    /// How many steps (or restarts) have begun on the pool: a pool thread lingering after one
+    /// (see [`LINGER`]) stops as soon as the next begins.
+    begun: Arc<AtomicU64>,
+    /// When the last step (or restart) on the pool ended.
+    ended: Option<std::time::Instant>,
     envs: Vec<Env>,
     observation_size: usize,
     observations: Vec<f32>,
@@ -193,6 +206,8 @@ impl Batch {
             lanes: Lanes {
                 pool,
                 spin: threads <= cores,
+                begun: Arc::new(AtomicU64::new(0)),
+                ended: None,
                 envs: (0..n)
                     .map(|_| Env {
                         episode: None,
@@ -439,6 +454,13 @@ impl Batch {
     }
 }
 
+impl Drop for Lanes {
+    /// Ends a pool thread's lingering (see [`LINGER`]) at once.
+    fn drop(&mut self) {
+        self.begun.fetch_add(1, Ordering::Release);
+    }
+}
+
 impl Lanes {
     /// Runs `f` on every environment with its index, observation row, final-observation row and
     /// step record, in runs of [`MIN_PER_TASK`] to [`RUN`] environments: the calling thread
@@ -495,12 +517,15 @@ impl Lanes {
             }
             done.fetch_add(1, Ordering::Release);
         };
-        let spin = self.spin;
+        let (spin, begun) = (self.spin, &self.begun);
+        let quick = self.ended.is_some_and(|t| t.elapsed() < LINGER);
         pool.in_place_scope(|s| {
             // No more helpers than runs beyond the caller's first: the scope waits for each.
             for _ in 0..helpers.min(total.saturating_sub(1)) {
                 s.spawn(|_| work());
             }
+            // Ends the threads' lingering after the last step: they take up these runs at once.
+            begun.fetch_add(1, Ordering::Release);
             work();
             if !spin {
                 return;
@@ -513,6 +538,20 @@ impl Lanes {
                 std::hint::spin_loop();
             }
         });
+        if spin && quick {
+            // Keeps the pool's threads awake for the next step, for at most [`LINGER`].
+            let step = begun.load(Ordering::Acquire);
+            for _ in 0..helpers {
+                let begun = Arc::clone(begun);
+                pool.spawn(move || {
+                    let clock = std::time::Instant::now();
+                    while begun.load(Ordering::Acquire) == step && clock.elapsed() < LINGER {
+                        std::hint::spin_loop();
+                    }
+                });
+            }
+        }
+        self.ended = Some(std::time::Instant::now());
         let first = first.into_inner().unwrap_or_else(PoisonError::into_inner);
         first.map_or(Ok(()), |(_, e)| Err(e))
     }

@@ -34,6 +34,16 @@ pub enum Status {
 }
 
 impl Status {
+    /// Every status, each at the index of its discriminant (`ALL[s as usize] == s`).
+    pub const ALL: [Self; 6] = [
+        Self::Running,
+        Self::Success,
+        Self::TimeOut,
+        Self::RewardMin,
+        Self::Collision,
+        Self::Deadlock,
+    ];
+
     /// Whether the episode is over: [`Status::is_terminated`] or [`Status::is_truncated`].
     pub fn is_done(self) -> bool {
         self != Status::Running
@@ -723,6 +733,23 @@ mod tests {
         let config = ValidConfig::default();
         let scene = Arc::new(maze_scene(&config, seed));
         Episode::new(&config, scene, seed).expect("default scene places")
+    }
+
+    #[test]
+    fn every_status_sits_in_all_at_its_discriminant() {
+        for (i, s) in Status::ALL.into_iter().enumerate() {
+            assert_eq!(s as usize, i, "{s:?}");
+            // A new status stops this match compiling until it joins `ALL` too.
+            match s {
+                Status::Running
+                | Status::Success
+                | Status::TimeOut
+                | Status::RewardMin
+                | Status::Collision
+                | Status::Deadlock => {}
+            }
+        }
+        assert_eq!(Status::ALL.len(), Status::Deadlock as usize + 1);
     }
 
     #[test]
