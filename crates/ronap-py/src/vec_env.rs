@@ -309,7 +309,7 @@ impl VecEnv {
             }
             // Checked in one pass, then converted in another: a loop that may stop at any
             // action to report it stored each action and the vector's length one at a time.
-            if let Some(i) = a.iter().position(|&a| !(0..3).contains(&a)) {
+            if let Some(i) = a.iter().position(|&a| conv::discrete(a).is_none()) {
                 return Err(errors::ActionError::new_err(format!(
                     "action {} for environment {i}: expected 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)",
                     a[i]
