@@ -100,7 +100,7 @@ const STATUS_CHARS: usize = 10;
 /// `status`'s name as a numpy fixed-width string (dtype `<U10`): an array of them costs no Python
 /// object per environment (a list of 1024 `str` per step once took a quarter of a step's time,
 /// with the garbage collection it set off). [`infos`] looks the names up in a table it builds
-/// once: a name built for each environment was read back whole straight after being written a
+/// once a call: a name built for each environment was read back whole straight after being written a
 /// character at a time, a stall on every one (half of `infos`'s time in `perf`).
 fn status_name(status: Status) -> PyFixedUnicode<STATUS_CHARS> {
     let mut chars = [0; STATUS_CHARS];

@@ -17,8 +17,8 @@ pub mod shape;
 use nalgebra::{Point2, Vector2};
 
 /// The instruction sets of this processor, detected once: loops written to vectorise run under
-/// `ARCH.dispatch`, compiled for the widest set the processor has up to AVX2 (AVX-512 gained
-/// nothing for the moving obstacles' pass). Multiplies and adds stay separate
+/// `ARCH.dispatch`, compiled for the widest set the processor has up to AVX2 (AVX-512, measured
+/// for the moving obstacles' pass, gained nothing there). Multiplies and adds stay separate
 /// (Rust never fuses them), so every set gives the same bits.
 pub(crate) static ARCH: std::sync::LazyLock<pulp::Arch> = std::sync::LazyLock::new(|| {
     #[cfg(target_arch = "x86_64")]
@@ -30,7 +30,7 @@ pub(crate) static ARCH: std::sync::LazyLock<pulp::Arch> = std::sync::LazyLock::n
 
 /// [`ARCH`], AVX-512 included where the processor has it: for the long rays' walks, scalar code
 /// whose selects and comparisons AVX-512's mask registers take without branches (a ray through a
-/// maze a sixth faster on an AMD EPYC, the same bits), and for the network's layers (5-8% faster
+/// maze a sixth faster on an AMD EPYC, the same bits), and for the network's layers (3-4% faster
 /// for sixteen rows on that EPYC; on an Intel Xeon, once, slower for one row).
 pub(crate) static WIDEST: std::sync::LazyLock<pulp::Arch> =
     std::sync::LazyLock::new(pulp::Arch::new);

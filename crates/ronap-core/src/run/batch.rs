@@ -31,8 +31,9 @@ const SPIN: Duration = Duration::from_micros(100);
 /// sleep: a caller stepping in a loop (Python's glue between two steps of 1024 environments is
 /// tens of microseconds) then finds them awake, instead of waking them with a system call and
 /// stepping alone until they run again (tens of microseconds on a virtual machine). They stay
-/// only when the caller came back within this time the last time, so a caller that works longer
-/// between steps (training a network, say) does not have them spin beside it in vain.
+/// only when the caller came back within this time of its last step, reset or restart, so a
+/// caller that works longer between calls (training a network, say) does not have them spin
+/// beside it in vain.
 const LINGER: Duration = Duration::from_micros(200);
 
 /// When an environment whose episode ended starts the next one.
@@ -167,8 +168,11 @@ struct Lanes {
     /// How many steps (or restarts) have begun on the pool: a pool thread lingering after one
     /// (see [`LINGER`]) stops as soon as the next begins.
     begun: Arc<AtomicU64>,
-    /// When the last step (or restart) on the pool ended.
+    /// When the caller's last step, reset or restart ended.
     ended: Option<std::time::Instant>,
+    /// Whether the caller came back within [`LINGER`] of that: the pool's threads linger after
+    /// this call's runs only then.
+    quick: bool,
     envs: Vec<Env>,
     observation_size: usize,
     observations: Vec<f32>,
@@ -208,6 +212,7 @@ impl Batch {
                 spin: threads <= cores,
                 begun: Arc::new(AtomicU64::new(0)),
                 ended: None,
+                quick: false,
                 envs: (0..n)
                     .map(|_| Env {
                         episode: None,
@@ -227,6 +232,14 @@ impl Batch {
 
     /// Starts every environment afresh: environment `i` gets seed `seed + i`.
     pub fn reset(&mut self, seed: u64) -> Result<(), RunError> {
+        self.lanes.arrive();
+        let result = self.reset_all(seed);
+        self.lanes.ended = Some(std::time::Instant::now());
+        result
+    }
+
+    /// [`Batch::reset`] between the caller's coming and going.
+    fn reset_all(&mut self, seed: u64) -> Result<(), RunError> {
         let n = self.lanes.envs.len() as u64;
         for (i, env) in self.lanes.envs.iter_mut().enumerate() {
             env.next_seed = seed.wrapping_add(i as u64);
@@ -243,6 +256,14 @@ impl Batch {
     /// automatic reset would have given it). The others are left as they are. An environment's
     /// later episodes follow from the seed it starts with, in the batch's seed order.
     pub fn restart(&mut self, which: &[bool], seeds: &[Option<u64>]) -> Result<(), RunError> {
+        self.lanes.arrive();
+        let result = self.restart_some(which, seeds);
+        self.lanes.ended = Some(std::time::Instant::now());
+        result
+    }
+
+    /// [`Batch::restart`] between the caller's coming and going.
+    fn restart_some(&mut self, which: &[bool], seeds: &[Option<u64>]) -> Result<(), RunError> {
         let n = self.lanes.envs.len();
         for (what, given) in [("reset flags", which.len()), ("seeds", seeds.len())] {
             if given != n {
@@ -288,6 +309,18 @@ impl Batch {
     /// episode's current state, drawing any randomness from `rng` (the episode seed's policy
     /// stream). Environments waiting for a next-step reset start their next episode instead.
     pub fn step(
+        &mut self,
+        choose: &(dyn Fn(usize, &Episode, &mut Rng) -> Action + Sync),
+    ) -> Result<(), RunError> {
+        self.lanes.arrive();
+        let result = self.step_all(choose);
+        self.lanes.ended = Some(std::time::Instant::now());
+        result
+    }
+
+    /// [`Batch::step`] between the caller's coming and going (it may run the environments more
+    /// than once: to start missing episodes, to step, to restart ended ones).
+    fn step_all(
         &mut self,
         choose: &(dyn Fn(usize, &Episode, &mut Rng) -> Action + Sync),
     ) -> Result<(), RunError> {
@@ -462,6 +495,11 @@ impl Drop for Lanes {
 }
 
 impl Lanes {
+    /// Notes whether the caller came back within [`LINGER`] of its last call's end.
+    fn arrive(&mut self) {
+        self.quick = self.ended.is_some_and(|t| t.elapsed() < LINGER);
+    }
+
     /// Runs `f` on every environment with its index, observation row, final-observation row and
     /// step record, in runs of [`MIN_PER_TASK`] to [`RUN`] environments: the calling thread
     /// takes runs one after another, and so do the pool's threads once they wake (without a
@@ -518,7 +556,7 @@ impl Lanes {
             done.fetch_add(1, Ordering::Release);
         };
         let (spin, begun) = (self.spin, &self.begun);
-        let quick = self.ended.is_some_and(|t| t.elapsed() < LINGER);
+        let quick = self.quick;
         pool.in_place_scope(|s| {
             // No more helpers than runs beyond the caller's first: the scope waits for each.
             for _ in 0..helpers.min(total.saturating_sub(1)) {
@@ -551,7 +589,6 @@ impl Lanes {
                 });
             }
         }
-        self.ended = Some(std::time::Instant::now());
         let first = first.into_inner().unwrap_or_else(PoisonError::into_inner);
         first.map_or(Ok(()), |(_, e)| Err(e))
     }

@@ -240,7 +240,8 @@ pub(crate) fn argmax(outputs: &[f32]) -> usize {
 
 /// The layers of [`Mlp::forward_rows_into`] (and of [`Mlp::forward_into`], one row), compiled
 /// once per instruction set (pulp picks the widest the processor has, AVX-512 included: on the
-/// development machine's AMD EPYC, sixteen rows 5-8% faster than under AVX2, the same bits):
+/// development machine's AMD EPYC, sixteen rows 3-4% faster than under AVX2, 6-11% with
+/// [`add_narrow`]; the same bits):
 /// `x` holds `rows` rows of input and, at the end, of output. A single row goes through
 /// [`add_columns`], whose blocks of up to eight vectors suit one row best; more go through
 /// [`add_rows`].
@@ -334,8 +335,9 @@ fn add_rows<S: pulp::Simd>(
 /// Most outputs [`add_narrow`] takes at once.
 const NARROW: usize = 8;
 
-/// The `W` outputs from `o` of the rows `rows` (at most four), for a layer narrower than a
-/// vector (eight outputs under AVX-512, three for the last layer): the rows' sums side by side,
+/// The `W` outputs from `o` of the rows `rows` (at most four), for what is left of a layer after
+/// its whole vectors (all of a layer narrower than one: eight outputs under AVX-512, three for
+/// the last layer): the rows' sums side by side,
 /// `W` to a row, in the same order as [`add_columns`] (so the same bits), which the compiler
 /// vectorises over the `W` outputs. A row at a time, each output's sum would be one chain of
 /// dependent adds.
