@@ -337,9 +337,8 @@ const NARROW: usize = 8;
 
 /// The `W` outputs from `o` of the rows `rows` (at most four), for what is left of a layer after
 /// its whole vectors (all of a layer narrower than one: eight outputs under AVX-512, three for
-/// the last layer): the rows' sums side by side,
-/// `W` to a row, in the same order as [`add_columns`] (so the same bits), which the compiler
-/// vectorises over the `W` outputs. A row at a time, each output's sum would be one chain of
+/// the last layer): the rows' sums side by side, `W` to a row, in the same order as
+/// [`add_columns`] (so the same bits), which the compiler vectorises over the `W` outputs. A row at a time, each output's sum would be one chain of
 /// dependent adds.
 #[inline(always)]
 fn add_narrow<const W: usize>(
@@ -434,20 +433,8 @@ fn add_block<S: pulp::Simd, const R: usize, const V: usize>(
 /// stay separate (no fused multiply-add), so every instruction set gives the same bits.
 #[inline(always)]
 fn add_columns<S: pulp::Simd>(simd: S, y: &mut [f32], x: &[f32], weights: &[f32], outputs: usize) {
-    add_columns_from(simd, y, x, weights, outputs, 0);
-}
-
-/// [`add_columns`] for the outputs from `o` on.
-#[inline(always)]
-fn add_columns_from<S: pulp::Simd>(
-    simd: S,
-    y: &mut [f32],
-    x: &[f32],
-    weights: &[f32],
-    outputs: usize,
-    mut o: usize,
-) {
     // One row: `x` is its inputs and `y` its outputs.
+    let mut o = 0;
     let shape = Shape {
         ins: x.len(),
         outs: outputs,
