@@ -139,6 +139,15 @@ fn setup(c: &mut Criterion) {
     group.bench_function("distance_field", |b| {
         b.iter(|| ronap_core::plan::DistanceField::new(world.scene(), grid, goal, 5.0, 4.0))
     });
+    // What geodesic reward shaping builds for an episode's first potential: the field searched
+    // out as far as the start (the same seed's goal and start as above, plain costs).
+    group.bench_function("lazy_field_to_start", |b| {
+        b.iter(|| {
+            let mut field =
+                ronap_core::plan::LazyField::new(world.scene(), grid, goal, start, 5.0, 1.0);
+            field.distance_at(grid, start)
+        })
+    });
     group.bench_function("grid_path", |b| {
         b.iter(|| ronap_core::plan::grid_path(world.scene(), grid, start, goal, 5.0, 4.0))
     });
@@ -164,12 +173,62 @@ fn setup(c: &mut Criterion) {
             (world, path)
         })
     });
+    // What an RL reset with geodesic reward shaping builds, averaged over the scenes and starts
+    // of 200 seeds: a new maze and its index, placement, the free-space grid and the shaping's
+    // first potential.
+    let mut shaped = ronap_core::SimConfig::default();
+    shaped.reward.shaping = ronap_core::config::Shaping::Geodesic;
+    let shaped = shaped.validate().expect("valid");
+    let mut next = 0u64;
+    group.bench_function("shaped_reset_over_seeds", |b| {
+        b.iter(|| {
+            let seed = next % 200;
+            next += 1;
+            let world = Arc::new(ronap_core::World::maze(shaped.clone(), seed));
+            let episode = world.episode(seed).expect("placement");
+            let shaper = ronap_core::run::shaping::Shaper::start(world, &episode);
+            shaper.map(|s| s.potential())
+        })
+    });
     let field = ronap_core::plan::DistanceField::new(world.scene(), grid, goal, 5.0, 1.0);
     let path = field
         .path(world.scene(), grid, start, 5.0)
         .expect("connected");
     group.bench_function("smooth", |b| {
         b.iter(|| ronap_core::plan::smooth(world.scene(), &path, 5.0))
+    });
+    group.finish();
+    // A shaping potential at each step: the geodesic distance at points 1.5 px apart along the
+    // path from start to goal and 20 px beside it, from a whole field and from a lazy one that
+    // has searched out to the start (per point).
+    let mut points = Vec::new();
+    for pair in path.windows(2) {
+        let (a, b) = (pair[0], pair[1]);
+        let n = ((b - a).norm() / 1.5).ceil().max(1.0) as usize;
+        for k in 0..n {
+            let p = a + (b - a) * (k as f64 / n as f64);
+            points.extend([p, p + ronap_core::Vector::new(0.0, 20.0)]);
+        }
+    }
+    let mut group = c.benchmark_group("potential");
+    group.throughput(Throughput::Elements(points.len() as u64));
+    group.bench_function("whole_field", |b| {
+        b.iter(|| {
+            points
+                .iter()
+                .map(|&p| field.distance_at(p))
+                .collect::<Vec<_>>()
+        })
+    });
+    let mut lazy = ronap_core::plan::LazyField::new(world.scene(), grid, goal, start, 5.0, 1.0);
+    lazy.distance_at(grid, start);
+    group.bench_function("lazy_field", |b| {
+        b.iter(|| {
+            points
+                .iter()
+                .map(|&p| lazy.distance_at(grid, p))
+                .collect::<Vec<_>>()
+        })
     });
     group.finish();
 }

@@ -69,29 +69,12 @@ impl DistanceField {
     /// eight neighbours, of the cell's cost plus the straight line from `p` to its centre, so it
     /// changes smoothly as `p` moves within a cell. `None` when none of them reaches the goal.
     pub fn distance_at(&self, p: Point) -> Option<f64> {
-        let (c, r) = ((p.x / self.cell_px).floor(), (p.y / self.cell_px).floor());
-        let mut best = f64::INFINITY;
-        for dr in -1..=1 {
-            for dc in -1..=1 {
-                let (cc, rr) = (c + f64::from(dc), r + f64::from(dr));
-                if cc < 0.0 || rr < 0.0 || cc >= self.cols as f64 || rr >= self.rows as f64 {
-                    continue;
-                }
-                let i = rr as usize * self.cols + cc as usize;
-                let cost = self.cost(i);
-                if cost.is_finite() {
-                    best = best.min(cost + (p - self.center(i)).norm());
-                }
-            }
-        }
+        let best = nearest(p, self.cols, self.rows, self.cell_px, |i| self.cost(i));
         best.is_finite().then_some(best)
     }
 
     fn center(&self, i: usize) -> Point {
-        Point::new(
-            ((i % self.cols) as f64 + 0.5) * self.cell_px,
-            ((i / self.cols) as f64 + 0.5) * self.cell_px,
-        )
+        center(i, self.cols, self.cell_px)
     }
 
     /// The grid path from `start` to the goal: `start`, cell centres down the field, the goal.
@@ -112,6 +95,176 @@ impl DistanceField {
             |i| self.cells[i].parent,
             |i| self.center(i),
         ))
+    }
+}
+
+/// The cells around `p`: the cell holding it and its eight neighbours, those in the grid.
+fn around(p: Point, cols: usize, rows: usize, cell_px: f64) -> impl Iterator<Item = Around> {
+    let (c, r) = ((p.x / cell_px).floor(), (p.y / cell_px).floor());
+    (-1..=1).flat_map(move |dr| {
+        (-1..=1).filter_map(move |dc| {
+            let (cc, rr) = (c + f64::from(dc), r + f64::from(dr));
+            (cc >= 0.0 && rr >= 0.0 && cc < cols as f64 && rr < rows as f64).then(|| Around {
+                index: rr as usize * cols + cc as usize,
+                col: cc as u32,
+                row: rr as u32,
+                line: (p - Point::new((cc + 0.5) * cell_px, (rr + 0.5) * cell_px)).norm(),
+            })
+        })
+    })
+}
+
+/// A cell [`around`] a point.
+#[derive(Clone, Copy, Default)]
+struct Around {
+    /// The cell's index, `row * cols + col`.
+    index: usize,
+    col: u32,
+    row: u32,
+    /// The straight line from the point to the cell's centre, px.
+    line: f64,
+}
+
+/// The least, over the cells [`around`] `p`, of a cell's `cost` (px; infinite where it does not
+/// reach the goal) plus the straight line from `p` to its centre: infinite when none reaches.
+fn nearest(p: Point, cols: usize, rows: usize, cell_px: f64, cost: impl Fn(usize) -> f64) -> f64 {
+    around(p, cols, rows, cell_px)
+        .map(|a| (cost(a.index), a.line))
+        .filter(|(c, _)| c.is_finite())
+        .fold(f64::INFINITY, |best, (c, line)| best.min(c + line))
+}
+
+/// The centre of cell `i` of a grid `cols` wide.
+fn center(i: usize, cols: usize, cell_px: f64) -> Point {
+    Point::new(
+        ((i % cols) as f64 + 0.5) * cell_px,
+        ((i / cols) as f64 + 0.5) * cell_px,
+    )
+}
+
+/// A [`DistanceField`] searched only as far as the points asked about need: what reward shaping
+/// asks at each step of an episode. Its search from the goal is [`grid_path`]'s A*, steered
+/// towards the first point to be asked about (the robot's start), and it stops once every cell
+/// that could give a point's distance is settled; a point further out carries it on from there.
+/// So an episode pays at its start for the cells between goal and start, and then for those its
+/// robot strays to, rather than for all. The distances are the whole field's, bit for bit: a
+/// cell's cost is its shortest path's, whichever order the cells are settled in.
+pub struct LazyField {
+    cols: usize,
+    rows: usize,
+    cell_px: f64,
+    goal: Point,
+    /// The search, stopped part way: its own buffers, since it goes on between calls.
+    work: Box<Work>,
+}
+
+/// How far, in units, a [`LazyField`] searches on at a time while none of a point's cells has
+/// been reached: about ten cells' side.
+const LAZY_CHUNK: u32 = 128;
+
+impl LazyField {
+    /// The field towards `goal` for a disc of `radius`, with steps into or out of a close cell
+    /// costing `close_cost` times their length (as [`DistanceField::new`]), its search steered
+    /// towards `toward` and nothing settled yet.
+    pub fn new(
+        scene: &Scene,
+        grid: &FreeGrid,
+        goal: Point,
+        toward: Point,
+        radius: f64,
+        close_cost: f64,
+    ) -> Self {
+        let (cols, rows) = grid.size();
+        let mut work = Box::<Work>::default();
+        work.cells.resize(cols * rows, UNREACHED);
+        let from = grid
+            .cell_of(toward)
+            .or(grid.cell_of(goal))
+            .unwrap_or((0, 0));
+        work.begin_steered(grid, &attach(scene, grid, goal, radius), close_cost, from);
+        Self {
+            cols,
+            rows,
+            cell_px: grid.cell_px(),
+            goal,
+            work,
+        }
+    }
+
+    /// The goal the field leads to.
+    pub fn goal(&self) -> Point {
+        self.goal
+    }
+
+    /// [`DistanceField::distance_at`], searching on as far as `p` needs. `grid` must be the
+    /// grid the field was made over.
+    pub fn distance_at(&mut self, grid: &FreeGrid, p: Point) -> Option<f64> {
+        debug_assert_eq!(grid.size(), (self.cols, self.rows));
+        let px_per_unit = self.cell_px / AXIS as f64;
+        let (cols, rows, cell_px) = (self.cols, self.rows, self.cell_px);
+        let (mut near, mut n) = ([Around::default(); 9], 0);
+        for a in around(p, cols, rows, cell_px) {
+            near[n] = a;
+            n += 1;
+        }
+        let near = &near[..n];
+        loop {
+            let work = &mut *self.work;
+            // Every cell whose cost plus least distance is below `next` is settled.
+            let (next, done) = (work.current, work.pending == 0);
+            let settled = |a: &Around| {
+                let c = work.cells[a.index].cost;
+                c != u32::MAX && (done || c + work.least(a.col, a.row) < next)
+            };
+            let best = near
+                .iter()
+                .filter(|a| settled(a))
+                .fold(f64::INFINITY, |best, a| {
+                    best.min(work.cells[a.index].cost as f64 * px_per_unit + a.line)
+                });
+            if done {
+                return best.is_finite().then_some(best);
+            }
+            // A free cell not yet settled costs at least `next` less its least distance; it
+            // is left out once that, plus its line from `p`, is no better than the best.
+            let mut until = u32::MIN;
+            let mut open = false;
+            for a in near {
+                if settled(a) || !grid.is_free_index(a.index) {
+                    continue;
+                }
+                let (least, line) = (work.least(a.col, a.row), a.line);
+                if next.saturating_sub(least) as f64 * px_per_unit + line >= best {
+                    continue;
+                }
+                open = true;
+                // On until that bound passes the best, or, sooner, until the cell settles.
+                let mut needed = if best.is_finite() {
+                    least.saturating_add(((best - line) / px_per_unit).ceil() as u32 + 1)
+                } else {
+                    next.saturating_add(LAZY_CHUNK)
+                };
+                let cost = work.cells[a.index].cost;
+                if cost != u32::MAX {
+                    needed = needed.min(cost + least + 1);
+                }
+                until = until.max(needed);
+            }
+            if !open {
+                return best.is_finite().then_some(best);
+            }
+            work.settle_steered(grid, &mut Until(until.max(next + 1)));
+        }
+    }
+}
+
+impl std::fmt::Debug for LazyField {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("LazyField")
+            .field("size", &(self.cols, self.rows))
+            .field("goal", &self.goal)
+            .field("settled_below", &self.work.current)
+            .finish_non_exhaustive()
     }
 }
 
@@ -149,13 +302,13 @@ pub fn grid_path(
             work.narrow(grid, first, close_cost);
             work.search(grid, &roots, close_cost);
             let (cols, cell_px) = (grid.size().0, grid.cell_px());
-            let center = |i: usize| {
-                Point::new(
-                    ((i % cols) as f64 + 0.5) * cell_px,
-                    ((i / cols) as f64 + 0.5) * cell_px,
-                )
-            };
-            walk(start, first, goal, |i| work.cells[i].parent, center)
+            walk(
+                start,
+                first,
+                goal,
+                |i| work.cells[i].parent,
+                |i| center(i, cols, cell_px),
+            )
         });
         work.tidy();
         path
@@ -195,6 +348,20 @@ struct Work {
     buckets: Vec<Vec<u32>>,
     /// Cells of the current bucket being settled.
     bucket: Vec<u32>,
+    /// A steered search's ([`Work::bound`]'s A*) step costs, plain and close (see
+    /// [`step_costs`]).
+    steps: [[u32; 8]; 2],
+    /// The length of [`Work::front`]'s ring.
+    ring: usize,
+    /// The sum (cost plus least distance) a steered search settles next: every cell whose sum
+    /// is less is settled.
+    current: u32,
+    /// The bucket of `current`: `current % ring`.
+    slot: usize,
+    /// How many entries wait in the ring and in [`Work::level`].
+    pending: usize,
+    /// The cell (column, row) a steered search heads for.
+    from: (u32, u32),
     /// [`Work::bound`]'s ring of buckets: cells by cost plus least distance to the start
     /// modulo the ring's length.
     front: Vec<Vec<u32>>,
@@ -207,6 +374,68 @@ struct Work {
     /// Whether every cell is unreached ([`UNREACHED`]): what [`Work::bound`] needs, left so by
     /// [`Work::tidy`] at the cost of the cells it touched rather than of all.
     clean: bool,
+}
+
+/// What a steered search ([`Work::settle_steered`]) tells as it goes, and asks.
+trait Steer {
+    /// Cell `i`, at column `c` and row `r`, has just been settled at `cost`.
+    fn settled(&mut self, i: usize, c: u32, r: u32, cost: u32);
+    /// Whether to stop, every cell whose cost plus least distance is at most `current` being
+    /// settled.
+    fn stop(&mut self, cells: &[Node], current: u32) -> bool;
+}
+
+/// [`Work::bound`]'s steer: on until no target left could begin a shorter path than the best
+/// through one settled.
+struct Entries<'a> {
+    /// The start's entries to the grid: cells and their straight line from the start, px.
+    targets: &'a [(usize, f64)],
+    /// The start's cell.
+    from: (u32, u32),
+    px_per_unit: f64,
+    /// The best path through a settled target so far, px (a start's straight line plus its
+    /// cell's cost).
+    best: f64,
+}
+
+impl Steer for Entries<'_> {
+    #[inline(always)]
+    fn settled(&mut self, i: usize, c: u32, r: u32, cost: u32) {
+        let (fc, fr) = self.from;
+        if c.abs_diff(fc) <= ATTACH_CELLS as u32 && r.abs_diff(fr) <= ATTACH_CELLS as u32 {
+            for &(t, d) in self.targets {
+                if t == i {
+                    self.best = self.best.min(d + cost as f64 * self.px_per_unit);
+                }
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn stop(&mut self, cells: &[Node], current: u32) -> bool {
+        // A target's least distance is nothing, so one not yet settled costs at least
+        // `current + 1` units.
+        let floor = (current + 1) as f64 * self.px_per_unit;
+        self.best.is_finite()
+            && self
+                .targets
+                .iter()
+                .all(|&(t, d)| cells[t].cost <= current || d + floor > self.best)
+    }
+}
+
+/// [`LazyField`]'s steer: on until every cell whose cost plus least distance is below a sum is
+/// settled.
+struct Until(u32);
+
+impl Steer for Until {
+    #[inline(always)]
+    fn settled(&mut self, _: usize, _: u32, _: u32, _: u32) {}
+
+    #[inline(always)]
+    fn stop(&mut self, _: &[Node], current: u32) -> bool {
+        current + 1 >= self.0
+    }
 }
 
 /// [`Work::narrow`]'s mark on a cell it keeps (no cell is a parent of this index).
@@ -338,57 +567,97 @@ impl Work {
         targets: &[(usize, f64)],
     ) -> Vec<Option<u32>> {
         let (cols, rows) = grid.size();
-        let cell_px = grid.cell_px();
-        let steps = step_costs(close_cost);
         if !self.clean || self.cells.len() != cols * rows {
             self.cells.clear();
             self.cells.resize(cols * rows, UNREACHED);
         }
         self.clean = false;
-        let (cells, closed) = (&mut self.cells, &mut self.closed);
-        closed.clear();
-        let (fc, fr) = (from.0 as u32, from.1 as u32);
-        // The least a path from cell (c, r) to a target costs, units.
+        self.closed.clear();
+        self.begin_steered(grid, roots, close_cost, from);
+        let mut entries = Entries {
+            targets,
+            from: (from.0 as u32, from.1 as u32),
+            px_per_unit: grid.cell_px() / AXIS as f64,
+            best: f64::INFINITY,
+        };
+        self.settle_steered(grid, &mut entries);
+        // Every cell whose cost plus least distance is below `current` is settled; a target's
+        // least distance is nothing.
+        let current = self.current;
+        targets
+            .iter()
+            .map(|&(t, _)| Some(self.cells[t].cost).filter(|&c| c < current))
+            .collect()
+    }
+
+    /// The least a path from cell (`c`, `r`) to the cell a steered search heads for costs,
+    /// less [`ENTRY_SLACK`], in units: the octile distance, which changes by no more than a
+    /// step's cost from a cell to its neighbour.
+    fn least(&self, c: u32, r: u32) -> u32 {
+        let (dc, dr) = (c.abs_diff(self.from.0), r.abs_diff(self.from.1));
+        (AXIS * dc.max(dr) + (DIAGONAL - AXIS) * dc.min(dr)).saturating_sub(ENTRY_SLACK)
+    }
+
+    /// A steered search's start ([`Work::bound`]'s A*): the goal's attachments `roots` put in an
+    /// empty ring by their cost plus least distance to cell `from`, nothing settled.
+    fn begin_steered(
+        &mut self,
+        grid: &FreeGrid,
+        roots: &[(usize, f64)],
+        close_cost: f64,
+        from: (usize, usize),
+    ) {
+        let cols = grid.size().0;
+        self.steps = step_costs(close_cost);
+        self.from = (from.0 as u32, from.1 as u32);
+        let units_per_px = AXIS as f64 / grid.cell_px();
+        let mut starts = Vec::new();
+        for &(i, d) in roots {
+            let c = (d * units_per_px).round() as u32;
+            if c < self.cells[i].cost {
+                self.cells[i].cost = c;
+                let (col, row) = ((i % cols) as u32, (i / cols) as u32);
+                starts.push((i as u32, c + self.least(col, row)));
+            }
+        }
+        let current = starts.iter().map(|s| s.1).min().unwrap_or(0);
+        // A step changes a cell's sum by 0 to twice its cost; the goal's attachments may spread
+        // wider than that.
+        let widest = starts.iter().map(|s| s.1 - current).max().unwrap_or(0);
+        self.ring = (2 * longest(&self.steps)).max(widest) as usize + 1;
+        reset_ring(&mut self.front, self.ring);
+        for &(at, sum) in &starts {
+            self.front[sum as usize % self.ring].push(at);
+        }
+        self.level.clear();
+        (self.current, self.slot, self.pending) =
+            (current, current as usize % self.ring, starts.len());
+    }
+
+    /// Carries a steered search on, sum by sum, until `steer` says to stop or nothing is left:
+    /// every cell whose cost plus least distance is below [`Work::current`] is then settled, at
+    /// its final cost, and listed in [`Work::closed`]; the cells reached but not settled wait in
+    /// [`Work::front`].
+    fn settle_steered(&mut self, grid: &FreeGrid, steer: &mut impl Steer) {
+        let cols = grid.size().0 as u32;
+        let (ring, steps) = (self.ring, self.steps);
+        let (mut pending, mut current, mut slot) = (self.pending, self.current, self.slot);
+        let (fc, fr) = self.from;
+        // [`Work::least`], on copies the loop can keep in registers.
         let least = |c: u32, r: u32| {
             let (dc, dr) = (c.abs_diff(fc), r.abs_diff(fr));
             (AXIS * dc.max(dr) + (DIAGONAL - AXIS) * dc.min(dr)).saturating_sub(ENTRY_SLACK)
         };
-        let units_per_px = AXIS as f64 / cell_px;
-        let px_per_unit = cell_px / AXIS as f64;
-        let mut starts = Vec::new();
-        for &(i, d) in roots {
-            let c = (d * units_per_px).round() as u32;
-            if c < cells[i].cost {
-                cells[i].cost = c;
-                let (col, row) = ((i % cols) as u32, (i / cols) as u32);
-                starts.push((i as u32, c + least(col, row)));
-            }
-        }
-        let mut current = starts.iter().map(|s| s.1).min().unwrap_or(0);
-        // A step changes a cell's sum by 0 to twice its cost; the goal's attachments may spread
-        // wider than that.
-        let widest = starts.iter().map(|s| s.1 - current).max().unwrap_or(0);
-        let ring = (2 * longest(&steps)).max(widest) as usize + 1;
-        reset_ring(&mut self.front, ring);
-        let front = &mut self.front;
-        let mut slot = current as usize % ring;
-        for &(at, sum) in &starts {
-            front[sum as usize % ring].push(at);
-        }
-        let mut pending = starts.len();
+        let (cells, closed, front) = (&mut self.cells, &mut self.closed, &mut self.front);
         let (moves, slow) = (grid.moves(), grid.close_moves());
         let offsets = grid.move_offsets();
         // Column and row changes of the moves E, W, N, S, NE, SE, NW, SW.
         const DC: [u32; 8] = [1, u32::MAX, 0, 0, 1, 1, u32::MAX, u32::MAX];
         const DR: [u32; 8] = [0, 0, 1, u32::MAX, 1, u32::MAX, 1, u32::MAX];
-        // The best path through a settled target so far, px (a start's straight line plus its
-        // cell's cost).
-        let mut best = f64::INFINITY;
         // Cells reached at the sum being settled (a step towards the start often keeps it), kept
         // apart from the ring: the ring's buffers, kept per thread, then grow only to the cells
         // put there from a lower sum.
         let level = &mut self.level;
-        level.clear();
         while pending > 0 {
             // Nothing is put in this bucket during its turn (a push lands 1 to `ring - 1` sums
             // ahead, or in `level`), so counting past its end reads `level` only.
@@ -396,7 +665,7 @@ impl Work {
             while let Some(i) = front[slot].get(n).copied().or_else(|| level.pop()) {
                 n += 1;
                 pending -= 1;
-                let (r, c) = (i / cols as u32, i % cols as u32);
+                let (r, c) = (i / cols, i % cols);
                 let i = i as usize;
                 let cost = cells[i].cost;
                 // The ring is wider than any push is ahead, so a bucket holds one sum (or less,
@@ -428,35 +697,20 @@ impl Work {
                     }
                     pending += 1;
                 }
-                if c.abs_diff(fc) <= ATTACH_CELLS as u32 && r.abs_diff(fr) <= ATTACH_CELLS as u32 {
-                    for &(t, d) in targets {
-                        if t == i {
-                            best = best.min(d + cost as f64 * px_per_unit);
-                        }
-                    }
-                }
+                steer.settled(i, c, r, cost);
             }
             front[slot].clear();
-            // A target's least distance is nothing, so one not yet settled costs at least
-            // `current + 1` units.
-            let floor = (current + 1) as f64 * px_per_unit;
-            if best.is_finite()
-                && targets
-                    .iter()
-                    .all(|&(t, d)| cells[t].cost <= current || d + floor > best)
-            {
-                break;
-            }
+            let stop = steer.stop(cells, current);
             current += 1;
             slot += 1;
             if slot == ring {
                 slot = 0;
             }
+            if stop {
+                break;
+            }
         }
-        targets
-            .iter()
-            .map(|&(t, _)| Some(cells[t].cost).filter(|&c| c <= current))
-            .collect()
+        (self.pending, self.current, self.slot) = (pending, current, slot);
     }
 
     /// Readies [`Work::cells`], after [`Work::bound`], for a [`Work::search`] over just the
@@ -685,5 +939,70 @@ mod tests {
             }
         }
         assert!(compared > 1000, "{compared}");
+    }
+
+    /// A lazy field gives the whole field's distances, bit for bit, whatever order points are
+    /// asked in: near the goal and far, in walls and outside the scene, mazes, warehouses and an
+    /// image map, plain and wall-shy costs; and it searches a fraction of the grid for the
+    /// start it heads for.
+    #[test]
+    fn a_lazy_field_gives_the_whole_fields_distances() {
+        let config = ValidConfig::default();
+        let office =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/office.png");
+        let (office, _) =
+            crate::scene::map::load(&office, &config.map, config.reach_px()).expect("a map");
+        let office = std::sync::Arc::new(office);
+        let (mut compared, mut searched, mut free) = (0, 0, 0);
+        for seed in 0..12u64 {
+            let world = match seed % 3 {
+                0 => World::maze(config.clone(), seed),
+                1 => World::warehouse(config.clone(), seed),
+                _ => World::new(config.clone(), office.clone()),
+            };
+            let (scene, grid) = (world.scene(), world.grid());
+            let Ok(episode) = world.episode(seed) else {
+                continue;
+            };
+            let goal = episode.goal();
+            let mut points = vec![goal, goal + Vector::new(3.0, 1.0), Point::new(-10.0, -10.0)];
+            // A walk away from the goal a few px at a time, as a robot's poses come.
+            for k in 0..300 {
+                let t = f64::from(k) * 0.02;
+                points.push(
+                    goal + Vector::new(3.0 * f64::from(k) * t.cos(), 2.5 * f64::from(k) * t.sin()),
+                );
+            }
+            for k in 0..200u64 {
+                let (x, y) = ((k * 379 + seed * 61) % 1013, (k * 617 + seed * 233) % 1009);
+                points.push(Point::new(
+                    scene.width() * x as f64 / 1000.0 - 2.0,
+                    scene.height() * y as f64 / 1000.0 - 2.0,
+                ));
+            }
+            for close_cost in [1.0, 4.0] {
+                let whole = DistanceField::new(scene, grid, goal, 5.0, close_cost);
+                let start = episode.start().position();
+                let mut lazy = LazyField::new(scene, grid, goal, start, 5.0, close_cost);
+                for q in [start, goal] {
+                    assert_eq!(lazy.distance_at(grid, q), whole.distance_at(q));
+                }
+                searched += lazy.work.closed.len();
+                free += grid.free_count();
+                for &p in &points {
+                    assert_eq!(
+                        lazy.distance_at(grid, p).map(f64::to_bits),
+                        whole.distance_at(p).map(f64::to_bits),
+                        "seed {seed} cost {close_cost} point {p}"
+                    );
+                    compared += 1;
+                }
+            }
+        }
+        assert!(compared > 5000, "{compared}");
+        assert!(
+            searched < free / 3,
+            "the starts' distances searched {searched} of {free} cells"
+        );
     }
 }

@@ -6,6 +6,6 @@ pub mod field;
 pub mod path;
 pub mod tour;
 
-pub use field::{grid_path, DistanceField};
+pub use field::{grid_path, DistanceField, LazyField};
 pub use path::{path_length, shortest_path, shortest_path_px, smooth};
 pub use tour::{order, CostMatrix, CostMatrixError, Order, Tour};

@@ -8,10 +8,11 @@
 //! Summed with discount gamma over an episode, F telescopes to `gamma^T Phi(s_T) - Phi(s_0)`:
 //! a constant for episodes from one start that end at the goal, so the order of their returns, and
 //! the optimal policy, are those of the other three terms. The sim layer's episode knows nothing
-//! of planners; the distance field comes from [`crate::plan`], built once per goal.
+//! of planners; the distance field comes from [`crate::plan`], one per goal, searched only as far
+//! as the robot's poses need.
 
 use crate::config::Shaping;
-use crate::plan::DistanceField;
+use crate::plan::LazyField;
 use crate::sim::episode::Episode;
 use crate::sim::world::World;
 use std::sync::Arc;
@@ -20,7 +21,7 @@ use std::sync::Arc;
 #[derive(Debug)]
 pub struct Shaper {
     world: Arc<World>,
-    field: DistanceField,
+    field: LazyField,
     /// Phi of the current state.
     potential: f64,
     /// Summed shaped reward so far.
@@ -74,22 +75,24 @@ impl Shaper {
 
     /// Phi at `episode`'s pose: the geodesic distance, or the straight line where the field does
     /// not reach (a pose outside the goal's free region, which a robot never enters).
-    fn potential_of(&self, episode: &Episode) -> f64 {
+    fn potential_of(&mut self, episode: &Episode) -> f64 {
         let p = episode.pose().position();
         let distance = self
             .field
-            .distance_at(p)
+            .distance_at(self.world.grid(), p)
             .unwrap_or_else(|| (episode.goal() - p).norm());
         -self.world.config().reward.progress_per_px * distance
     }
 }
 
-/// The plain shortest-path field towards `episode`'s goal for its robot's disc.
-fn field(world: &World, episode: &Episode) -> DistanceField {
-    DistanceField::new(
+/// The plain shortest-path field towards `episode`'s goal for its robot's disc, searched out from
+/// the goal towards the robot.
+fn field(world: &World, episode: &Episode) -> LazyField {
+    LazyField::new(
         world.scene(),
         world.grid(),
         episode.goal(),
+        episode.pose().position(),
         world.config().robot.radius_px,
         1.0,
     )
