@@ -11,7 +11,7 @@ use ronap_core::geometry::unit;
 use ronap_core::policy::{Decision, Policy};
 use ronap_core::scene::freespace::FreeGrid;
 use ronap_core::sim::world::maze_scene;
-use ronap_core::{Episode, Laser, ValidConfig};
+use ronap_core::{Action, DiscreteAction, Episode, Laser, ValidConfig};
 use std::hint::black_box;
 use std::sync::Arc;
 
@@ -227,6 +227,48 @@ fn setup(c: &mut Criterion) {
             points
                 .iter()
                 .map(|&p| lazy.distance_at(grid, p))
+                .collect::<Vec<_>>()
+        })
+    });
+    // A shaped episode's field, whole and lazy: built at its start, then asked at each pose of a
+    // robot driven at random for up to 2000 steps (the default limit), as a learner starts out
+    // (per pose).
+    let poses = {
+        let mut episode = world.episode(3).expect("placement");
+        let mut poses = vec![episode.pose().position()];
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        while !episode.status().is_done() && poses.len() < 2000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            episode.step(Action::from(
+                [
+                    DiscreteAction::Left,
+                    DiscreteAction::Ahead,
+                    DiscreteAction::Right,
+                ][(x % 3) as usize],
+            ));
+            poses.push(episode.pose().position());
+        }
+        poses
+    };
+    group.throughput(Throughput::Elements(poses.len() as u64));
+    group.bench_function("random_walk_whole_field", |b| {
+        b.iter(|| {
+            let field = ronap_core::plan::DistanceField::new(world.scene(), grid, goal, 5.0, 1.0);
+            poses
+                .iter()
+                .map(|&p| field.distance_at(p))
+                .collect::<Vec<_>>()
+        })
+    });
+    group.bench_function("random_walk_lazy_field", |b| {
+        b.iter(|| {
+            let mut field =
+                ronap_core::plan::LazyField::new(world.scene(), grid, goal, start, 5.0, 1.0);
+            poses
+                .iter()
+                .map(|&p| field.distance_at(grid, p))
                 .collect::<Vec<_>>()
         })
     });
