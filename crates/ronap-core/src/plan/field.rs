@@ -187,6 +187,8 @@ impl LazyField {
             .cell_of(toward)
             .or(grid.cell_of(goal))
             .unwrap_or((0, 0));
+        // Heading for one cell, the search needs no slack for the start's entries.
+        work.slack = 0;
         work.begin_steered(grid, &attach(scene, grid, goal, radius), close_cost, from);
         Self {
             cols,
@@ -299,6 +301,8 @@ impl LazyField {
                     settled,
                 },
             );
+            // The list of settled cells is `grid_path`'s; the marks above are this field's.
+            work.closed.clear();
         }
     }
 }
@@ -308,7 +312,7 @@ impl std::fmt::Debug for LazyField {
         f.debug_struct("LazyField")
             .field("size", &(self.cols, self.rows))
             .field("goal", &self.goal)
-            .field("settled_below", &self.work.current)
+            .field("settled", &self.settled.iter().filter(|&&s| s).count())
             .finish_non_exhaustive()
     }
 }
@@ -407,6 +411,10 @@ struct Work {
     pending: usize,
     /// The cell (column, row) a steered search heads for.
     from: (u32, u32),
+    /// What [`Work::least`] takes off the octile distance to `from`: [`ENTRY_SLACK`] for
+    /// [`Work::bound`], whose start enters the grid anywhere around its cell; nothing for a
+    /// [`LazyField`].
+    slack: u32,
     /// [`Work::bound`]'s ring of buckets: cells by cost plus least distance to the start
     /// modulo the ring's length.
     front: Vec<Vec<u32>>,
@@ -623,6 +631,7 @@ impl Work {
         }
         self.clean = false;
         self.closed.clear();
+        self.slack = ENTRY_SLACK;
         self.begin_steered(grid, roots, close_cost, from);
         let mut entries = Entries {
             targets,
@@ -641,11 +650,11 @@ impl Work {
     }
 
     /// The least a path from cell (`c`, `r`) to the cell a steered search heads for costs,
-    /// less [`ENTRY_SLACK`], in units: the octile distance, which changes by no more than a
+    /// less [`Work::slack`], in units: the octile distance, which changes by no more than a
     /// step's cost from a cell to its neighbour.
     fn least(&self, c: u32, r: u32) -> u32 {
         let (dc, dr) = (c.abs_diff(self.from.0), r.abs_diff(self.from.1));
-        (AXIS * dc.max(dr) + (DIAGONAL - AXIS) * dc.min(dr)).saturating_sub(ENTRY_SLACK)
+        (AXIS * dc.max(dr) + (DIAGONAL - AXIS) * dc.min(dr)).saturating_sub(self.slack)
     }
 
     /// A steered search's start ([`Work::bound`]'s A*): the goal's attachments `roots` put in an
@@ -704,11 +713,11 @@ impl Work {
         let cols = grid.size().0 as u32;
         let (ring, steps) = (self.ring, self.steps);
         let (mut pending, mut current, mut slot) = (self.pending, self.current, self.slot);
-        let (fc, fr) = self.from;
+        let ((fc, fr), slack) = (self.from, self.slack);
         // [`Work::least`], on copies the loop can keep in registers.
         let least = |c: u32, r: u32| {
             let (dc, dr) = (c.abs_diff(fc), r.abs_diff(fr));
-            (AXIS * dc.max(dr) + (DIAGONAL - AXIS) * dc.min(dr)).saturating_sub(ENTRY_SLACK)
+            (AXIS * dc.max(dr) + (DIAGONAL - AXIS) * dc.min(dr)).saturating_sub(slack)
         };
         let (cells, closed, front) = (&mut self.cells, &mut self.closed, &mut self.front);
         let (moves, slow) = (grid.moves(), grid.close_moves());
@@ -1049,7 +1058,7 @@ mod tests {
                 for q in [start, goal] {
                     assert_eq!(lazy.distance_at(grid, q), whole.distance_at(q));
                 }
-                searched += lazy.work.closed.len();
+                searched += lazy.settled.iter().filter(|&&s| s).count();
                 free += grid.free_count();
                 for &p in &points {
                     assert_eq!(
@@ -1103,7 +1112,7 @@ mod tests {
                 ];
                 episode.step(Action::from(turn[(x % 3) as usize]));
             }
-            steered += lazy.work.closed.len();
+            steered += lazy.settled.iter().filter(|&&s| s).count();
             free += grid.free_count();
         }
         assert!(steered * 10 < free * 3, "settled {steered} of {free} cells");
