@@ -145,10 +145,11 @@ fn center(i: usize, cols: usize, cell_px: f64) -> Point {
 /// A [`DistanceField`] searched only as far as the points asked about need: what reward shaping
 /// asks at each step of an episode. Its search from the goal is [`grid_path`]'s A*, steered
 /// towards the first point to be asked about (the robot's start), and it stops once every cell
-/// that could give a point's distance is settled; a point further out carries it on from there.
-/// So an episode pays at its start for the cells between goal and start, and then for those its
-/// robot strays to, rather than for all. The distances are the whole field's, bit for bit: a
-/// cell's cost is its shortest path's, whichever order the cells are settled in.
+/// that could give a point's distance is settled; a point further out carries it on from there,
+/// steered anew towards that point when it lies far from where the search heads. So an episode
+/// pays at its start for the cells between goal and start, and then for those its robot strays
+/// to, rather than for all. The distances are the whole field's, bit for bit: a cell's cost is
+/// its shortest path's, whichever order the cells are settled in.
 pub struct LazyField {
     cols: usize,
     rows: usize,
@@ -201,9 +202,9 @@ impl LazyField {
     }
 
     /// Steers the search on towards cell `to`: the cells waiting in its front put in a new ring
-    /// by their cost plus least distance to `to`. A* stays exact when its estimate changes as long
-    /// as the new one never rises by more than a step's cost from a cell to its neighbour: a cell
-    /// not yet settled still costs at least the least sum waiting, less its least distance.
+    /// by their cost plus least distance to `to`. A* stays exact when its estimate changes, as
+    /// long as the new one changes by no more than a step's cost from a cell to its neighbour: a
+    /// cell not yet settled still costs at least the least sum waiting, less its least distance.
     fn steer(&mut self, grid: &FreeGrid, to: (usize, usize)) {
         let work = &mut *self.work;
         // Each waiting cell once: its latest entry is the one at its cost, the others are stale.
