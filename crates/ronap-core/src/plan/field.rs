@@ -954,24 +954,32 @@ mod tests {
     use crate::geometry::Vector;
     use crate::sim::world::World;
 
-    /// The search over just the cells a path could use gives exactly the whole field's path:
-    /// in mazes, warehouses and an image map, plain and wall-shy costs, near and far starts,
-    /// starts cut off from the goal, in walls and outside the scene.
-    #[test]
-    fn grid_path_is_the_whole_fields_path() {
+    /// Worlds of seeds `0..n` with the default configuration, by turns a maze, a warehouse and
+    /// `scenarios/office.png`.
+    fn mixed_worlds(n: u64) -> impl Iterator<Item = (u64, World)> {
         let config = ValidConfig::default();
         let office =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/office.png");
         let (office, _) =
             crate::scene::map::load(&office, &config.map, config.reach_px()).expect("a map");
         let office = std::sync::Arc::new(office);
-        let mut compared = 0;
-        for seed in 0..15u64 {
+        (0..n).map(move |seed| {
             let world = match seed % 3 {
                 0 => World::maze(config.clone(), seed),
                 1 => World::warehouse(config.clone(), seed),
                 _ => World::new(config.clone(), office.clone()),
             };
+            (seed, world)
+        })
+    }
+
+    /// The search over just the cells a path could use gives exactly the whole field's path:
+    /// in mazes, warehouses and an image map, plain and wall-shy costs, near and far starts,
+    /// starts cut off from the goal, in walls and outside the scene.
+    #[test]
+    fn grid_path_is_the_whole_fields_path() {
+        let mut compared = 0;
+        for (seed, world) in mixed_worlds(15) {
             let (scene, grid) = (world.scene(), world.grid());
             let Ok(episode) = world.episode(seed) else {
                 continue;
@@ -1019,19 +1027,8 @@ mod tests {
     /// start it heads for.
     #[test]
     fn a_lazy_field_gives_the_whole_fields_distances() {
-        let config = ValidConfig::default();
-        let office =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/office.png");
-        let (office, _) =
-            crate::scene::map::load(&office, &config.map, config.reach_px()).expect("a map");
-        let office = std::sync::Arc::new(office);
         let (mut compared, mut searched, mut free) = (0, 0, 0);
-        for seed in 0..12u64 {
-            let world = match seed % 3 {
-                0 => World::maze(config.clone(), seed),
-                1 => World::warehouse(config.clone(), seed),
-                _ => World::new(config.clone(), office.clone()),
-            };
+        for (seed, world) in mixed_worlds(12) {
             let (scene, grid) = (world.scene(), world.grid());
             let Ok(episode) = world.episode(seed) else {
                 continue;
