@@ -232,8 +232,15 @@ impl Batch {
 
     /// Starts every environment afresh: environment `i` gets seed `seed + i`.
     pub fn reset(&mut self, seed: u64) -> Result<(), RunError> {
+        self.call(|batch| batch.reset_all(seed))
+    }
+
+    /// Runs `f`, one of the caller's calls (step, reset, restart), noting when the caller came
+    /// and went: whether the pool's threads linger after its runs follows from that (see
+    /// [`LINGER`]).
+    fn call<T>(&mut self, f: impl FnOnce(&mut Self) -> T) -> T {
         self.lanes.arrive();
-        let result = self.reset_all(seed);
+        let result = f(self);
         self.lanes.ended = Some(std::time::Instant::now());
         result
     }
@@ -256,10 +263,7 @@ impl Batch {
     /// automatic reset would have given it). The others are left as they are. An environment's
     /// later episodes follow from the seed it starts with, in the batch's seed order.
     pub fn restart(&mut self, which: &[bool], seeds: &[Option<u64>]) -> Result<(), RunError> {
-        self.lanes.arrive();
-        let result = self.restart_some(which, seeds);
-        self.lanes.ended = Some(std::time::Instant::now());
-        result
+        self.call(|batch| batch.restart_some(which, seeds))
     }
 
     /// [`Batch::restart`] between the caller's coming and going.
@@ -312,10 +316,7 @@ impl Batch {
         &mut self,
         choose: &(dyn Fn(usize, &Episode, &mut Rng) -> Action + Sync),
     ) -> Result<(), RunError> {
-        self.lanes.arrive();
-        let result = self.step_all(choose);
-        self.lanes.ended = Some(std::time::Instant::now());
-        result
+        self.call(|batch| batch.step_all(choose))
     }
 
     /// [`Batch::step`] between the caller's coming and going (it may run the environments more

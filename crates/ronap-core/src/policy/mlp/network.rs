@@ -338,8 +338,8 @@ const NARROW: usize = 8;
 /// The `W` outputs from `o` of the rows `rows` (at most four), for what is left of a layer after
 /// its whole vectors (all of a layer narrower than one: eight outputs under AVX-512, three for
 /// the last layer): the rows' sums side by side, `W` to a row, in the same order as
-/// [`add_columns`] (so the same bits), which the compiler vectorises over the `W` outputs. A row at a time, each output's sum would be one chain of
-/// dependent adds.
+/// [`add_columns`] (so the same bits), which the compiler vectorises over the `W` outputs. A row
+/// at a time, each output's sum would be one chain of dependent adds.
 #[inline(always)]
 fn add_narrow<const W: usize>(
     y: &mut [f32],
