@@ -186,8 +186,15 @@ impl LazyField {
         close_cost: f64,
     ) -> Self {
         let (cols, rows) = grid.size();
-        let mut work = Box::<Work>::default();
-        work.cells.resize(cols * rows, UNREACHED);
+        let (mut work, mut settled) = LAZY_WORK
+            .with_borrow_mut(Vec::pop)
+            .unwrap_or_else(|| (Box::default(), Vec::new()));
+        if work.cells.len() != cols * rows {
+            work.cells.clear();
+            work.cells.resize(cols * rows, UNREACHED);
+            settled.clear();
+            settled.resize(cols * rows, false);
+        }
         let from = grid
             .cell_of(toward)
             .or(grid.cell_of(goal))
@@ -201,7 +208,7 @@ impl LazyField {
             cell_px: grid.cell_px(),
             goal,
             work,
-            settled: vec![false; cols * rows],
+            settled,
         }
     }
 
@@ -306,9 +313,38 @@ impl LazyField {
                     settled,
                 },
             );
-            // The list of settled cells is `grid_path`'s; the marks above are this field's.
-            work.closed.clear();
         }
+    }
+}
+
+/// Most searches of dropped lazy fields a thread keeps: an environment's shaping drops its old
+/// field about when it makes a new one.
+const LAZY_KEPT: usize = 4;
+
+thread_local! {
+    /// Searches (with their settled marks) of lazy fields dropped on this thread, every cell
+    /// unreached and unmarked again, for the next lazy field to take up instead of clearing a
+    /// whole grid's worth of new buffers.
+    static LAZY_WORK: std::cell::RefCell<Vec<(Box<Work>, Vec<bool>)>> =
+        const { std::cell::RefCell::new(Vec::new()) };
+}
+
+impl Drop for LazyField {
+    /// Hands the search to the thread's [`LAZY_WORK`], its cells put back as they were at the
+    /// cost of the cells it reached rather than of all.
+    fn drop(&mut self) {
+        let mut work = std::mem::take(&mut self.work);
+        let mut settled = std::mem::take(&mut self.settled);
+        for &i in &work.closed {
+            settled[i as usize] = false;
+        }
+        work.tidy();
+        work.closed.clear();
+        LAZY_WORK.with_borrow_mut(|kept| {
+            if kept.len() < LAZY_KEPT {
+                kept.push((work, settled));
+            }
+        });
     }
 }
 
@@ -425,7 +461,7 @@ struct Work {
     front: Vec<Vec<u32>>,
     /// [`Work::bound`]'s cells reached at the sum it is settling.
     level: Vec<u32>,
-    /// The cells [`Work::bound`] settled.
+    /// The cells [`Work::bound`] settled; a [`LazyField`]'s, every cell it has settled.
     closed: Vec<u32>,
     /// The cells [`Work::narrow`] keeps.
     shortest: Vec<u32>,
@@ -830,8 +866,9 @@ impl Work {
         }
     }
 
-    /// Leaves every cell unreached again after a [`Work::bound`] and [`Work::search`]: only the
-    /// cells they reached, which wait in the ring or are settled.
+    /// Leaves every cell unreached again after a [`Work::bound`] and [`Work::search`], or a
+    /// [`LazyField`]'s searches: only the cells they reached, which wait in the ring or are
+    /// settled.
     fn tidy(&mut self) {
         for &i in self.front.iter().flatten() {
             self.cells[i as usize] = UNREACHED;
@@ -1152,6 +1189,41 @@ mod tests {
     /// A lazy field steered after a robot that wanders off at random gives the whole field's
     /// distances at every pose, and settles fewer cells than one that kept heading for the start
     /// (under 30% of them over these 8 mazes, against 35% when never steered anew).
+    /// A dropped lazy field's search goes back to its thread with every cell unreached and
+    /// unmarked, however far it went and however often it was steered anew, and the next lazy
+    /// field takes it up (a robot wandering over it is the test above).
+    #[test]
+    fn a_dropped_lazy_fields_search_is_left_clean() {
+        LAZY_WORK.with_borrow_mut(Vec::clear);
+        for (seed, world) in mixed_worlds(6) {
+            let grid = world.grid();
+            let Ok(episode) = world.episode(seed) else {
+                continue;
+            };
+            let (start, goal) = (episode.start().position(), episode.goal());
+            let mut lazy = LazyField::new(world.scene(), grid, goal, start, 5.0, 4.0);
+            let (w, h) = (world.scene().width(), world.scene().height());
+            for k in 0..12 {
+                let p = Point::new(w * (k as f64 * 0.37 % 1.0), h * (k as f64 * 0.61 % 1.0));
+                lazy.distance_at(grid, p);
+            }
+            assert!(lazy.settled.iter().any(|&s| s), "seed {seed}");
+            drop(lazy);
+            LAZY_WORK.with_borrow(|kept| {
+                assert_eq!(kept.len(), 1, "seed {seed}");
+                let (work, settled) = &kept[0];
+                assert!(work.closed.is_empty());
+                assert!(!settled.iter().any(|&s| s), "seed {seed}");
+                assert!(
+                    work.cells
+                        .iter()
+                        .all(|c| c.cost == u32::MAX && c.parent == ROOT),
+                    "seed {seed}"
+                );
+            });
+        }
+    }
+
     #[test]
     fn a_lazy_field_follows_a_wandering_robot() {
         use crate::sim::robot::{Action, DiscreteAction};
