@@ -440,9 +440,8 @@ struct Work {
     buckets: Vec<Vec<u32>>,
     /// Cells of the current bucket being settled.
     bucket: Vec<u32>,
-    /// A steered search's ([`Work::bound`]'s A*) step costs, plain and close (see
-    /// [`step_costs`]).
-    steps: [[u32; 8]; 2],
+    /// The step costs of the search under way.
+    steps: Steps,
     /// The length of [`Work::front`]'s ring.
     ring: usize,
     /// The sum (cost plus least distance) a steered search settles next: every cell whose sum
@@ -570,69 +569,69 @@ impl Work {
     /// searched cell its cost is searched too.
     fn search(&mut self, grid: &FreeGrid, roots: &[(usize, f64)], close_cost: f64) {
         let cell_px = grid.cell_px();
-        let steps = step_costs(close_cost);
-        let ring = longest(&steps) as usize + 1;
-        reset_ring(&mut self.buckets, ring);
-        let (cells, buckets) = (&mut self.cells, &mut self.buckets);
-        let mut pending = 0usize;
+        self.set_steps(close_cost);
         let units_per_px = AXIS as f64 / cell_px;
-        for &(i, d) in roots {
-            let c = (d * units_per_px).round() as u32;
+        let starts: Vec<(usize, u32)> = roots
+            .iter()
+            .map(|&(i, d)| (i, (d * units_per_px).round() as u32))
+            .collect();
+        // Longer than any step and than the goal's attachments spread, so every cell in a bucket
+        // costs the level being settled (or less, when improved since it was put there); a power
+        // of two, so a cost's bucket is its low bits.
+        let widest = starts.iter().map(|s| s.1).max().unwrap_or(0);
+        let ring = (self.steps.longest().max(widest) as usize + 1).next_power_of_two();
+        let mask = ring - 1;
+        reset_ring(&mut self.buckets, ring);
+        let (cells, buckets, steps) = (&mut self.cells, &mut self.buckets, &self.steps);
+        for (i, c) in starts {
             if c < cells[i].cost {
                 cells[i].cost = c;
-                buckets[c as usize % ring].push(i as u32);
-                pending += 1;
+                buckets[c as usize].push(i as u32);
             }
         }
-        let (moves, slow) = (grid.moves(), grid.close_moves());
+        let n = cells.len();
+        // As long as the cells, so a cell's index needs checking only once.
+        let (moves, slow) = (&grid.moves()[..n], &grid.close_moves()[..n]);
         let offsets = grid.move_offsets();
         let mut current = 0u32;
-        // `current % ring`, kept by hand: a step lands less than a ring ahead, so its bucket is
-        // an addition and at most one wrap away.
-        let mut slot = 0usize;
+        // Buckets found empty in a row: a whole ring of them, and no cell is left to settle.
+        let mut idle = 0;
         let mut bucket = std::mem::take(&mut self.bucket);
-        while pending > 0 {
+        while idle < ring {
+            let slot = current as usize & mask;
+            current += 1;
+            if buckets[slot].is_empty() {
+                idle += 1;
+                continue;
+            }
+            idle = 0;
+            let cost = current - 1;
             std::mem::swap(&mut bucket, &mut buckets[slot]);
             for &i in &bucket {
                 let i = i as usize;
-                if cells[i].cost > current {
-                    // A start cost a ring or more ahead (the goal's attachments spread wider than
-                    // one step): keep it for a later turn of the ring.
-                    buckets[slot].push(i as u32);
-                    continue;
-                }
-                pending -= 1;
-                if cells[i].cost < current {
+                if cells[i].cost != cost {
+                    // Improved since it was put here, and settled then.
                     continue;
                 }
                 // Open moves as bits in the order E, W, N, S, NE, SE, NW, SW: the order decides
                 // which of two equal-cost parents a cell keeps.
                 let open = moves[i] as u32;
-                let slow = slow[i] as u32;
-                let mut better = improving(cells, i, current, open, slow, &offsets, &steps);
+                let slow = slow[i] & steps.close_mask;
+                let st = &steps.by_close[slow as usize];
+                let mut better = improving(cells, i, cost, open, slow, st, &offsets);
                 while better != 0 {
                     let k = better.trailing_zeros() as usize;
                     better &= better - 1;
                     let j = i.wrapping_add(offsets[k] as usize);
-                    let step = steps[(slow >> k & 1) as usize][k];
+                    let to = cost + st[k];
                     cells[j] = Node {
-                        cost: current + step,
+                        cost: to,
                         parent: i as u32,
                     };
-                    let mut to = slot + step as usize;
-                    if to >= ring {
-                        to -= ring;
-                    }
-                    buckets[to].push(j as u32);
-                    pending += 1;
+                    buckets[to as usize & mask].push(j as u32);
                 }
             }
             bucket.clear();
-            current += 1;
-            slot += 1;
-            if slot == ring {
-                slot = 0;
-            }
         }
         self.bucket = bucket;
     }
@@ -700,7 +699,7 @@ impl Work {
         close_cost: f64,
         from: (usize, usize),
     ) {
-        self.steps = step_costs(close_cost);
+        self.set_steps(close_cost);
         let units_per_px = AXIS as f64 / grid.cell_px();
         let mut starts = Vec::new();
         for &(i, d) in roots {
@@ -729,7 +728,7 @@ impl Work {
         // A step changes a cell's sum by 0 to twice its cost; the goal's attachments, or a front
         // steered anew, may spread wider than that.
         let widest = starts.iter().map(|s| s.1 - current).max().unwrap_or(0);
-        self.ring = (2 * longest(&self.steps)).max(widest) as usize + 1;
+        self.ring = (2 * self.steps.longest()).max(widest) as usize + 1;
         reset_ring(&mut self.front, self.ring);
         for &(at, sum) in &starts {
             self.front[sum as usize % self.ring].push(at);
@@ -745,7 +744,7 @@ impl Work {
     /// [`Work::front`].
     fn settle_steered(&mut self, grid: &FreeGrid, steer: &mut impl Steer) {
         let cols = grid.size().0 as u32;
-        let (ring, steps) = (self.ring, self.steps);
+        let ring = self.ring;
         let (mut pending, mut current, mut slot) = (self.pending, self.current, self.slot);
         let ((fc, fr), slack) = (self.from, self.slack);
         // [`Work::least`], on copies the loop can keep in registers.
@@ -754,6 +753,7 @@ impl Work {
             (AXIS * dc.max(dr) + (DIAGONAL - AXIS) * dc.min(dr)).saturating_sub(slack)
         };
         let (cells, closed, front) = (&mut self.cells, &mut self.closed, &mut self.front);
+        let steps = &self.steps;
         let (moves, slow) = (grid.moves(), grid.close_moves());
         let offsets = grid.move_offsets();
         // Column and row changes of the moves E, W, N, S, NE, SE, NW, SW.
@@ -781,13 +781,14 @@ impl Work {
                 }
                 closed.push(i as u32);
                 let open = moves[i] as u32;
-                let slow = slow[i] as u32;
-                let mut better = improving(cells, i, cost, open, slow, &offsets, &steps);
+                let slow = slow[i] & steps.close_mask;
+                let st = &steps.by_close[slow as usize];
+                let mut better = improving(cells, i, cost, open, slow, st, &offsets);
                 while better != 0 {
                     let k = better.trailing_zeros() as usize;
                     better &= better - 1;
                     let j = i.wrapping_add(offsets[k] as usize);
-                    let nd = cost + steps[(slow >> k & 1) as usize][k];
+                    let nd = cost + st[k];
                     cells[j].cost = nd;
                     let (nc, nr) = (c.wrapping_add(DC[k]), r.wrapping_add(DR[k]));
                     let ahead = (nd + least(nc, nr) - current) as usize;
@@ -868,6 +869,13 @@ impl Work {
         }
     }
 
+    /// Makes [`Work::steps`] those of `close_cost`, building their table only when they change.
+    fn set_steps(&mut self, close_cost: f64) {
+        if self.steps.pair != step_costs(close_cost) {
+            self.steps = Steps::new(close_cost);
+        }
+    }
+
     /// Leaves every cell unreached again after a [`Work::bound`] and [`Work::search`], or a
     /// [`LazyField`]'s searches: only the cells they reached, which wait in the ring or are
     /// settled.
@@ -889,49 +897,95 @@ fn step_costs(close_cost: f64) -> [[u32; 8]; 2] {
     [STEP, STEP.map(|s| s * close)]
 }
 
-/// The longest of [`step_costs`]' steps: a diagonal from or into a close cell.
-fn longest(steps: &[[u32; 8]; 2]) -> u32 {
-    steps[1][7]
+/// Step costs by move (E, W, N, S, NE, SE, NW, SW) for a cell, whatever its close moves.
+struct Steps {
+    /// Plain, and from or into a close cell (see [`step_costs`]).
+    pair: [[u32; 8]; 2],
+    /// Row `slow`: the step costs from a cell whose close moves are the bits of `slow`, so a
+    /// move's cost is one look-up rather than a pick between the two.
+    by_close: Box<[[u32; 8]; 256]>,
+    /// What of a cell's close moves matters: all of them, or none when close steps cost what
+    /// plain ones do (every cell inside the grid then takes [`improving`]'s quickest way).
+    close_mask: u8,
+}
+
+impl Steps {
+    fn new(close_cost: f64) -> Self {
+        let pair = step_costs(close_cost);
+        let by_close = Box::new(std::array::from_fn(|slow| {
+            std::array::from_fn(|k| pair[slow >> k & 1][k])
+        }));
+        let close_mask = if pair[0] == pair[1] { 0 } else { u8::MAX };
+        Self {
+            pair,
+            by_close,
+            close_mask,
+        }
+    }
+
+    /// The longest step: a diagonal from or into a close cell.
+    fn longest(&self) -> u32 {
+        self.pair[1][7]
+    }
+}
+
+impl Default for Steps {
+    fn default() -> Self {
+        Self::new(1.0)
+    }
 }
 
 /// Which open moves from cell `i` (at `cost`; `open` and `slow` its open and close moves as
-/// bits) improve the cell they reach, as bits. Found for all eight before any is taken (they
-/// reach eight different cells), without a branch on each: whether a neighbour improves is a
-/// coin toss to the branch predictor.
+/// bits, `st` its moves' step costs) improve the cell they reach, as bits. Found for all eight
+/// before any is taken (they reach eight different cells), without a branch on each: whether a
+/// neighbour improves is a coin toss to the branch predictor.
 #[inline(always)]
 fn improving(
     cells: &[Node],
     i: usize,
     cost: u32,
     open: u32,
-    slow: u32,
+    slow: u8,
+    st: &[u32; 8],
     offsets: &[isize; 8],
-    steps: &[[u32; 8]; 2],
 ) -> u32 {
-    // Most cells lie inside the grid and make no close move: their three rows of neighbours are
-    // read whole, at plain costs, and the closed moves masked off at the end.
+    // Most cells lie inside the grid: their three rows of neighbours are read whole, and the
+    // closed moves masked off at the end.
     let w = offsets[2] as usize;
-    if slow == 0 && i > w && i + w + 1 < cells.len() {
+    if i > w && i + w + 1 < cells.len() {
         let rows = (
             <&[Node; 3]>::try_from(&cells[i - w - 1..i - w + 2]),
             <&[Node; 3]>::try_from(&cells[i - 1..i + 2]),
             <&[Node; 3]>::try_from(&cells[i + w - 1..i + w + 2]),
         );
         if let (Ok(south), Ok(row), Ok(north)) = rows {
-            let (axis, diagonal) = (cost + steps[0][0], cost + steps[0][4]);
-            let lt = |step: u32, node: &Node, k: u32| u32::from(step < node.cost) << k;
+            if slow == 0 {
+                // No close move: two offers, in registers.
+                let (axis, diagonal) = (cost + st[0], cost + st[4]);
+                let lt = |step: u32, node: &Node, k: u32| u32::from(step < node.cost) << k;
+                return open
+                    & (lt(axis, &row[2], 0)
+                        | lt(axis, &row[0], 1)
+                        | lt(axis, &north[1], 2)
+                        | lt(axis, &south[1], 3)
+                        | lt(diagonal, &north[2], 4)
+                        | lt(diagonal, &south[2], 5)
+                        | lt(diagonal, &north[0], 6)
+                        | lt(diagonal, &south[0], 7));
+            }
+            let lt = |k: usize, node: &Node| u32::from(cost + st[k] < node.cost) << k;
             return open
-                & (lt(axis, &row[2], 0)
-                    | lt(axis, &row[0], 1)
-                    | lt(axis, &north[1], 2)
-                    | lt(axis, &south[1], 3)
-                    | lt(diagonal, &north[2], 4)
-                    | lt(diagonal, &south[2], 5)
-                    | lt(diagonal, &north[0], 6)
-                    | lt(diagonal, &south[0], 7));
+                & (lt(0, &row[2])
+                    | lt(1, &row[0])
+                    | lt(2, &north[1])
+                    | lt(3, &south[1])
+                    | lt(4, &north[2])
+                    | lt(5, &south[2])
+                    | lt(6, &north[0])
+                    | lt(7, &south[0]));
         }
     }
-    improving_each(cells, i, cost, open, slow, offsets, steps)
+    improving_each(cells, i, cost, open, st, offsets)
 }
 
 /// [`improving`] one move at a time, for any cell: a closed move looks at the cell itself, which
@@ -942,16 +996,14 @@ fn improving_each(
     i: usize,
     cost: u32,
     open: u32,
-    slow: u32,
+    st: &[u32; 8],
     offsets: &[isize; 8],
-    steps: &[[u32; 8]; 2],
 ) -> u32 {
     let mut better = 0u32;
     for k in 0..8 {
         let mask = ((open as usize >> k) & 1).wrapping_neg();
         let j = i.wrapping_add(offsets[k] as usize & mask);
-        let nd = cost + steps[(slow >> k & 1) as usize][k];
-        better |= u32::from(nd < cells[j].cost) << k;
+        better |= u32::from(cost + st[k] < cells[j].cost) << k;
     }
     better
 }
@@ -1045,10 +1097,10 @@ mod tests {
         })
     }
 
-    /// [`improving`]'s quick path for cells inside the grid with no close move finds the moves
-    /// that [`improving_each`] finds one at a time: at every cell of mazes, warehouses and an
-    /// image map, border cells included, among neighbours at costs drawn at random (some not
-    /// reached), with and without close moves.
+    /// [`improving`], reading rows for cells inside the grid and its step costs from a table,
+    /// finds the moves that each open move on its own finds with its step picked by its bit: at
+    /// every cell of mazes, warehouses and an image map, border cells included, among neighbours
+    /// at costs drawn at random (some not reached), with and without close moves.
     #[test]
     fn improving_reads_rows_as_each_move_would() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
@@ -1067,23 +1119,102 @@ mod tests {
                 })
                 .collect();
             let (moves, close) = (grid.moves(), grid.close_moves());
-            let (offsets, steps) = (grid.move_offsets(), step_costs(4.0));
+            let (offsets, steps) = (grid.move_offsets(), Steps::new(4.0));
             for (i, cell) in cells.iter().enumerate().filter(|(_, c)| c.cost != u32::MAX) {
                 let open = u32::from(moves[i]);
-                for slow in [u32::from(close[i]), 0] {
-                    let each = improving_each(&cells, i, cell.cost, open, slow, &offsets, &steps);
+                for slow in [close[i], 0] {
+                    // Each open move on its own, its step picked by its bit.
+                    let each = (0..8).filter(|&k| open >> k & 1 == 1).fold(0, |bits, k| {
+                        let j = i.wrapping_add(offsets[k] as usize);
+                        let step = steps.pair[usize::from(slow >> k & 1)][k];
+                        bits | u32::from(cell.cost + step < cells[j].cost) << k
+                    });
+                    let st = &steps.by_close[usize::from(slow)];
                     assert_eq!(
-                        improving(&cells, i, cell.cost, open, slow, &offsets, &steps),
+                        improving(&cells, i, cell.cost, open, slow, st, &offsets),
                         each,
                         "cell {i} cost {} open {open:#b} slow {slow:#b}",
                         cell.cost
                     );
-                    quick += usize::from(slow == 0 && i > cols && i + cols + 1 < cells.len());
+                    quick += usize::from(i > cols && i + cols + 1 < cells.len());
                     found += usize::from(each != 0);
                 }
             }
         }
         assert!(quick > 100_000 && found > 50_000, "{quick} {found}");
+    }
+
+    /// Dijkstra as its definition reads, level by level of cost in a sorted map, each level's
+    /// cells in the order they were reached, each move on its own: the costs and parents
+    /// [`Work::search`] must give.
+    fn by_levels(grid: &FreeGrid, roots: &[(usize, f64)], close_cost: f64) -> Vec<Node> {
+        let (cols, rows) = grid.size();
+        let mut cells = vec![UNREACHED; cols * rows];
+        let steps = step_costs(close_cost);
+        let mut levels = std::collections::BTreeMap::<u32, Vec<usize>>::new();
+        for &(i, d) in roots {
+            let c = (d * AXIS as f64 / grid.cell_px()).round() as u32;
+            if c < cells[i].cost {
+                cells[i].cost = c;
+                levels.entry(c).or_default().push(i);
+            }
+        }
+        let (moves, close, offsets) = (grid.moves(), grid.close_moves(), grid.move_offsets());
+        while let Some((cost, level)) = levels.pop_first() {
+            for i in level {
+                if cells[i].cost != cost {
+                    continue;
+                }
+                for k in (0..8).filter(|&k| moves[i] >> k & 1 == 1) {
+                    let j = i.wrapping_add(offsets[k] as usize);
+                    let to = cost + steps[usize::from(close[i] >> k & 1)][k];
+                    if to < cells[j].cost {
+                        cells[j] = Node {
+                            cost: to,
+                            parent: i as u32,
+                        };
+                        levels.entry(to).or_default().push(j);
+                    }
+                }
+            }
+        }
+        cells
+    }
+
+    /// A whole field has, at every cell, the cost and parent of Dijkstra as its definition
+    /// reads ([`by_levels`]): mazes, warehouses and an image map, plain and wall-shy costs,
+    /// goals where episodes put them and at random free cells.
+    #[test]
+    fn a_whole_field_is_dijkstras_by_levels() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        let mut cells = 0;
+        for (seed, world) in mixed_worlds(9) {
+            let (scene, grid) = (world.scene(), world.grid());
+            let (cols, rows) = grid.size();
+            let free: Vec<(usize, usize)> = (0..rows)
+                .flat_map(|r| (0..cols).map(move |c| (c, r)))
+                .filter(|&(c, r)| grid.is_free(c, r))
+                .collect();
+            let random = free[rng.random_range(0..free.len())];
+            let mut goals = vec![grid.center(random.0, random.1)];
+            goals.extend(world.episode(seed).ok().map(|e| e.goal()));
+            for goal in goals {
+                for close_cost in [1.0, 4.0] {
+                    let field = DistanceField::new(scene, grid, goal, 5.0, close_cost);
+                    let roots = attach(scene, grid, goal, 5.0);
+                    let expected = by_levels(grid, &roots, close_cost);
+                    for (i, (got, want)) in field.cells.iter().zip(&expected).enumerate() {
+                        assert_eq!(
+                            (got.cost, got.parent),
+                            (want.cost, want.parent),
+                            "seed {seed}, goal {goal:?}, close cost {close_cost}, cell {i}"
+                        );
+                    }
+                    cells += expected.iter().filter(|n| n.cost != u32::MAX).count();
+                }
+            }
+        }
+        assert!(cells > 500_000, "{cells}");
     }
 
     /// The search over just the cells a path could use gives exactly the whole field's path:
