@@ -568,13 +568,8 @@ impl Work {
     /// alone: it is the same whatever cells are left out, as long as every neighbour offering a
     /// searched cell its cost is searched too.
     fn search(&mut self, grid: &FreeGrid, roots: &[(usize, f64)], close_cost: f64) {
-        let cell_px = grid.cell_px();
         self.set_steps(close_cost);
-        let units_per_px = AXIS as f64 / cell_px;
-        let starts: Vec<(usize, u32)> = roots
-            .iter()
-            .map(|&(i, d)| (i, (d * units_per_px).round() as u32))
-            .collect();
+        let starts: Vec<(usize, u32)> = root_costs(grid, roots).collect();
         // Longer than any step and than the goal's attachments spread, so every cell in a bucket
         // costs the level being settled (or less, when improved since it was put there); a power
         // of two, so a cost's bucket is its low bits.
@@ -598,14 +593,13 @@ impl Work {
         let mut idle = 0;
         let mut bucket = std::mem::take(&mut self.bucket);
         while idle < ring {
-            let slot = current as usize & mask;
+            let (cost, slot) = (current, current as usize & mask);
             current += 1;
             if buckets[slot].is_empty() {
                 idle += 1;
                 continue;
             }
             idle = 0;
-            let cost = current - 1;
             std::mem::swap(&mut bucket, &mut buckets[slot]);
             for &i in &bucket {
                 let i = i as usize;
@@ -616,8 +610,7 @@ impl Work {
                 // Open moves as bits in the order E, W, N, S, NE, SE, NW, SW: the order decides
                 // which of two equal-cost parents a cell keeps.
                 let open = moves[i] as u32;
-                let slow = slow[i] & steps.close_mask;
-                let st = &steps.by_close[slow as usize];
+                let (slow, st) = steps.of(slow[i]);
                 let mut better = improving(cells, i, cost, open, slow, st, &offsets);
                 while better != 0 {
                     let k = better.trailing_zeros() as usize;
@@ -700,10 +693,8 @@ impl Work {
         from: (usize, usize),
     ) {
         self.set_steps(close_cost);
-        let units_per_px = AXIS as f64 / grid.cell_px();
         let mut starts = Vec::new();
-        for &(i, d) in roots {
-            let c = (d * units_per_px).round() as u32;
+        for (i, c) in root_costs(grid, roots) {
             if c < self.cells[i].cost {
                 self.cells[i].cost = c;
                 starts.push(i as u32);
@@ -781,8 +772,7 @@ impl Work {
                 }
                 closed.push(i as u32);
                 let open = moves[i] as u32;
-                let slow = slow[i] & steps.close_mask;
-                let st = &steps.by_close[slow as usize];
+                let (slow, st) = steps.of(slow[i]);
                 let mut better = improving(cells, i, cost, open, slow, st, &offsets);
                 while better != 0 {
                     let k = better.trailing_zeros() as usize;
@@ -897,6 +887,18 @@ fn step_costs(close_cost: f64) -> [[u32; 8]; 2] {
     [STEP, STEP.map(|s| s * close)]
 }
 
+/// The cells the goal attaches to (`roots`, with their distances from the goal in px) and those
+/// distances in the searches' units, rounded: where both searches start.
+fn root_costs<'a>(
+    grid: &FreeGrid,
+    roots: &'a [(usize, f64)],
+) -> impl Iterator<Item = (usize, u32)> + 'a {
+    let units_per_px = AXIS as f64 / grid.cell_px();
+    roots
+        .iter()
+        .map(move |&(i, d)| (i, (d * units_per_px).round() as u32))
+}
+
 /// Step costs by move (E, W, N, S, NE, SE, NW, SW) for a cell, whatever its close moves.
 struct Steps {
     /// Plain, and from or into a close cell (see [`step_costs`]).
@@ -926,6 +928,14 @@ impl Steps {
     /// The longest step: a diagonal from or into a close cell.
     fn longest(&self) -> u32 {
         self.pair[1][7]
+    }
+
+    /// Of a cell whose close moves are the bits of `close`, those that matter, and its moves'
+    /// step costs.
+    #[inline(always)]
+    fn of(&self, close: u8) -> (u8, &[u32; 8]) {
+        let slow = close & self.close_mask;
+        (slow, &self.by_close[usize::from(slow)])
     }
 }
 
