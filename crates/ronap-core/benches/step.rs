@@ -275,11 +275,33 @@ fn setup(c: &mut Criterion) {
     group.finish();
 }
 
+/// What `ronap collect --expert geodesic` spends on its rows: the expert's label of a state, which
+/// plans afresh from it (the field's path, then its first 80 points smoothed). An episode's first
+/// 100 rows (fewer if the expert driving reaches the goal first) each way the robot moves on (the
+/// expert driving, or re-posed after each action), the episode's whole field included, over the
+/// seeds of 16 episodes in turn.
+fn label(c: &mut Criterion) {
+    use ronap_core::collect::expert::{collect_episode, Posing};
+    let config = ValidConfig::default();
+    let evaluator = ronap_core::eval::Evaluator::new(config, ronap_core::Scenes::MazePerSeed);
+    let mut group = c.benchmark_group("label");
+    for (name, posing) in [("drive_100", Posing::Drive), ("repose_100", Posing::Repose)] {
+        let mut k = 0u64;
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                k += 1;
+                collect_episode(&evaluator, 3_000_000 + k % 16, 100, posing, None)
+            })
+        });
+    }
+    group.finish();
+}
+
 // The macro defines an undocumented `benches` function.
 #[allow(missing_docs)]
 mod group {
     use super::*;
-    criterion_group!(benches, step, scan, movers, setup, mlp, batch);
+    criterion_group!(benches, step, scan, movers, setup, mlp, batch, label);
 }
 use group::benches;
 criterion_main!(benches);

@@ -116,7 +116,9 @@ impl BinIndex {
         if radius > self.reach_px || !(fx >= 0.0 && fy >= 0.0) {
             return None;
         }
-        let (c, r) = (fx as usize, fy as usize);
+        // Through i64, a few instructions, where a float's conversion to usize takes a dozen on
+        // the baseline x86-64 (both truncate; a huge value saturates either way, off the grid).
+        let (c, r) = (fx as i64 as usize, fy as i64 as usize);
         (c < self.cols && r < self.rows).then_some(r * self.cols + c)
     }
 

@@ -41,14 +41,23 @@ pub fn smooth(scene: &Scene, points: &[Point], radius: f64) -> Vec<Point> {
     let mut directions: Vec<crate::geometry::Vector> = (0..16)
         .map(|k| crate::geometry::unit(k as f64 * 22.5))
         .collect();
+    // Per corner, whether it stayed put when last tried at this step with its neighbours where
+    // they are now: tried again it would stay put again (the same points give the same tries), so
+    // it is passed over until it or a neighbour moves.
+    let mut still = vec![false; out.len()];
     for step in TIGHTEN_STEPS_PX {
+        still.fill(false);
         let mut moved = true;
         let mut rounds = 0;
         while moved && rounds < 8 {
             moved = false;
             rounds += 1;
             for k in 1..out.len().saturating_sub(1) {
+                if still[k] {
+                    continue;
+                }
                 let (a, b) = (out[k - 1], out[k + 1]);
+                let start = out[k];
                 let length = |p: Point| (p - a).norm() + (b - p).norm();
                 // Sliding along either segment keeps that segment clear, so the two directions
                 // towards the neighbours make progress where a tight corner leaves no other.
@@ -81,6 +90,12 @@ pub fn smooth(scene: &Scene, points: &[Point], radius: f64) -> Vec<Point> {
                         here = length(p);
                         moved = true;
                     }
+                }
+                if out[k] == start {
+                    still[k] = true;
+                } else {
+                    still[k - 1] = false;
+                    still[k + 1] = false;
                 }
             }
         }
@@ -166,6 +181,108 @@ mod tests {
         for w in path.windows(2) {
             assert!(scene.sweep_clear(w[0], w[1], 5.0));
         }
+    }
+
+    /// [`smooth`] as it was before it passed over corners that would stay put: every corner
+    /// tried in every round.
+    fn smooth_trying_every_corner(scene: &Scene, points: &[Point], radius: f64) -> Vec<Point> {
+        let mut out = vec![points[0]];
+        let mut i = 0;
+        while i + 1 < points.len() {
+            let mut j = i + 1;
+            while j + 1 < points.len() && scene.sweep_clear(points[i], points[j + 1], radius) {
+                j += 1;
+            }
+            out.push(points[j]);
+            i = j;
+        }
+        let mut dense = Vec::new();
+        for w in out.windows(2) {
+            dense.push(w[0]);
+            dense.push(Point::from((w[0].coords + w[1].coords) / 2.0));
+        }
+        dense.push(out[out.len() - 1]);
+        out = dense;
+        let mut directions: Vec<crate::geometry::Vector> = (0..16)
+            .map(|k| crate::geometry::unit(k as f64 * 22.5))
+            .collect();
+        for step in TIGHTEN_STEPS_PX {
+            let mut moved = true;
+            let mut rounds = 0;
+            while moved && rounds < 8 {
+                moved = false;
+                rounds += 1;
+                for k in 1..out.len().saturating_sub(1) {
+                    let (a, b) = (out[k - 1], out[k + 1]);
+                    let length = |p: Point| (p - a).norm() + (b - p).norm();
+                    directions.truncate(16);
+                    for n in [a, b] {
+                        if let Some(d) = (n - out[k]).try_normalize(1e-12) {
+                            directions.push(d);
+                        }
+                    }
+                    let mut here = length(out[k]);
+                    for d in &directions {
+                        let p = out[k] + d * step;
+                        let clear = scene.disc_clear(p, radius)
+                            && scene.sweep_clear(a, p, radius)
+                            && scene.sweep_clear(p, b, radius);
+                        if length(p) < here - 1e-9 && clear {
+                            out[k] = p;
+                            here = length(p);
+                            moved = true;
+                        }
+                    }
+                }
+            }
+        }
+        let mut k = 1;
+        while k + 1 < out.len() {
+            if scene.sweep_clear(out[k - 1], out[k + 1], radius) {
+                out.remove(k);
+            } else {
+                k += 1;
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn passing_over_corners_that_stay_put_changes_no_bit() {
+        use rand::{Rng, SeedableRng};
+        let config = crate::SimConfig::default().validate().expect("valid");
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut corners = 0;
+        for seed in 0..6 {
+            let world = World::maze(config.clone(), seed);
+            let (scene, grid) = (world.scene(), world.grid());
+            for _ in 0..8 {
+                let free = |rng: &mut rand_chacha::ChaCha8Rng| loop {
+                    let p =
+                        Point::new(rng.random_range(0.0..1000.0), rng.random_range(0.0..1000.0));
+                    if scene.disc_clear(p, 12.0) {
+                        return p;
+                    }
+                };
+                let (a, b) = (free(&mut rng), free(&mut rng));
+                let Some(path) = grid_path(scene, grid, a, b, 5.0, 4.0) else {
+                    continue;
+                };
+                // Whole paths and the expert's 80-point prefixes, at the radii the planners use.
+                for points in [&path[..], &path[..path.len().min(80)]] {
+                    for radius in [5.0, 11.0] {
+                        let ours = smooth(scene, points, radius);
+                        let every = smooth_trying_every_corner(scene, points, radius);
+                        let bits = |p: &[Point]| -> Vec<[u64; 2]> {
+                            p.iter().map(|p| [p.x.to_bits(), p.y.to_bits()]).collect()
+                        };
+                        assert_eq!(bits(&ours), bits(&every), "maze {seed} from {a:?} to {b:?}");
+                        corners += ours.len();
+                    }
+                }
+            }
+        }
+        assert!(corners > 500, "only {corners} points");
     }
 
     #[test]
