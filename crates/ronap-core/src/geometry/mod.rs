@@ -510,8 +510,9 @@ mod tests {
             size in (0.0f64..60.0, 0.0f64..60.0),
             a in (-40.0f64..200.0, -40.0f64..200.0),
             d in (-80.0f64..80.0, -80.0f64..80.0),
-            snap in 0u8..4,
+            snap in 0u8..5,
             radius in 0.0f64..20.0,
+            turn in 0.0f64..90.0,
         ) {
             let b = Aabb::from_corners(
                 Point::new(min.0, min.1),
@@ -526,6 +527,16 @@ mod tests {
                 _ => a,
             };
             let a = if snap == 2 { Point::new(a.x + d.0, b.max.y + radius) } else { a };
+            // Or slanted past the top right corner at `radius` from it, give or take rounding:
+            // beside the box within the segment's bounding box.
+            let (a, end) = if snap == 4 {
+                let out = unit(turn);
+                let along = Vector::new(-out.y, out.x);
+                let touch = b.max + out * radius;
+                (touch - along * d.0.abs(), touch + along * d.1.abs())
+            } else {
+                (a, end)
+            };
             proptest::prop_assert_eq!(
                 b.segment_clear(a, end, radius),
                 b.segment_distance_squared(a, end) >= radius * radius
