@@ -449,7 +449,7 @@ struct Work {
     current: u32,
     /// The bucket of `current`: `current % ring`.
     slot: usize,
-    /// How many entries wait in the ring and in [`Work::level`].
+    /// How many entries wait in the ring.
     pending: usize,
     /// The cell (column, row) a steered search heads for.
     from: (u32, u32),
@@ -460,8 +460,6 @@ struct Work {
     /// [`Work::bound`]'s ring of buckets: cells by cost plus least distance to the start
     /// modulo the ring's length.
     front: Vec<Vec<u32>>,
-    /// [`Work::bound`]'s cells reached at the sum it is settling.
-    level: Vec<u32>,
     /// The cells [`Work::bound`] settled; a [`LazyField`]'s, every cell it has settled.
     closed: Vec<u32>,
     /// The cells [`Work::narrow`] keeps.
@@ -724,7 +722,6 @@ impl Work {
         for &(at, sum) in &starts {
             self.front[sum as usize % self.ring].push(at);
         }
-        self.level.clear();
         (self.current, self.slot, self.pending) =
             (current, current as usize % self.ring, starts.len());
     }
@@ -750,15 +747,12 @@ impl Work {
         // Column and row changes of the moves E, W, N, S, NE, SE, NW, SW.
         const DC: [u32; 8] = [1, u32::MAX, 0, 0, 1, 1, u32::MAX, u32::MAX];
         const DR: [u32; 8] = [0, 0, 1, u32::MAX, 1, u32::MAX, 1, u32::MAX];
-        // Cells reached at the sum being settled (a step towards the start often keeps it), kept
-        // apart from the ring: the ring's buffers, kept per thread, then grow only to the cells
-        // put there from a lower sum.
-        let level = &mut self.level;
         while pending > 0 {
-            // Nothing is put in this bucket during its turn (a push lands 1 to `ring - 1` sums
-            // ahead, or in `level`), so counting past its end reads `level` only.
+            // A push lands 0 to `ring - 1` sums ahead: one at the sum being settled (a step
+            // towards the start often keeps it) joins the end of this bucket, which is read to
+            // its end, without a branch on which (one the processor would often guess wrong).
             let mut n = 0;
-            while let Some(i) = front[slot].get(n).copied().or_else(|| level.pop()) {
+            while let Some(i) = front[slot].get(n).copied() {
                 n += 1;
                 pending -= 1;
                 let (r, c) = (i / cols, i % cols);
@@ -782,15 +776,11 @@ impl Work {
                     cells[j].cost = nd;
                     let (nc, nr) = (c.wrapping_add(DC[k]), r.wrapping_add(DR[k]));
                     let ahead = (nd + least(nc, nr) - current) as usize;
-                    if ahead == 0 {
-                        level.push(j as u32);
-                    } else {
-                        let mut to = slot + ahead;
-                        if to >= ring {
-                            to -= ring;
-                        }
-                        front[to].push(j as u32);
+                    let mut to = slot + ahead;
+                    if to >= ring {
+                        to -= ring;
                     }
+                    front[to].push(j as u32);
                     pending += 1;
                 }
                 steer.settled(i, c, r, cost);
