@@ -182,24 +182,25 @@ impl FreeGrid {
     pub(crate) fn close_moves(&self) -> &[u8] {
         self.close_moves.get_or_init(|| {
             let n = self.moves.len();
+            // The close marks as bytes with a row and a cell of nothing either side, so every
+            // cell reads its eight neighbours' in one pass: a move off the grid (or across its
+            // edge) reads a mark that is not its target's, but it is never open.
+            let pad = self.cols + 1;
+            let mut close = vec![0u8; n + 2 * pad];
+            for (c, &x) in close[pad..pad + n].iter_mut().zip(&self.close) {
+                *c = u8::from(x);
+            }
+            let there = self
+                .move_offsets()
+                .map(|off| &close[(pad as isize + off) as usize..][..n]);
+            let here = &close[pad..pad + n];
             let mut out = vec![0u8; n];
-            for (k, off) in self.move_offsets().into_iter().enumerate() {
-                // Cells `i` in `lo..hi` have their move's target `i + off` in the grid; a move
-                // off the grid (or across its edge) is never open, so its bit stays clear.
-                let lo = off.min(0).unsigned_abs();
-                let hi = n.saturating_sub(off.max(0) as usize);
-                if hi <= lo {
-                    continue;
+            for (i, (o, &m)) in out.iter_mut().zip(&self.moves).enumerate() {
+                let mut near = 0u8.wrapping_sub(here[i]);
+                for (k, there) in there.iter().enumerate() {
+                    near |= there[i] << k;
                 }
-                let there = &self.close[(lo as isize + off) as usize..(hi as isize + off) as usize];
-                for (((o, &m), &here), &there) in out[lo..hi]
-                    .iter_mut()
-                    .zip(&self.moves[lo..hi])
-                    .zip(&self.close[lo..hi])
-                    .zip(there)
-                {
-                    *o |= (m >> k & 1 & u8::from(here | there)) << k;
-                }
+                *o = m & near;
             }
             out
         })
