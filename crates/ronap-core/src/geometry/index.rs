@@ -117,9 +117,9 @@ impl BinIndex {
             return None;
         }
         // Through i64, a few instructions, where a float's conversion to usize takes a dozen on
-        // the baseline x86-64 (both truncate; a huge value saturates either way, off the grid).
-        let (c, r) = (fx as i64 as usize, fy as i64 as usize);
-        (c < self.cols && r < self.rows).then_some(r * self.cols + c)
+        // the baseline x86-64 (both truncate towards zero; a huge value saturates, off the grid).
+        let (c, r) = (fx as i64, fy as i64);
+        (c < self.cols as i64 && r < self.rows as i64).then(|| r as usize * self.cols + c as usize)
     }
 
     #[inline]
