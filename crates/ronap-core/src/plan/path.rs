@@ -2,7 +2,7 @@
 //! ([`smooth`]), which brings its length to within a fraction of a percent of the true shortest
 //! path; and the shortest-path length of a world, SPL's yardstick.
 
-use crate::geometry::Point;
+use crate::geometry::{unit, Point, Vector};
 use crate::plan::field::grid_path;
 use crate::scene::freespace::FreeGrid;
 use crate::scene::Scene;
@@ -17,30 +17,11 @@ const TIGHTEN_STEPS_PX: [f64; 7] = [4.0, 2.0, 1.0, 0.5, 0.25, 0.125, 0.0625];
 /// removes most of the grid's detour around obstacle corners: the result is within about 2% of
 /// the true shortest path (tested on a wall tip, the tightest case in a maze).
 pub fn smooth(scene: &Scene, points: &[Point], radius: f64) -> Vec<Point> {
-    let Some(&first) = points.first() else {
+    if points.is_empty() {
         return Vec::new();
-    };
-    let mut out = vec![first];
-    let mut i = 0;
-    while i + 1 < points.len() {
-        let mut j = i + 1;
-        while j + 1 < points.len() && scene.sweep_clear(points[i], points[j + 1], radius) {
-            j += 1;
-        }
-        out.push(points[j]);
-        i = j;
     }
-    // Midpoints give the band more joints to bend around a rounded corner with.
-    let mut dense = Vec::with_capacity(out.len() * 2);
-    for w in out.windows(2) {
-        dense.push(w[0]);
-        dense.push(Point::from((w[0].coords + w[1].coords) / 2.0));
-    }
-    dense.push(out[out.len() - 1]);
-    out = dense;
-    let mut directions: Vec<crate::geometry::Vector> = (0..16)
-        .map(|k| crate::geometry::unit(k as f64 * 22.5))
-        .collect();
+    let mut out = with_midpoints(&jump_ahead(scene, points, radius));
+    let mut directions = directions();
     // Per corner, whether it stayed put when last tried at this step with its neighbours where
     // they are now: tried again it would stay put again (the same points give the same tries), so
     // it is passed over until it or a neighbour moves.
@@ -56,51 +37,104 @@ pub fn smooth(scene: &Scene, points: &[Point], radius: f64) -> Vec<Point> {
                 if still[k] {
                     continue;
                 }
-                let (a, b) = (out[k - 1], out[k + 1]);
-                let start = out[k];
-                let length = |p: Point| (p - a).norm() + (b - p).norm();
-                // Sliding along either segment keeps that segment clear, so the two directions
-                // towards the neighbours make progress where a tight corner leaves no other.
-                directions.truncate(16);
-                for n in [a, b] {
-                    if let Some(d) = (n - out[k]).try_normalize(1e-12) {
-                        directions.push(d);
-                    }
-                }
-                // The corner's own length, kept as it moves (the same value, bit for bit).
-                let mut here = length(out[k]);
-                for d in &directions {
-                    let p = out[k] + d * step;
-                    // Both legs clear (the disc at `p` first: both legs end there, and a quarter
-                    // of the tries fail on it; then the shorter, cheaper leg).
-                    let clear = || {
-                        let legs = [(a, p), (p, b)];
-                        let order = if (p - a).norm_squared() <= (b - p).norm_squared() {
-                            [0, 1]
-                        } else {
-                            [1, 0]
-                        };
-                        scene.disc_clear(p, radius)
-                            && order
-                                .iter()
-                                .all(|&l| scene.sweep_clear(legs[l].0, legs[l].1, radius))
-                    };
-                    if length(p) < here - 1e-9 && clear() {
-                        out[k] = p;
-                        here = length(p);
-                        moved = true;
-                    }
-                }
-                if out[k] == start {
-                    still[k] = true;
-                } else {
+                if try_corner(scene, &mut out, k, step, radius, &mut directions) {
+                    moved = true;
                     still[k - 1] = false;
                     still[k + 1] = false;
+                } else {
+                    still[k] = true;
                 }
             }
         }
     }
-    // Corners whose neighbours now see each other drop out.
+    drop_seen_corners(scene, &mut out, radius);
+    out
+}
+
+/// The points of a path (not empty) that [`smooth`] starts from: from each kept point, the
+/// furthest later point the disc can reach in a straight line (scanning forward until the line is
+/// blocked).
+fn jump_ahead(scene: &Scene, points: &[Point], radius: f64) -> Vec<Point> {
+    let mut out = vec![points[0]];
+    let mut i = 0;
+    while i + 1 < points.len() {
+        let mut j = i + 1;
+        while j + 1 < points.len() && scene.sweep_clear(points[i], points[j + 1], radius) {
+            j += 1;
+        }
+        out.push(points[j]);
+        i = j;
+    }
+    out
+}
+
+/// `points` (not empty) with the midpoint of each segment between: they give the band more
+/// joints to bend around a rounded corner with.
+fn with_midpoints(points: &[Point]) -> Vec<Point> {
+    let mut dense = Vec::with_capacity(points.len() * 2);
+    for w in points.windows(2) {
+        dense.push(w[0]);
+        dense.push(Point::from((w[0].coords + w[1].coords) / 2.0));
+    }
+    dense.push(points[points.len() - 1]);
+    dense
+}
+
+/// The 16 directions every corner tries, 22.5 degrees apart; [`try_corner`] adds two of its own.
+fn directions() -> Vec<Vector> {
+    (0..16).map(|k| unit(k as f64 * 22.5)).collect()
+}
+
+/// Tries moving corner `k` of `out` (neither end) by `step` in each of `directions` and towards
+/// each neighbour, taking each move that shortens the path with the disc clear; whether it moved.
+fn try_corner(
+    scene: &Scene,
+    out: &mut [Point],
+    k: usize,
+    step: f64,
+    radius: f64,
+    directions: &mut Vec<Vector>,
+) -> bool {
+    let (a, b) = (out[k - 1], out[k + 1]);
+    let start = out[k];
+    let length = |p: Point| (p - a).norm() + (b - p).norm();
+    // Sliding along either segment keeps that segment clear, so the two directions towards the
+    // neighbours make progress where a tight corner leaves no other.
+    directions.truncate(16);
+    for n in [a, b] {
+        if let Some(d) = (n - out[k]).try_normalize(1e-12) {
+            directions.push(d);
+        }
+    }
+    // The corner's own length, kept as it moves (the same value, bit for bit).
+    let mut here = length(out[k]);
+    for d in directions.iter() {
+        let p = out[k] + d * step;
+        // Both legs clear (the disc at `p` first: both legs end there, and a quarter of the tries
+        // fail on it; then the shorter, cheaper leg).
+        let clear = || {
+            let legs = [(a, p), (p, b)];
+            let order = if (p - a).norm_squared() <= (b - p).norm_squared() {
+                [0, 1]
+            } else {
+                [1, 0]
+            };
+            scene.disc_clear(p, radius)
+                && order
+                    .iter()
+                    .all(|&l| scene.sweep_clear(legs[l].0, legs[l].1, radius))
+        };
+        if length(p) < here - 1e-9 && clear() {
+            out[k] = p;
+            here = length(p);
+        }
+    }
+    // Each move shortens the corner's length, so it never ends back where it began.
+    out[k] != start
+}
+
+/// Drops the corners whose neighbours see each other.
+fn drop_seen_corners(scene: &Scene, out: &mut Vec<Point>, radius: f64) {
     let mut k = 1;
     while k + 1 < out.len() {
         if scene.sweep_clear(out[k - 1], out[k + 1], radius) {
@@ -109,7 +143,6 @@ pub fn smooth(scene: &Scene, points: &[Point], radius: f64) -> Vec<Point> {
             k += 1;
         }
     }
-    out
 }
 
 /// Length of a polyline, px.
@@ -186,26 +219,8 @@ mod tests {
     /// [`smooth`] as it was before it passed over corners that would stay put: every corner
     /// tried in every round.
     fn smooth_trying_every_corner(scene: &Scene, points: &[Point], radius: f64) -> Vec<Point> {
-        let mut out = vec![points[0]];
-        let mut i = 0;
-        while i + 1 < points.len() {
-            let mut j = i + 1;
-            while j + 1 < points.len() && scene.sweep_clear(points[i], points[j + 1], radius) {
-                j += 1;
-            }
-            out.push(points[j]);
-            i = j;
-        }
-        let mut dense = Vec::new();
-        for w in out.windows(2) {
-            dense.push(w[0]);
-            dense.push(Point::from((w[0].coords + w[1].coords) / 2.0));
-        }
-        dense.push(out[out.len() - 1]);
-        out = dense;
-        let mut directions: Vec<crate::geometry::Vector> = (0..16)
-            .map(|k| crate::geometry::unit(k as f64 * 22.5))
-            .collect();
+        let mut out = with_midpoints(&jump_ahead(scene, points, radius));
+        let mut directions = directions();
         for step in TIGHTEN_STEPS_PX {
             let mut moved = true;
             let mut rounds = 0;
@@ -213,37 +228,11 @@ mod tests {
                 moved = false;
                 rounds += 1;
                 for k in 1..out.len().saturating_sub(1) {
-                    let (a, b) = (out[k - 1], out[k + 1]);
-                    let length = |p: Point| (p - a).norm() + (b - p).norm();
-                    directions.truncate(16);
-                    for n in [a, b] {
-                        if let Some(d) = (n - out[k]).try_normalize(1e-12) {
-                            directions.push(d);
-                        }
-                    }
-                    let mut here = length(out[k]);
-                    for d in &directions {
-                        let p = out[k] + d * step;
-                        let clear = scene.disc_clear(p, radius)
-                            && scene.sweep_clear(a, p, radius)
-                            && scene.sweep_clear(p, b, radius);
-                        if length(p) < here - 1e-9 && clear {
-                            out[k] = p;
-                            here = length(p);
-                            moved = true;
-                        }
-                    }
+                    moved |= try_corner(scene, &mut out, k, step, radius, &mut directions);
                 }
             }
         }
-        let mut k = 1;
-        while k + 1 < out.len() {
-            if scene.sweep_clear(out[k - 1], out[k + 1], radius) {
-                out.remove(k);
-            } else {
-                k += 1;
-            }
-        }
+        drop_seen_corners(scene, &mut out, radius);
         out
     }
 
