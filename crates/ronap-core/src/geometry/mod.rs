@@ -268,6 +268,45 @@ impl Aabb {
     }
 }
 
+impl Aabb {
+    /// Whether the segment `a`–`b` comes nearer the box than the distance whose square is
+    /// `within2` (meeting it included), without a division or a square root. Rounding can only
+    /// err for a segment within rounding of that distance.
+    pub fn segment_nearer_than(&self, a: Point, b: Point, within2: f64) -> bool {
+        if self.distance_squared(a) < within2 || self.distance_squared(b) < within2 {
+            return true;
+        }
+        let d = b - a;
+        let corners = [
+            self.min,
+            Point::new(self.max.x, self.min.y),
+            self.max,
+            Point::new(self.min.x, self.max.y),
+        ];
+        // Each corner's side of the segment's line, times the segment's length.
+        let sides = corners.map(|c| {
+            let v = c - a;
+            v.x * d.y - v.y * d.x
+        });
+        // The segment meets the box when their bounds overlap and its line does not have every
+        // corner strictly to one side (the separating axes of a segment and a box).
+        let overlap = a.x.min(b.x) <= self.max.x
+            && a.x.max(b.x) >= self.min.x
+            && a.y.min(b.y) <= self.max.y
+            && a.y.max(b.y) >= self.min.y;
+        if overlap && sides.iter().any(|&s| s <= 0.0) && sides.iter().any(|&s| s >= 0.0) {
+            return true;
+        }
+        // Apart, they are nearest at an end of the segment (tested first) or at a corner of the
+        // box whose foot on the line falls between the ends.
+        let dd = d.norm_squared();
+        corners.iter().zip(sides).any(|(&c, side)| {
+            let along = (c - a).dot(&d);
+            along > 0.0 && along < dd && side * side < within2 * dd
+        })
+    }
+}
+
 /// How much further than asked [`Aabb::segment_clear`]'s division-free test wants a segment to
 /// keep, px: far above the rounding of coordinates up to millions of px, far below anything
 /// that matters.
@@ -502,7 +541,7 @@ mod tests {
             }
         }
 
-        /// The division-free test answers as the distance does, including segments that graze
+        /// The division-free tests answer as the distance does, including segments that graze
         /// the grown box, lie along a face, or are a single point.
         #[test]
         fn segment_clear_is_segment_distance_at_least_radius(
@@ -510,9 +549,10 @@ mod tests {
             size in (0.0f64..60.0, 0.0f64..60.0),
             a in (-40.0f64..200.0, -40.0f64..200.0),
             d in (-80.0f64..80.0, -80.0f64..80.0),
-            snap in 0u8..5,
+            snap in 0u8..6,
             radius in 0.0f64..20.0,
             turn in 0.0f64..90.0,
+            gap in -1e-2f64..1e-2,
         ) {
             let b = Aabb::from_corners(
                 Point::new(min.0, min.1),
@@ -529,18 +569,23 @@ mod tests {
             let a = if snap == 2 { Point::new(a.x + d.0, b.max.y + radius) } else { a };
             // Or slanted past the top right corner at `radius` from it, give or take rounding:
             // beside the box within the segment's bounding box.
-            let (a, end) = if snap == 4 {
+            // Or past it a hair nearer or further than `radius`.
+            let (a, end) = if snap >= 4 {
                 let out = unit(turn);
                 let along = Vector::new(-out.y, out.x);
-                let touch = b.max + out * radius;
+                let hair = if snap == 5 { gap } else { 0.0 };
+                let touch = b.max + out * (radius + hair).max(0.0);
                 (touch - along * d.0.abs(), touch + along * d.1.abs())
             } else {
                 (a, end)
             };
-            proptest::prop_assert_eq!(
-                b.segment_clear(a, end, radius),
-                b.segment_distance_squared(a, end) >= radius * radius
-            );
+            let (exact, r2) = (b.segment_distance_squared(a, end), radius * radius);
+            proptest::prop_assert_eq!(b.segment_clear(a, end, radius), exact >= r2);
+            // The nearness test without a division answers as the distance does, but for
+            // rounding: never near when the distance is clearly more, always when clearly less.
+            let (near, rounding) = (b.segment_nearer_than(a, end, r2), 1e-9 * (1.0 + r2));
+            proptest::prop_assert!(!near || exact < r2 + rounding, "near at {}", exact);
+            proptest::prop_assert!(near || exact >= r2 - rounding, "not near at {}", exact);
         }
     }
 }

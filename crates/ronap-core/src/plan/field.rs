@@ -1071,7 +1071,7 @@ fn attach(scene: &Scene, grid: &FreeGrid, p: Point, radius: f64) -> Vec<(usize, 
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::config::ValidConfig;
     use crate::geometry::Vector;
@@ -1080,7 +1080,7 @@ mod tests {
 
     /// Worlds of seeds `0..n` with the default configuration, by turns a maze, a warehouse and
     /// `scenarios/office.png`.
-    fn mixed_worlds(n: u64) -> impl Iterator<Item = (u64, World)> {
+    pub(crate) fn mixed_worlds(n: u64) -> impl Iterator<Item = (u64, World)> {
         let config = ValidConfig::default();
         let office =
             std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenarios/office.png");

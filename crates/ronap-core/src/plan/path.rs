@@ -20,7 +20,15 @@ pub fn smooth(scene: &Scene, points: &[Point], radius: f64) -> Vec<Point> {
     if points.is_empty() {
         return Vec::new();
     }
-    let mut out = with_midpoints(&jump_ahead(scene, points, radius));
+    let out = with_midpoints(&jump_ahead(scene, points, radius));
+    let mut blockers = Blockers::new(scene, points, out.len(), radius);
+    tighten(scene, out, radius, &mut blockers)
+}
+
+/// [`smooth`]'s corners moved in shrinking steps, each wherever it shortens the path with the
+/// disc clear (moves `blockers` refuse untested), then the corners whose neighbours see each
+/// other dropped.
+fn tighten(scene: &Scene, mut out: Vec<Point>, radius: f64, blockers: &mut Blockers) -> Vec<Point> {
     let mut directions = directions();
     // Per corner, whether it stayed put when last tried at this step with its neighbours where
     // they are now: tried again it would stay put again (the same points give the same tries), so
@@ -37,7 +45,7 @@ pub fn smooth(scene: &Scene, points: &[Point], radius: f64) -> Vec<Point> {
                 if still[k] {
                     continue;
                 }
-                if try_corner(scene, &mut out, k, step, radius, &mut directions) {
+                if try_corner(scene, &mut out, k, step, radius, &mut directions, blockers) {
                     moved = true;
                     still[k - 1] = false;
                     still[k + 1] = false;
@@ -87,6 +95,7 @@ fn directions() -> Vec<Vector> {
 
 /// Tries moving corner `k` of `out` (neither end) by `step` in each of `directions` and towards
 /// each neighbour, taking each move that shortens the path with the disc clear; whether it moved.
+/// A move that one of `blockers` clearly blocks is refused without the scene's tests.
 fn try_corner(
     scene: &Scene,
     out: &mut [Point],
@@ -94,6 +103,7 @@ fn try_corner(
     step: f64,
     radius: f64,
     directions: &mut Vec<Vector>,
+    blockers: &mut Blockers,
 ) -> bool {
     let (a, b) = (out[k - 1], out[k + 1]);
     let start = out[k];
@@ -124,13 +134,105 @@ fn try_corner(
                     .iter()
                     .all(|&l| scene.sweep_clear(legs[l].0, legs[l].1, radius))
         };
-        if length(p) < here - 1e-9 && clear() {
-            out[k] = p;
-            here = length(p);
+        if length(p) < here - 1e-9 && !blockers.block(scene, k, a, p, b) {
+            if clear() {
+                out[k] = p;
+                here = length(p);
+            } else {
+                blockers.learn(scene, k, a, p, b);
+            }
         }
     }
     // Each move shortens the corner's length, so it never ends back where it began.
     out[k] != start
+}
+
+/// Per corner, the box that last kept it from moving, tried first on its next moves: [`smooth`]'s
+/// corners lie against the walls they bend around, and most of their tries fail on the wall the
+/// last failure met.
+///
+/// A box whose distance from the disc's position or from either leg is less than the radius by a
+/// margin blocks the move: the scene's own tests ([`Scene::disc_clear`], [`Scene::sweep_clear`])
+/// list every box within the radius and find that one within it too, since their rounding is far
+/// below the margin. So refusing such a move gives the same path, bit for bit, as testing it.
+/// Moves no remembered box blocks by the margin are tested as before.
+struct Blockers {
+    /// By corner, the box ([`NO_BOX`] while unknown).
+    by_corner: Vec<u32>,
+    /// The squared distance within which a box blocks: the radius less the margin, squared;
+    /// negative when nothing may be refused so (a radius no more than the margin).
+    within2: f64,
+    radius: f64,
+    /// How many moves were refused untested.
+    refused: usize,
+}
+
+/// No box yet, in [`Blockers`].
+const NO_BOX: u32 = u32::MAX;
+
+impl Blockers {
+    /// For the `corners` of a path smoothed from `points` in `scene` at `radius`: a margin of a
+    /// millionth of a pixel, and more on scenes and paths so far from the origin that their
+    /// coordinates' rounding nears it.
+    fn new(scene: &Scene, points: &[Point], corners: usize, radius: f64) -> Self {
+        let far = points
+            .iter()
+            .map(|p| p.x.abs().max(p.y.abs()))
+            .fold(scene.width().max(scene.height()), f64::max);
+        let within = radius - (1e-6 + far * 1e-12);
+        Self {
+            by_corner: vec![NO_BOX; corners],
+            within2: if within > 0.0 { within * within } else { -1.0 },
+            radius,
+            refused: 0,
+        }
+    }
+
+    /// Blockers that refuse nothing: every move tested by the scene, as before they were kept.
+    #[cfg(test)]
+    fn off(corners: usize) -> Self {
+        Self {
+            by_corner: vec![NO_BOX; corners],
+            within2: -1.0,
+            radius: 0.0,
+            refused: 0,
+        }
+    }
+
+    /// Whether box `i` (if any) comes within the margin of the disc at `p` or of a leg `a`-`p`
+    /// or `p`-`b` (the disc first: the cheapest test).
+    fn blocks(&self, scene: &Scene, i: u32, a: Point, p: Point, b: Point) -> bool {
+        let Some(o) = scene.boxes().get(i as usize) else {
+            return false;
+        };
+        let r2 = self.within2;
+        r2 > 0.0
+            && (o.distance_squared(p) < r2
+                || o.segment_nearer_than(a, p, r2)
+                || o.segment_nearer_than(p, b, r2))
+    }
+
+    /// Whether corner `k`'s box blocks moving it, between `a` and `b`, to `p`.
+    fn block(&mut self, scene: &Scene, k: usize, a: Point, p: Point, b: Point) -> bool {
+        let blocked = self.blocks(scene, self.by_corner[k], a, p, b);
+        self.refused += usize::from(blocked);
+        blocked
+    }
+
+    /// After the scene refused moving corner `k` to `p`: remembers a box near `p` that blocks
+    /// it by the margin, if there is one.
+    fn learn(&mut self, scene: &Scene, k: usize, a: Point, p: Point, b: Point) {
+        if self.within2 <= 0.0 {
+            return;
+        }
+        if let Some(&i) = scene
+            .boxes_near(p, self.radius)
+            .iter()
+            .find(|&&i| self.blocks(scene, i, a, p, b))
+        {
+            self.by_corner[k] = i;
+        }
+    }
 }
 
 /// Drops the corners whose neighbours see each other.
@@ -216,11 +318,12 @@ mod tests {
         }
     }
 
-    /// [`smooth`] as it was before it passed over corners that would stay put: every corner
-    /// tried in every round.
+    /// [`smooth`] as it was before it passed over corners that would stay put and refused moves
+    /// a remembered box blocks: every corner tried in every round, every try tested.
     fn smooth_trying_every_corner(scene: &Scene, points: &[Point], radius: f64) -> Vec<Point> {
         let mut out = with_midpoints(&jump_ahead(scene, points, radius));
         let mut directions = directions();
+        let mut blockers = Blockers::off(out.len());
         for step in TIGHTEN_STEPS_PX {
             let mut moved = true;
             let mut rounds = 0;
@@ -228,7 +331,15 @@ mod tests {
                 moved = false;
                 rounds += 1;
                 for k in 1..out.len().saturating_sub(1) {
-                    moved |= try_corner(scene, &mut out, k, step, radius, &mut directions);
+                    moved |= try_corner(
+                        scene,
+                        &mut out,
+                        k,
+                        step,
+                        radius,
+                        &mut directions,
+                        &mut blockers,
+                    );
                 }
             }
         }
@@ -236,19 +347,28 @@ mod tests {
         out
     }
 
-    #[test]
-    fn passing_over_corners_that_stay_put_changes_no_bit() {
+    /// The bits of a path's points, to compare paths exactly.
+    fn bits(points: &[Point]) -> Vec<[u64; 2]> {
+        points
+            .iter()
+            .map(|p| [p.x.to_bits(), p.y.to_bits()])
+            .collect()
+    }
+
+    /// Calls `check` with what smoothing meets: in the worlds of seeds `0..worlds` (mazes,
+    /// warehouses and an image map by turns), grid paths between random free points, whole and
+    /// cut to the expert's 80-point prefixes, at the radii the planners use.
+    fn each_smoothing_case(worlds: u64, mut check: impl FnMut(&str, &Scene, &[Point], f64)) {
         use rand::{Rng, SeedableRng};
-        let config = crate::SimConfig::default().validate().expect("valid");
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
-        let mut corners = 0;
-        for seed in 0..6 {
-            let world = World::maze(config.clone(), seed);
+        for (seed, world) in crate::plan::field::tests::mixed_worlds(worlds) {
             let (scene, grid) = (world.scene(), world.grid());
-            for _ in 0..8 {
+            for _ in 0..6 {
                 let free = |rng: &mut rand_chacha::ChaCha8Rng| loop {
-                    let p =
-                        Point::new(rng.random_range(0.0..1000.0), rng.random_range(0.0..1000.0));
+                    let p = Point::new(
+                        rng.random_range(0.0..scene.width()),
+                        rng.random_range(0.0..scene.height()),
+                    );
                     if scene.disc_clear(p, 12.0) {
                         return p;
                     }
@@ -257,21 +377,45 @@ mod tests {
                 let Some(path) = grid_path(scene, grid, a, b, 5.0, 4.0) else {
                     continue;
                 };
-                // Whole paths and the expert's 80-point prefixes, at the radii the planners use.
+                let case = format!("world {seed}, {a:?} to {b:?}");
                 for points in [&path[..], &path[..path.len().min(80)]] {
                     for radius in [5.0, 11.0] {
-                        let ours = smooth(scene, points, radius);
-                        let every = smooth_trying_every_corner(scene, points, radius);
-                        let bits = |p: &[Point]| -> Vec<[u64; 2]> {
-                            p.iter().map(|p| [p.x.to_bits(), p.y.to_bits()]).collect()
-                        };
-                        assert_eq!(bits(&ours), bits(&every), "maze {seed} from {a:?} to {b:?}");
-                        corners += ours.len();
+                        check(&case, scene, points, radius);
                     }
                 }
             }
         }
+    }
+
+    #[test]
+    fn passing_over_corners_that_stay_put_changes_no_bit() {
+        let mut corners = 0;
+        each_smoothing_case(6, |case, scene, points, radius| {
+            let ours = smooth(scene, points, radius);
+            let every = smooth_trying_every_corner(scene, points, radius);
+            assert_eq!(bits(&ours), bits(&every), "{case}");
+            corners += ours.len();
+        });
         assert!(corners > 500, "only {corners} points");
+    }
+
+    /// Refusing the moves a remembered box clearly blocks gives the path that testing every
+    /// move gives, bit for bit, and most failing moves are refused so.
+    #[test]
+    fn refusing_moves_a_remembered_box_blocks_changes_no_bit() {
+        let (mut refused, mut corners) = (0, 0);
+        each_smoothing_case(9, |case, scene, points, radius| {
+            let start = with_midpoints(&jump_ahead(scene, points, radius));
+            let n = start.len();
+            let mut blockers = Blockers::new(scene, points, n, radius);
+            let ours = tighten(scene, start.clone(), radius, &mut blockers);
+            let tested = tighten(scene, start, radius, &mut Blockers::off(n));
+            assert_eq!(bits(&ours), bits(&tested), "{case}");
+            refused += blockers.refused;
+            corners += ours.len();
+        });
+        assert!(corners > 500, "only {corners} points");
+        assert!(refused > 50_000, "only {refused} moves refused untested");
     }
 
     #[test]
