@@ -155,6 +155,16 @@ impl Aabb {
         ]
     }
 
+    /// The four corners, counter-clockwise from `min`.
+    pub fn corners(&self) -> [Point; 4] {
+        [
+            self.min,
+            Point::new(self.max.x, self.min.y),
+            self.max,
+            Point::new(self.min.x, self.max.y),
+        ]
+    }
+
     /// The box spanning two corners given in any order.
     pub fn from_corners(a: Point, b: Point) -> Self {
         Self {
@@ -229,14 +239,10 @@ impl Aabb {
         }
         self.distance_squared(a) >= r2
             && self.distance_squared(b) >= r2
-            && [
-                self.min,
-                Point::new(self.max.x, self.min.y),
-                self.max,
-                Point::new(self.min.x, self.max.y),
-            ]
-            .iter()
-            .all(|&c| point_segment_distance_squared(c, a, b) >= r2)
+            && self
+                .corners()
+                .iter()
+                .all(|&c| point_segment_distance_squared(c, a, b) >= r2)
     }
 
     /// Squared distance between the segment `a`–`b` and the box (0 when they meet).
@@ -252,12 +258,7 @@ impl Aabb {
             return 0.0;
         }
         // Disjoint convex sets in the plane are closest at a vertex of one of them.
-        let corners = [
-            self.min,
-            Point::new(self.max.x, self.min.y),
-            self.max,
-            Point::new(self.min.x, self.max.y),
-        ];
+        let corners = self.corners();
         corners
             .iter()
             .map(|&c| point_segment_distance_squared(c, a, b))
@@ -266,23 +267,17 @@ impl Aabb {
                 f64::min,
             )
     }
-}
 
-impl Aabb {
     /// Whether the segment `a`–`b` comes nearer the box than the distance whose square is
-    /// `within2` (meeting it included), without a division or a square root. Rounding can only
-    /// err for a segment within rounding of that distance.
+    /// `within2` (meeting it included), without a division or a square root. Rounding errs only
+    /// for a segment within rounding of that distance: of its coordinates, and where the segment
+    /// crosses the box's bounds, of the box's size.
     pub fn segment_nearer_than(&self, a: Point, b: Point, within2: f64) -> bool {
         if self.distance_squared(a) < within2 || self.distance_squared(b) < within2 {
             return true;
         }
         let d = b - a;
-        let corners = [
-            self.min,
-            Point::new(self.max.x, self.min.y),
-            self.max,
-            Point::new(self.min.x, self.max.y),
-        ];
+        let corners = self.corners();
         // Each corner's side of the segment's line, times the segment's length.
         let sides = corners.map(|c| {
             let v = c - a;
@@ -567,9 +562,8 @@ mod tests {
                 _ => a,
             };
             let a = if snap == 2 { Point::new(a.x + d.0, b.max.y + radius) } else { a };
-            // Or slanted past the top right corner at `radius` from it, give or take rounding:
-            // beside the box within the segment's bounding box.
-            // Or past it a hair nearer or further than `radius`.
+            // Or slanted past the top right corner at `radius` from it, give or take rounding
+            // (beside the box within the segment's bounding box), or a hair nearer or further.
             let (a, end) = if snap >= 4 {
                 let out = unit(turn);
                 let along = Vector::new(-out.y, out.x);

@@ -147,9 +147,9 @@ fn try_corner(
     out[k] != start
 }
 
-/// Per corner, the box that last kept it from moving, tried first on its next moves: [`smooth`]'s
-/// corners lie against the walls they bend around, and most of their tries fail on the wall the
-/// last failure met.
+/// Per corner, a box that blocked one of its moves (the last found, near the refused position),
+/// tried first on its next moves: [`smooth`]'s corners lie against the walls they bend around,
+/// and most of their tries fail on the wall the last failure met.
 ///
 /// A box whose distance from the disc's position or from either leg is less than the radius by a
 /// margin blocks the move: the scene's own tests ([`Scene::disc_clear`], [`Scene::sweep_clear`])
@@ -162,6 +162,7 @@ struct Blockers {
     /// The squared distance within which a box blocks: the radius less the margin, squared;
     /// negative when nothing may be refused so (a radius no more than the margin).
     within2: f64,
+    /// The disc's radius, px.
     radius: f64,
     /// How many moves were refused untested.
     refused: usize,
@@ -172,13 +173,13 @@ const NO_BOX: u32 = u32::MAX;
 
 impl Blockers {
     /// For the `corners` of a path smoothed from `points` in `scene` at `radius`: a margin of a
-    /// millionth of a pixel, and more on scenes and paths so far from the origin that their
-    /// coordinates' rounding nears it.
+    /// millionth of a pixel, and more for scenes, paths or radii so large that their rounding
+    /// nears it.
     fn new(scene: &Scene, points: &[Point], corners: usize, radius: f64) -> Self {
         let far = points
             .iter()
             .map(|p| p.x.abs().max(p.y.abs()))
-            .fold(scene.width().max(scene.height()), f64::max);
+            .fold(scene.width().max(scene.height()).max(radius), f64::max);
         let within = radius - (1e-6 + far * 1e-12);
         Self {
             by_corner: vec![NO_BOX; corners],
@@ -199,8 +200,8 @@ impl Blockers {
         }
     }
 
-    /// Whether box `i` (if any) comes within the margin of the disc at `p` or of a leg `a`-`p`
-    /// or `p`-`b` (the disc first: the cheapest test).
+    /// Whether box `i` (if any) comes nearer than the radius less the margin to `p` or to a leg
+    /// `a`-`p` or `p`-`b` (`p` first: the cheapest test).
     fn blocks(&self, scene: &Scene, i: u32, a: Point, p: Point, b: Point) -> bool {
         let Some(o) = scene.boxes().get(i as usize) else {
             return false;
@@ -416,6 +417,52 @@ mod tests {
         });
         assert!(corners > 500, "only {corners} points");
         assert!(refused > 50_000, "only {refused} moves refused untested");
+    }
+
+    /// Whenever a box blocks a move by the margin, the scene's own tests refuse the move too. A
+    /// leg passes a corner of the scene's one box a hair nearer or further than the radius, long
+    /// enough for the sweep to cut it into pieces, at radii within the index's reach and beyond.
+    #[test]
+    fn a_box_that_blocks_by_the_margin_is_one_the_scene_refuses() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let mut blocked = 0;
+        for _ in 0..4000 {
+            let min = Point::new(
+                rng.random_range(300.0..600.0),
+                rng.random_range(300.0..600.0),
+            );
+            let size = Vector::new(rng.random_range(0.5..80.0), rng.random_range(0.5..80.0));
+            let o = Aabb::from_corners(min, min + size);
+            let scene = Scene::from_boxes(1000.0, 1000.0, vec![o], 50.0);
+            let radius = [5.0, 11.0, 30.0, 70.0][rng.random_range(0..4)];
+            let hair =
+                [-1e-4, -3e-6, -1.5e-6, -1e-6, -5e-7, 0.0, 1e-7, 1e-5][rng.random_range(0..8)];
+            // The leg touches the circle of `radius + hair` about a corner, outside the box.
+            let corner = o.corners()[rng.random_range(0..4)];
+            let out = (corner - (min + size / 2.0)).normalize();
+            let turn = rng.random_range(-1.0..1.0);
+            let tangent = Vector::new(-out.y, out.x) + out * (turn * 1e-3);
+            let touch = corner + out * (radius + hair);
+            let (a, p) = (
+                touch - tangent * rng.random_range(20.0..250.0),
+                touch + tangent * rng.random_range(20.0..250.0),
+            );
+            let b = p + out * rng.random_range(1.0..100.0);
+            let mut blockers = Blockers::new(&scene, &[a, p, b], 3, radius);
+            blockers.by_corner[1] = 0;
+            let refused = !(scene.disc_clear(p, radius)
+                && scene.sweep_clear(a, p, radius)
+                && scene.sweep_clear(p, b, radius));
+            if blockers.block(&scene, 1, a, p, b) {
+                blocked += 1;
+                assert!(refused, "{o:?} at {radius} + {hair}: {a:?} {p:?} {b:?}");
+            } else {
+                // Only those a hair inside the radius, within the margin, go to the scene.
+                assert!(hair > -1.5e-6, "{o:?} at {radius} + {hair}: not blocked");
+            }
+        }
+        assert!(blocked > 1500, "only {blocked} blocked");
     }
 
     #[test]

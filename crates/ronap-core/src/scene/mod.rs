@@ -658,14 +658,10 @@ impl Scene {
             .near(center, half.norm())
             .iter()
             .any(|&i| overlaps(&self.boxes[i as usize]))
-            && self.shapes.iter().all(|s| {
-                s.hull_distance(&[
-                    b.min,
-                    Point::new(b.max.x, b.min.y),
-                    b.max,
-                    Point::new(b.min.x, b.max.y),
-                ]) > 0.0
-            })
+            && self
+                .shapes
+                .iter()
+                .all(|s| s.hull_distance(&b.corners()) > 0.0)
     }
 
     /// Whether an axis-aligned box of half extents `half` can move its centre in a straight line
