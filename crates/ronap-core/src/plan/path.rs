@@ -200,17 +200,14 @@ impl Blockers {
         }
     }
 
-    /// Whether box `i` (if any) comes nearer than the radius less the margin to `p` or to a leg
-    /// `a`-`p` or `p`-`b` (`p` first: the cheapest test).
+    /// Whether box `i` (if any) comes nearer than the radius less the margin to a leg `p`-`a` or
+    /// `p`-`b`: `p` itself first, the cheapest test (each leg's first end).
     fn blocks(&self, scene: &Scene, i: u32, a: Point, p: Point, b: Point) -> bool {
         let Some(o) = scene.boxes().get(i as usize) else {
             return false;
         };
         let r2 = self.within2;
-        r2 > 0.0
-            && (o.distance_squared(p) < r2
-                || o.segment_nearer_than(a, p, r2)
-                || o.segment_nearer_than(p, b, r2))
+        r2 > 0.0 && (o.segment_nearer_than(p, a, r2) || o.segment_nearer_than(p, b, r2))
     }
 
     /// Whether corner `k`'s box blocks moving it, between `a` and `b`, to `p`.
