@@ -14,14 +14,6 @@
 
 use crate::geometry::{Aabb, Point, Vector};
 
-/// 1 when a walk between cell lines crosses a vertical line next (`next_x < next_y`, the `t` of
-/// the next line across x and across y), else 0: read from the sign of the difference, because a
-/// comparison would be compiled into a branch the processor guesses wrong half the time.
-#[inline(always)]
-fn crosses_x_first(next_x: f64, next_y: f64) -> u64 {
-    (next_x - next_y).to_bits() >> 63
-}
-
 /// Most cells a grid has; its cells grow to keep under it.
 pub const MAX_CELLS: usize = 1 << 20;
 
@@ -269,7 +261,7 @@ impl RayGrid {
         let c = self.cell_px;
         // Per axis: the step between cells, the `t` of the next cell line ahead and the `t`
         // between lines. An axis the ray runs parallel to never steps: its next line is further
-        // than any other (and finite, so that the blends below stay exact).
+        // than any other.
         let ahead_x = isize::from(inv_dir.x > 0.0);
         let ahead_y = isize::from(inv_dir.y > 0.0);
         let (step_x, step_y) = (2 * ahead_x - 1, 2 * ahead_y - 1);
@@ -307,24 +299,28 @@ impl RayGrid {
                     }
                 }
             }
-            // `x * 1.0 + y * 0.0` is exactly `x` for the finite values here: a step is blended
-            // from both axes rather than chosen by a branch the processor would guess wrong half
-            // the time.
-            let x_first = crosses_x_first(next_x, next_y);
-            let wx = x_first as f64;
-            let wy = 1.0 - wx;
-            let exit = next_x.min(next_y);
-            if best.min(max_t) <= exit {
-                break;
-            }
-            let (kx, ky) = (x_first as isize, 1 - x_first as isize);
-            col += step_x * kx;
-            row += step_y * ky;
-            cell += step_x * kx + step_y * cols * ky;
-            next_x += delta_x * wx;
-            next_y += delta_y * wy;
-            if (col as usize) >= cols as usize || (row as usize) >= rows as usize {
-                break;
+            // A branch on the axis crossed next: the processor guesses it well enough that the
+            // walk's steps overlap, where a blend of the two would chain each step to the last.
+            if next_x < next_y {
+                if best.min(max_t) <= next_x {
+                    break;
+                }
+                col += step_x;
+                cell += step_x;
+                next_x += delta_x;
+                if (col as usize) >= cols as usize {
+                    break;
+                }
+            } else {
+                if best.min(max_t) <= next_y {
+                    break;
+                }
+                row += step_y;
+                cell += step_y * cols;
+                next_y += delta_y;
+                if (row as usize) >= rows as usize {
+                    break;
+                }
             }
         }
         (best <= max_t).then_some(best)

@@ -29,12 +29,17 @@ pub struct MazeRays {
     inv_cell_px: f64,
     /// How far a wall box reaches from its edge (half its thickness and a rounding margin), px.
     reach_px: f64,
-    /// `vertical[row * (cols + 1) + col]`: the box on the edge at `x = col * cell_px` beside
-    /// cell `(col, row)`, [`NO_WALL`] where there is none.
-    vertical: Vec<u32>,
-    /// `horizontal[row * cols + col]`: the box on the edge at `y = row * cell_px` below cell
-    /// `(col, row)`, [`NO_WALL`] where there is none.
-    horizontal: Vec<u32>,
+    /// The box on each edge, [`NO_WALL`] where there is none: first the vertical edges, at
+    /// `row * (cols + 1) + col` the edge at `x = col * cell_px` beside cell `(col, row)`; then
+    /// from [`MazeRays::horizontal`] on the horizontal ones, at `row * (cols + 1) + col` the edge
+    /// at `y = row * cell_px` below cell `(col, row)` (`col == cols` holds no edge). Both by
+    /// the index of the grid corner at the edge's lower or left end.
+    edges: Vec<u32>,
+    /// Where the horizontal edges start in [`MazeRays::edges`].
+    horizontal: usize,
+    /// `corners[j * (cols + 1) + i]`: the walls on the edges meeting at grid corner `(i, j)`,
+    /// each once, then [`NO_WALL`].
+    corners: Vec<[u32; 4]>,
     boxes: Vec<Aabb>,
 }
 
@@ -46,10 +51,9 @@ pub struct Start {
     inside: bool,
     /// The origin less the lower-left corner of its cell.
     offset: Vector,
-    /// The vertical edge left of the origin's cell and the horizontal edge below it, as indices
-    /// into [`MazeRays::vertical`] and [`MazeRays::horizontal`].
-    vertical: isize,
-    horizontal: isize,
+    /// The origin's cell's lower-left grid corner, `row * (cols + 1) + col`: the index of the
+    /// cell's left and lower edges in their halves of [`MazeRays::edges`].
+    cell: isize,
     /// The walls a ray may meet before it reaches an edge of the origin's cell: those of each side
     /// the origin is within reach of, and of the corners at the side's ends (`NO_WALL` beyond
     /// `near_count`; a wall may repeat).
@@ -73,16 +77,38 @@ impl MazeRays {
         }
         let (vertical, horizontal) = maze.wall_box_of_edges();
         let edge = |b: Option<u32>| b.unwrap_or(NO_WALL);
-        Some(Self {
+        let mut edges: Vec<u32> = vertical.into_iter().map(edge).collect();
+        let horizontal_from = edges.len();
+        for row in horizontal.chunks(cols) {
+            edges.extend(row.iter().copied().map(edge));
+            edges.push(NO_WALL);
+        }
+        let mut rays = Self {
             cols,
             rows,
             cell_px,
             inv_cell_px: 1.0 / cell_px,
             reach_px,
-            vertical: vertical.into_iter().map(edge).collect(),
-            horizontal: horizontal.into_iter().map(edge).collect(),
+            edges,
+            horizontal: horizontal_from,
+            corners: Vec::new(),
             boxes: maze.wall_boxes(cell_px, wall_thickness_px),
-        })
+        };
+        rays.corners = (0..=rows)
+            .flat_map(|j| (0..=cols).map(move |i| (i, j)))
+            .map(|(i, j)| {
+                let mut walls = [NO_WALL; 4];
+                let mut n = 0;
+                for w in rays.corner_edges(i, j) {
+                    if w != NO_WALL && !walls[..n].contains(&w) {
+                        walls[n] = w;
+                        n += 1;
+                    }
+                }
+                walls
+            })
+            .collect();
+        Some(rays)
     }
 
     /// The boxes of the walls, in the order of [`Maze::wall_boxes`].
@@ -107,8 +133,7 @@ impl MazeRays {
             origin,
             inside,
             offset,
-            vertical: row * (cols + 1) + col,
-            horizontal: row * cols + col,
+            cell: row * (cols + 1) + col,
             near: [NO_WALL; 16],
             near_count: 0,
         };
@@ -125,7 +150,7 @@ impl MazeRays {
             for (gap, ends) in gaps.into_iter().zip(sides) {
                 if gap <= self.reach_px {
                     for (i, j) in ends {
-                        for wall in self.corner_walls(i, j) {
+                        for wall in self.corners[j * (self.cols + 1) + i] {
                             if wall != NO_WALL && start.near_count < start.near.len() {
                                 start.near[start.near_count] = wall;
                                 start.near_count += 1;
@@ -154,7 +179,7 @@ impl MazeRays {
         }
         // Per axis, the step between cells, and the `t` of the next cell line ahead and between
         // lines. An axis the ray runs parallel to never steps: its next line is further than any
-        // other (and finite, so that the blends below stay exact).
+        // other (and finite, so that how far along an edge the walk crosses it stays a number).
         let (ahead_x, ahead_y) = (isize::from(inv_dir.x > 0.0), isize::from(inv_dir.y > 0.0));
         let (step_x, step_y) = (2 * ahead_x - 1, 2 * ahead_y - 1);
         let axis = |gap: f64, inv: f64| {
@@ -170,41 +195,52 @@ impl MazeRays {
         let (mut next_x, delta_x) = axis(gap_x, inv_dir.x);
         let (mut next_y, delta_y) = axis(gap_y, inv_dir.y);
         let across = Vector::new(dir.y.abs(), dir.x.abs());
-        // The edges ahead on either axis, and how a step across x or across y moves them.
-        let cols = self.cols as isize;
-        let mut vertical = start.vertical + ahead_x;
-        let mut horizontal = start.horizontal + ahead_y * cols;
-        let (vertical_by_y, horizontal_by_y) = (step_y * (cols + 1), step_y * cols);
-        let reach = 2.0 * self.reach_px;
+        // The lower-left corner of the cell the walk is in; the edges ahead on either axis, as
+        // offsets from it into `edges`; and how a step across y moves it (across x: `step_x`).
+        let stride = self.cols as isize + 1;
+        let mut cell = start.cell;
+        let (ahead_vertical, ahead_horizontal) =
+            (ahead_x, self.horizontal as isize + ahead_y * stride);
+        let cell_by_y = step_y * stride;
+        // A crossing comes within `reach` of an end of its edge when it lies further than this
+        // from the edge's middle.
+        let (half, reach) = (c / 2.0, 2.0 * self.reach_px);
+        let off_middle = half - reach;
         let mut limit = max_t;
-        let wall = loop {
-            // Selects rather than branches on the axis crossed next, which the processor would
-            // guess wrong about every other step.
-            let x_first = next_x < next_y;
-            let t = if x_first { next_x } else { next_y };
-            // How far along the crossed edge, from its end ahead on the other axis, the ray
-            // crosses it: the `t` to the next line across, times the speed across.
-            let ahead = (next_x - next_y).abs() * if x_first { across.x } else { across.y };
-            let (edges, edge) = if x_first {
-                (&self.vertical, vertical)
-            } else {
-                (&self.horizontal, horizontal)
+        // One crossing of the edge `edge` at `t`, `ahead` from its end ahead on the other axis:
+        // the wall on it if the walk stops there (a wall, or the ray's end), else `None`.
+        let mut cross = |x_first: bool, edge: isize, t: f64, ahead: f64| {
+            // The closed boundary ends every walk inside the maze before it leaves the grid
+            // (`get` keeps a stray index from panicking all the same).
+            let Some(&wall) = self.edges.get(edge as usize) else {
+                return Some(NO_WALL);
             };
-            // The closed boundary ends every walk inside the maze.
-            let Some(&wall) = edges.get(edge as usize) else {
-                break NO_WALL;
-            };
-            if ahead < reach || ahead > c - reach {
+            if (ahead - half).abs() > off_middle {
                 self.crossing_corners(x_first, edge as usize, t, dir, inv_dir, o, max_t, &mut best);
                 limit = best.min(max_t);
             }
-            if wall != NO_WALL || limit <= t {
-                break wall;
+            (wall != NO_WALL || limit <= t).then_some(wall)
+        };
+        // A branch on the axis crossed next: the processor guesses it well enough that the
+        // walk's steps overlap, where selects would chain each step to the last.
+        let wall = loop {
+            // How far along the crossed edge, from its end ahead on the other axis, the ray
+            // crosses it: the `t` to the next line across, times the speed across.
+            if next_x < next_y {
+                let ahead = (next_y - next_x) * across.x;
+                if let Some(wall) = cross(true, cell + ahead_vertical, next_x, ahead) {
+                    break wall;
+                }
+                next_x += delta_x;
+                cell += step_x;
+            } else {
+                let ahead = (next_x - next_y) * across.y;
+                if let Some(wall) = cross(false, cell + ahead_horizontal, next_y, ahead) {
+                    break wall;
+                }
+                next_y += delta_y;
+                cell += cell_by_y;
             }
-            next_x += if x_first { delta_x } else { 0.0 };
-            next_y += if x_first { 0.0 } else { delta_y };
-            vertical += if x_first { step_x } else { vertical_by_y };
-            horizontal += if x_first { step_x } else { horizontal_by_y };
         };
         // The ray leaves its last cell through a wall (which it meets by then), or it ends.
         if wall != NO_WALL {
@@ -213,9 +249,8 @@ impl MazeRays {
         (best <= max_t).then_some(best)
     }
 
-    /// Tests the walls meeting at each end of the crossed edge (the vertical edge `edge` when
-    /// `vertical`, else the horizontal one, crossed at `t`) that the crossing comes within reach
-    /// of.
+    /// Tests the walls meeting at each end of the crossed edge (`edge` in [`MazeRays::edges`], a
+    /// vertical one when `vertical`, crossed at `t`) that the crossing comes within reach of.
     #[cold]
     #[allow(clippy::too_many_arguments)]
     fn crossing_corners(
@@ -229,21 +264,27 @@ impl MazeRays {
         max_t: f64,
         best: &mut f64,
     ) {
-        let (c, reach) = (self.cell_px, 2.0 * self.reach_px);
-        // The edge's lower or left end `(i, j)`, the step to its other end, and where along it
-        // the ray crosses.
-        let (i, j, di, dj, along) = if vertical {
-            let (i, j) = (edge % (self.cols + 1), edge / (self.cols + 1));
-            (i, j, 0, 1, origin.y + t * dir.y - j as f64 * c)
+        let (c, reach, stride) = (self.cell_px, 2.0 * self.reach_px, self.cols + 1);
+        // The grid corner at the edge's lower or left end (whose index the edge's is), the step
+        // to its other end, and where along the edge the ray crosses.
+        let corner = if vertical {
+            edge
         } else {
-            let (i, j) = (edge % self.cols, edge / self.cols);
-            (i, j, 1, 0, origin.x + t * dir.x - i as f64 * c)
+            edge.wrapping_sub(self.horizontal)
         };
-        if along < reach {
-            self.corner(i, j, origin, inv, max_t, best);
-        }
-        if along > c - reach {
-            self.corner(i + di, j + dj, origin, inv, max_t, best);
+        let (i, j) = (corner % stride, corner / stride);
+        let (other, along) = if vertical {
+            (corner + stride, origin.y + t * dir.y - j as f64 * c)
+        } else {
+            (corner + 1, origin.x + t * dir.x - i as f64 * c)
+        };
+        for (end, near) in [(corner, along < reach), (other, along > c - reach)] {
+            // (A walk inside the maze only crosses edges with both ends on the grid.)
+            if let Some(walls) = self.corners.get(end).filter(|_| near) {
+                for &w in walls.iter().take_while(|&&w| w != NO_WALL) {
+                    self.test(w, origin, inv, max_t, best);
+                }
+            }
         }
     }
 
@@ -258,32 +299,23 @@ impl MazeRays {
     }
 
     /// The walls on the (up to four) edges meeting at grid corner `(i, j)`, [`NO_WALL`] for the
-    /// open ones.
-    fn corner_walls(&self, i: usize, j: usize) -> [u32; 4] {
-        let (cols, rows) = (self.cols, self.rows);
+    /// open ones (a wall may repeat).
+    fn corner_edges(&self, i: usize, j: usize) -> [u32; 4] {
+        let (cols, rows, stride) = (self.cols, self.rows, self.cols + 1);
         let mut walls = [NO_WALL; 4];
         if j > 0 && i <= cols {
-            walls[0] = self.vertical[(j - 1) * (cols + 1) + i];
+            walls[0] = self.edges[(j - 1) * stride + i];
         }
         if j < rows && i <= cols {
-            walls[1] = self.vertical[j * (cols + 1) + i];
+            walls[1] = self.edges[j * stride + i];
         }
         if i > 0 && j <= rows {
-            walls[2] = self.horizontal[j * cols + i - 1];
+            walls[2] = self.edges[self.horizontal + j * stride + i - 1];
         }
         if i < cols && j <= rows {
-            walls[3] = self.horizontal[j * cols + i];
+            walls[3] = self.edges[self.horizontal + j * stride + i];
         }
         walls
-    }
-
-    /// Tests the walls on the edges meeting at grid corner `(i, j)`.
-    fn corner(&self, i: usize, j: usize, origin: Point, inv: Vector, max_t: f64, best: &mut f64) {
-        for w in self.corner_walls(i, j) {
-            if w != NO_WALL {
-                self.test(w, origin, inv, max_t, best);
-            }
-        }
     }
 
     /// The nearest hit testing every box.
