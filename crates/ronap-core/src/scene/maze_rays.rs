@@ -265,8 +265,8 @@ impl MazeRays {
         best: &mut f64,
     ) {
         let (c, reach, stride) = (self.cell_px, 2.0 * self.reach_px, self.cols + 1);
-        // The grid corner at the edge's lower or left end (whose index the edge's is), the step
-        // to its other end, and where along the edge the ray crosses.
+        // The grid corner at the edge's lower or left end (the edge's index in its half of
+        // `edges`), the step to its other end, and where along the edge the ray crosses.
         let corner = if vertical {
             edge
         } else {
