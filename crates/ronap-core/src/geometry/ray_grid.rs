@@ -301,6 +301,8 @@ impl RayGrid {
             }
             // A branch on the axis crossed next: the processor guesses it well enough that the
             // walk's steps overlap, where a blend of the two would chain each step to the last.
+            // Each arm checks the ray's end against its own line (one check before the branch,
+            // against the nearer of the two, measured 2-5% slower on image rays).
             if next_x < next_y {
                 if best.min(max_t) <= next_x {
                     break;
