@@ -1,7 +1,9 @@
 //! Policies by name, as the command line gives them.
 
 use anyhow::Result;
-use ronap_core::policy::{Builtin, PolicyFactory, PolicyNameError};
+use ronap_core::policy::{
+    Builtin, PerRobot, PolicyError, PolicyFactory, PolicyNameError, TeamPolicy, TeamPolicyFactory,
+};
 use ronap_core::ValidConfig;
 
 /// The policy `name` names: a built-in, `mlp:FILE[@RULE]` or `py:FILE:FUNCTION`.
@@ -69,17 +71,11 @@ impl TeamPolicies {
         Ok(team)
     }
 
-    /// One factory per robot.
-    pub fn per_robot(&self) -> Vec<&dyn PolicyFactory> {
-        self.of_robot
-            .iter()
-            .map(|&i| self.factories[i].as_ref())
-            .collect()
-    }
-
-    /// A new policy per robot.
-    pub fn make(&self) -> Result<Vec<Box<dyn ronap_core::policy::Policy>>> {
-        self.of_robot
+    /// A new team policy, each robot's policy fresh from its factory; an error names the
+    /// policy that could not start.
+    pub fn start(&self) -> Result<Box<dyn TeamPolicy>> {
+        let policies = self
+            .of_robot
             .iter()
             .zip(&self.names)
             .map(|(&i, name)| {
@@ -87,6 +83,23 @@ impl TeamPolicies {
                     .make()
                     .map_err(|e| anyhow::anyhow!("cannot start policy {name}: {e}"))
             })
-            .collect()
+            .collect::<Result<Vec<_>>>()?;
+        Ok(Box::new(PerRobot::new(policies)))
+    }
+}
+
+/// Each robot driven by a policy of its own ([`PerRobot`]).
+impl TeamPolicyFactory for TeamPolicies {
+    fn make(&self) -> Result<Box<dyn TeamPolicy>, PolicyError> {
+        let policies = self
+            .of_robot
+            .iter()
+            .map(|&i| self.factories[i].make())
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Box::new(PerRobot::new(policies)))
+    }
+
+    fn names(&self) -> Vec<String> {
+        self.names.clone()
     }
 }

@@ -387,7 +387,6 @@ fn run_team(
         );
     }
     let policies = crate::args::TeamPolicies::new(&config, &job.policy)?;
-    let factories_per_robot = policies.per_robot();
     let names = policies.names.clone();
     let (first, last) = job.span();
     if let Some(s) = job.gif.iter().find(|&&s| s < first || s > last) {
@@ -425,8 +424,7 @@ fn run_team(
     };
     let evaluation = evaluate_team_into(
         &evaluator,
-        &factories_per_robot,
-        &names,
+        &policies,
         &options,
         &info,
         Some(writer),
@@ -452,8 +450,7 @@ fn run_team(
                 let record = evaluation.result.records.iter().find(|r| r.seed == seed);
                 gif_notes.extend(write_team_gif(
                     &evaluator,
-                    &factories_per_robot,
-                    &names,
+                    &policies,
                     seed,
                     record,
                     &job.out_dir,
@@ -564,16 +561,12 @@ fn write_gif(
 /// deterministic), since the GIF then shows the re-run.
 fn write_team_gif(
     evaluator: &Evaluator,
-    factories: &[&dyn ronap_core::policy::PolicyFactory],
-    names: &[String],
+    policies: &crate::args::TeamPolicies,
     seed: u64,
     record: Option<&ronap_core::eval::TeamRecord>,
     out_dir: &std::path::Path,
 ) -> Result<Option<String>> {
-    let mut policies = factories
-        .iter()
-        .map(|f| f.make())
-        .collect::<Result<Vec<_>, _>>()?;
+    let mut policy = ronap_core::policy::TeamPolicyFactory::make(policies)?;
     // About 500 pixels along the scene's longer side.
     let scene_side = evaluator
         .worlds()
@@ -584,9 +577,14 @@ fn write_team_gif(
         scale: (500.0 / scene_side).clamp(0.1, 4.0),
         ..Default::default()
     };
-    let (animation, rerun) =
-        ronap_core::render::team::animate_team(evaluator, &mut policies, names, seed, &options)
-            .with_context(|| format!("--gif {seed}"))?;
+    let (animation, rerun) = ronap_core::render::team::animate_team(
+        evaluator,
+        policy.as_mut(),
+        &policies.names,
+        seed,
+        &options,
+    )
+    .with_context(|| format!("--gif {seed}"))?;
     let dir = out_dir.join("gif");
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot make {}", dir.display()))?;
     let path = dir.join(format!("seed-{seed:06}-{}.gif", rerun.outcome.name()));

@@ -15,7 +15,7 @@ use ratatui::text::{Line, Span};
 use ratatui::Frame;
 use ronap_core::eval::Evaluator;
 use ronap_core::geometry::Point;
-use ronap_core::policy::Policy;
+use ronap_core::policy::TeamPolicy;
 use ronap_core::run::team::TeamRollout;
 use ronap_core::run::RunError;
 use ronap_core::sim::team::Team;
@@ -67,9 +67,9 @@ impl TeamViewState {
         self.rollout.finished() || self.ending.is_some()
     }
 
-    /// One step of every running robot's policy, keeping the paths.
-    pub fn advance(&mut self, policies: &mut [Box<dyn Policy>]) {
-        match self.rollout.advance(policies) {
+    /// One step of the team's policy, keeping the paths.
+    pub fn advance(&mut self, policy: &mut dyn TeamPolicy) {
+        match self.rollout.advance(policy) {
             Ok(true) => {
                 let team = self.rollout.team();
                 for (k, path) in self.paths.iter_mut().enumerate() {
@@ -247,20 +247,20 @@ pub struct TeamWatch<'a> {
     /// What is on screen.
     pub state: TeamViewState,
     evaluator: &'a Evaluator,
-    policies: Vec<Box<dyn Policy>>,
+    policies: Box<dyn TeamPolicy>,
 }
 
-/// The team episode of `seed` with `policies` reset for it.
+/// The team episode of `seed` with `policy` reset for it.
 fn start_team(
     evaluator: &Evaluator,
-    policies: &mut [Box<dyn Policy>],
+    policy: &mut dyn TeamPolicy,
     seed: u64,
 ) -> Result<TeamRollout, String> {
     TeamRollout::start(
         evaluator.config(),
         evaluator.worlds().team(seed),
         seed,
-        policies,
+        policy,
     )
     .map_err(|e| match e {
         RunError::Episode { source, .. } => format!("cannot start seed {seed}: {source}"),
@@ -277,8 +277,8 @@ impl<'a> TeamWatch<'a> {
         seed: u64,
         speed: u32,
     ) -> Result<Self> {
-        let mut made = policies.make()?;
-        let rollout = start_team(evaluator, &mut made, seed).map_err(anyhow::Error::msg)?;
+        let mut made = policies.start()?;
+        let rollout = start_team(evaluator, made.as_mut(), seed).map_err(anyhow::Error::msg)?;
         Ok(Self {
             state: TeamViewState::new(rollout, seed, policies.names.clone(), speed),
             evaluator,
@@ -301,7 +301,7 @@ impl Watched for TeamWatch<'_> {
     }
 
     fn advance(&mut self) {
-        self.state.advance(&mut self.policies);
+        self.state.advance(self.policies.as_mut());
     }
 
     fn seed(&self) -> u64 {
@@ -309,7 +309,7 @@ impl Watched for TeamWatch<'_> {
     }
 
     fn restart(&mut self, seed: u64) {
-        match start_team(self.evaluator, &mut self.policies, seed) {
+        match start_team(self.evaluator, self.policies.as_mut(), seed) {
             Ok(rollout) => {
                 let (controls, focus) = (self.state.controls, self.state.focus);
                 let names = std::mem::take(&mut self.state.names);

@@ -1,4 +1,4 @@
-//! Evaluating teams (SPEC "Several robots", metrics): per-robot records beside team figures
+//! Evaluating teams (docs/model.md "Several robots", metrics): per-robot records beside team figures
 //! (team success: every robot arrived; makespan; summed path length; robot collisions;
 //! deadlocks), and their summary.
 
@@ -7,7 +7,7 @@ use crate::eval::summary::wilson95;
 use crate::eval::{worker_pool, EvalOptions, Evaluator, Failure, Outcome, RunEnd};
 use crate::geometry::Point;
 use crate::plan::shortest_path_px;
-use crate::policy::{PolicyError, PolicyFactory};
+use crate::policy::{PolicyError, TeamPolicy, TeamPolicyFactory};
 use crate::run::team::TeamRollout;
 use crate::run::RunError;
 use crate::sim::robot::Pose;
@@ -396,23 +396,23 @@ pub struct TeamRunResult {
 }
 
 impl Evaluator {
-    /// Runs the team episode of `seed` with `policies` (one per robot).
+    /// Runs the team episode of `seed` with `policy`, robot `k`'s policy named `names[k]`.
     /// With `paths`, keeps every robot's path and the scene (for a picture).
     pub fn run_team_episode(
         &self,
-        policies: &mut [Box<dyn crate::policy::Policy>],
+        policy: &mut dyn TeamPolicy,
         names: &[String],
         seed: u64,
         paths: bool,
     ) -> Result<TeamRecord, RunError> {
-        self.watch_team_episode(policies, names, seed, paths, &mut |_| {})
+        self.watch_team_episode(policy, names, seed, paths, &mut |_| {})
     }
 
     /// [`Evaluator::run_team_episode`], showing `watch` the team at its start and after every
     /// step (for an animation).
     pub fn watch_team_episode(
         &self,
-        policies: &mut [Box<dyn crate::policy::Policy>],
+        policy: &mut dyn TeamPolicy,
         names: &[String],
         seed: u64,
         paths: bool,
@@ -420,7 +420,7 @@ impl Evaluator {
     ) -> Result<TeamRecord, RunError> {
         let clock = Instant::now();
         let worlds = self.worlds().team(seed);
-        let mut rollout = TeamRollout::start(self.config(), worlds, seed, policies)?;
+        let mut rollout = TeamRollout::start(self.config(), worlds, seed, policy)?;
         watch(rollout.team());
         let n = rollout.team().robots().len();
         let mut tracks: Vec<Vec<Point>> = vec![Vec::new(); if paths { n } else { 0 }];
@@ -432,7 +432,7 @@ impl Evaluator {
             }
         };
         note(rollout.team(), &mut tracks);
-        while rollout.advance(policies)? {
+        while rollout.advance(policy)? {
             note(rollout.team(), &mut tracks);
             watch(rollout.team());
         }
@@ -521,19 +521,17 @@ impl Evaluator {
         })
     }
 
-    /// Runs `options.seeds` as team episodes, robot `k` driven by a policy from
-    /// `factories[k]` (named `names[k]`), keeping every record in seed order:
-    /// [`Evaluator::stream_team`] into a vector.
+    /// Runs `options.seeds` as team episodes, each driven by a team policy from `factory`,
+    /// keeping every record in seed order: [`Evaluator::stream_team`] into a vector.
     pub fn run_team(
         &self,
-        factories: &[&dyn PolicyFactory],
-        names: &[String],
+        factory: &dyn TeamPolicyFactory,
         options: &EvalOptions,
         cancel: &AtomicBool,
         on_record: &(dyn Fn(&TeamRecord) + Sync),
     ) -> Result<TeamRunResult, PolicyError> {
         let mut records = Vec::new();
-        let end = self.stream_team(factories, names, options, cancel, on_record, &mut |r| {
+        let end = self.stream_team(factory, options, cancel, on_record, &mut |r| {
             records.push(r);
             true
         })?;
@@ -550,8 +548,7 @@ impl Evaluator {
     /// flat memory; `sink` returning `false` or `cancel` stops the run after a prefix of seeds.
     pub fn stream_team(
         &self,
-        factories: &[&dyn PolicyFactory],
-        names: &[String],
+        factory: &dyn TeamPolicyFactory,
         options: &EvalOptions,
         cancel: &AtomicBool,
         on_finish: &(dyn Fn(&TeamRecord) + Sync),
@@ -559,15 +556,15 @@ impl Evaluator {
     ) -> Result<RunEnd, PolicyError> {
         let clock = Instant::now();
         let pool = worker_pool(options.threads)?;
-        // A team's policies are made afresh for every episode.
+        let names = factory.names();
+        // A team's policy is made afresh for every episode.
         let work = |_: &mut Option<()>, i: usize| {
-            let made: Result<Vec<_>, _> = factories.iter().map(|f| f.make()).collect();
-            let mut policies = made.map_err(Failure::Policy)?;
+            let mut policy = factory.make().map_err(Failure::Policy)?;
             let paths = options.recording.trajectory;
             let mut r = self
                 .run_team_episode(
-                    &mut policies,
-                    names,
+                    policy.as_mut(),
+                    &names,
                     options.seeds.get(i).unwrap_or_default(),
                     paths,
                 )
@@ -593,7 +590,7 @@ impl Evaluator {
 mod tests {
     use super::*;
     use crate::config::TeamRobotConfig;
-    use crate::policy::factory;
+    use crate::policy::{factory, PerRobotFactory};
     use crate::sim::world::Scenes;
 
     fn evaluator(count: u32) -> Evaluator {
@@ -613,26 +610,22 @@ mod tests {
     fn team_runs_are_the_same_on_one_and_two_threads() {
         let ev = evaluator(4);
         let f = factory("geodesic", ev.config().observation_size()).expect("geodesic");
-        let factories: Vec<&dyn PolicyFactory> = (0..4).map(|_| f.as_ref()).collect();
-        let names = vec!["geodesic".to_string(); 4];
+        let team = PerRobotFactory::new(
+            (0..4).map(|_| f.as_ref()).collect(),
+            vec!["geodesic".to_string(); 4],
+        );
         let run = |threads| {
             let options = EvalOptions {
                 seeds: (0..8).collect::<Vec<_>>().into(),
                 threads,
                 ..Default::default()
             };
-            ev.run_team(
-                &factories,
-                &names,
-                &options,
-                &AtomicBool::new(false),
-                &|_| {},
-            )
-            .expect("runs")
-            .records
-            .into_iter()
-            .map(|r| (r.seed, r.outcome, r.steps, r.makespan, r.robots))
-            .collect::<Vec<_>>()
+            ev.run_team(&team, &options, &AtomicBool::new(false), &|_| {})
+                .expect("runs")
+                .records
+                .into_iter()
+                .map(|r| (r.seed, r.outcome, r.steps, r.makespan, r.robots))
+                .collect::<Vec<_>>()
         };
         let one = run(1);
         assert_eq!(one, run(2));
@@ -649,13 +642,7 @@ mod tests {
             ..Default::default()
         };
         let records = ev
-            .run_team(
-                &factories,
-                &names,
-                &options,
-                &AtomicBool::new(false),
-                &|_| {},
-            )
+            .run_team(&team, &options, &AtomicBool::new(false), &|_| {})
             .expect("runs")
             .records;
         let summary = TeamSummary::new(&records, 1.0);
@@ -680,20 +667,16 @@ mod tests {
         .expect("valid");
         let ev = Evaluator::new(config, Scenes::MazePerSeed);
         let f = factory("geodesic", ev.config().observation_size()).expect("geodesic");
-        let factories: Vec<&dyn PolicyFactory> = (0..3).map(|_| f.as_ref()).collect();
-        let names = vec!["geodesic".to_string(); 3];
+        let team = PerRobotFactory::new(
+            (0..3).map(|_| f.as_ref()).collect(),
+            vec!["geodesic".to_string(); 3],
+        );
         let options = EvalOptions {
             seeds: (0..6).collect::<Vec<_>>().into(),
             ..Default::default()
         };
         let records = ev
-            .run_team(
-                &factories,
-                &names,
-                &options,
-                &AtomicBool::new(false),
-                &|_| {},
-            )
+            .run_team(&team, &options, &AtomicBool::new(false), &|_| {})
             .expect("runs")
             .records;
         let mut arrived = 0;

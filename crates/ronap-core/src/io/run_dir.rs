@@ -22,7 +22,7 @@ use crate::io::manifest::{
 };
 use crate::io::partial::{partial_path, whole_rows, PartialCsv};
 use crate::io::steplog::write_steps;
-use crate::policy::{PolicyError, PolicyFactory};
+use crate::policy::{PolicyError, PolicyFactory, TeamPolicyFactory};
 use crate::render::trajectory::trajectory_image;
 use crate::scene::map::MapSource;
 use crate::sim::world::SceneSpec;
@@ -1123,14 +1123,12 @@ pub struct TeamEvaluation {
     pub write_error: Option<OutputError>,
 }
 
-/// Runs a team evaluation (robot `k` driven by `factories[k]`, named `names[k]`) and, given a
+/// Runs a team evaluation (each episode driven by a team policy from `factory`) and, given a
 /// `writer`, writes `episodes.csv` (team rows), `robots.csv` and `timing.csv` row by row in seed
 /// order as [`evaluate_into`] does, pictures as episodes finish and `summary.json` at the end.
-#[allow(clippy::too_many_arguments)]
 pub fn evaluate_team_into(
     evaluator: &Evaluator,
-    factories: &[&dyn PolicyFactory],
-    names: &[String],
+    factory: &dyn TeamPolicyFactory,
     options: &EvalOptions,
     info: &RunInfo,
     writer: Option<RunWriter>,
@@ -1203,7 +1201,7 @@ pub fn evaluate_team_into(
             }
             on_record(r);
         };
-        evaluator.stream_team(factories, names, &rest, cancel, &on_finish, &mut |r| {
+        evaluator.stream_team(factory, &rest, cancel, &on_finish, &mut |r| {
             let t = TeamFigures::of(&r);
             let lone: Vec<Figures> = r
                 .robots

@@ -10,8 +10,10 @@ pub mod geodesic;
 pub mod mlp;
 pub mod name;
 pub mod random;
+pub mod team;
 
 pub use name::{factory, Builtin, PolicyNameError};
+pub use team::{PerRobot, PerRobotFactory, TeamPolicy, TeamPolicyFactory};
 
 use crate::sim::episode::Episode;
 use crate::sim::robot::Action;

@@ -3,7 +3,7 @@
 
 use crate::eval::{Evaluator, TeamRecord};
 use crate::geometry::Point;
-use crate::policy::Policy;
+use crate::policy::TeamPolicy;
 use crate::render::chart::{policy_colour, POLICY_COUNT};
 use crate::render::gif::{Animation, AnimationError, GifOptions, GifWriter};
 use crate::render::Canvas;
@@ -118,13 +118,14 @@ pub enum TeamAnimationError {
     Animation(#[from] AnimationError),
 }
 
-/// Runs team episode `seed` again with `policies` (one per robot, fresh from their factories)
+/// Runs team episode `seed` again with `policy` (fresh from its factory; robot `k`'s named
+/// `names[k]`)
 /// and draws it from above ([`team_frame`] at `options.scale`) every `options.stride` steps.
 /// Returns the animation and the re-run's record (a policy that is not deterministic may play
 /// the episode otherwise than the run did).
 pub fn animate_team(
     evaluator: &Evaluator,
-    policies: &mut [Box<dyn Policy>],
+    policy: &mut dyn TeamPolicy,
     names: &[String],
     seed: u64,
     options: &GifOptions,
@@ -171,7 +172,7 @@ pub fn animate_team(
         }
         pending = Some(team_frame(team, &paths, options.scale));
     };
-    let record = evaluator.watch_team_episode(policies, names, seed, false, &mut watch)?;
+    let record = evaluator.watch_team_episode(policy, names, seed, false, &mut watch)?;
     if let Some(e) = failed {
         return Err(AnimationError::from(e).into());
     }

@@ -6,7 +6,8 @@
 use crate::geometry::Point;
 use crate::plan::tour::{self, CostMatrix, Order};
 use crate::plan::{path_length, smooth, DistanceField};
-use crate::policy::{Decision, Policy};
+use crate::policy::team::TeamPolicy;
+use crate::policy::Decision;
 use crate::run::RunError;
 use crate::sim::robot::Action;
 use crate::sim::team::Team;
@@ -111,27 +112,17 @@ fn plan_tour(
 
 impl TeamRollout {
     /// The team episode of `seed` under `config` (with its `[[robots]]`) in `worlds` (one per
-    /// entry, [`crate::sim::world::Worlds::team`]), with `policies[k]` (one per robot) reset
-    /// for it.
+    /// entry, [`crate::sim::world::Worlds::team`]), with `policy` reset for it.
     pub fn start(
         config: &crate::ValidConfig,
         worlds: Vec<Arc<World>>,
         seed: u64,
-        policies: &mut [Box<dyn Policy>],
+        policy: &mut dyn TeamPolicy,
     ) -> Result<Self, RunError> {
-        let n = config.team_size();
-        if policies.len() != n {
-            return Err(RunError::ActionCount {
-                given: policies.len(),
-                envs: n,
-            });
-        }
         let rollout = Self::placed(config, worlds, seed)?;
-        for (k, policy) in policies.iter_mut().enumerate() {
-            policy
-                .reset(&rollout.worlds[k], rollout.team.robot(k))
-                .map_err(|e| RunError::reset(seed, e))?;
-        }
+        policy
+            .reset(&rollout.team, &rollout.worlds)
+            .map_err(|(_, e)| RunError::reset(seed, e))?;
         Ok(rollout)
     }
 
@@ -208,28 +199,27 @@ impl TeamRollout {
         self.team.is_done()
     }
 
-    /// One step: every running robot's policy decides, then the team moves. `false` once the
-    /// episode is over (nothing was stepped).
-    pub fn advance(&mut self, policies: &mut [Box<dyn Policy>]) -> Result<bool, RunError> {
+    /// One step: the team policy decides for every running robot, then the team moves. `false`
+    /// once the episode is over (nothing was stepped).
+    pub fn advance(&mut self, policy: &mut dyn TeamPolicy) -> Result<bool, RunError> {
         if self.finished() {
             return Ok(false);
         }
         let n = self.team.robots().len();
         let step = self.team.steps() + 1;
+        let seed = self.team.robot(0).seed();
+        let mut decisions: Vec<Option<Decision>> = vec![None; n];
+        let failed = policy.act(&self.team, &mut decisions).err();
+        // Robot by robot, as the robots decided: a robot's invalid action before the robot
+        // whose policy failed is the error.
         let mut actions: Vec<Option<Action>> = vec![None; n];
         let mut message = vec![0.0f32; self.message_size];
-        for k in 0..n {
-            if !self.team.running(k) {
-                continue;
+        for (k, decision) in decisions.into_iter().enumerate() {
+            if failed.as_ref().is_some_and(|(j, _)| *j <= k) {
+                break;
             }
-            policies[k].hear(self.team.inbox(k));
-            let episode = self.team.robot(k);
-            let seed = episode.seed();
-            match policies[k]
-                .act(episode)
-                .map_err(|source| RunError::Policy { seed, step, source })?
-            {
-                Decision::Act(action) => {
+            match decision {
+                Some(Decision::Act(action)) if self.team.running(k) => {
                     if let Action::Continuous { v, w_deg } = action {
                         if !v.is_finite() || !w_deg.is_finite() {
                             return Err(RunError::InvalidAction { seed, step, action });
@@ -238,15 +228,19 @@ impl TeamRollout {
                     actions[k] = Some(action);
                     if !message.is_empty() {
                         message.fill(0.0);
-                        policies[k].message(&mut message);
+                        policy.message(k, &mut message);
                         self.team.set_message(k, &message);
                     }
                 }
-                Decision::GiveUp(why) => {
+                Some(Decision::GiveUp(why)) if self.team.running(k) => {
                     self.gave_up[k] = Some(why);
                     self.team.retire(k);
                 }
+                _ => {}
             }
+        }
+        if let Some((_, source)) = failed {
+            return Err(RunError::Policy { seed, step, source });
         }
         if self.finished() {
             return Ok(false);
@@ -259,12 +253,11 @@ impl TeamRollout {
             .collect();
         self.team.step(&actions);
         // A robot on to the next goal of its list starts a new leg: its policy plans afresh.
-        for (k, policy) in policies.iter_mut().enumerate() {
+        for (k, reached) in reached.into_iter().enumerate() {
             let r = self.team.robot(k);
-            if self.team.running(k) && r.goals_reached() > reached[k] {
-                let seed = r.seed();
+            if self.team.running(k) && r.goals_reached() > reached {
                 policy
-                    .reset(&self.worlds[k], r)
+                    .next_goal(k, &self.worlds[k], r)
                     .map_err(|source| RunError::Policy { seed, step, source })?;
             }
         }

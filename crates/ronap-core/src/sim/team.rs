@@ -1,4 +1,4 @@
-//! Several robots in one episode (SPEC "Several robots"): each robot an [`Episode`] of its own
+//! Several robots in one episode (docs/model.md "Several robots"): each robot an [`Episode`] of its own
 //! configuration (radius, speeds, laser), all in one scene among one set of moving obstacles.
 //!
 //! Each step the moving obstacles move first, then every robot that is still going makes its
@@ -355,6 +355,11 @@ impl Team {
     /// Whether the team ended in a deadlock.
     pub fn deadlocked(&self) -> bool {
         self.robots.iter().any(|r| r.status() == Status::Deadlock)
+    }
+
+    /// Floats in a robot's message (`team.message_size`).
+    pub fn message_size(&self) -> usize {
+        self.comm.message_size as usize
     }
 
     /// Sets robot `k`'s message for the next broadcast (the first `team.message_size` floats of
