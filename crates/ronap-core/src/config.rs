@@ -1,4 +1,4 @@
-//! The simulation configuration: every default of SPEC.md as a field, with its unit.
+//! The simulation configuration: every default of docs/model.md as a field, with its unit.
 //!
 //! [`SimConfig`] is what a user writes (TOML, flags, keyword arguments); [`ValidConfig`] is the
 //! same data after [`SimConfig::validate`] has checked every field. The rest of the core only takes
@@ -36,7 +36,7 @@ pub enum ConfigError {
     },
 }
 
-/// Which scene episodes take place in (SPEC "Scenario files").
+/// Which scene episodes take place in (docs/model.md "Scenario files").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum SceneKind {
@@ -62,7 +62,7 @@ pub struct SceneConfig {
     pub file: Option<std::path::PathBuf>,
 }
 
-/// A static obstacle added to the scene (SPEC "Static obstacles beyond boxes").
+/// A static obstacle added to the scene (docs/model.md "Static obstacles beyond boxes").
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "shape", rename_all = "lowercase", deny_unknown_fields)]
 pub enum ObstacleConfig {
@@ -98,7 +98,7 @@ pub enum MovingShape {
     Box,
 }
 
-/// How a moving obstacle moves (SPEC "Moving obstacles").
+/// How a moving obstacle moves (docs/model.md "Moving obstacles").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum MotionKind {
@@ -127,7 +127,7 @@ pub enum Patrol {
     PingPong,
 }
 
-/// One `[[moving]]` entry: `count` obstacles alike (SPEC "Moving obstacles").
+/// One `[[moving]]` entry: `count` obstacles alike (docs/model.md "Moving obstacles").
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MovingConfig {
@@ -187,7 +187,7 @@ impl Default for MovingConfig {
     }
 }
 
-/// Maze generation (SPEC "Scene: maze").
+/// Maze generation (docs/model.md "Scene: maze").
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MazeConfig {
@@ -216,7 +216,7 @@ impl Default for MazeConfig {
     }
 }
 
-/// How an image becomes a scene (SPEC "maze loaded as a picture").
+/// How an image becomes a scene (docs/model.md "Maze loaded as a picture").
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MapConfig {
@@ -235,7 +235,7 @@ impl Default for MapConfig {
     }
 }
 
-/// A generated logistics warehouse (SPEC "Warehouse scene"): rows of racks back to back in pairs,
+/// A generated logistics warehouse (docs/model.md "Warehouse scene"): rows of racks back to back in pairs,
 /// aisles between them, cross aisles, a free loading area along the bottom, and pallets of clutter
 /// in the aisles.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -313,7 +313,7 @@ pub enum OnCollision {
     Terminate,
 }
 
-/// The robot disc and its actions (SPEC "Robot").
+/// The robot disc and its actions (docs/model.md "Robot").
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct RobotConfig {
@@ -344,7 +344,7 @@ impl Default for RobotConfig {
     }
 }
 
-/// The laser range finder (SPEC "Sensors").
+/// The laser range finder (docs/model.md "Sensors").
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct LaserConfig {
@@ -369,7 +369,7 @@ impl Default for LaserConfig {
     }
 }
 
-/// Start, goal and the end of an episode (SPEC "Episode").
+/// Start, goal and the end of an episode (docs/model.md "Episode").
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct EpisodeConfig {
@@ -412,7 +412,7 @@ impl Default for EpisodeConfig {
     }
 }
 
-/// The four reward terms `r = r_a + r_b + r_c + r_d` (SPEC "Observation and reward").
+/// The four reward terms `r = r_a + r_b + r_c + r_d` (docs/model.md "Observation and reward").
 ///
 /// The paper gives no numbers. The defaults make one AHEAD step straight at the goal worth +0.5,
 /// a collision cost as much as two such steps, a turn cost a tenth of one, and arriving worth
@@ -451,7 +451,7 @@ fn is_default_shaping_gamma(gamma: &f64) -> bool {
     *gamma == SHAPING_GAMMA
 }
 
-/// How progress towards the goal is paid (SPEC "Reward"; Ng, Harada and Russell 1999).
+/// How progress towards the goal is paid (docs/model.md "Reward"; Ng, Harada and Russell 1999).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Shaping {
@@ -463,7 +463,7 @@ pub enum Shaping {
     /// goal for the robot's disc), and `Phi = 0` once an episode ends by success, collision or
     /// `reward_min`. It keeps the optimal policy of the other three terms and no longer pays for
     /// heading into a dead end. Uses the map only for the reward a learner is given: the
-    /// observation is unchanged, and `episodes.csv`'s `total_reward` stays the paper's return.
+    /// observation is unchanged, and `episodes.csv`'s `return` stays the paper's return.
     Geodesic,
 }
 
@@ -487,7 +487,7 @@ impl Default for RewardConfig {
     }
 }
 
-/// The artificial potential field policy (SPEC "Algorithms", Algorithm 3).
+/// The artificial potential field policy (docs/model.md "Algorithms", Algorithm 3).
 ///
 /// `U = 1/2 xi d^2(q, goal) + 1/2 eta (1/c - 1/d0)^2` where `c <= d0`, with `c` the clearance of
 /// the robot disc at `q` (distance to the nearest obstacle minus the radius). The paper gives no
@@ -551,15 +551,15 @@ pub struct SimConfig {
     pub obstacles: Vec<ObstacleConfig>,
     /// Moving obstacles.
     pub moving: Vec<MovingConfig>,
-    /// Several robots (SPEC "Several robots"); none: the one robot of `[robot]`.
+    /// Several robots (docs/model.md "Several robots"); none: the one robot of `[robot]`.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub robots: Vec<TeamRobotConfig>,
-    /// How the robots of a team talk (SPEC "Several robots", communication).
+    /// How the robots of a team talk (docs/model.md "Several robots", communication).
     #[serde(skip_serializing_if = "TeamConfig::is_default")]
     pub team: TeamConfig,
 }
 
-/// Observation memory (SPEC "Observation and reward"): with `history = k`, the observation is
+/// Observation memory (docs/model.md "Observation and reward"): with `history = k`, the observation is
 /// the last `k` frames of the paper's values, newest first, then the last `k - 1` actions, newest
 /// first, each as three values in [0, 1] (one-hot LEFT, AHEAD, RIGHT; a continuous action as
 /// `w+ / w_max, v / v_max, w- / w_max`). At an episode's start the past frames repeat the first
@@ -626,7 +626,7 @@ impl TeamConfig {
 /// Most neighbours, and most floats in a message.
 pub const MAX_NEIGHBOURS: u32 = 64;
 
-/// In which order a robot visits its goals (SPEC "Multi-destination tasks").
+/// In which order a robot visits its goals (docs/model.md "Multi-destination tasks").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Order {
@@ -736,7 +736,7 @@ impl ValidConfig {
     }
 
     /// Length of the observation a policy sees: one value per laser beam, then the goal
-    /// direction (SPEC "Observation and reward").
+    /// direction (docs/model.md "Observation and reward").
     pub fn observation_size(&self) -> usize {
         let k = self.observation.history.max(1) as usize;
         self.frame_size() * k + ACTION_MEMORY * (k - 1)

@@ -1,4 +1,4 @@
-//! ronap-core: the RoNAP robot-navigation model (SPEC.md), as a library.
+//! ronap-core: the RoNAP robot-navigation model (docs/model.md), as a library.
 //!
 //! A robot disc drives through a scene (a seeded maze or an image) with a 17-beam laser, discrete
 //! or continuous actions and a goal; an [`Episode`] steps it and scores it. Units are scene px and

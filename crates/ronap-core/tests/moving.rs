@@ -1,5 +1,5 @@
 //! Scenes beyond a still maze: static discs and polygons, moving and appearing obstacles, and
-//! warehouses, held to parry2d and to the invariants of SPEC "Moving obstacles".
+//! warehouses, held to parry2d and to the invariants of docs/model.md "Moving obstacles".
 
 // Test helpers may panic on setup failures: that is a failed test, as intended.
 #![allow(clippy::unwrap_used)]

@@ -1,4 +1,4 @@
-//! Deep Q-learning (the paper's Algorithm 1): epsilon-greedy episodes on the SPEC reward, a
+//! Deep Q-learning (the paper's Algorithm 1): epsilon-greedy episodes on the model's reward, a
 //! replay memory, mini-batches, a target network refreshed every F updates, mean-squared loss.
 //!
 //! The environment side runs `envs` episodes side by side, stepped on every core with the core's

@@ -1,7 +1,7 @@
 //! `ronap._ronap`: the Python extension. Thin wrappers over ronap-core: a single environment, a
 //! batch of environments stepped in parallel with the GIL released (the core's `Batch`), the
 //! core's evaluator with built-in or Python policies, and maze pictures as numpy arrays. Every
-//! Python <-> Rust conversion is in [`conv`], every exception in [`errors`].
+//! Python <-> Rust conversion is in `conv.rs`, every exception in `errors.rs`.
 //!
 //! The Python package `ronap` (python/ronap) builds the Gymnasium classes on these.
 

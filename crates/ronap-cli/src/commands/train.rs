@@ -38,7 +38,7 @@ enum Algorithm {
         mut_arg("decision", |a| with_default(a, "sample:2 (on class scores)")),
     )]
     Bc(BcArgs),
-    /// Deep Q-learning (the paper's Algorithm 1) on the SPEC reward, episodes on every core;
+    /// Deep Q-learning (the paper's Algorithm 1) on the model's reward, episodes on every core;
     /// prints returns and success rate as it trains.
     #[command(
         mut_arg("hidden", |a| with_default(a, "128,128")),
@@ -100,7 +100,7 @@ struct BcArgs {
     #[arg(long, allow_negative_numbers = true, value_name = "F", default_value_t = 0.8, value_parser = crate::args::share)]
     train_fraction: f64,
     /// Laser range, px: ronap's rows hold readings in px, the network sees them over this range
-    /// (SPEC.md's d_max).
+    /// (the laser's d_max).
     #[arg(long, allow_negative_numbers = true, value_name = "PX", default_value_t = 50.0, value_parser = crate::args::positive)]
     laser_range: f64,
 }

@@ -1,7 +1,7 @@
 //! Data collection without a human: an expert (the geodesic planner) labels states with the action
 //! it would take, for behaviour cloning.
 //!
-//! Two ways to visit states. [`Posing::Repose`] is the paper's Collect Data mode (SPEC.md): after
+//! Two ways to visit states. [`Posing::Repose`] is the paper's Collect Data mode (docs/model.md "Data log"): after
 //! each recorded action the robot jumps to a random free pose facing roughly towards the goal.
 //! [`Posing::Drive`] keeps the robot moving: a driver policy (the expert itself, or a learned policy
 //! being improved, as in DAgger) chooses where it goes while the expert labels every state.

@@ -1,4 +1,4 @@
-//! The paper's Collect Data mode with a person at the keys (SPEC.md, "Data log"): the person
+//! The paper's Collect Data mode with a person at the keys (docs/model.md "Data log"): the person
 //! chooses LEFT, AHEAD or RIGHT for the state shown; the action is recorded with that state
 //! ([`Sample::before`]), taken, and the robot then jumps to a random free pose facing roughly
 //! towards the goal ([`Episode::repose`], from the seed's re-posing stream, as `ronap collect

@@ -68,7 +68,7 @@ impl Outcome {
     }
 }
 
-/// One logged step (SPEC "Data log").
+/// One logged step (docs/model.md "Data log").
 #[derive(Clone, Debug, PartialEq)]
 pub struct StepLog {
     /// Step number, from 1.

@@ -1,13 +1,13 @@
 //! The data log (the paper's "Save Data" / "Collect Data"): one CSV row per recorded action, and
 //! the data sets learned policies train on.
 //!
-//! ronap's own rows (SPEC.md order, then extras) are
+//! ronap's own rows (docs/model.md "Data log" order, then extras) are
 //! `laser_0..laser_{m-1},heading,bearing,distance,action,direction,seed,step,x,y,goal_x,goal_y,collided`
 //! with distances in px and angles in degrees, recorded at the pose *before* the action.
 //! [`read`] also takes the original platform's header-less rows,
 //! `"[498, ..., 330]",343.72,10.902,AHEAD`: 17 laser readings in view px (10.01 view px = 1 px,
 //! 498 = nothing in range), D, direction and the action, or `WARNING` for a collision row.
-//! Either way a row becomes the 18-value observation of SPEC.md and an action index.
+//! Either way a row becomes the 18-value observation of docs/model.md "Observation" and an action index.
 
 use crate::geometry::{wrap_deg, Point};
 use crate::sim::episode::Episode;
@@ -64,7 +64,7 @@ impl Sample {
         wrap_deg(self.bearing_deg - self.pose.z_deg)
     }
 
-    /// The observation (SPEC.md) for a laser of `range_px`.
+    /// The observation (docs/model.md "Observation") for a laser of `range_px`.
     pub fn observation(&self, range_px: f64) -> Vec<f32> {
         observation(&self.readings, self.direction_deg(), range_px)
     }

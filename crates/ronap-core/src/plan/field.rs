@@ -330,7 +330,7 @@ thread_local! {
 }
 
 impl Drop for LazyField {
-    /// Hands the search to the thread's [`LAZY_WORK`], its cells put back as they were at the
+    /// Hands the search to the thread's `LAZY_WORK`, its cells put back as they were at the
     /// cost of the cells it reached rather than of all.
     fn drop(&mut self) {
         let mut work = std::mem::take(&mut self.work);

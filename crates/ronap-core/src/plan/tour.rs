@@ -1,4 +1,4 @@
-//! Visiting orders for multi-destination tasks (SPEC "Multi-destination tasks"): in which order a
+//! Visiting orders for multi-destination tasks (docs/model.md "Multi-destination tasks"): in which order a
 //! robot visits its goals, and how long that tour is. Tours are open paths from the start through
 //! every goal once, not returning. The module sees only a [`CostMatrix`] of geodesic distances, px
 //! (infinite where unreachable, possibly asymmetric), so it knows nothing of geometry.

@@ -40,7 +40,7 @@ const MAX_WAIT_STEPS: u32 = 40;
 
 /// Shortest-path following that gives way: where the laser sees an obstacle the still scene does
 /// not have close ahead (a moving or appeared one), it waits, turning on the spot left then right,
-/// until the way is clear (at most [`MAX_WAIT_STEPS`] in a row).
+/// until the way is clear (at most `MAX_WAIT_STEPS` in a row).
 #[derive(Debug, Default)]
 pub struct GeodesicWait {
     inner: Geodesic,

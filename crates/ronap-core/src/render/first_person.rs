@@ -1,4 +1,4 @@
-//! The paper's first-person view (SPEC.md, "Display only"): the scene turned so the heading
+//! The paper's first-person view (docs/model.md "Sensors", display only): the scene turned so the heading
 //! points up, the circle of laser range, the rays in their colour classes and the goal arrow.
 
 use crate::geometry::Point;
@@ -10,7 +10,7 @@ use image::{Rgb, RgbImage};
 /// the circle of range with a margin around it.
 pub const FIRST_PERSON_HALF_SPAN: f64 = 1.2;
 
-/// The first-person frame (SPEC.md, "Display only"): the scene turned by `theta_s = 90 - z` about
+/// The first-person frame (docs/model.md "Sensors", display only): the scene turned by `theta_s = 90 - z` about
 /// the robot, so the heading points up. View coordinates are px from the robot, `u` to the right
 /// and `v` up (straight ahead); they keep scene lengths.
 #[derive(Clone, Copy, Debug, PartialEq)]

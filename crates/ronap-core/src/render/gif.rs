@@ -1,5 +1,5 @@
 //! Animated GIFs of episodes: an episode stepped again through the actions it took, drawn from
-//! above ([`render::top_down`]) or first-person ([`render::first_person`]) every `stride` steps.
+//! above ([`render::top_down`]) or first-person ([`render::first_person()`]) every `stride` steps.
 //!
 //! Stepping the model again, rather than drawing logged numbers, gives exact frames (the pose after
 //! the last action included) from nothing but the scene, the configuration and the actions, so a

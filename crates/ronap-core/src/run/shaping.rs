@@ -1,4 +1,4 @@
-//! The reward a learner is given under `reward.shaping = "geodesic"` (SPEC "Reward"): the
+//! The reward a learner is given under `reward.shaping = "geodesic"` (docs/model.md "Reward"): the
 //! paper's straight-line progress term r_b replaced by potential-based shaping
 //! `F = gamma Phi(s') - Phi(s)`, `Phi = -progress_per_px x` the geodesic distance to the goal
 //! (Ng, Harada and Russell 1999), so that heading into a dead end no longer pays. The potential of

@@ -1,4 +1,4 @@
-//! Maze generation: the recursive backtracker of SPEC.md, plus a fraction of extra openings.
+//! Maze generation: the recursive backtracker of docs/model.md "Scene: maze", plus a fraction of extra openings.
 //!
 //! Cells are `cell_px` squares indexed `(col, row)` from the scene's bottom-left corner (y up), so
 //! the top-left cell, where generation starts, is `(0, rows - 1)`. Walls lie on cell edges.

@@ -226,7 +226,7 @@ impl RaysFrom<'_> {
     /// The same as asking beam by beam, with what the beams share worked out once.
     ///
     /// The walks run compiled for the widest instruction set the processor has, AVX-512
-    /// included (see [`WIDEST`](crate::geometry::WIDEST)); the same bits.
+    /// included (see `geometry::WIDEST`); the same bits.
     #[inline]
     pub fn first_box_hits<'b>(
         &self,

@@ -1,4 +1,4 @@
-//! Generated logistics warehouses (SPEC "Warehouse scene").
+//! Generated logistics warehouses (docs/model.md "Warehouse scene").
 //!
 //! # Layout
 //!

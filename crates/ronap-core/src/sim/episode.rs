@@ -148,7 +148,7 @@ pub struct Episode {
     goals_reached: u32,
 }
 
-/// How an episode went among moving obstacles (SPEC "Moving obstacles", metrics).
+/// How an episode went among moving obstacles (docs/model.md "Moving obstacles", metrics).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DynamicMetrics {
     /// Steps with contact between the robot and a moving obstacle, either way.
@@ -335,7 +335,7 @@ impl Episode {
         }
     }
 
-    /// The paper's re-posing in data collection (SPEC.md): the robot jumps to a random free pose,
+    /// The paper's re-posing in data collection (docs/model.md "Data log"): the robot jumps to a random free pose,
     /// `x, y` uniform over the scene where the robot fits (and, given `grid`, in the goal's free
     /// region, so the goal stays reachable), heading `theta + 360 lambda3` with
     /// `lambda3 ~ N(0, 0.03^2)`: roughly towards the goal. The goal, step and collision counts stay.
@@ -473,7 +473,7 @@ impl Episode {
     }
 
     /// Makes `goals` the robot's goals, visited one after the other from the first (a goal
-    /// list, SPEC "Multi-destination tasks"); the observation follows the current one.
+    /// list, docs/model.md "Multi-destination tasks"); the observation follows the current one.
     pub(crate) fn set_goals(&mut self, goals: &[Point]) {
         if let Some((&first, rest)) = goals.split_first() {
             self.goal = first;

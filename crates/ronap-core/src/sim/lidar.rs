@@ -98,7 +98,7 @@ fn atan2_deg_near(y: f64, x: f64) -> f64 {
     r.to_degrees()
 }
 
-/// Colour class of a reading, for drawing rays (SPEC "Sensors").
+/// Colour class of a reading, for drawing rays (docs/model.md "Sensors").
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RayClass {
     /// d > 0.6 d_max.

@@ -1,4 +1,4 @@
-//! Moving and appearing obstacles (SPEC "Moving obstacles"): discs and boxes that move before the
+//! Moving and appearing obstacles (docs/model.md "Moving obstacles"): discs and boxes that move before the
 //! robot in every step, as `linear`, `waypoints`, `random_walk` or `appear` say, all drawn from the
 //! episode seed's own moving-obstacle stream, so adding one never changes the maze, the start or
 //! the goal.

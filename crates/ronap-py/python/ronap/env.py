@@ -21,11 +21,11 @@ class NavEnv(gym.Env[np.ndarray, Any]):
     """One RoNAP episode at a time.
 
     Observation: ``float32[beams + 1]``, the laser readings over their range and the goal
-    direction over 360 (SPEC's 18 values by default); with ``observation_history=k`` the last
+    direction over 360 (the model's 18 values by default, docs/model.md); with ``observation_history=k`` the last
     ``k`` of those frames, newest first, then the last ``k - 1`` actions as three values each
     (one-hot LEFT, AHEAD, RIGHT), all in [0, 1]. Actions: ``Discrete(3)`` (0 LEFT, 1 AHEAD,
     2 RIGHT), or with ``continuous=True`` ``Box(-1, 1, (2,))``: ``(v / v_max, w / w_max)``.
-    Rewards: SPEC's four terms; with ``reward_shaping="geodesic"`` the straight-line progress
+    Rewards: the model's four terms; with ``reward_shaping="geodesic"`` the straight-line progress
     term becomes potential-based shaping along the geodesic distance (discount
     ``reward_shaping_gamma``, 0.99 by default: set it to your algorithm's).
     ``terminated`` on success (and on collision with ``robot_on_collision="terminate"``, or at

@@ -13,7 +13,7 @@
 //! - `format`: `ronap-mlp/1`;
 //! - `activation`: `relu`, `tanh`, `leaky_relu:SLOPE`, or `rrelu` (the paper's RReLU; at inference
 //!   it is a leaky ReLU of slope `(1/8 + 1/3) / 2`, PyTorch's evaluation mode);
-//! - `observation`: the observation layout, [`OBSERVATION_LAYOUT`] for SPEC.md's 18 values;
+//! - `observation`: the observation layout, [`OBSERVATION_LAYOUT`] for the 18 values of docs/model.md "Observation";
 //! - `observation_size`: the number of inputs;
 //! - optional, for people: `output` (`q_values` or `logits`), `command` (what trained it),
 //!   `trained` (a description of the training data or run).

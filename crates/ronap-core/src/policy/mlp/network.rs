@@ -7,7 +7,7 @@ use std::collections::HashMap;
 
 /// The `format` metadata value this version reads and writes.
 pub const FORMAT: &str = "ronap-mlp/1";
-/// The `observation` metadata value for SPEC.md's observation.
+/// The `observation` metadata value for the observation of docs/model.md "Observation".
 pub const OBSERVATION_LAYOUT: &str = "laser_0/range,...,laser_16/range,direction/360";
 /// Slope of RReLU at inference: the mean of its default bounds 1/8 and 1/3.
 pub const RRELU_SLOPE: f32 = (1.0 / 8.0 + 1.0 / 3.0) / 2.0;
