@@ -450,25 +450,7 @@ impl Episode {
         let a = f * k;
         self.observation
             .copy_within(a..a + ACTION_MEMORY * (k - 2), a + ACTION_MEMORY);
-        let values = match action {
-            Action::Discrete(d) => {
-                let mut v = [0.0; ACTION_MEMORY];
-                v[d as usize] = 1.0;
-                v
-            }
-            Action::Continuous { v, w_deg } => {
-                let (v_max, w_max) = (
-                    self.config.robot.max_linear_speed_px,
-                    self.config.robot.max_angular_speed_deg,
-                );
-                let w = (w_deg / w_max).clamp(-1.0, 1.0);
-                [
-                    w.max(0.0) as f32,
-                    (v / v_max).clamp(0.0, 1.0) as f32,
-                    (-w).max(0.0) as f32,
-                ]
-            }
-        };
+        let values = self.robot.kinematics().remembered(action);
         self.observation[a..a + ACTION_MEMORY].copy_from_slice(&values);
     }
 

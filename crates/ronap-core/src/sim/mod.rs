@@ -3,6 +3,7 @@
 //! episodes run in. Uses `config`, `geometry` and `scene`.
 
 pub mod episode;
+pub mod kinematics;
 pub mod lidar;
 pub mod moving;
 pub mod placement;
