@@ -2,6 +2,7 @@
 //! and goal, the episode that steps and scores them, a team of several robots, and the worlds
 //! episodes run in. Uses `config`, `geometry` and `scene`.
 
+pub mod action;
 pub mod episode;
 pub mod kinematics;
 pub mod lidar;

@@ -11,7 +11,7 @@ pub use unicycle::Unicycle;
 
 use crate::config::RobotConfig;
 use crate::geometry::{Point, Vector};
-use crate::sim::robot::{Action, Pose};
+use crate::sim::action::{Action, Pose};
 use std::fmt::Debug;
 use std::sync::Arc;
 

@@ -6,8 +6,8 @@
 
 use crate::config::{RobotConfig, ACTION_MEMORY};
 use crate::geometry::{Point, Vector};
+use crate::sim::action::{Action, DiscreteAction, Pose};
 use crate::sim::kinematics::{Kinematics, Motion};
-use crate::sim::robot::{Action, DiscreteAction, Pose};
 
 /// Largest sagitta, px, between a continuous step's arc and the chords it is checked along; the
 /// chords are checked with the radius grown by it, so the check errs on the side of a collision.

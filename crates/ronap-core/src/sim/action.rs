@@ -1,0 +1,149 @@
+//! What a robot is told and where it is: its pose `[x px, y px, z deg]`, the paper's three
+//! discrete actions and the continuous `(v, w)` command, with the text logs write them as.
+
+use crate::geometry::{wrap_deg, Point};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::str::FromStr;
+
+/// Position and heading.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Pose {
+    /// x, px.
+    pub x: f64,
+    /// y, px.
+    pub y: f64,
+    /// Heading, degrees counter-clockwise from +x, in [0, 360).
+    pub z_deg: f64,
+}
+
+impl Pose {
+    /// A pose with the heading wrapped into [0, 360).
+    pub fn new(x: f64, y: f64, z_deg: f64) -> Self {
+        Self {
+            x,
+            y,
+            z_deg: wrap_deg(z_deg),
+        }
+    }
+
+    /// The position.
+    pub fn position(&self) -> Point {
+        Point::new(self.x, self.y)
+    }
+}
+
+/// The paper's three discrete actions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "UPPERCASE")]
+pub enum DiscreteAction {
+    /// Turn counter-clockwise by `turn_speed_deg`.
+    Left = 0,
+    /// Move `move_speed_px` along the heading.
+    Ahead = 1,
+    /// Turn clockwise by `turn_speed_deg`.
+    Right = 2,
+}
+
+impl DiscreteAction {
+    /// All actions in index order (the index a learned policy outputs).
+    pub const ALL: [Self; 3] = [Self::Left, Self::Ahead, Self::Right];
+
+    /// The action with index `i` (0 LEFT, 1 AHEAD, 2 RIGHT).
+    pub fn from_index(i: usize) -> Option<Self> {
+        Self::ALL.get(i).copied()
+    }
+
+    /// The name used in data logs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Left => "LEFT",
+            Self::Ahead => "AHEAD",
+            Self::Right => "RIGHT",
+        }
+    }
+}
+
+impl fmt::Display for DiscreteAction {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for DiscreteAction {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.trim() {
+            "LEFT" => Ok(Self::Left),
+            "AHEAD" => Ok(Self::Ahead),
+            "RIGHT" => Ok(Self::Right),
+            other => Err(format!(
+                "unknown action {other:?} (expected LEFT, AHEAD or RIGHT)"
+            )),
+        }
+    }
+}
+
+/// One step's command.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Action {
+    /// A discrete action.
+    Discrete(DiscreteAction),
+    /// Linear speed `v` px per step and angular speed `w_deg` degrees per step, clipped to the
+    /// robot's limits.
+    Continuous {
+        /// Linear speed, px per step.
+        v: f64,
+        /// Angular speed, degrees per step.
+        w_deg: f64,
+    },
+}
+
+impl From<DiscreteAction> for Action {
+    fn from(a: DiscreteAction) -> Self {
+        Action::Discrete(a)
+    }
+}
+
+impl Action {
+    /// The discrete action, if this is one.
+    pub fn discrete(self) -> Option<DiscreteAction> {
+        match self {
+            Action::Discrete(a) => Some(a),
+            Action::Continuous { .. } => None,
+        }
+    }
+}
+
+/// As logs write it: `LEFT`, `AHEAD`, `RIGHT`, or `v=SPEED;w=TURN` for a continuous action.
+impl fmt::Display for Action {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Action::Discrete(a) => f.write_str(a.name()),
+            Action::Continuous { v, w_deg } => write!(f, "v={v};w={w_deg}"),
+        }
+    }
+}
+
+/// Reads what [`Action`]'s `Display` writes.
+impl FromStr for Action {
+    type Err = String;
+    fn from_str(text: &str) -> Result<Self, String> {
+        if let Some(rest) = text.strip_prefix("v=") {
+            let (v, w) = rest
+                .split_once(";w=")
+                .ok_or_else(|| format!("{text:?}: expected v=SPEED;w=TURN"))?;
+            let number = |s: &str| {
+                s.parse::<f64>()
+                    .ok()
+                    .filter(|x| x.is_finite())
+                    .ok_or_else(|| format!("{text:?}: {s:?} is not a finite number"))
+            };
+            return Ok(Action::Continuous {
+                v: number(v)?,
+                w_deg: number(w)?,
+            });
+        }
+        text.parse::<DiscreteAction>().map(Action::from)
+    }
+}
