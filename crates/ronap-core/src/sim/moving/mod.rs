@@ -7,137 +7,59 @@
 //! whose own motion would touch the robot stays where it was (and the robot is charged a dynamic
 //! collision); a robot step is swept against the obstacles' new positions. Obstacles do not
 //! collide with each other.
+//!
+//! [`Movers`] is the engine. The heading motions (`linear`, `random_walk`) are moved together in
+//! one vectorised pass (`heading.rs`); every other motion is a [`Behaviour`], one file each
+//! (`waypoints.rs`), which sees the other obstacles and the robots through a [`Neighbours`]
+//! query: a new motion is a new file implementing it and the line of [`Movers`] that makes it.
 
-use crate::config::{MotionKind, MovingConfig, MovingShape, Patrol, ValidConfig};
-use crate::geometry::{point_segment_distance_squared, unit, Aabb, Point, Vector};
+mod behaviour;
+mod body;
+mod heading;
+mod waypoints;
+
+pub use behaviour::{Agent, Behaviour, Neighbours};
+pub use body::Body;
+pub use waypoints::Waypoints;
+
+use crate::config::{MotionKind, MovingConfig, MovingShape, ValidConfig};
+use crate::geometry::{point_segment_distance_squared, unit, Point, Vector};
 use crate::scene::Scene;
 use crate::sim::rng::{stream, Rng, Stream};
+use heading::{State, RESORT_EVERY};
 use rand::Rng as _;
 use rand_distr::{Distribution, StandardNormal};
 
 /// Attempts at finding a free spot for an obstacle.
 const SPOT_TRIES: usize = 1000;
 
-/// A moving obstacle's body.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Body {
-    /// A disc of this radius, px.
-    Disc(f64),
-    /// An axis-aligned box of these half extents, px.
-    Box(Vector),
-}
-
-impl Body {
-    /// Radius of the smallest disc round the body, px.
-    pub fn bounding_radius(&self) -> f64 {
-        match *self {
-            Body::Disc(r) => r,
-            Body::Box(h) => h.norm(),
-        }
-    }
-
-    /// Half extents of the box the body covers (a disc's bounding box), px.
-    pub fn half_extents(&self) -> Vector {
-        match *self {
-            Body::Disc(r) => Vector::new(r, r),
-            Body::Box(h) => h,
-        }
-    }
-
-    /// The box the body covers at `center` (a disc's bounding box).
-    pub fn aabb(&self, center: Point) -> Aabb {
-        let h = self.half_extents();
-        Aabb::from_corners(center - h, center + h)
-    }
-
-    /// The gap between the body at `center` and a disc of `radius` at `p` (negative when they
-    /// overlap, for discs).
-    pub fn gap(&self, center: Point, p: Point, radius: f64) -> f64 {
-        match *self {
-            Body::Disc(r) => (p - center).norm() - r - radius,
-            Body::Box(_) => self.aabb(center).distance_squared(p).sqrt() - radius,
-        }
-    }
-
-    /// Whether the body moving from `a` to `b` comes closer than `radius` to the point `p`
-    /// (a robot disc of `radius` at `p` would be touched).
-    fn sweep_touches(&self, a: Point, b: Point, p: Point, radius: f64) -> bool {
-        match *self {
-            Body::Disc(r) => point_segment_distance_squared(p, a, b) < (r + radius).powi(2),
-            Body::Box(h) => {
-                // The point against the box at rest, moving the other way.
-                let rest = Aabb::from_corners(Point::from(-h), Point::from(h));
-                let d = b - a;
-                rest.segment_distance_squared(Point::from(p - a), Point::from(p - a - d))
-                    < radius * radius
-            }
-        }
-    }
-
-    /// Whether the body fits at `center` in `scene` without touching a static obstacle.
-    fn clear_at(&self, scene: &Scene, center: Point) -> bool {
-        let inside = scene.bounds();
-        match *self {
-            Body::Disc(r) => {
-                let b = self.aabb(center);
-                inside.contains(b.min) && inside.contains(b.max) && scene.disc_clear(center, r)
-            }
-            Body::Box(_) => scene.box_clear(self.aabb(center)),
-        }
-    }
-
-    /// Whether the body can move in a straight line from `a` to `b` in `scene`.
-    fn sweep_clear(&self, scene: &Scene, a: Point, b: Point) -> bool {
-        match *self {
-            Body::Disc(r) => scene.bounds().inflated(-r).contains(b) && scene.sweep_clear(a, b, r),
-            Body::Box(h) => scene.box_sweep_clear(a, b, h),
-        }
-    }
-
-    /// Distance along the unit direction `dir` from `origin` to the body at `center`.
-    #[inline]
-    pub(crate) fn ray(&self, center: Point, origin: Point, dir: Vector, max: f64) -> Option<f64> {
-        match *self {
-            Body::Disc(r) => {
-                let oc = center - origin;
-                let along = oc.dot(&dir);
-                let d2 = oc.norm_squared() - along * along;
-                let r2 = r * r;
-                if d2 > r2 {
-                    return None;
-                }
-                let t = along - (r2 - d2).sqrt();
-                let t = if oc.norm_squared() <= r2 { 0.0 } else { t };
-                (t >= 0.0 && t <= max).then_some(t)
-            }
-            Body::Box(_) => {
-                let inv = Vector::new(1.0 / dir.x, 1.0 / dir.y);
-                self.aabb(center).ray_hit(origin, inv, max)
-            }
-        }
-    }
-}
-
 /// How one obstacle moves, with the state its heading and speed (kept in [`State`]) leave out.
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 enum Motion {
     Still,
-    /// `linear` (no turning) or `random_walk` (turning by N(0, sigma^2) rad each step).
+    /// `linear` (no turning) or `random_walk` (turning by N(0, sigma^2) rad each step), moved
+    /// with every other heading in one pass.
     Heading {
         sigma_rad: f64,
     },
-    Waypoints {
-        points: std::sync::Arc<[Point]>,
-        target: usize,
-        forward: bool,
-        mode: Patrol,
-    },
+    /// Moved by its [`Behaviour`] (kept beside the entries, in [`Movers::behaviours`]).
+    Behaves,
+}
+
+/// An entry's behaviour: a built-in held as itself, so that its step is called directly and
+/// inlined into the obstacles' step (through the trait, the three forklifts of
+/// `warehouse-forklifts.toml` cost 12% of `ronap bench --threads 1`'s steps), any other
+/// behind the trait.
+#[derive(Clone, Debug)]
+enum Behave {
+    Waypoints(Waypoints),
+    Other(Box<dyn Behaviour>),
 }
 
 /// What one moving obstacle is, apart from where it is and where it heads.
 #[derive(Clone, Debug)]
-struct Entry {
-    body: Body,
+pub(super) struct Entry {
+    pub(super) body: Body,
     motion: Motion,
     /// `appear`: the step it appears in, until it has.
     appears_at: Option<u32>,
@@ -147,367 +69,18 @@ struct Entry {
 }
 
 impl Entry {
-    fn present(&self) -> bool {
+    pub(super) fn present(&self) -> bool {
         self.appears_at.is_none() && !self.held
     }
 
     /// Whether it moves along its heading this step (present, `linear` or `random_walk`), and
     /// the standard deviation of its turns, rad (0 when it does not turn).
-    fn walk(&self) -> (bool, f64) {
+    pub(super) fn walk(&self) -> (bool, f64) {
         match self.motion {
             Motion::Heading { sigma_rad } if self.present() => (true, sigma_rad),
             _ => (false, 0.0),
         }
     }
-}
-
-/// Where the obstacles are and where they head, one array per quantity, so that the turns, the
-/// moves and the fast clearance test of every obstacle run as one vectorised pass.
-#[derive(Clone, Debug, Default)]
-struct State {
-    x: Vec<f64>,
-    y: Vec<f64>,
-    /// Unit heading (`linear`, `random_walk`).
-    dx: Vec<f64>,
-    dy: Vec<f64>,
-    speed: Vec<f64>,
-    /// Where the centre may go with no query: a box clear of the still scene shrunk by the body
-    /// (empty until first measured). A straight move between two points inside it is clear.
-    lo_x: Vec<f64>,
-    lo_y: Vec<f64>,
-    hi_x: Vec<f64>,
-    hi_y: Vec<f64>,
-    /// Bounding radius of the body, px.
-    bound: Vec<f64>,
-    /// Squared distance from the robot's centre within which a move must be checked against it.
-    near_robot2: Vec<f64>,
-    /// Whether it moves along its heading this step ([`Entry::walk`], kept up to date as
-    /// obstacles appear or are released).
-    walks: Vec<bool>,
-    /// The standard deviation of its turns, rad (0 when absent or not turning; the same).
-    sigma: Vec<f64>,
-    /// This step's turn, rad (0 for the obstacles not turning), and its sine and cosine.
-    turn: Vec<f64>,
-    sin: Vec<f64>,
-    cos: Vec<f64>,
-    /// This step's intended centre, and whether it lies in the free box.
-    ahead_x: Vec<f64>,
-    ahead_y: Vec<f64>,
-    fits: Vec<bool>,
-    /// Whether the pass has moved it (a walk in its free box and far from the robot).
-    moved: Vec<bool>,
-    /// This step's turns beyond 1 rad, as `(obstacle, sin, cos)`, applied after the pass.
-    wide: Vec<(usize, f64, f64)>,
-    /// The obstacles by band of [`BAND_PX`] in y, then by x, as of the end of the last step, and
-    /// where each band starts in that order (`band_start`, one past the last band at the end): a
-    /// scan looks only at the obstacles of the bands within its reach whose x is within its reach
-    /// too. Obstacles move a few px a step, so the order barely changes and an insertion sort
-    /// keeps it in a pass.
-    keys: Vec<Key>,
-    band_start: Vec<u32>,
-    /// Steps since `keys` were put in order: an obstacle may since have moved up to `age *
-    /// drift` px on either axis, so a scan looks that much further in the old order, and the
-    /// order is brought up to date every [`RESORT_EVERY`] steps (or when an obstacle appears).
-    age: u32,
-    /// The furthest an obstacle moves in a step on either axis (its speed), px, with a margin
-    /// for rounding.
-    drift: f64,
-}
-
-/// Steps between bringing the obstacles' order by band and x up to date: sorting costs more
-/// than a step's scan, and in a few steps obstacles barely move.
-const RESORT_EVERY: u32 = 8;
-
-/// An obstacle's place in [`State::keys`].
-#[derive(Clone, Copy, Debug)]
-struct Key {
-    band: u32,
-    obstacle: u32,
-    x: f64,
-}
-
-impl Key {
-    /// Whether `self` comes after `other`: by band, then by x.
-    #[inline]
-    fn after(&self, other: &Key) -> bool {
-        self.band > other.band || (self.band == other.band && self.x > other.x)
-    }
-}
-
-/// Height of the bands of y by which [`State`] orders the obstacles for scans, px.
-const BAND_PX: f64 = 64.0;
-
-/// The band of y (below 0: band 0).
-fn band(y: f64) -> u32 {
-    // A float cast saturates (and takes NaN to 0), so every y has a band, in order.
-    (y.max(0.0) / BAND_PX) as u32
-}
-
-/// [`State::pass`] as pulp runs it, compiled once per instruction set.
-struct Pass<'a> {
-    state: &'a mut State,
-    robots: &'a [Point],
-}
-
-impl pulp::WithSimd for Pass<'_> {
-    type Output = ();
-
-    #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, _: S) {
-        self.state.pass(self.robots);
-    }
-}
-
-/// Margin by which a centre must lie inside its free box, px: the fast test never accepts what
-/// the exact one might refuse by a rounding.
-const FIT_MARGIN: f64 = 1e-9;
-
-impl State {
-    fn push(&mut self, entry: &Entry, position: Point, dir: Vector, speed: f64, near_robot: f64) {
-        self.drift = self.drift.max(speed * (1.0 + 1e-9));
-        self.bound.push(entry.body.bounding_radius());
-        self.near_robot2.push(near_robot * near_robot);
-        let (walks, sigma) = entry.walk();
-        self.walks.push(walks);
-        self.sigma.push(sigma);
-        self.moved.push(false);
-        self.x.push(position.x);
-        self.y.push(position.y);
-        self.dx.push(dir.x);
-        self.dy.push(dir.y);
-        self.speed.push(speed);
-        self.lo_x.push(f64::INFINITY);
-        self.lo_y.push(f64::INFINITY);
-        self.hi_x.push(f64::NEG_INFINITY);
-        self.hi_y.push(f64::NEG_INFINITY);
-        self.turn.push(0.0);
-        self.sin.push(0.0);
-        self.cos.push(1.0);
-        self.ahead_x.push(0.0);
-        self.ahead_y.push(0.0);
-        self.fits.push(false);
-    }
-
-    fn position(&self, i: usize) -> Point {
-        Point::new(self.x[i], self.y[i])
-    }
-
-    /// Brings the order by band and x ([`State::keys`]) up to date with where the obstacles are.
-    fn sort_keys(&mut self) {
-        self.age = 0;
-        let n = self.x.len();
-        if self.keys.len() != n {
-            self.keys = (0..n as u32)
-                .map(|obstacle| Key {
-                    band: 0,
-                    obstacle,
-                    x: 0.0,
-                })
-                .collect();
-        }
-        let (x, y) = (&self.x[..n], &self.y[..n]);
-        for key in &mut self.keys {
-            let i = key.obstacle as usize;
-            key.x = x[i];
-            key.band = band(y[i]);
-        }
-        let keys = &mut self.keys[..];
-        for k in 1..keys.len() {
-            if keys[k - 1].after(&keys[k]) {
-                let key = keys[k];
-                let mut j = k;
-                while j > 0 && keys[j - 1].after(&key) {
-                    keys[j] = keys[j - 1];
-                    j -= 1;
-                }
-                keys[j] = key;
-            }
-        }
-        self.band_start.clear();
-        for (k, key) in self.keys.iter().enumerate() {
-            while self.band_start.len() <= key.band as usize {
-                self.band_start.push(k as u32);
-            }
-        }
-        self.band_start.push(n as u32);
-    }
-
-    /// Calls `f` with every obstacle whose centre may lie within `slab` px of `p` on both axes
-    /// (and some that do not): those of the bands within reach whose x is within reach, as of
-    /// the last sort, reach grown by how far obstacles may have moved since.
-    #[inline]
-    fn near(&self, p: Point, slab: f64, mut f: impl FnMut(usize)) {
-        let slab = slab + f64::from(self.age) * self.drift;
-        let bands = self.band_start.len().saturating_sub(1);
-        let (lo, hi) = (band(p.y - slab) as usize, band(p.y + slab) as usize);
-        let (left, right) = (p.x - slab, p.x + slab);
-        for b in lo..=hi.min(bands.saturating_sub(1)) {
-            let (s, e) = (self.band_start[b] as usize, self.band_start[b + 1] as usize);
-            let run = &self.keys[s..e];
-            // A band holds a few obstacles: a plain walk beats a binary search to the first.
-            for key in run {
-                if key.x < left {
-                    continue;
-                }
-                if key.x > right {
-                    break;
-                }
-                f(key.obstacle as usize);
-            }
-        }
-    }
-
-    /// Turns every heading by this step's turn and moves it `speed` ahead into `ahead`, marking
-    /// in `fits` those whose move stays in their free box; moves there, and marks `moved`, the
-    /// walks that fit and are not near any robot at `robots`. Turns beyond 1 rad are applied one
-    /// by one first; the rest is plain arithmetic over the arrays in loops with no branch, which
-    /// vectorise (compiled for the processor's widest instruction set, the same bits on each).
-    fn turn_and_look_ahead(&mut self, robots: &[Point]) {
-        for &(i, s, c) in &self.wide {
-            let (dx, dy) = (self.dx[i], self.dy[i]);
-            self.dx[i] = dx * c - dy * s;
-            self.dy[i] = dx * s + dy * c;
-        }
-        crate::geometry::ARCH.dispatch(Pass {
-            state: self,
-            robots,
-        });
-    }
-
-    /// The vectorised part of [`State::turn_and_look_ahead`].
-    #[inline(always)]
-    fn pass(&mut self, robots: &[Point]) {
-        let n = self.x.len();
-        let (x, y, speed) = (&mut self.x[..n], &mut self.y[..n], &self.speed[..n]);
-        let (dx, dy, turn) = (&mut self.dx[..n], &mut self.dy[..n], &self.turn[..n]);
-        let (lo_x, lo_y) = (&self.lo_x[..n], &self.lo_y[..n]);
-        let (hi_x, hi_y) = (&self.hi_x[..n], &self.hi_y[..n]);
-        let (ax, ay) = (&mut self.ahead_x[..n], &mut self.ahead_y[..n]);
-        let (fits, moved) = (&mut self.fits[..n], &mut self.moved[..n]);
-        let (walks, near2) = (&self.walks[..n], &self.near_robot2[..n]);
-        let (sin, cos) = (&mut self.sin[..n], &mut self.cos[..n]);
-        // Which walks are far from every robot (from where they are now), robot by robot.
-        moved.copy_from_slice(walks);
-        for robot in robots {
-            for i in 0..n {
-                let (rx, ry) = (x[i] - robot.x, y[i] - robot.y);
-                moved[i] &= rx * rx + ry * ry >= near2[i];
-            }
-        }
-        // The series alone first: a short loop the compiler interleaves, hiding the latency of
-        // the long chains of multiplications.
-        for i in 0..n {
-            (sin[i], cos[i]) = sin_cos_within_1(turn[i]);
-        }
-        for i in 0..n {
-            let (s, c) = (sin[i], cos[i]);
-            let (tx, ty) = (dx[i] * c - dy[i] * s, dx[i] * s + dy[i] * c);
-            // A rotation keeps the length to within rounding; one Newton step towards length 1
-            // stops the drift without a square root or a division.
-            let k = 1.5 - 0.5 * (tx * tx + ty * ty);
-            let (ux, uy) = (tx * k, ty * k);
-            dx[i] = ux;
-            dy[i] = uy;
-            let (px, py) = (x[i], y[i]);
-            let (qx, qy) = (px + ux * speed[i], py + uy * speed[i]);
-            ax[i] = qx;
-            ay[i] = qy;
-            // The move is clear when both ends lie in the box (it is convex).
-            let fit = (qx > lo_x[i])
-                & (qx < hi_x[i])
-                & (qy > lo_y[i])
-                & (qy < hi_y[i])
-                & (px > lo_x[i])
-                & (px < hi_x[i])
-                & (py > lo_y[i])
-                & (py < hi_y[i]);
-            fits[i] = fit;
-            let go = moved[i] & fit;
-            moved[i] = go;
-            x[i] = if go { qx } else { px };
-            y[i] = if go { qy } else { py };
-        }
-    }
-
-    /// Sets this step's turn of obstacle `i` to `a` rad.
-    #[inline]
-    fn set_turn(&mut self, i: usize, a: f64) {
-        if a.abs() <= 1.0 {
-            self.turn[i] = a;
-        } else {
-            // Turned before the vectorised pass, which then only renormalises it.
-            self.turn[i] = 0.0;
-            let (s, c) = sin_cos(a);
-            self.wide.push((i, s, c));
-        }
-    }
-
-    /// Sets obstacle `i`'s free box to `free` shrunk by `half` (the body's half extents).
-    fn set_free(&mut self, i: usize, free: Aabb, half: Vector) {
-        self.lo_x[i] = free.min.x + half.x + FIT_MARGIN;
-        self.lo_y[i] = free.min.y + half.y + FIT_MARGIN;
-        self.hi_x[i] = free.max.x - half.x - FIT_MARGIN;
-        self.hi_y[i] = free.max.y - half.y - FIT_MARGIN;
-    }
-
-    /// Whether `p` lies in obstacle `i`'s free box (a straight move to it is then clear).
-    fn in_free(&self, i: usize, p: Point) -> bool {
-        p.x > self.lo_x[i] && p.x < self.hi_x[i] && p.y > self.lo_y[i] && p.y < self.hi_y[i]
-    }
-}
-
-/// `(sin a, cos a)` for |a| <= 1 by Taylor series (to a^17 and a^18: the first term left out is
-/// below 1e-17), plain multiplications and additions, so the same bits on every platform and one
-/// vectorised pass for many turns. Wrong beyond |a| = 1: see [`sin_cos`].
-#[inline(always)]
-fn sin_cos_within_1(a: f64) -> (f64, f64) {
-    let a2 = a * a;
-    const S: [f64; 8] = [
-        -1.0 / 6.0,
-        1.0 / 120.0,
-        -1.0 / 5040.0,
-        1.0 / 362_880.0,
-        -1.0 / 39_916_800.0,
-        1.0 / 6_227_020_800.0,
-        -1.0 / 1_307_674_368_000.0,
-        1.0 / 355_687_428_096_000.0,
-    ];
-    const C: [f64; 9] = [
-        -1.0 / 2.0,
-        1.0 / 24.0,
-        -1.0 / 720.0,
-        1.0 / 40_320.0,
-        -1.0 / 3_628_800.0,
-        1.0 / 479_001_600.0,
-        -1.0 / 87_178_291_200.0,
-        1.0 / 20_922_789_888_000.0,
-        -1.0 / 6_402_373_705_728_000.0,
-    ];
-    let mut s = S[7];
-    for k in (0..7).rev() {
-        s = S[k] + a2 * s;
-    }
-    let mut c = C[8];
-    for k in (0..8).rev() {
-        c = C[k] + a2 * c;
-    }
-    (a * (1.0 + a2 * s), 1.0 + a2 * c)
-}
-
-/// `(sin a, cos a)` for any `a`: halved until within 1 rad, then doubled back. Plain arithmetic,
-/// so the same on every platform (a random walk's turns beyond 1 rad are rare).
-fn sin_cos(a: f64) -> (f64, f64) {
-    let mut halvings = 0;
-    let mut h = a;
-    while h.abs() > 1.0 && halvings < 1100 {
-        h *= 0.5;
-        halvings += 1;
-    }
-    let (mut s, mut c) = sin_cos_within_1(h);
-    for _ in 0..halvings {
-        (s, c) = (2.0 * s * c, c * c - s * s);
-    }
-    (s, c)
 }
 
 /// A moving obstacle as pictures and tests see it.
@@ -571,6 +144,8 @@ pub struct MovingError {
 #[derive(Clone, Debug)]
 pub struct Movers {
     entries: Vec<Entry>,
+    /// The behaviour of each entry that has one ([`Motion::Behaves`]).
+    behaviours: Vec<Option<Behave>>,
     state: State,
     rng: Rng,
     /// Largest bounding radius plus step, for the quick distance tests.
@@ -639,6 +214,7 @@ impl Movers {
             .fold(config.robot.radius_px, f64::max);
         let mut rng = stream(seed, Stream::Moving);
         let mut entries = Vec::new();
+        let mut behaviours = Vec::new();
         let mut state = State::default();
         let mut reach: f64 = 0.0;
         for (entry, m) in config.moving.iter().enumerate() {
@@ -649,17 +225,19 @@ impl Movers {
             };
             reach = reach.max(body.bounding_radius() + m.speed_px);
             for _ in 0..m.count {
-                let (e, position, dir) =
+                let (e, behaviour, position, dir) =
                     Self::make(m, body, scene, robots, goals, &mut rng).map_err(err)?;
                 let near = m.speed_px + body.bounding_radius() + robot_radius;
                 state.push(&e, position, dir, m.speed_px, near);
                 entries.push(e);
+                behaviours.push(behaviour);
             }
         }
         state.sort_keys();
         let waiting = entries.iter().filter(|e| !e.present()).count();
         Ok(Some(Self {
             entries,
+            behaviours,
             state,
             rng,
             reach,
@@ -677,7 +255,7 @@ impl Movers {
         robots: &[Disc],
         goals: &[Point],
         rng: &mut Rng,
-    ) -> Result<(Entry, Point, Vector), String> {
+    ) -> Result<(Entry, Option<Behave>, Point, Vector), String> {
         let kind = if m.motion == MotionKind::Appear {
             m.then
         } else {
@@ -710,6 +288,7 @@ impl Movers {
                 .iter()
                 .any(|r| body.gap(position, r.at, r.radius) < 0.0);
         let mut dir = Vector::new(1.0, 0.0);
+        let mut behaviour = None;
         let motion = match kind {
             MotionKind::Still | MotionKind::Appear => Motion::Still,
             MotionKind::Linear | MotionKind::RandomWalk => {
@@ -726,12 +305,12 @@ impl Movers {
                     },
                 }
             }
-            MotionKind::Waypoints => Motion::Waypoints {
-                points: m.points.iter().map(|p| Point::new(p[0], p[1])).collect(),
-                target: if m.start.is_some() { 0 } else { 1 },
-                forward: true,
-                mode: m.mode,
-            },
+            MotionKind::Waypoints => {
+                let points = m.points.iter().map(|p| Point::new(p[0], p[1])).collect();
+                let first = if m.start.is_some() { 0 } else { 1 };
+                behaviour = Some(Behave::Waypoints(Waypoints::new(points, first, m.mode)));
+                Motion::Behaves
+            }
         };
         let entry = Entry {
             body,
@@ -740,7 +319,19 @@ impl Movers {
             held,
             min_gap: m.min_robot_distance_px,
         };
-        Ok((entry, position, dir))
+        Ok((entry, behaviour, position, dir))
+    }
+
+    /// Gives obstacle `index` (in entry order) a behaviour of one's own in place of the motion
+    /// its entry configured (a motion no configuration names, a library user's): from the next
+    /// step it goes where `behaviour` says, under the same contact rules.
+    pub fn set_behaviour(&mut self, index: usize, behaviour: Box<dyn Behaviour>) {
+        let Some(e) = self.entries.get_mut(index) else {
+            return;
+        };
+        e.motion = Motion::Behaves;
+        (self.state.walks[index], self.state.sigma[index]) = e.walk();
+        self.behaviours[index] = Some(Behave::Other(behaviour));
     }
 
     /// The obstacles, present or not.
@@ -840,13 +431,13 @@ impl Movers {
             }
         }
         state.turn_and_look_ahead(&self.centres);
-        for (i, e) in self.entries.iter_mut().enumerate() {
+        for (i, e) in self.entries.iter().enumerate() {
             if state.moved[i] || !e.present() {
                 continue;
             }
             let from = state.position(i);
             let speed = state.speed[i];
-            let to = match &mut e.motion {
+            let to = match e.motion {
                 Motion::Still => continue,
                 Motion::Heading { .. } => {
                     if state.fits[i] {
@@ -858,30 +449,29 @@ impl Movers {
                         }
                     }
                 }
-                Motion::Waypoints {
-                    points,
-                    target,
-                    forward,
-                    mode,
-                } => {
-                    let mut at = from;
-                    let mut left = speed;
-                    // Each leg at least as long as a step is entered once per call.
-                    for _ in 0..points.len() * 2 {
-                        let goal = points[*target];
-                        let d = (goal - at).norm();
-                        if d > left {
-                            at += (goal - at) * (left / d);
-                            break;
-                        }
-                        at = goal;
-                        left -= d;
-                        advance_target(target, forward, *mode, points.len());
-                        if left <= 0.0 {
-                            break;
-                        }
+                Motion::Behaves => {
+                    let Some(behaviour) = self.behaviours[i].as_mut() else {
+                        continue;
+                    };
+                    let me = Agent {
+                        index: i,
+                        position: from,
+                        body: e.body,
+                        speed_px: speed,
+                    };
+                    let near = Neighbours {
+                        state,
+                        entries: &self.entries,
+                        robots,
+                    };
+                    let to = match behaviour {
+                        Behave::Waypoints(w) => w.next(&me, &near, scene, &mut self.rng),
+                        Behave::Other(b) => b.next(&me, &near, scene, &mut self.rng),
+                    };
+                    match to {
+                        Some(to) => to,
+                        None => continue,
                     }
-                    at
                 }
             };
             // Every motion moves at most `speed` a step.
@@ -1087,21 +677,6 @@ impl Movers {
     }
 }
 
-/// The next waypoint after reaching `target`.
-fn advance_target(target: &mut usize, forward: &mut bool, mode: Patrol, n: usize) {
-    match mode {
-        Patrol::Loop => *target = (*target + 1) % n,
-        Patrol::PingPong => {
-            if *forward && *target + 1 == n {
-                *forward = false;
-            } else if !*forward && *target == 0 {
-                *forward = true;
-            }
-            *target = if *forward { *target + 1 } else { *target - 1 };
-        }
-    }
-}
-
 /// A spot drawn uniformly over `scene` where `body` fits and `ok` holds.
 fn free_spot(
     body: Body,
@@ -1166,6 +741,118 @@ mod tests {
                 body.aabb(o.position()).segment_distance_squared(a, b) >= radius * radius
             }
         })
+    }
+
+    /// Heads for the first robot at full speed.
+    #[derive(Clone, Debug)]
+    struct Chase;
+
+    impl Behaviour for Chase {
+        fn next(
+            &mut self,
+            me: &Agent,
+            near: &Neighbours<'_>,
+            _: &Scene,
+            _: &mut Rng,
+        ) -> Option<Point> {
+            let robot = near.robots().first()?;
+            let d = robot.at - me.position;
+            Some(me.position + d * (me.speed_px / d.norm()).min(1.0))
+        }
+
+        fn boxed_clone(&self) -> Box<dyn Behaviour> {
+            Box::new(self.clone())
+        }
+    }
+
+    #[test]
+    fn a_behaviour_of_ones_own_moves_its_obstacle_under_the_contact_rules() {
+        let config = crate::SimConfig {
+            moving: vec![MovingConfig {
+                count: 6,
+                motion: MotionKind::Still,
+                speed_px: 3.0,
+                ..Default::default()
+            }],
+            ..Default::default()
+        }
+        .validate()
+        .expect("valid");
+        let scene = Scene::from_boxes(400.0, 400.0, Vec::new(), config.reach_px());
+        let robot = Point::new(200.0, 200.0);
+        let mut movers = Movers::new(&config, &scene, robot, Point::new(20.0, 20.0), 5)
+            .expect("places")
+            .expect("has movers");
+        movers.set_behaviour(0, Box::new(Chase));
+        let start = movers.items().next().expect("six").position();
+        let still: Vec<Point> = movers.items().skip(1).map(|m| m.position()).collect();
+        let radius = config.robot.radius_px;
+        let (mut touched, mut closest) = (0, f64::INFINITY);
+        for step in 1..=400 {
+            touched += usize::from(movers.advance(step, &scene, robot).touched_robot);
+            let at = movers.items().next().expect("six").position();
+            let gap = Body::Disc(8.0).gap(at, robot, radius);
+            assert!(
+                gap >= 0.0,
+                "step {step}: the chaser overlaps the robot at {at}"
+            );
+            closest = closest.min(gap);
+        }
+        // It came to the robot, was then held off it, and the still ones stayed put.
+        assert!((start - robot).norm() > 20.0);
+        assert!(closest < 3.0, "closest gap {closest}");
+        assert!(touched > 300, "touched {touched} times");
+        let now: Vec<Point> = movers.items().skip(1).map(|m| m.position()).collect();
+        assert_eq!(still, now);
+        // A clone carries the behaviour on.
+        let mut copy = movers.clone();
+        assert!(copy.advance(401, &scene, robot).touched_robot);
+    }
+
+    #[test]
+    fn neighbours_are_the_present_obstacles_within_the_distance() {
+        let config = crate::SimConfig {
+            moving: vec![MovingConfig {
+                count: 200,
+                speed_px: 4.0,
+                ..Default::default()
+            }],
+            ..Default::default()
+        }
+        .validate()
+        .expect("valid");
+        let scene = maze_scene(&config, 2);
+        let robot = Point::new(150.0, 150.0);
+        let mut movers = Movers::new(&config, &scene, robot, Point::new(850.0, 850.0), 2)
+            .expect("places")
+            .expect("has movers");
+        let mut found = 0;
+        for step in 1..=30 {
+            movers.advance(step, &scene, robot);
+            let near = Neighbours {
+                state: &movers.state,
+                entries: &movers.entries,
+                robots: &[],
+            };
+            for (p, d) in [
+                (robot, 120.0),
+                (Point::new(500.0, 500.0), 60.0),
+                (robot, 0.0),
+            ] {
+                let mut got = Vec::new();
+                near.obstacles_within(p, d, |i, at, _| got.push((i, at)));
+                got.sort_by_key(|&(i, _)| i);
+                let want: Vec<(usize, Point)> = movers
+                    .items()
+                    .enumerate()
+                    .filter(|(_, m)| m.present() && (m.position() - p).norm() <= d)
+                    .map(|(i, m)| (i, m.position()))
+                    .collect();
+                assert_eq!(got, want, "step {step} at {p} within {d}");
+                found += got.len();
+            }
+        }
+        assert!(found > 30, "found only {found}");
     }
 
     #[test]
@@ -1242,21 +929,6 @@ mod tests {
                 "the laser met obstacles in only {scanned} scans"
             );
             assert!(blocked > 20, "only {blocked} sweeps met an obstacle");
-        }
-    }
-
-    #[test]
-    fn sin_cos_matches_the_library() {
-        for k in -3000..=3000 {
-            let a = k as f64 * 0.0011;
-            let (s, c) = sin_cos(a);
-            let (s0, c0) = a.sin_cos();
-            assert!((s - s0).abs() < 4e-15 && (c - c0).abs() < 4e-15, "{a}");
-        }
-        for a in [-1.0, 1.0, 20.0, -1e3] {
-            let (s, c) = sin_cos(a);
-            let (s0, c0) = f64::sin_cos(a);
-            assert!((s - s0).abs() < 1e-9 && (c - c0).abs() < 1e-9, "{a}");
         }
     }
 }
