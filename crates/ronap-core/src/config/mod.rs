@@ -1,0 +1,422 @@
+//! The simulation configuration: every default of docs/model.md as a field, with its unit.
+//!
+//! [`SimConfig`] is what a user writes (TOML, flags, keyword arguments); [`ValidConfig`] is the
+//! same data after [`SimConfig::validate`] has checked every field. The rest of the core only takes
+//! a `ValidConfig`, so it never re-checks a value.
+//!
+//! One file per section, each with its fields, their defaults and their checks: `scene.rs` (scene,
+//! maze, warehouse, map, static obstacles), `robot.rs` (robot, laser), `episode.rs` (episode,
+//! reward, observation), `moving.rs`, `team.rs` (robots, team), `apf.rs`. This file assembles
+//! them into [`SimConfig`] and [`ValidConfig`]; `docs.rs` writes the commented TOML and `file.rs`
+//! reads files. The sections sit here, below the layers that use them, rather than beside their
+//! code: a scene, a robot and a policy all read the one validated configuration, and a section
+//! kept in `sim` or `policy` would make this layer import from above it.
+
+mod apf;
+mod docs;
+mod episode;
+mod file;
+mod moving;
+mod robot;
+mod scene;
+mod team;
+
+pub use apf::ApfConfig;
+pub use episode::{
+    EpisodeConfig, ObservationConfig, RewardConfig, Shaping, ACTION_MEMORY, MAX_HISTORY,
+};
+pub use file::{key_line, ConfigFile};
+pub use moving::{MotionKind, MovingConfig, MovingShape, Patrol, MAX_MOVING};
+pub use robot::{LaserConfig, OnCollision, RobotConfig, MAX_BEAMS};
+pub use scene::{
+    is_convex_polygon, MapConfig, MazeConfig, ObstacleConfig, SceneConfig, SceneKind,
+    WarehouseConfig,
+};
+pub use team::{
+    OnArrival, Order, TeamConfig, TeamRobotConfig, MAX_GOALS, MAX_NEIGHBOURS, MAX_ROBOTS,
+};
+
+use serde::{Deserialize, Serialize};
+use std::ops::Deref;
+
+/// A configuration value that is out of its range or malformed.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum ConfigError {
+    /// A field holds a value outside its allowed range.
+    #[error("{field} = {value}: {expected}")]
+    OutOfRange {
+        /// Dotted field name, as in the TOML file (`maze.cols`, `moving[2].speed_px`).
+        field: String,
+        /// The offending value, as written.
+        value: String,
+        /// What the field accepts.
+        expected: &'static str,
+    },
+    /// The TOML text could not be read into a configuration (syntax, type or unknown key).
+    #[error("{0}")]
+    Toml(String),
+    /// A configuration or scenario file that cannot be used: the file, the line when known, and
+    /// what was wrong.
+    #[error("{}{}: {message}", path.display(), line.map_or(String::new(), |l| format!(":{l}")))]
+    File {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The line of the offending key, from 1.
+        line: Option<usize>,
+        /// What was wrong, naming the key and value.
+        message: String,
+    },
+}
+
+/// The whole simulation configuration, as a user writes it.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SimConfig {
+    /// Where episodes take place.
+    pub scene: SceneConfig,
+    /// Maze generation.
+    pub maze: MazeConfig,
+    /// Warehouse generation.
+    pub warehouse: WarehouseConfig,
+    /// Image scenes.
+    pub map: MapConfig,
+    /// The robot.
+    pub robot: RobotConfig,
+    /// The laser.
+    pub laser: LaserConfig,
+    /// Start, goal, episode end.
+    pub episode: EpisodeConfig,
+    /// What a policy observes beyond the current values.
+    #[serde(skip_serializing_if = "ObservationConfig::is_default")]
+    pub observation: ObservationConfig,
+    /// Reward terms.
+    pub reward: RewardConfig,
+    /// The artificial potential field policy.
+    pub apf: ApfConfig,
+    /// Static obstacles added to the scene.
+    pub obstacles: Vec<ObstacleConfig>,
+    /// Moving obstacles.
+    pub moving: Vec<MovingConfig>,
+    /// Several robots (docs/model.md "Several robots"); none: the one robot of `[robot]`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub robots: Vec<TeamRobotConfig>,
+    /// How the robots of a team talk (docs/model.md "Several robots", communication).
+    #[serde(skip_serializing_if = "TeamConfig::is_default")]
+    pub team: TeamConfig,
+}
+
+/// A [`SimConfig`] whose every field has been checked. Dereferences to the `SimConfig`.
+/// The default is the (valid) default configuration.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ValidConfig(SimConfig);
+
+impl Deref for ValidConfig {
+    type Target = SimConfig;
+    fn deref(&self) -> &SimConfig {
+        &self.0
+    }
+}
+
+impl ValidConfig {
+    /// The configuration as written, for saving next to results.
+    pub fn as_sim_config(&self) -> &SimConfig {
+        &self.0
+    }
+
+    /// Length of the observation a policy sees: one value per laser beam, then the goal
+    /// direction (docs/model.md "Observation and reward").
+    pub fn observation_size(&self) -> usize {
+        let k = self.observation.history.max(1) as usize;
+        self.frame_size() * k + ACTION_MEMORY * (k - 1)
+    }
+
+    /// Length of one frame of the observation: one value per laser beam, the goal direction and
+    /// a team's neighbour slots. The observation is this alone unless `observation.history` > 1.
+    pub fn frame_size(&self) -> usize {
+        self.laser.beams as usize + 1 + self.team.neighbours as usize * self.team.slot_size()
+    }
+
+    /// Robots in a team (0: no `[[robots]]`, the one robot of `[robot]`).
+    pub fn team_size(&self) -> usize {
+        self.robots.iter().map(|r| r.count as usize).sum()
+    }
+
+    /// The `[[robots]]` entry of team robot `k` (from 0, in entry order).
+    pub fn team_entry(&self, k: usize) -> Option<&TeamRobotConfig> {
+        let mut left = k;
+        self.robots.iter().find(|r| {
+            if left < r.count as usize {
+                true
+            } else {
+                left -= r.count as usize;
+                false
+            }
+        })
+    }
+
+    /// The configuration of team robot `k` as a one-robot configuration: `[robot]`, `[laser]`
+    /// and `[episode]` with its entry's fields put in (validated with the whole team).
+    pub fn team_robot(&self, k: usize) -> ValidConfig {
+        let mut c = self.0.clone();
+        c.robots = Vec::new();
+        if let Some(e) = self.team_entry(k) {
+            if let Some(v) = e.radius_px {
+                c.robot.radius_px = v;
+            }
+            if let Some(v) = e.move_speed_px {
+                c.robot.move_speed_px = v;
+            }
+            if let Some(v) = e.turn_speed_deg {
+                c.robot.turn_speed_deg = v;
+            }
+            if let Some(v) = e.laser_beams {
+                c.laser.beams = v;
+            }
+            if let Some(v) = e.laser_range_px {
+                c.laser.range_px = v;
+            }
+            if let Some(v) = e.laser_fov_deg {
+                c.laser.fov_deg = v;
+            }
+            c.episode.start = e.start;
+            c.episode.goal = e.goal.or(e.goals.first().copied());
+        }
+        ValidConfig(c)
+    }
+
+    /// The query distance scenes are indexed for: the laser range or a step plus the robot
+    /// radius, whichever is longer, px.
+    pub fn reach_px(&self) -> f64 {
+        let step = self.robot.move_speed_px.max(self.robot.max_linear_speed_px);
+        self.laser.range_px.max(step + self.robot.radius_px)
+    }
+}
+
+fn check(
+    ok: bool,
+    field: &str,
+    value: impl ToString,
+    expected: &'static str,
+) -> Result<(), ConfigError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(ConfigError::OutOfRange {
+            field: field.to_string(),
+            value: value.to_string(),
+            expected,
+        })
+    }
+}
+
+fn non_negative(field: &str, v: f64) -> Result<(), ConfigError> {
+    check(
+        v.is_finite() && v >= 0.0,
+        field,
+        v,
+        "must be zero or positive",
+    )
+}
+
+fn finite(field: &str, v: f64) -> Result<(), ConfigError> {
+    check(
+        v.is_finite(),
+        field,
+        format!("{v:?}"),
+        "must be a finite number",
+    )
+}
+
+/// Largest maze side in cells: keeps a generated scene (and its pictures) within memory.
+pub const MAX_MAZE_CELLS_PER_SIDE: u32 = 1000;
+/// Largest length any field may give, px: scene sides, ranges, radii and speeds.
+pub const MAX_LENGTH_PX: f64 = 100_000.0;
+
+fn length(field: &str, v: f64, zero_ok: bool) -> Result<(), ConfigError> {
+    let low_ok = if zero_ok { v >= 0.0 } else { v > 0.0 };
+    check(
+        v.is_finite() && low_ok && v <= MAX_LENGTH_PX,
+        field,
+        format!("{v:?}"),
+        if zero_ok {
+            "must be between 0 and 100000 px"
+        } else {
+            "must be a positive length of at most 100000 px"
+        },
+    )
+}
+/// Checks that `v` is a fraction, 0 to 1.
+fn fraction(field: &str, v: f64) -> Result<(), ConfigError> {
+    check(
+        (0.0..=1.0).contains(&v),
+        field,
+        format!("{v:?}"),
+        "must be between 0 and 1",
+    )
+}
+
+fn point(field: &str, p: [f64; 2]) -> Result<(), ConfigError> {
+    check(
+        p.iter().all(|v| v.is_finite() && v.abs() <= MAX_LENGTH_PX),
+        field,
+        format!("{p:?}"),
+        "must be two finite numbers [x, y] within 100000 px",
+    )
+}
+
+impl SimConfig {
+    /// Reads a configuration from TOML text; missing fields keep their defaults and an unknown
+    /// key is an error that names it.
+    pub fn from_toml_str(text: &str) -> Result<Self, ConfigError> {
+        toml::from_str(text).map_err(|e| {
+            let message = e.message().trim().replace('\n', " ");
+            match e.span() {
+                Some(span) => {
+                    let before = &text[..span.start.min(text.len())];
+                    let line = before.matches('\n').count() + 1;
+                    let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+                    ConfigError::Toml(format!("line {line}, column {column}: {message}"))
+                }
+                None => ConfigError::Toml(message),
+            }
+        })
+    }
+
+    /// Checks every field, naming the first one that is out of range.
+    pub fn validate(self) -> Result<ValidConfig, ConfigError> {
+        self.maze.validate()?;
+        self.map.validate()?;
+        self.robot.validate()?;
+        self.laser.validate()?;
+        self.episode.validate()?;
+        self.reward.validate_terms()?;
+        self.observation.validate(self.robots.is_empty())?;
+        self.reward.validate_shaping()?;
+        self.apf.validate()?;
+        self.episode.validate_team_fields()?;
+        self.scene.validate()?;
+        self.warehouse.validate()?;
+        scene::validate_obstacles(&self.obstacles)?;
+        moving::validate_moving(&self.moving)?;
+        team::validate_robots(&self.robots)?;
+        self.team.validate()?;
+        Ok(ValidConfig(self))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_the_spec_values_and_valid() {
+        let c = SimConfig::default();
+        assert_eq!((c.maze.cols, c.maze.rows, c.maze.cell_px), (10, 10, 100.0));
+        assert_eq!(c.maze.loops, 0.4);
+        assert_eq!(
+            (c.laser.beams, c.laser.fov_deg, c.laser.range_px),
+            (17, 180.0, 50.0)
+        );
+        assert_eq!((c.robot.move_speed_px, c.robot.turn_speed_deg), (5.0, 15.0));
+        assert_eq!(c.episode.goal_tolerance_px, 10.0);
+        assert!(c.validate().is_ok());
+    }
+
+    #[test]
+    fn out_of_range_names_the_field_and_value() {
+        let mut c = SimConfig::default();
+        c.maze.loops = 1.5;
+        let e = c.validate().unwrap_err();
+        assert_eq!(e.to_string(), "maze.loops = 1.5: must be between 0 and 1");
+        let mut c = SimConfig::default();
+        c.maze.cols = 0;
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("maze.cols = 0"));
+    }
+
+    #[test]
+    fn toml_unknown_key_is_named() {
+        let e = SimConfig::from_toml_str("[maze]\ncolz = 3\n").unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("line 2, column 1: unknown field `colz`"),
+            "{e}"
+        );
+        let e = SimConfig::from_toml_str("[laser]\nbeams = \"many\"\n").unwrap_err();
+        assert!(e.to_string().starts_with("line 2, column 9:"), "{e}");
+        let c = SimConfig::from_toml_str("[maze]\ncols = 3\n").unwrap();
+        assert_eq!(c.maze.cols, 3);
+        assert_eq!(c.maze.rows, 10);
+    }
+
+    #[test]
+    fn the_example_scenario_reads_back_and_validates() {
+        let c = SimConfig::example_scenario();
+        let text = c.to_documented_toml();
+        let back = SimConfig::from_toml_str(&text).unwrap();
+        assert_eq!(back, c);
+        assert!(back.validate().is_ok());
+        // With no obstacles, the examples are there but commented out.
+        let plain = SimConfig::default().to_documented_toml();
+        assert!(plain.contains("# [[moving]]"));
+        assert_eq!(
+            SimConfig::from_toml_str(&plain).unwrap(),
+            SimConfig::default()
+        );
+    }
+
+    #[test]
+    fn scenario_errors_name_file_line_key_and_value() {
+        let text =
+            "[scene]\nkind = \"maze\"\n\n[[moving]]\ncount = 2\n\n[[moving]]\nspeed_px = -3.0\n";
+        let file = ConfigFile::from_text(std::path::Path::new("s.toml"), text.to_string());
+        let e = file.parse().unwrap().validate().unwrap_err();
+        let e = file.locate(e).to_string();
+        assert_eq!(
+            e,
+            "s.toml:8: moving[1].speed_px = -3.0: must be between 0 and 100000 px"
+        );
+        let file = ConfigFile::from_text(
+            std::path::Path::new("s.toml"),
+            "[[moving]]\nmotion = \"teleport\"\n".to_string(),
+        );
+        let e = file.parse().unwrap_err().to_string();
+        assert!(
+            e.starts_with("s.toml:2: `motion = \"teleport\"`: unknown variant"),
+            "{e}"
+        );
+        let file = ConfigFile::from_text(
+            std::path::Path::new("s.toml"),
+            "[[obstacles]]\nshape = \"polygon\"\npoints = [[0.0, 0.0], [10.0, 0.0], [0.0, 10.0], [10.0, 10.0]]\n".to_string(),
+        );
+        let e = file
+            .locate(file.parse().unwrap().validate().unwrap_err())
+            .to_string();
+        assert!(e.starts_with("s.toml:3: obstacles[0].points = "), "{e}");
+        assert_eq!(key_line("laser.beams = 3\n", "laser.beams"), Some(1));
+        assert_eq!(key_line("[laser]\nrange_px = 3\n", "laser.beams"), None);
+    }
+
+    #[test]
+    fn a_map_scene_file_is_relative_to_the_scenario() {
+        let file = ConfigFile::from_text(
+            std::path::Path::new("dir/s.toml"),
+            "[scene]\nkind = \"map\"\nfile = \"room.png\"\n".to_string(),
+        );
+        let c = file.parse().unwrap();
+        assert_eq!(
+            c.scene.file.as_deref(),
+            Some(std::path::Path::new("dir/room.png"))
+        );
+        let mut c = SimConfig::default();
+        c.scene.kind = SceneKind::Map;
+        assert!(c
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("scene.file"));
+    }
+}
