@@ -21,6 +21,7 @@
 //! | [`eval`] | the batch evaluator, its records and summary |
 //! | [`render`] | pictures: canvas, first-person view, trajectories, GIFs |
 //! | [`io`] | files: atomic writes, run directories and their manifest, data logs, step logs |
+//! | [`job`] | use-cases: an evaluation (lone or team) run into a run directory |
 //! | [`collect`] | labelled data: expert and human collection |
 //! | [`compare`] | several policies on the same seeds: paired statistics, pictures, a report |
 
@@ -31,6 +32,7 @@ pub mod config;
 pub mod eval;
 pub mod geometry;
 pub mod io;
+pub mod job;
 pub mod plan;
 pub mod policy;
 pub mod render;

@@ -11,9 +11,9 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 /// The layers, lowest first: a module may use its own layer and those before it.
-const LAYERS: [&str; 13] = [
+const LAYERS: [&str; 14] = [
     "bounded", "config", "geometry", "scene", "sim", "plan", "policy", "run", "eval", "render",
-    "io", "collect", "compare",
+    "io", "job", "collect", "compare",
 ];
 
 /// Module path (`sim::episode`) of every source file, with its text up to the test module.

@@ -7,9 +7,8 @@ use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use ronap_core::eval::{EvalOptions, Evaluator};
-use ronap_core::io::run_dir::{
-    evaluate_into, BlockRun, EpisodeRows, Pictures, RunFiles, RunInfo, RunWriter,
-};
+use ronap_core::io::run_dir::{BlockRun, EpisodeRows, Pictures, RunFiles, RunInfo, RunWriter};
+use ronap_core::job::{evaluate_into, RunRequest};
 use ronap_core::policy::batched::{BatchPolicy, Batched};
 use ronap_core::policy::{Decision, Policy, PolicyError, PolicyFactory};
 use ronap_core::sim::world::Scenes;
@@ -317,16 +316,14 @@ pub fn evaluate<'py>(
     let cancel = AtomicBool::new(false);
     let evaluation = py
         .allow_threads(|| {
-            evaluate_into(
-                &evaluator,
-                factory.as_ref(),
-                &options,
-                &info,
+            let request = RunRequest {
+                evaluator: &evaluator,
+                options: &options,
+                info: &info,
                 writer,
-                &cancel,
-                &|_| {},
-                &|_| true,
-            )
+                cancel: &cancel,
+            };
+            evaluate_into(request, factory.as_ref(), &|_| {}, &|_| true)
         })
         .map_err(|e| errors::PolicyError::new_err(e.to_string()))?;
     if let Some(e) = &evaluation.write_error {

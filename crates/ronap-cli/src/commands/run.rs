@@ -8,9 +8,8 @@ use clap::Args;
 use ronap_core::eval::{EpisodeRecord, EvalOptions, Evaluator, Recording, Seeds};
 use ronap_core::io::atomic::OutputError;
 use ronap_core::io::manifest::PLAN_FILE;
-use ronap_core::io::run_dir::{
-    evaluate_into, evaluate_team_into, Pictures, ResumeError, RunFiles, RunInfo, RunWriter,
-};
+use ronap_core::io::run_dir::{Pictures, ResumeError, RunFiles, RunInfo, RunWriter};
+use ronap_core::job::{evaluate_into, evaluate_team_into, RunRequest};
 use ronap_core::policy::PolicyFactory;
 use ronap_core::scene::map::MapSource;
 use ronap_core::sim::world::SceneSpec;
@@ -294,16 +293,16 @@ fn run_lone(
         scenes: job.info_scenes.clone(),
         map: job.map.clone(),
     };
-    let evaluation = evaluate_into(
-        &evaluator,
-        factory.as_ref(),
-        &options,
-        &info,
-        Some(writer),
-        &cancel,
-        &|_| bar.inc(1),
-        &|r| job.gif.contains(&r.seed),
-    )?;
+    let request = RunRequest {
+        evaluator: &evaluator,
+        options: &options,
+        info: &info,
+        writer: Some(writer),
+        cancel: &cancel,
+    };
+    let evaluation = evaluate_into(request, factory.as_ref(), &|_| bar.inc(1), &|r| {
+        job.gif.contains(&r.seed)
+    })?;
     bar.finish_and_clear();
     let (result, summary) = (&evaluation.result, &evaluation.summary);
     let mut gif_notes = Vec::new();
@@ -422,15 +421,14 @@ fn run_team(
         scenes: job.info_scenes.clone(),
         map: job.map.clone(),
     };
-    let evaluation = evaluate_team_into(
-        &evaluator,
-        &policies,
-        &options,
-        &info,
-        Some(writer),
-        &cancel,
-        &|_| bar.inc(1),
-    )?;
+    let request = RunRequest {
+        evaluator: &evaluator,
+        options: &options,
+        info: &info,
+        writer: Some(writer),
+        cancel: &cancel,
+    };
+    let evaluation = evaluate_team_into(request, &policies, &|_| bar.inc(1))?;
     bar.finish_and_clear();
     let mut stdout = std::io::stdout().lock();
     writeln!(

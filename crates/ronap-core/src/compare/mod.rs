@@ -16,7 +16,8 @@ use crate::config::{OnCollision, ValidConfig};
 use crate::eval::{EvalOptions, Evaluator, Recording};
 use crate::io::atomic::OutputError;
 use crate::io::manifest::{ManifestError, RunManifest};
-use crate::io::run_dir::{evaluate_into, RunFiles, RunInfo, RunWriter};
+use crate::io::run_dir::{RunFiles, RunInfo, RunWriter};
+use crate::job::{evaluate_into, RunRequest};
 use crate::policy::{PolicyError, PolicyFactory};
 use crate::render::chart;
 use crate::scene::map::MapSource;
@@ -402,13 +403,16 @@ fn run_one(
         scenes: info.scenes.clone(),
         map: info.map.clone(),
     };
-    let evaluation = evaluate_into(
+    let request = RunRequest {
         evaluator,
-        c.factory.as_ref(),
-        &eval_options,
-        &run_info,
+        options: &eval_options,
+        info: &run_info,
         writer,
         cancel,
+    };
+    let evaluation = evaluate_into(
+        request,
+        c.factory.as_ref(),
         &|_| progress(Progress::Episode),
         &|_| true,
     )

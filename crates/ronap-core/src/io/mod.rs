@@ -9,4 +9,5 @@ pub mod manifest;
 pub mod partial;
 pub mod run_dir;
 pub mod steplog;
+pub mod team_rows;
 pub mod training;

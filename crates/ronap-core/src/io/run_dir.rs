@@ -1,6 +1,5 @@
-//! A run directory: what an evaluation writes, and the one sequence that runs an evaluation into
-//! it (used by `ronap run`, `ronap compare` and Python's `ronap.evaluate`). The plan `run.json`
-//! first; `episodes.csv` and `timing.csv` (`robots.csv` for teams) row by row in seed order as
+//! A run directory: what an evaluation writes (the sequence that runs an evaluation into it is
+//! [`crate::job`]'s). The plan `run.json` first; `episodes.csv` and `timing.csv` (`robots.csv` for teams) row by row in seed order as
 //! episodes finish, under partial names until the end; the manifest `summary.json` at the end;
 //! trajectory pictures (`png/`) and step logs (`steps/`) as each episode finishes. A run stopped
 //! short can be finished by another process ([`RunWriter::resume`]), and a lock keeps two runs
@@ -11,8 +10,7 @@
 
 use crate::config::ValidConfig;
 use crate::eval::{
-    EpisodeRecord, EvalOptions, Evaluator, Figures, Outcome, Recording, RunEnd, RunResult, Seeds,
-    Summary, Tally, TeamFigures, TeamRecord, TeamRunResult, TeamSummary, TeamTally,
+    EpisodeRecord, EvalOptions, Figures, Outcome, Recording, RunResult, Seeds, Summary, Tally,
 };
 use crate::io::atomic::{save_image, write_atomic, OutputError};
 use crate::io::figures::{self, FIGURES_FILE};
@@ -22,13 +20,11 @@ use crate::io::manifest::{
 };
 use crate::io::partial::{partial_path, whole_rows, PartialCsv};
 use crate::io::steplog::write_steps;
-use crate::policy::{PolicyError, PolicyFactory, TeamPolicyFactory};
 use crate::render::trajectory::trajectory_image;
 use crate::scene::map::MapSource;
 use crate::sim::world::SceneSpec;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -201,8 +197,8 @@ const RUN_FILES: [&str; 4] = ["episodes.csv", "timing.csv", "robots.csv", FIGURE
 /// first episode, or taken up again to finish a run stopped short ([`RunWriter::resume`]).
 #[derive(Debug)]
 pub struct RunWriter {
-    dir: PathBuf,
-    files: RunFiles,
+    pub(crate) dir: PathBuf,
+    pub(crate) files: RunFiles,
     first_seed: u64,
     errors: Mutex<Vec<String>>,
     front_end: serde_json::Value,
@@ -396,14 +392,19 @@ impl RunWriter {
         }
     }
 
-    fn note(&self, e: OutputError) {
+    pub(crate) fn note(&self, e: OutputError) {
         if let Ok(mut all) = self.errors.lock() {
             all.push(e.to_string());
         }
     }
 
     /// The plan of this run: the resumed run's own, else one made of what it is.
-    fn plan(&self, config: &ValidConfig, options: &EvalOptions, info: &RunInfo) -> RunPlan {
+    pub(crate) fn plan(
+        &self,
+        config: &ValidConfig,
+        options: &EvalOptions,
+        info: &RunInfo,
+    ) -> RunPlan {
         if let Some(r) = &self.resumed {
             return r.plan.clone();
         }
@@ -435,7 +436,7 @@ impl RunWriter {
 
     /// Opens the run files (`headers[k]` for `RUN_FILES[k]`; `None`: not written), writing the
     /// plan first for a new run, or reopening them after the finished episodes for a resumed one.
-    fn open(
+    pub(crate) fn open(
         &self,
         plan: &RunPlan,
         headers: [Option<Vec<String>>; 4],
@@ -468,7 +469,7 @@ impl RunWriter {
     }
 
     /// The errors of per-episode files, as one.
-    fn episode_errors(&self) -> Option<OutputError> {
+    pub(crate) fn episode_errors(&self) -> Option<OutputError> {
         let errors = self
             .errors
             .lock()
@@ -508,7 +509,7 @@ fn remove_if_there(path: &Path) -> Result<(), OutputError> {
 
 /// The run files under way, in the order of [`RUN_FILES`] (those the run writes).
 #[derive(Debug)]
-struct Streams {
+pub(crate) struct Streams {
     files: Vec<PartialCsv>,
     flushed: Instant,
 }
@@ -518,7 +519,7 @@ impl Streams {
     const FLUSH_EVERY: Duration = Duration::from_secs(1);
 
     /// Adds one episode's rows (`rows[k]` to file `k`).
-    fn add(&mut self, rows: &[Vec<Vec<String>>]) -> Result<(), OutputError> {
+    pub(crate) fn add(&mut self, rows: &[Vec<Vec<String>>]) -> Result<(), OutputError> {
         for (file, rows) in self.files.iter_mut().zip(rows) {
             for row in rows {
                 file.row(row)?;
@@ -654,119 +655,6 @@ impl RunInfo {
     }
 }
 
-/// A finished evaluation: the records kept, the summary of every episode of the run and the
-/// manifest that went to `summary.json` (or would have, for a run without a directory).
-#[derive(Debug)]
-pub struct Evaluation {
-    /// How the run stopped, and the records the caller chose to keep (in seed order).
-    pub result: RunResult,
-    /// The figures of every finished episode (those of a resumed run's earlier process too).
-    pub summary: Summary,
-    /// The manifest.
-    pub manifest: RunManifest,
-    /// The run directory's files could not all be written.
-    pub write_error: Option<OutputError>,
-}
-
-/// Runs an evaluation and, given a `writer`, writes it into its directory as it goes:
-/// `episodes.csv`, `timing.csv` (and the exact figures a resume needs) row by row in seed order
-/// under their partial names, per-episode files as episodes finish, `summary.json` at the end,
-/// when the run files take their final names (also after an interruption or a failing episode,
-/// so finished episodes are never lost; not after a write error, so no file under a final name
-/// is ever half-written). Memory stays flat however many episodes: only the records `keep`
-/// accepts are kept. A resumed `writer` runs only the seeds its run had not finished.
-/// `on_record` hears every finished episode (progress).
-#[allow(clippy::too_many_arguments)]
-pub fn evaluate_into(
-    evaluator: &Evaluator,
-    factory: &dyn PolicyFactory,
-    options: &EvalOptions,
-    info: &RunInfo,
-    writer: Option<RunWriter>,
-    cancel: &AtomicBool,
-    on_record: &(dyn Fn(&EpisodeRecord) + Sync),
-    keep: &dyn Fn(&EpisodeRecord) -> bool,
-) -> Result<Evaluation, PolicyError> {
-    let mut options = options.clone();
-    if let Some(w) = &writer {
-        options.recording = w.recording();
-    }
-    let config = evaluator.config();
-    let mut tally = Tally::default();
-    let mut write_error = None;
-    let mut streams = None;
-    let done = writer.as_ref().map_or(0, RunWriter::done);
-    if let Some(w) = &writer {
-        let plan = w.plan(config, &options, info);
-        match w.open(&plan, lone_headers(!config.moving.is_empty())) {
-            Ok(s) => streams = Some(s),
-            Err(e) => write_error = Some(e),
-        }
-        if write_error.is_none() && done > 0 {
-            if let Err(e) = restore(&w.dir, done, &mut |row| {
-                let (_, f) = figures::parse_lone(row)?;
-                tally.add(&f);
-                Ok(())
-            }) {
-                write_error = Some(e);
-            }
-        }
-    }
-    let steps_before = tally.steps();
-    let mut kept = Vec::new();
-    let end = if write_error.is_some() {
-        RunEnd {
-            episodes: 0,
-            cancelled: false,
-            error: None,
-            wall_time_s: 0.0,
-        }
-    } else {
-        let rest = EvalOptions {
-            seeds: options.seeds.after(done),
-            ..options.clone()
-        };
-        let dynamic = !config.moving.is_empty();
-        let on_finish = |r: &EpisodeRecord| {
-            if let Some(w) = &writer {
-                w.episode(r);
-            }
-            on_record(r);
-        };
-        evaluator.stream(factory, &rest, cancel, &on_finish, &mut |r| {
-            let f = Figures::of(&r);
-            if let Some(s) = &mut streams {
-                if let Err(e) = s.add(&EpisodeRows::with(&r, &f, dynamic).files()) {
-                    write_error = Some(e);
-                    return false;
-                }
-            }
-            tally.add(&f);
-            if keep(&r) {
-                kept.push(r);
-            }
-            true
-        })?
-    };
-    let result = RunResult {
-        records: kept,
-        cancelled: end.cancelled && write_error.is_none(),
-        error: end.error,
-        wall_time_s: end.wall_time_s,
-    };
-    let summary = tally.summary(result.wall_time_s, tally.steps() - steps_before);
-    let manifest = manifest(config, &options, info, &result, &summary);
-    if let (Some(w), None) = (&writer, &write_error) {
-        write_error = finish(w, streams, &manifest, &result).err();
-    }
-    Ok(Evaluation {
-        result,
-        summary,
-        manifest,
-        write_error,
-    })
-}
-
 /// The rows one finished episode adds to a lone robot's run files: its `episodes.csv` and
 /// `timing.csv` rows and its exact figures (what the summary is made of). What a seed block
 /// evaluated elsewhere hands back to the [`BlockRun`] that writes the whole run.
@@ -799,7 +687,7 @@ impl EpisodeRows {
     }
 
     /// The rows for each run file, in the order of [`RUN_FILES`] (no `robots.csv`).
-    fn files(&self) -> [Vec<Vec<String>>; 3] {
+    pub(crate) fn files(&self) -> [Vec<Vec<String>>; 3] {
         [
             vec![self.episode.clone()],
             vec![self.timing.clone()],
@@ -907,7 +795,7 @@ impl BlockRun {
 }
 
 /// The headers of a lone robot's run files, in the order of [`RUN_FILES`].
-fn lone_headers(dynamic: bool) -> [Option<Vec<String>>; 4] {
+pub(crate) fn lone_headers(dynamic: bool) -> [Option<Vec<String>>; 4] {
     let strings = |h: &[&str]| Some(h.iter().map(|c| c.to_string()).collect());
     [
         strings(&episode_header(dynamic)),
@@ -918,7 +806,7 @@ fn lone_headers(dynamic: bool) -> [Option<Vec<String>>; 4] {
 }
 
 /// Reads the exact figures of the first `done` episodes of the run in `dir` into `add`.
-fn restore(
+pub(crate) fn restore(
     dir: &Path,
     done: usize,
     add: &mut dyn FnMut(&csv::StringRecord) -> Result<(), String>,
@@ -946,7 +834,7 @@ fn restore(
 
 /// Ends a run's files: the run files to their final names, then `summary.json`, then whether
 /// any per-episode file failed.
-fn finish(
+pub(crate) fn finish(
     writer: &RunWriter,
     streams: Option<Streams>,
     manifest: &RunManifest,
@@ -963,7 +851,7 @@ fn finish(
     }
 }
 
-fn manifest(
+pub(crate) fn manifest(
     config: &ValidConfig,
     options: &EvalOptions,
     info: &RunInfo,
@@ -987,279 +875,13 @@ fn manifest(
     }
 }
 
-/// Columns of a team run's `episodes.csv` (one row per team episode).
-pub const TEAM_COLUMNS: [&str; 10] = [
-    "seed",
-    "outcome",
-    "robots",
-    "arrived",
-    "steps",
-    "makespan",
-    "path_length_px",
-    "collisions",
-    "robot_collisions",
-    "deadlock",
-];
-
-/// The team `episodes.csv` row of `r`.
-pub fn team_episode_row(r: &TeamRecord) -> Vec<String> {
-    vec![
-        r.seed.to_string(),
-        r.outcome.name().to_string(),
-        r.robots.len().to_string(),
-        r.robots
-            .iter()
-            .filter(|x| x.outcome == Outcome::Success)
-            .count()
-            .to_string(),
-        r.steps.to_string(),
-        r.makespan.map_or(String::new(), |m| m.to_string()),
-        format!("{:.3}", r.path_length_px),
-        r.collisions.to_string(),
-        r.robot_collisions.to_string(),
-        r.deadlock.to_string(),
-    ]
-}
-
-/// Writes a team run's `episodes.csv`: one row per team episode.
-pub fn write_team_episodes(records: &[TeamRecord], out: &mut dyn Write) -> std::io::Result<()> {
-    let mut w = csv::Writer::from_writer(out);
-    w.write_record(TEAM_COLUMNS)?;
-    for r in records {
-        w.write_record(team_episode_row(r))?;
-    }
-    w.flush()
-}
-
-/// Columns of a team run's `robots.csv` (one row per robot per episode).
-pub const ROBOT_COLUMNS: [&str; 24] = [
-    "seed",
-    "robot",
-    "policy",
-    "outcome",
-    "steps",
-    "arrived_at",
-    "collisions",
-    "robot_collisions",
-    "dynamic_collisions",
-    "goals",
-    "goals_reached",
-    "tour_px",
-    "given_tour_px",
-    "nearest_tour_px",
-    "optimal_tour_px",
-    "path_length_px",
-    "shortest_px",
-    "spl",
-    "start_x",
-    "start_y",
-    "start_heading_deg",
-    "goal_x",
-    "goal_y",
-    "reason",
-];
-
-/// The `robots.csv` rows of `r`: one per robot.
-pub fn robot_rows(r: &TeamRecord) -> Vec<Vec<String>> {
-    r.robots
-        .iter()
-        .map(|x| {
-            vec![
-                r.seed.to_string(),
-                x.robot.to_string(),
-                x.policy.clone(),
-                x.outcome.name().to_string(),
-                x.steps.to_string(),
-                x.arrived_at.map_or(String::new(), |a| a.to_string()),
-                x.collisions.to_string(),
-                x.robot_collisions.to_string(),
-                x.dynamic_collisions
-                    .map_or(String::new(), |d| d.to_string()),
-                x.goals.to_string(),
-                x.goals_reached.to_string(),
-                x.tour
-                    .map_or(String::new(), |t| format!("{:.3}", t.chosen_px())),
-                x.tour.map_or(String::new(), |t| format!("{:.3}", t.given)),
-                x.tour
-                    .map_or(String::new(), |t| format!("{:.3}", t.nearest)),
-                x.tour
-                    .map_or(String::new(), |t| format!("{:.3}", t.optimal)),
-                format!("{:.3}", x.path_length_px),
-                x.shortest_px.map_or(String::new(), |l| format!("{l:.3}")),
-                format!("{:.4}", x.spl),
-                format!("{:.3}", x.start.x),
-                format!("{:.3}", x.start.y),
-                format!("{:.3}", x.start.z_deg),
-                format!("{:.3}", x.goal.x),
-                format!("{:.3}", x.goal.y),
-                x.reason.clone().unwrap_or_default(),
-            ]
-        })
-        .collect()
-}
-
-/// Writes a team run's `robots.csv`: one row per robot of every episode.
-pub fn write_robots(records: &[TeamRecord], out: &mut dyn Write) -> std::io::Result<()> {
-    let mut w = csv::Writer::from_writer(out);
-    w.write_record(ROBOT_COLUMNS)?;
-    for r in records {
-        for row in robot_rows(r) {
-            w.write_record(row)?;
-        }
-    }
-    w.flush()
-}
-
-/// A finished team evaluation.
-#[derive(Debug)]
-pub struct TeamEvaluation {
-    /// How the run stopped (no records are kept: they went to the run files).
-    pub result: TeamRunResult,
-    /// The team figures.
-    pub team: TeamSummary,
-    /// The figures of every robot.
-    pub summary: Summary,
-    /// The run directory's files could not all be written.
-    pub write_error: Option<OutputError>,
-}
-
-/// Runs a team evaluation (each episode driven by a team policy from `factory`) and, given a
-/// `writer`, writes `episodes.csv` (team rows), `robots.csv` and `timing.csv` row by row in seed
-/// order as [`evaluate_into`] does, pictures as episodes finish and `summary.json` at the end.
-pub fn evaluate_team_into(
-    evaluator: &Evaluator,
-    factory: &dyn TeamPolicyFactory,
-    options: &EvalOptions,
-    info: &RunInfo,
-    writer: Option<RunWriter>,
-    cancel: &AtomicBool,
-    on_record: &(dyn Fn(&TeamRecord) + Sync),
-) -> Result<TeamEvaluation, PolicyError> {
-    let mut options = options.clone();
-    let pictures = writer.as_ref().and_then(|w| w.files.pictures);
-    options.recording.trajectory = pictures.is_some();
-    let config = evaluator.config();
-    let first = options.seeds.first().unwrap_or(0);
-    let (mut team, mut robots) = (TeamTally::default(), Tally::default());
-    let mut write_error = None;
-    let mut streams = None;
-    let done = writer.as_ref().map_or(0, RunWriter::done);
-    let size = config.team_size();
-    if let Some(w) = &writer {
-        let plan = w.plan(config, &options, info);
-        let strings = |h: &[&str]| Some(h.iter().map(|c| c.to_string()).collect());
-        let headers = [
-            strings(&TEAM_COLUMNS),
-            strings(&TIMING_COLUMNS),
-            strings(&ROBOT_COLUMNS),
-            Some(figures::team_columns(size)),
-        ];
-        match w.open(&plan, headers) {
-            Ok(s) => streams = Some(s),
-            Err(e) => write_error = Some(e),
-        }
-        if write_error.is_none() && done > 0 {
-            if let Err(e) = restore(&w.dir, done, &mut |row| {
-                let (_, t, lone) = figures::parse_team(row, size)?;
-                team.add(&t);
-                for f in &lone {
-                    robots.add(f);
-                }
-                Ok(())
-            }) {
-                write_error = Some(e);
-            }
-        }
-    }
-    let (robot_steps_before, steps_before) = (team.robot_steps(), robots.steps());
-    let end = if write_error.is_some() {
-        RunEnd {
-            episodes: 0,
-            cancelled: false,
-            error: None,
-            wall_time_s: 0.0,
-        }
-    } else {
-        let rest = EvalOptions {
-            seeds: options.seeds.after(done),
-            ..options.clone()
-        };
-        let on_finish = |r: &TeamRecord| {
-            if let (Some(w), Some(p)) = (&writer, pictures) {
-                if p.wants_seed(r.seed, r.outcome, first) {
-                    if let Some(img) = crate::render::team::team_image(r, 1.0) {
-                        let path = w.dir.join("png").join(format!(
-                            "seed-{:06}-{}.png",
-                            r.seed,
-                            r.outcome.name()
-                        ));
-                        if let Err(e) = save_image(&path, &img) {
-                            w.note(e);
-                        }
-                    }
-                }
-            }
-            on_record(r);
-        };
-        evaluator.stream_team(factory, &rest, cancel, &on_finish, &mut |r| {
-            let t = TeamFigures::of(&r);
-            let lone: Vec<Figures> = r
-                .robots
-                .iter()
-                .map(|x| Figures::of(&x.as_episode(r.seed)))
-                .collect();
-            if let Some(s) = &mut streams {
-                let rows = [
-                    vec![team_episode_row(&r)],
-                    vec![timing_row(r.seed, r.wall_time_s).to_vec()],
-                    robot_rows(&r),
-                    vec![figures::team_row(r.seed, &t, &lone)],
-                ];
-                if let Err(e) = s.add(&rows) {
-                    write_error = Some(e);
-                    return false;
-                }
-            }
-            team.add(&t);
-            for f in &lone {
-                robots.add(f);
-            }
-            true
-        })?
-    };
-    let result = TeamRunResult {
-        records: Vec::new(),
-        cancelled: end.cancelled && write_error.is_none(),
-        error: end.error,
-        wall_time_s: end.wall_time_s,
-    };
-    let wall = result.wall_time_s;
-    let team = team.summary(wall, team.robot_steps() - robot_steps_before);
-    let summary = robots.summary(wall, robots.steps() - steps_before);
-    if let (Some(w), None) = (&writer, &write_error) {
-        let run = RunResult {
-            records: Vec::new(),
-            cancelled: result.cancelled,
-            error: result.error.clone(),
-            wall_time_s: wall,
-        };
-        let mut m = manifest(config, &options, info, &run, &summary);
-        m.team = Some(team.clone());
-        write_error = finish(w, streams, &m, &run).err();
-    }
-    Ok(TeamEvaluation {
-        result,
-        team,
-        summary,
-        write_error,
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::eval::Evaluator;
     use crate::policy::Builtin;
     use crate::sim::world::Scenes;
+    use std::sync::atomic::AtomicBool;
 
     fn setting() -> (ValidConfig, Evaluator, RunInfo) {
         let mut c = crate::SimConfig::default();
@@ -1313,17 +935,15 @@ mod tests {
         let tmp = tempfile::tempdir().unwrap();
         let (one, blocks) = (tmp.path().join("one"), tmp.path().join("blocks"));
         let writer = RunWriter::create(&one, RunFiles::default(), 0).unwrap();
-        let whole = evaluate_into(
-            &evaluator,
-            &Builtin::Apf,
-            &options(0, 30),
-            &info,
-            Some(writer),
-            &AtomicBool::new(false),
-            &|_| {},
-            &|_| false,
-        )
-        .unwrap();
+        // The whole run as the job layer writes it, for the blocks to be held to.
+        let request = crate::job::RunRequest {
+            evaluator: &evaluator,
+            options: &options(0, 30),
+            info: &info,
+            writer: Some(writer),
+            cancel: &AtomicBool::new(false),
+        };
+        let whole = crate::job::evaluate_into(request, &Builtin::Apf, &|_| {}, &|_| false).unwrap();
         let writer = RunWriter::create(&blocks, RunFiles::default(), 0).unwrap();
         let mut run = BlockRun::create(writer, &config, &options(0, 30), &info).unwrap();
         for start in [0, 12, 24] {

@@ -1,0 +1,128 @@
+//! A team run's rows: `episodes.csv` (a row per team episode) and `robots.csv` (a row per robot
+//! of each), their columns, and the writers of whole files.
+
+use crate::eval::{Outcome, TeamRecord};
+use std::io::Write;
+
+/// Columns of a team run's `episodes.csv` (one row per team episode).
+pub const TEAM_COLUMNS: [&str; 10] = [
+    "seed",
+    "outcome",
+    "robots",
+    "arrived",
+    "steps",
+    "makespan",
+    "path_length_px",
+    "collisions",
+    "robot_collisions",
+    "deadlock",
+];
+
+/// The team `episodes.csv` row of `r`.
+pub fn team_episode_row(r: &TeamRecord) -> Vec<String> {
+    vec![
+        r.seed.to_string(),
+        r.outcome.name().to_string(),
+        r.robots.len().to_string(),
+        r.robots
+            .iter()
+            .filter(|x| x.outcome == Outcome::Success)
+            .count()
+            .to_string(),
+        r.steps.to_string(),
+        r.makespan.map_or(String::new(), |m| m.to_string()),
+        format!("{:.3}", r.path_length_px),
+        r.collisions.to_string(),
+        r.robot_collisions.to_string(),
+        r.deadlock.to_string(),
+    ]
+}
+
+/// Writes a team run's `episodes.csv`: one row per team episode.
+pub fn write_team_episodes(records: &[TeamRecord], out: &mut dyn Write) -> std::io::Result<()> {
+    let mut w = csv::Writer::from_writer(out);
+    w.write_record(TEAM_COLUMNS)?;
+    for r in records {
+        w.write_record(team_episode_row(r))?;
+    }
+    w.flush()
+}
+
+/// Columns of a team run's `robots.csv` (one row per robot per episode).
+pub const ROBOT_COLUMNS: [&str; 24] = [
+    "seed",
+    "robot",
+    "policy",
+    "outcome",
+    "steps",
+    "arrived_at",
+    "collisions",
+    "robot_collisions",
+    "dynamic_collisions",
+    "goals",
+    "goals_reached",
+    "tour_px",
+    "given_tour_px",
+    "nearest_tour_px",
+    "optimal_tour_px",
+    "path_length_px",
+    "shortest_px",
+    "spl",
+    "start_x",
+    "start_y",
+    "start_heading_deg",
+    "goal_x",
+    "goal_y",
+    "reason",
+];
+
+/// The `robots.csv` rows of `r`: one per robot.
+pub fn robot_rows(r: &TeamRecord) -> Vec<Vec<String>> {
+    r.robots
+        .iter()
+        .map(|x| {
+            vec![
+                r.seed.to_string(),
+                x.robot.to_string(),
+                x.policy.clone(),
+                x.outcome.name().to_string(),
+                x.steps.to_string(),
+                x.arrived_at.map_or(String::new(), |a| a.to_string()),
+                x.collisions.to_string(),
+                x.robot_collisions.to_string(),
+                x.dynamic_collisions
+                    .map_or(String::new(), |d| d.to_string()),
+                x.goals.to_string(),
+                x.goals_reached.to_string(),
+                x.tour
+                    .map_or(String::new(), |t| format!("{:.3}", t.chosen_px())),
+                x.tour.map_or(String::new(), |t| format!("{:.3}", t.given)),
+                x.tour
+                    .map_or(String::new(), |t| format!("{:.3}", t.nearest)),
+                x.tour
+                    .map_or(String::new(), |t| format!("{:.3}", t.optimal)),
+                format!("{:.3}", x.path_length_px),
+                x.shortest_px.map_or(String::new(), |l| format!("{l:.3}")),
+                format!("{:.4}", x.spl),
+                format!("{:.3}", x.start.x),
+                format!("{:.3}", x.start.y),
+                format!("{:.3}", x.start.z_deg),
+                format!("{:.3}", x.goal.x),
+                format!("{:.3}", x.goal.y),
+                x.reason.clone().unwrap_or_default(),
+            ]
+        })
+        .collect()
+}
+
+/// Writes a team run's `robots.csv`: one row per robot of every episode.
+pub fn write_robots(records: &[TeamRecord], out: &mut dyn Write) -> std::io::Result<()> {
+    let mut w = csv::Writer::from_writer(out);
+    w.write_record(ROBOT_COLUMNS)?;
+    for r in records {
+        for row in robot_rows(r) {
+            w.write_record(row)?;
+        }
+    }
+    w.flush()
+}

@@ -1,0 +1,126 @@
+//! A lone robot's evaluation into a run directory: the sequence `ronap run`, `ronap compare` and
+//! Python's `ronap.evaluate` share.
+
+use crate::eval::EvalOptions;
+use crate::eval::{EpisodeRecord, Figures, RunEnd, RunResult, Summary, Tally};
+use crate::io::atomic::OutputError;
+use crate::io::figures;
+use crate::io::manifest::RunManifest;
+use crate::io::run_dir::{finish, lone_headers, manifest, restore, EpisodeRows, RunWriter};
+use crate::job::RunRequest;
+use crate::policy::{PolicyError, PolicyFactory};
+
+/// A finished evaluation: the records kept, the summary of every episode of the run and the
+/// manifest that went to `summary.json` (or would have, for a run without a directory).
+#[derive(Debug)]
+pub struct Evaluation {
+    /// How the run stopped, and the records the caller chose to keep (in seed order).
+    pub result: RunResult,
+    /// The figures of every finished episode (those of a resumed run's earlier process too).
+    pub summary: Summary,
+    /// The manifest.
+    pub manifest: RunManifest,
+    /// The run directory's files could not all be written.
+    pub write_error: Option<OutputError>,
+}
+
+/// Runs an evaluation and, given a `writer`, writes it into its directory as it goes:
+/// `episodes.csv`, `timing.csv` (and the exact figures a resume needs) row by row in seed order
+/// under their partial names, per-episode files as episodes finish, `summary.json` at the end,
+/// when the run files take their final names (also after an interruption or a failing episode,
+/// so finished episodes are never lost; not after a write error, so no file under a final name
+/// is ever half-written). Memory stays flat however many episodes: only the records `keep`
+/// accepts are kept. A resumed `writer` runs only the seeds its run had not finished.
+/// `on_record` hears every finished episode (progress).
+pub fn evaluate_into(
+    request: RunRequest<'_>,
+    factory: &dyn PolicyFactory,
+    on_record: &(dyn Fn(&EpisodeRecord) + Sync),
+    keep: &dyn Fn(&EpisodeRecord) -> bool,
+) -> Result<Evaluation, PolicyError> {
+    let RunRequest {
+        evaluator,
+        options,
+        info,
+        writer,
+        cancel,
+    } = request;
+    let mut options = options.clone();
+    if let Some(w) = &writer {
+        options.recording = w.recording();
+    }
+    let config = evaluator.config();
+    let mut tally = Tally::default();
+    let mut write_error = None;
+    let mut streams = None;
+    let done = writer.as_ref().map_or(0, RunWriter::done);
+    if let Some(w) = &writer {
+        let plan = w.plan(config, &options, info);
+        match w.open(&plan, lone_headers(!config.moving.is_empty())) {
+            Ok(s) => streams = Some(s),
+            Err(e) => write_error = Some(e),
+        }
+        if write_error.is_none() && done > 0 {
+            if let Err(e) = restore(&w.dir, done, &mut |row| {
+                let (_, f) = figures::parse_lone(row)?;
+                tally.add(&f);
+                Ok(())
+            }) {
+                write_error = Some(e);
+            }
+        }
+    }
+    let steps_before = tally.steps();
+    let mut kept = Vec::new();
+    let end = if write_error.is_some() {
+        RunEnd {
+            episodes: 0,
+            cancelled: false,
+            error: None,
+            wall_time_s: 0.0,
+        }
+    } else {
+        let rest = EvalOptions {
+            seeds: options.seeds.after(done),
+            ..options.clone()
+        };
+        let dynamic = !config.moving.is_empty();
+        let on_finish = |r: &EpisodeRecord| {
+            if let Some(w) = &writer {
+                w.episode(r);
+            }
+            on_record(r);
+        };
+        evaluator.stream(factory, &rest, cancel, &on_finish, &mut |r| {
+            let f = Figures::of(&r);
+            if let Some(s) = &mut streams {
+                if let Err(e) = s.add(&EpisodeRows::with(&r, &f, dynamic).files()) {
+                    write_error = Some(e);
+                    return false;
+                }
+            }
+            tally.add(&f);
+            if keep(&r) {
+                kept.push(r);
+            }
+            true
+        })?
+    };
+    let result = RunResult {
+        records: kept,
+        cancelled: end.cancelled && write_error.is_none(),
+        error: end.error,
+        wall_time_s: end.wall_time_s,
+    };
+    let summary = tally.summary(result.wall_time_s, tally.steps() - steps_before);
+    let manifest = manifest(config, &options, info, &result, &summary);
+    if let (Some(w), None) = (&writer, &write_error) {
+        write_error = finish(w, streams, &manifest, &result).err();
+    }
+    Ok(Evaluation {
+        result,
+        summary,
+        manifest,
+        write_error,
+    })
+}

@@ -1,0 +1,29 @@
+//! Use-cases, above `io`: running an evaluation into a run directory, a lone robot's
+//! ([`evaluate_into`]) or a team's ([`evaluate_team_into`]), the sequences the command line,
+//! Python and `compare` share. A use-case takes one [`RunRequest`] (what to run, where its
+//! results go, how to stop it) rather than a long list of arguments. Uses every layer up to `io`;
+//! `io` reads and writes formats, `render` draws, and neither runs an episode for this layer.
+
+mod evaluate;
+mod team;
+
+pub use evaluate::{evaluate_into, Evaluation};
+pub use team::{evaluate_team_into, TeamEvaluation};
+
+use crate::eval::{EvalOptions, Evaluator};
+use crate::io::run_dir::{RunInfo, RunWriter};
+use std::sync::atomic::AtomicBool;
+
+/// An evaluation to run and where its results go.
+pub struct RunRequest<'a> {
+    /// The episodes' configuration and scenes.
+    pub evaluator: &'a Evaluator,
+    /// The seeds, threads and what to record.
+    pub options: &'a EvalOptions,
+    /// What the manifest records of the run: the policy's name, the scenes, the map.
+    pub info: &'a RunInfo,
+    /// The run directory, made or taken up again to resume (`None`: figures only, no files).
+    pub writer: Option<RunWriter>,
+    /// Set (Ctrl-C, a signal) to stop the run between episodes, keeping what finished.
+    pub cancel: &'a AtomicBool,
+}

@@ -1,0 +1,161 @@
+//! A team's evaluation into a run directory: team rows in `episodes.csv`, a row per robot in
+//! `robots.csv`, the team and per-robot figures in `summary.json`.
+
+use crate::eval::{
+    EvalOptions, Figures, RunEnd, RunResult, Summary, Tally, TeamFigures, TeamRecord,
+    TeamRunResult, TeamSummary, TeamTally,
+};
+use crate::io::atomic::{save_image, OutputError};
+use crate::io::figures;
+use crate::io::run_dir::{finish, manifest, restore, timing_row, RunWriter, TIMING_COLUMNS};
+use crate::io::team_rows::{robot_rows, team_episode_row, ROBOT_COLUMNS, TEAM_COLUMNS};
+use crate::job::RunRequest;
+use crate::policy::{PolicyError, TeamPolicyFactory};
+
+/// A finished team evaluation.
+#[derive(Debug)]
+pub struct TeamEvaluation {
+    /// How the run stopped (no records are kept: they went to the run files).
+    pub result: TeamRunResult,
+    /// The team figures.
+    pub team: TeamSummary,
+    /// The figures of every robot.
+    pub summary: Summary,
+    /// The run directory's files could not all be written.
+    pub write_error: Option<OutputError>,
+}
+
+/// Runs a team evaluation (each episode driven by a team policy from `factory`) and, given a
+/// `writer`, writes `episodes.csv` (team rows), `robots.csv` and `timing.csv` row by row in seed
+/// order as [`crate::job::evaluate_into`] does, pictures as episodes finish and `summary.json` at the end.
+pub fn evaluate_team_into(
+    request: RunRequest<'_>,
+    factory: &dyn TeamPolicyFactory,
+    on_record: &(dyn Fn(&TeamRecord) + Sync),
+) -> Result<TeamEvaluation, PolicyError> {
+    let RunRequest {
+        evaluator,
+        options,
+        info,
+        writer,
+        cancel,
+    } = request;
+    let mut options = options.clone();
+    let pictures = writer.as_ref().and_then(|w| w.files.pictures);
+    options.recording.trajectory = pictures.is_some();
+    let config = evaluator.config();
+    let first = options.seeds.first().unwrap_or(0);
+    let (mut team, mut robots) = (TeamTally::default(), Tally::default());
+    let mut write_error = None;
+    let mut streams = None;
+    let done = writer.as_ref().map_or(0, RunWriter::done);
+    let size = config.team_size();
+    if let Some(w) = &writer {
+        let plan = w.plan(config, &options, info);
+        let strings = |h: &[&str]| Some(h.iter().map(|c| c.to_string()).collect());
+        let headers = [
+            strings(&TEAM_COLUMNS),
+            strings(&TIMING_COLUMNS),
+            strings(&ROBOT_COLUMNS),
+            Some(figures::team_columns(size)),
+        ];
+        match w.open(&plan, headers) {
+            Ok(s) => streams = Some(s),
+            Err(e) => write_error = Some(e),
+        }
+        if write_error.is_none() && done > 0 {
+            if let Err(e) = restore(&w.dir, done, &mut |row| {
+                let (_, t, lone) = figures::parse_team(row, size)?;
+                team.add(&t);
+                for f in &lone {
+                    robots.add(f);
+                }
+                Ok(())
+            }) {
+                write_error = Some(e);
+            }
+        }
+    }
+    let (robot_steps_before, steps_before) = (team.robot_steps(), robots.steps());
+    let end = if write_error.is_some() {
+        RunEnd {
+            episodes: 0,
+            cancelled: false,
+            error: None,
+            wall_time_s: 0.0,
+        }
+    } else {
+        let rest = EvalOptions {
+            seeds: options.seeds.after(done),
+            ..options.clone()
+        };
+        let on_finish = |r: &TeamRecord| {
+            if let (Some(w), Some(p)) = (&writer, pictures) {
+                if p.wants_seed(r.seed, r.outcome, first) {
+                    if let Some(img) = crate::render::team::team_image(r, 1.0) {
+                        let path = w.dir.join("png").join(format!(
+                            "seed-{:06}-{}.png",
+                            r.seed,
+                            r.outcome.name()
+                        ));
+                        if let Err(e) = save_image(&path, &img) {
+                            w.note(e);
+                        }
+                    }
+                }
+            }
+            on_record(r);
+        };
+        evaluator.stream_team(factory, &rest, cancel, &on_finish, &mut |r| {
+            let t = TeamFigures::of(&r);
+            let lone: Vec<Figures> = r
+                .robots
+                .iter()
+                .map(|x| Figures::of(&x.as_episode(r.seed)))
+                .collect();
+            if let Some(s) = &mut streams {
+                let rows = [
+                    vec![team_episode_row(&r)],
+                    vec![timing_row(r.seed, r.wall_time_s).to_vec()],
+                    robot_rows(&r),
+                    vec![figures::team_row(r.seed, &t, &lone)],
+                ];
+                if let Err(e) = s.add(&rows) {
+                    write_error = Some(e);
+                    return false;
+                }
+            }
+            team.add(&t);
+            for f in &lone {
+                robots.add(f);
+            }
+            true
+        })?
+    };
+    let result = TeamRunResult {
+        records: Vec::new(),
+        cancelled: end.cancelled && write_error.is_none(),
+        error: end.error,
+        wall_time_s: end.wall_time_s,
+    };
+    let wall = result.wall_time_s;
+    let team = team.summary(wall, team.robot_steps() - robot_steps_before);
+    let summary = robots.summary(wall, robots.steps() - steps_before);
+    if let (Some(w), None) = (&writer, &write_error) {
+        let run = RunResult {
+            records: Vec::new(),
+            cancelled: result.cancelled,
+            error: result.error.clone(),
+            wall_time_s: wall,
+        };
+        let mut m = manifest(config, &options, info, &run, &summary);
+        m.team = Some(team.clone());
+        write_error = finish(w, streams, &m, &run).err();
+    }
+    Ok(TeamEvaluation {
+        result,
+        team,
+        summary,
+        write_error,
+    })
+}
