@@ -269,3 +269,48 @@ fn bench_times_a_team_step_of_every_robot() {
         "{two}"
     );
 }
+
+#[test]
+fn log_steps_writes_a_log_per_robot_and_replay_plays_the_team_again() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("team");
+    let scenario = repo_root().join("scenarios/warehouse-team.toml");
+    run_team(&scenario, &out, &["--seeds", "2", "--log-steps"]);
+    let robots = rows(&out.join("robots.csv"));
+    let (seed, robot, taken) = (
+        col(&robots, "seed"),
+        col(&robots, "robot"),
+        col(&robots, "steps"),
+    );
+    let steps = out.join("steps");
+    assert_eq!(robots.len(), 1 + 2 * 8);
+    for r in &robots[1..] {
+        let seed: u64 = r[seed].parse().unwrap();
+        let log = steps.join(format!("seed-{seed:06}-robot-{}.csv", r[robot]));
+        // One row per step the robot acted, as robots.csv counts them (and the header).
+        assert_eq!(
+            (rows(&log).len() - 1).to_string(),
+            r[taken],
+            "{}",
+            log.display()
+        );
+    }
+    let one = steps.join("seed-000001-robot-2.csv");
+    let said = ok(&ronap(&["replay", one.to_str().unwrap(), "--stride", "5"]));
+    assert!(said.contains("8 robots"), "{said}");
+    let gif = steps.join("seed-000001-team-top.gif");
+    assert!(std::fs::read(&gif).unwrap().starts_with(b"GIF89a"));
+    // A robot's log bent at one step no longer replays, and the error names the robot.
+    let bent = steps.join("seed-000001-robot-5.csv");
+    let text = std::fs::read_to_string(&bent).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let mut cells: Vec<String> = lines[4].split(',').map(String::from).collect();
+    let x: f64 = cells[2].parse().unwrap();
+    cells[2] = format!("{:.3}", x + 0.5);
+    lines[4] = cells.join(",");
+    std::fs::write(&bent, lines.join("\n") + "\n").unwrap();
+    let o = ronap(&["replay", one.to_str().unwrap()]);
+    assert_ne!(o.status.code(), Some(0));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("robot 5, step 4"), "{err}");
+}

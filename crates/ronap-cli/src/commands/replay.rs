@@ -11,6 +11,7 @@ use clap::Args;
 use ronap_core::eval::Evaluator;
 use ronap_core::io::manifest::RunManifest;
 use ronap_core::io::steplog::read_steps;
+use ronap_core::job::{replay_team, RobotLog};
 use ronap_core::render::gif::{animate, GifOptions, View};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -19,7 +20,9 @@ use std::process::ExitCode;
 /// Arguments of `ronap replay`.
 #[derive(Args, Debug)]
 pub struct ReplayArgs {
-    /// A step log that `ronap run --log-steps` wrote: RUN_DIR/steps/seed-<seed>.csv.
+    /// A step log that `ronap run --log-steps` wrote: RUN_DIR/steps/seed-<seed>.csv, or for a
+    /// team any robot's RUN_DIR/steps/seed-<seed>-robot-<k>.csv (the episode's other robots'
+    /// logs beside it are read too).
     #[arg(value_name = "STEPS_CSV")]
     steps: PathBuf,
     /// The run's summary.json, which holds its configuration and scenes [default: summary.json in
@@ -43,7 +46,7 @@ pub struct ReplayArgs {
     #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=50))]
     fps: u32,
     /// The GIF to write [default: beside the log, named after it: seed-<seed>-top.gif or
-    /// seed-<seed>-first.gif].
+    /// seed-<seed>-first.gif; for a team, seed-<seed>-team-top.gif].
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
 }
@@ -92,26 +95,62 @@ pub fn run(args: ReplayArgs) -> Result<ExitCode> {
         .and_then(|m| m.setting(&summary))
         .context("replay needs the run's configuration (pass --summary FILE)")?;
     let out = args.out.clone().unwrap_or_else(|| {
+        // A team's logs are one per robot; its animation is the team's: seed-<seed>-team-top.gif.
         let stem = args.steps.with_extension("");
-        PathBuf::from(format!("{}-{}.gif", stem.display(), args.view.name()))
+        let stem = stem.to_string_lossy();
+        let stem = match stem.rsplit_once("-robot-") {
+            Some((seed, _)) if config.team_size() > 0 => format!("{seed}-team"),
+            _ => stem.into_owned(),
+        };
+        PathBuf::from(format!("{stem}-{}.gif", args.view.name()))
     });
     if out.extension().and_then(|e| e.to_str()) != Some("gif") {
         bail!("--out {}: the file name must end in .gif", out.display());
     }
-    let Some(seed) = steps.first().map(|s| s.seed) else {
+    // A team robot that never acted has a log of no rows: its name still gives the seed.
+    let named_seed = args
+        .steps
+        .file_name()
+        .and_then(|n| n.to_str())
+        .and_then(|n| n.strip_prefix("seed-"))
+        .and_then(|n| n.split_once("-robot-"))
+        .and_then(|(seed, _)| seed.parse::<u64>().ok());
+    let Some(seed) = steps.first().map(|s| s.seed).or(named_seed) else {
         bail!(
             "{}: the log has no steps: nothing to replay",
             args.steps.display()
         );
     };
     let evaluator = Evaluator::new(config, scenes);
+    let options = options(args.view, args.stride, args.scale, args.size, args.fps);
+    if evaluator.config().team_size() > 0 {
+        if args.view == View::FirstPerson {
+            bail!("--view first: a team episode is replayed from above only (--view top)");
+        }
+        let logs = team_logs(&args.steps, seed)?;
+        let animation = replay_team(&evaluator, seed, &logs, &options)
+            .with_context(|| format!("cannot replay {}", args.steps.display()))?;
+        ronap_core::io::atomic::write_atomic(&out, |w| w.write_all(&animation.bytes))?;
+        writeln!(
+            std::io::stdout().lock(),
+            "{}: seed {seed}, {} robots, {} steps, {} frames of {} x {} (stride {}), {:.0} KB",
+            out.display(),
+            logs.len(),
+            animation.steps,
+            animation.frames,
+            animation.size.0,
+            animation.size.1,
+            args.stride,
+            animation.bytes.len() as f64 / 1024.0
+        )?;
+        return Ok(ExitCode::SUCCESS);
+    }
     let episode = evaluator
         .worlds()
         .episode(seed)
         .with_context(|| format!("cannot start the episode of seed {seed}"))?;
     let actions: Vec<_> = steps.iter().map(|s| s.action).collect();
     let poses: Vec<_> = steps.iter().map(|s| s.pose).collect();
-    let options = options(args.view, args.stride, args.scale, args.size, args.fps);
     let animation = animate(episode, &actions, Some(&poses), &options)
         .with_context(|| format!("cannot replay {}", args.steps.display()))?;
     ronap_core::io::atomic::write_atomic(&out, |w| w.write_all(&animation.bytes))?;
@@ -129,4 +168,46 @@ pub fn run(args: ReplayArgs) -> Result<ExitCode> {
         animation.bytes.len() as f64 / 1024.0
     )?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// Every robot's log of the team episode of `seed` whose robot log `one` is: the files
+/// `seed-<seed>-robot-<k>.csv` beside it, robot `k` each.
+fn team_logs(one: &Path, seed: u64) -> Result<Vec<RobotLog>> {
+    let dir = one
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let prefix = format!("seed-{seed:06}-robot-");
+    let mut logs = Vec::new();
+    let entries =
+        std::fs::read_dir(dir).with_context(|| format!("cannot list {}", dir.display()))?;
+    for entry in entries {
+        let entry = entry.with_context(|| format!("cannot list {}", dir.display()))?;
+        let name = entry.file_name();
+        let Some(robot) = name
+            .to_str()
+            .and_then(|n| n.strip_prefix(&prefix))
+            .and_then(|n| n.strip_suffix(".csv"))
+            .and_then(|k| k.parse::<usize>().ok())
+        else {
+            continue;
+        };
+        let steps = read_steps(&entry.path())?;
+        if let Some(other) = steps.iter().find(|s| s.seed != seed) {
+            bail!(
+                "{}: a row of seed {} in the log of seed {seed}",
+                entry.path().display(),
+                other.seed
+            );
+        }
+        logs.push(RobotLog { robot, steps });
+    }
+    if logs.is_empty() {
+        bail!(
+            "{}: a team run's step logs are named {prefix}<k>.csv, one per robot",
+            one.display()
+        );
+    }
+    logs.sort_by_key(|l| l.robot);
+    Ok(logs)
 }

@@ -50,7 +50,8 @@ pub struct RunArgs {
     /// started in (policy and map paths are read from there). Takes no other flag.
     #[arg(long, value_name = "DIR", exclusive = true)]
     resume: Option<PathBuf>,
-    /// Also write each episode's steps to steps/seed-<seed>.csv (the data-log format).
+    /// Also write each episode's steps to steps/seed-<seed>.csv (the data-log format); a team
+    /// writes one per robot, steps/seed-<seed>-robot-<k>.csv.
     #[arg(long)]
     log_steps: bool,
     /// Trajectory pictures in png/: the first N seeds, `failures` or `all` [default: none].
@@ -372,19 +373,13 @@ fn run_lone(
 
 /// `ronap run` of a scenario with `[[robots]]`: team episodes, each robot driven by its entry's
 /// policy (or `--policy`); `episodes.csv` holds a row per team episode, `robots.csv` a row per
-/// robot.
+/// robot, and `--log-steps` a step log per robot (`steps/seed-SEED-robot-K.csv`).
 fn run_team(
     job: Job,
     config: ValidConfig,
     scenes: Scenes,
     writer: Option<RunWriter>,
 ) -> Result<ExitCode> {
-    if job.log_steps {
-        bail!(
-            "--log-steps does not log team runs yet; run without it (robots.csv holds every \
-             robot's figures, --gif SEED animates an episode)"
-        );
-    }
     let policies = crate::args::TeamPolicies::new(&config, &job.policy)?;
     let names = policies.names.clone();
     let (first, last) = job.span();
@@ -397,7 +392,7 @@ fn run_team(
         .with_context(|| format!("cannot start team episodes in this scene (seed {first})"))?;
     let files = RunFiles {
         pictures: job.png,
-        steps: false,
+        steps: job.log_steps,
         gifs: false,
     };
     let writer = match writer {

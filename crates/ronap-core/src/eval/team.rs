@@ -4,7 +4,9 @@
 
 use crate::eval::ordered::{run_in_order, Window};
 use crate::eval::summary::wilson95;
-use crate::eval::{worker_pool, EvalOptions, Evaluator, Failure, Outcome, RunEnd};
+use crate::eval::{
+    worker_pool, EvalOptions, Evaluator, Failure, Outcome, Recording, RunEnd, StepLog,
+};
 use crate::geometry::Point;
 use crate::plan::shortest_path_px;
 use crate::policy::{PolicyError, TeamPolicy, TeamPolicyFactory};
@@ -114,6 +116,8 @@ pub struct TeamRecord {
     pub wall_time_s: f64,
     /// Each robot's centre at every step from the start (while present), when recorded.
     pub paths: Vec<Vec<Point>>,
+    /// Each robot's steps (the steps it acted), when recorded: a step log per robot.
+    pub step_logs: Vec<Vec<StepLog>>,
     /// The scene, when paths were recorded (for pictures).
     pub scene: Option<Arc<crate::Scene>>,
 }
@@ -382,6 +386,47 @@ impl TeamSummary {
     }
 }
 
+/// A robot's state before a step, as its step log keeps it.
+struct Before {
+    pose: crate::sim::robot::Pose,
+    readings: Vec<f64>,
+    bearing_deg: f64,
+    distance_px: f64,
+    direction_deg: f64,
+}
+
+impl Before {
+    fn of(robot: &crate::sim::episode::Episode) -> Self {
+        Self {
+            pose: robot.pose(),
+            readings: robot.readings().to_vec(),
+            bearing_deg: robot.bearing_deg(),
+            distance_px: robot.distance_px(),
+            direction_deg: robot.direction_deg(),
+        }
+    }
+
+    /// Robot `k`'s step log row for the step it just took with `action` in `team`.
+    fn logged(
+        self,
+        team: &crate::sim::team::Team,
+        k: usize,
+        action: crate::sim::robot::Action,
+    ) -> StepLog {
+        StepLog {
+            step: team.robot(k).steps(),
+            pose: self.pose,
+            readings: self.readings,
+            bearing_deg: self.bearing_deg,
+            distance_px: self.distance_px,
+            direction_deg: self.direction_deg,
+            action,
+            collided: team.collided(k),
+            reward: team.rewards()[k],
+        }
+    }
+}
+
 /// What a team evaluation produced.
 #[derive(Debug)]
 pub struct TeamRunResult {
@@ -397,15 +442,16 @@ pub struct TeamRunResult {
 
 impl Evaluator {
     /// Runs the team episode of `seed` with `policy`, robot `k`'s policy named `names[k]`.
-    /// With `paths`, keeps every robot's path and the scene (for a picture).
+    /// Keeps what `recording` asks for: every robot's path and the scene (for a picture), every
+    /// robot's steps (step logs).
     pub fn run_team_episode(
         &self,
         policy: &mut dyn TeamPolicy,
         names: &[String],
         seed: u64,
-        paths: bool,
+        recording: Recording,
     ) -> Result<TeamRecord, RunError> {
-        self.watch_team_episode(policy, names, seed, paths, &mut |_| {})
+        self.watch_team_episode(policy, names, seed, recording, &mut |_| {})
     }
 
     /// [`Evaluator::run_team_episode`], showing `watch` the team at its start and after every
@@ -415,7 +461,7 @@ impl Evaluator {
         policy: &mut dyn TeamPolicy,
         names: &[String],
         seed: u64,
-        paths: bool,
+        recording: Recording,
         watch: &mut dyn FnMut(&crate::sim::team::Team),
     ) -> Result<TeamRecord, RunError> {
         let clock = Instant::now();
@@ -423,7 +469,10 @@ impl Evaluator {
         let mut rollout = TeamRollout::start(self.config(), worlds, seed, policy)?;
         watch(rollout.team());
         let n = rollout.team().robots().len();
+        let paths = recording.trajectory;
         let mut tracks: Vec<Vec<Point>> = vec![Vec::new(); if paths { n } else { 0 }];
+        let mut step_logs: Vec<Vec<StepLog>> =
+            vec![Vec::new(); if recording.steps { n } else { 0 }];
         let note = |team: &crate::sim::team::Team, tracks: &mut Vec<Vec<Point>>| {
             for (k, t) in tracks.iter_mut().enumerate() {
                 if team.present(k) {
@@ -432,9 +481,27 @@ impl Evaluator {
             }
         };
         note(rollout.team(), &mut tracks);
-        while rollout.advance(policy)? {
-            note(rollout.team(), &mut tracks);
-            watch(rollout.team());
+        loop {
+            // Each running robot's state before the step, for its step log.
+            let before: Vec<Option<Before>> = if recording.steps {
+                let team = rollout.team();
+                (0..n)
+                    .map(|k| team.running(k).then(|| Before::of(team.robot(k))))
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            if !rollout.advance(policy)? {
+                break;
+            }
+            let team = rollout.team();
+            for (k, b) in before.into_iter().enumerate() {
+                if let (Some(b), Some(action)) = (b, rollout.last_actions()[k]) {
+                    step_logs[k].push(b.logged(team, k, action));
+                }
+            }
+            note(team, &mut tracks);
+            watch(team);
         }
         let team = rollout.team();
         let mut robots = Vec::new();
@@ -518,6 +585,7 @@ impl Evaluator {
             wall_time_s: clock.elapsed().as_secs_f64(),
             scene: paths.then(|| team.robot(0).scene().clone()),
             paths: tracks,
+            step_logs,
         })
     }
 
@@ -560,17 +628,17 @@ impl Evaluator {
         // A team's policy is made afresh for every episode.
         let work = |_: &mut Option<()>, i: usize| {
             let mut policy = factory.make().map_err(Failure::Policy)?;
-            let paths = options.recording.trajectory;
             let mut r = self
                 .run_team_episode(
                     policy.as_mut(),
                     &names,
                     options.seeds.get(i).unwrap_or_default(),
-                    paths,
+                    options.recording,
                 )
                 .map_err(Failure::Run)?;
             on_finish(&r);
             r.paths = Vec::new();
+            r.step_logs = Vec::new();
             r.scene = None;
             Ok(r)
         };

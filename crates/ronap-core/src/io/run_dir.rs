@@ -11,6 +11,7 @@
 use crate::config::ValidConfig;
 use crate::eval::{
     EpisodeRecord, EvalOptions, Figures, Outcome, Recording, RunResult, Seeds, Summary, Tally,
+    TeamRecord,
 };
 use crate::io::atomic::{save_image, write_atomic, OutputError};
 use crate::io::figures::{self, FIGURES_FILE};
@@ -19,7 +20,7 @@ use crate::io::manifest::{
     ManifestError, RunManifest, RunPlan, PLAN_FILE, PLAN_SCHEMA_VERSION, SCHEMA_VERSION,
 };
 use crate::io::partial::{partial_path, whole_rows, PartialCsv};
-use crate::io::steplog::write_steps;
+use crate::io::steplog::{write_step_log, write_steps};
 use crate::render::trajectory::trajectory_image;
 use crate::scene::map::MapSource;
 use crate::sim::world::SceneSpec;
@@ -392,6 +393,19 @@ impl RunWriter {
         }
     }
 
+    /// Writes the per-episode files of team episode `record` (its picture; a step log per
+    /// robot, `steps/seed-SEED-robot-K.csv`, robot `k`'s laser having `beams[k]` beams); a
+    /// failure is kept for the end, as [`RunWriter::episode`] does.
+    pub fn team_episode(&self, record: &TeamRecord, beams: &[usize]) {
+        let picture = self
+            .files
+            .pictures
+            .is_some_and(|p| p.wants_seed(record.seed, record.outcome, self.first_seed));
+        if let Err(e) = write_team_files(&self.dir, record, picture, beams) {
+            self.note(e);
+        }
+    }
+
     pub(crate) fn note(&self, e: OutputError) {
         if let Ok(mut all) = self.errors.lock() {
             all.push(e.to_string());
@@ -575,6 +589,34 @@ fn write_episode_files(
             .join("steps")
             .join(format!("seed-{:06}.csv", record.seed));
         write_atomic(&path, |out| write_steps(record, out))?;
+    }
+    Ok(())
+}
+
+/// Writes team episode `record`'s picture (when `picture`) and its robots' step logs (those it
+/// recorded).
+fn write_team_files(
+    dir: &Path,
+    record: &TeamRecord,
+    picture: bool,
+    beams: &[usize],
+) -> Result<(), OutputError> {
+    if picture {
+        if let Some(img) = crate::render::team::team_image(record, 1.0) {
+            let path = dir.join("png").join(format!(
+                "seed-{:06}-{}.png",
+                record.seed,
+                record.outcome.name()
+            ));
+            save_image(&path, &img)?;
+        }
+    }
+    for (k, steps) in record.step_logs.iter().enumerate() {
+        let path = dir
+            .join("steps")
+            .join(format!("seed-{:06}-robot-{k}.csv", record.seed));
+        let beams = beams.get(k).copied().unwrap_or_default();
+        write_atomic(&path, |out| write_step_log(record.seed, beams, steps, out))?;
     }
     Ok(())
 }

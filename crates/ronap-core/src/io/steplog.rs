@@ -1,7 +1,7 @@
 //! Step logs (`ronap run --log-steps`): one episode's steps in the data-log format, written as
 //! the episode ends and read back by `ronap replay`.
 
-use crate::eval::EpisodeRecord;
+use crate::eval::{EpisodeRecord, StepLog};
 use crate::sim::robot::{Action, Pose};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -9,15 +9,30 @@ use std::path::{Path, PathBuf};
 /// Writes one episode's steps in the data-log format: `seed, step, x, y, z, d_1..d_m, theta, D,
 /// direction, action, collided, reward`, the state being the one the action was taken in.
 pub fn write_steps(record: &EpisodeRecord, out: &mut dyn Write) -> std::io::Result<()> {
+    write_step_log(
+        record.seed,
+        record.last_readings.len(),
+        &record.step_log,
+        out,
+    )
+}
+
+/// Writes `steps` of the episode of `seed`, taken by a robot whose laser has `beams` beams, in
+/// the data-log format of [`write_steps`] (a team's robots get a log each).
+pub fn write_step_log(
+    seed: u64,
+    beams: usize,
+    steps: &[StepLog],
+    out: &mut dyn Write,
+) -> std::io::Result<()> {
     let mut w = csv::Writer::from_writer(out);
-    let beams = record.last_readings.len();
     let mut header: Vec<String> = ["seed", "step", "x", "y", "z"].map(String::from).to_vec();
     header.extend((1..=beams).map(|i| format!("d_{i}")));
     header.extend(["theta", "D", "direction", "action", "collided", "reward"].map(String::from));
     w.write_record(&header)?;
-    for s in &record.step_log {
+    for s in steps {
         let mut row = vec![
-            record.seed.to_string(),
+            seed.to_string(),
             s.step.to_string(),
             format!("{:.3}", s.pose.x),
             format!("{:.3}", s.pose.y),

@@ -1,13 +1,16 @@
 //! Use-cases, above `io`: running an evaluation into a run directory, a lone robot's
-//! ([`evaluate_into`]) or a team's ([`evaluate_team_into`]), the sequences the command line,
+//! ([`evaluate_into`]) or a team's ([`evaluate_team_into`]), and replaying a team episode from
+//! its robots' step logs ([`replay_team`]): the sequences the command line,
 //! Python and `compare` share. A use-case takes one [`RunRequest`] (what to run, where its
 //! results go, how to stop it) rather than a long list of arguments. Uses every layer up to `io`;
 //! `io` reads and writes formats, `render` draws, and neither runs an episode for this layer.
 
 mod evaluate;
+mod replay;
 mod team;
 
 pub use evaluate::{evaluate_into, Evaluation};
+pub use replay::{replay_team, ReplayError, RobotLog};
 pub use team::{evaluate_team_into, TeamEvaluation};
 
 use crate::eval::{EvalOptions, Evaluator};

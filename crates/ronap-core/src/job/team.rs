@@ -5,7 +5,7 @@ use crate::eval::{
     EvalOptions, Figures, RunEnd, RunResult, Summary, Tally, TeamFigures, TeamRecord,
     TeamRunResult, TeamSummary, TeamTally,
 };
-use crate::io::atomic::{save_image, OutputError};
+use crate::io::atomic::OutputError;
 use crate::io::figures;
 use crate::io::run_dir::{finish, manifest, restore, timing_row, RunWriter, TIMING_COLUMNS};
 use crate::io::team_rows::{robot_rows, team_episode_row, ROBOT_COLUMNS, TEAM_COLUMNS};
@@ -27,7 +27,8 @@ pub struct TeamEvaluation {
 
 /// Runs a team evaluation (each episode driven by a team policy from `factory`) and, given a
 /// `writer`, writes `episodes.csv` (team rows), `robots.csv` and `timing.csv` row by row in seed
-/// order as [`crate::job::evaluate_into`] does, pictures as episodes finish and `summary.json` at the end.
+/// order as [`crate::job::evaluate_into`] does, pictures and step logs (one per robot) as episodes
+/// finish and `summary.json` at the end.
 pub fn evaluate_team_into(
     request: RunRequest<'_>,
     factory: &dyn TeamPolicyFactory,
@@ -41,10 +42,10 @@ pub fn evaluate_team_into(
         cancel,
     } = request;
     let mut options = options.clone();
-    let pictures = writer.as_ref().and_then(|w| w.files.pictures);
-    options.recording.trajectory = pictures.is_some();
+    if let Some(w) = &writer {
+        options.recording = w.recording();
+    }
     let config = evaluator.config();
-    let first = options.seeds.first().unwrap_or(0);
     let (mut team, mut robots) = (TeamTally::default(), Tally::default());
     let mut write_error = None;
     let mut streams = None;
@@ -89,20 +90,13 @@ pub fn evaluate_team_into(
             seeds: options.seeds.after(done),
             ..options.clone()
         };
+        // Each robot's beam count, for its step log's columns.
+        let beams: Vec<usize> = (0..config.team_size())
+            .map(|k| config.team_robot(k).laser.beams as usize)
+            .collect();
         let on_finish = |r: &TeamRecord| {
-            if let (Some(w), Some(p)) = (&writer, pictures) {
-                if p.wants_seed(r.seed, r.outcome, first) {
-                    if let Some(img) = crate::render::team::team_image(r, 1.0) {
-                        let path = w.dir.join("png").join(format!(
-                            "seed-{:06}-{}.png",
-                            r.seed,
-                            r.outcome.name()
-                        ));
-                        if let Err(e) = save_image(&path, &img) {
-                            w.note(e);
-                        }
-                    }
-                }
+            if let Some(w) = &writer {
+                w.team_episode(r, &beams);
             }
             on_record(r);
         };

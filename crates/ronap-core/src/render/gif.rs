@@ -213,7 +213,7 @@ pub fn animate(
 }
 
 /// Whether two poses agree to a log's precision (headings compared around the circle).
-fn same_pose(a: Pose, b: Pose) -> bool {
+pub(crate) fn same_pose(a: Pose, b: Pose) -> bool {
     let dz = crate::geometry::wrap_deg(a.z_deg - b.z_deg);
     (a.x - b.x).abs() <= POSE_TOLERANCE
         && (a.y - b.y).abs() <= POSE_TOLERANCE

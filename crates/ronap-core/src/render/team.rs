@@ -172,7 +172,8 @@ pub fn animate_team(
         }
         pending = Some(team_frame(team, &paths, options.scale));
     };
-    let record = evaluator.watch_team_episode(policy, names, seed, false, &mut watch)?;
+    let record =
+        evaluator.watch_team_episode(policy, names, seed, Default::default(), &mut watch)?;
     if let Some(e) = failed {
         return Err(AnimationError::from(e).into());
     }

@@ -24,6 +24,8 @@ pub struct TeamRollout {
     tours: Vec<Option<TourLengths>>,
     /// Floats in a policy's message.
     message_size: usize,
+    /// The actions of the last step, robot by robot (`None`: the robot did not act).
+    actions: Vec<Option<Action>>,
 }
 
 /// A goal list's tour lengths under each order (geodesic, px; infinite where a leg cannot be
@@ -155,6 +157,7 @@ impl TeamRollout {
         }
         Ok(Self {
             gave_up: vec![None; n],
+            actions: vec![None; n],
             team,
             worlds: per_robot,
             tours,
@@ -192,6 +195,19 @@ impl TeamRollout {
     /// Robots whose episodes are over ignore theirs.
     pub fn step(&mut self, actions: &[Option<Action>]) {
         self.team.step(actions);
+        self.actions.clear();
+        self.actions.extend_from_slice(actions);
+    }
+
+    /// Takes robot `k` out of the running, as its policy giving up does (replaying a log that
+    /// ends while the team goes on).
+    pub fn retire(&mut self, k: usize) {
+        self.team.retire(k);
+    }
+
+    /// What each robot did at the last step (`None`: it did not act).
+    pub fn last_actions(&self) -> &[Option<Action>] {
+        &self.actions
     }
 
     /// Whether every robot is done.
@@ -252,6 +268,7 @@ impl TeamRollout {
             .map(|r| r.goals_reached())
             .collect();
         self.team.step(&actions);
+        self.actions = actions;
         // A robot on to the next goal of its list starts a new leg: its policy plans afresh.
         for (k, reached) in reached.into_iter().enumerate() {
             let r = self.team.robot(k);

@@ -1,0 +1,304 @@
+//! Replaying a team episode from its robots' step logs (`ronap run --log-steps` on a scenario
+//! with `[[robots]]`): the episode is placed again from its seed, every robot takes its logged
+//! action at each step, each logged pose is held to the model's, and the team is drawn as it goes.
+
+use crate::eval::Evaluator;
+use crate::geometry::Point;
+use crate::io::steplog::LoggedStep;
+use crate::render::gif::{same_pose, Animation, AnimationError, GifOptions, GifWriter};
+use crate::render::team::{team_frame, team_palette};
+use crate::run::team::TeamRollout;
+use crate::run::RunError;
+use crate::sim::robot::{Action, Pose};
+
+/// One robot's step log, read back.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RobotLog {
+    /// The robot, from 0 in `[[robots]]` order.
+    pub robot: usize,
+    /// Its logged steps, in order.
+    pub steps: Vec<LoggedStep>,
+}
+
+/// A team episode that its logs do not reproduce.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayError {
+    /// The episode could not be placed again.
+    #[error("cannot start the team episode of seed {seed}: {source}")]
+    Start {
+        /// The seed.
+        seed: u64,
+        /// Why.
+        source: RunError,
+    },
+    /// A log names a robot the team does not have, or a robot has two logs.
+    #[error("robot {robot}: {message}")]
+    Robot {
+        /// The robot.
+        robot: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A logged pose is not where the model, stepping every robot's logged actions, puts it.
+    #[error(
+        "robot {robot}, step {step}: the log has the robot at ({:.3}, {:.3}, {:.3} deg) but \
+         stepping the logged actions from the episode's start puts it at ({:.3}, {:.3}, {:.3} \
+         deg): the logs do not come from this scene and configuration, or not all of the \
+         episode's robots' logs were given",
+        logged.x, logged.y, logged.z_deg, model.x, model.y, model.z_deg
+    )]
+    Diverged {
+        /// The robot.
+        robot: usize,
+        /// The team step (1-based) whose starting pose differs.
+        step: u32,
+        /// The pose in the log.
+        logged: Pose,
+        /// The pose the model gives.
+        model: Pose,
+    },
+    /// A robot's episode ended (or it was taken out) before its log did.
+    #[error(
+        "robot {robot}, step {step}: its episode already ended ({status}) but its log goes on"
+    )]
+    EndedEarly {
+        /// The robot.
+        robot: usize,
+        /// The team step (1-based) the model could not take.
+        step: u32,
+        /// How the model's episode of the robot ended.
+        status: &'static str,
+    },
+    /// The frames could not be drawn or encoded.
+    #[error(transparent)]
+    Animation(#[from] AnimationError),
+}
+
+/// Replays team episode `seed` of `evaluator` from `logs` (one per robot that has one; a robot
+/// without a log does nothing) and draws it from above every `options.stride` steps at
+/// `options.scale`. A robot whose log ends while it still runs gives up there, as its policy did.
+pub fn replay_team(
+    evaluator: &Evaluator,
+    seed: u64,
+    logs: &[RobotLog],
+    options: &GifOptions,
+) -> Result<Animation, ReplayError> {
+    let mut rollout = TeamRollout::placed(evaluator.config(), evaluator.worlds().team(seed), seed)
+        .map_err(|source| ReplayError::Start { seed, source })?;
+    let n = rollout.team().robots().len();
+    let mut by_robot: Vec<Option<&[LoggedStep]>> = vec![None; n];
+    for log in logs {
+        let slot = by_robot
+            .get_mut(log.robot)
+            .ok_or_else(|| ReplayError::Robot {
+                robot: log.robot,
+                message: format!("the team has {n} robots"),
+            })?;
+        if slot.replace(&log.steps).is_some() {
+            return Err(ReplayError::Robot {
+                robot: log.robot,
+                message: "two logs given".into(),
+            });
+        }
+    }
+    let last = logs
+        .iter()
+        .filter_map(|l| l.steps.last().map(|s| s.step))
+        .max()
+        .unwrap_or(0);
+    let stride = options.stride.max(1);
+    let mut paths: Vec<Vec<Point>> = (0..n)
+        .map(|k| vec![rollout.team().robot(k).pose().position()])
+        .collect();
+    let first = team_frame(rollout.team(), &paths, options.scale);
+    let (width, height) = first.dimensions();
+    let too_large = || AnimationError::TooLarge { width, height };
+    let mut writer = GifWriter::with_palette(
+        Vec::new(),
+        u16::try_from(width).map_err(|_| too_large())?,
+        u16::try_from(height).map_err(|_| too_large())?,
+        &team_palette(),
+    )
+    .map_err(AnimationError::from)?;
+    // Each frame is written when the next one is known, so the last can be held longer.
+    let mut pending = first;
+    let mut next = vec![0usize; n];
+    for step in 1..=last {
+        let mut actions: Vec<Option<Action>> = vec![None; n];
+        for (k, log) in by_robot.iter().enumerate() {
+            let team = rollout.team();
+            let due = log.and_then(|l| l.get(next[k])).filter(|s| s.step == step);
+            let Some(logged) = due else {
+                if team.running(k) && log.is_some_and(|l| next[k] >= l.len()) {
+                    rollout.retire(k);
+                }
+                continue;
+            };
+            let robot = team.robot(k);
+            if !team.running(k) {
+                return Err(ReplayError::EndedEarly {
+                    robot: k,
+                    step,
+                    status: robot.status().name(),
+                });
+            }
+            if !same_pose(logged.pose, robot.pose()) {
+                return Err(ReplayError::Diverged {
+                    robot: k,
+                    step,
+                    logged: logged.pose,
+                    model: robot.pose(),
+                });
+            }
+            actions[k] = Some(logged.action);
+            next[k] += 1;
+        }
+        rollout.step(&actions);
+        let team = rollout.team();
+        for (k, path) in paths.iter_mut().enumerate() {
+            let p = team.robot(k).pose().position();
+            if team.present(k) && path.last() != Some(&p) {
+                path.push(p);
+            }
+        }
+        if step % stride == 0 || step == last {
+            let frame = team_frame(team, &paths, options.scale);
+            writer
+                .add(&pending, options.frame_delay_cs)
+                .map_err(AnimationError::from)?;
+            pending = frame;
+        }
+    }
+    writer
+        .add(&pending, options.last_frame_delay_cs)
+        .map_err(AnimationError::from)?;
+    let frames = writer.frames();
+    let bytes = writer.finish().map_err(AnimationError::from)?;
+    Ok(Animation {
+        bytes,
+        frames,
+        steps: last as usize,
+        size: (width, height),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::TeamRobotConfig;
+    use crate::eval::{Outcome, Recording};
+    use crate::policy::{factory, PerRobotFactory, TeamPolicyFactory};
+    use crate::render::team::animate_team;
+    use crate::sim::world::Scenes;
+
+    fn logs_of(record: &crate::eval::TeamRecord) -> Vec<RobotLog> {
+        record
+            .step_logs
+            .iter()
+            .enumerate()
+            .map(|(robot, steps)| RobotLog {
+                robot,
+                steps: steps
+                    .iter()
+                    .map(|s| LoggedStep {
+                        seed: record.seed,
+                        step: s.step,
+                        pose: s.pose,
+                        action: s.action,
+                    })
+                    .collect(),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_team_replayed_from_its_logs_is_the_team_run_again_frame_for_frame() {
+        // APF robots get stuck in a maze and give up while the geodesic ones drive on.
+        let config = crate::SimConfig {
+            robots: vec![
+                TeamRobotConfig {
+                    count: 2,
+                    policy: Some("apf".into()),
+                    ..Default::default()
+                },
+                TeamRobotConfig {
+                    count: 3,
+                    ..Default::default()
+                },
+            ],
+            ..Default::default()
+        }
+        .validate()
+        .expect("valid");
+        let size = config.observation_size();
+        let evaluator = Evaluator::new(config, Scenes::MazePerSeed);
+        let (apf, geodesic) = (
+            factory("apf", size).expect("apf"),
+            factory("geodesic", size).expect("geodesic"),
+        );
+        let team = PerRobotFactory::new(
+            vec![
+                apf.as_ref(),
+                apf.as_ref(),
+                geodesic.as_ref(),
+                geodesic.as_ref(),
+                geodesic.as_ref(),
+            ],
+            ["apf", "apf", "geodesic", "geodesic", "geodesic"]
+                .map(String::from)
+                .to_vec(),
+        );
+        let names = team.names();
+        let options = GifOptions {
+            stride: 4,
+            scale: 0.2,
+            ..GifOptions::default()
+        };
+        let recording = Recording {
+            trajectory: false,
+            steps: true,
+        };
+        let mut gave_up = 0;
+        for seed in 0..4 {
+            let mut policy = team.make().expect("policies");
+            let record = evaluator
+                .run_team_episode(policy.as_mut(), &names, seed, recording)
+                .expect("runs");
+            gave_up += record
+                .robots
+                .iter()
+                .filter(|r| r.outcome == Outcome::Stuck)
+                .count();
+            for (k, log) in record.step_logs.iter().enumerate() {
+                assert_eq!(
+                    log.len() as u32,
+                    record.robots[k].steps,
+                    "seed {seed} robot {k}"
+                );
+            }
+            let logs = logs_of(&record);
+            let replayed = replay_team(&evaluator, seed, &logs, &options).expect("replays");
+            let mut policy = team.make().expect("policies");
+            let (rerun, _) =
+                animate_team(&evaluator, policy.as_mut(), &names, seed, &options).expect("reruns");
+            assert_eq!(replayed.steps, rerun.steps, "seed {seed}");
+            assert!(
+                replayed.bytes == rerun.bytes,
+                "seed {seed}: the frames differ"
+            );
+            // A log moved by a hair at one step is caught there, naming the robot.
+            let mut bent = logs.clone();
+            let step = &mut bent[3].steps[5];
+            step.pose.x += 0.01;
+            let at = step.step;
+            match replay_team(&evaluator, seed, &bent, &options) {
+                Err(ReplayError::Diverged { robot: 3, step, .. }) => assert_eq!(step, at),
+                other => panic!("seed {seed}: expected robot 3 to diverge, got {other:?}"),
+            }
+        }
+        assert!(
+            gave_up > 0,
+            "no robot gave up: the test misses the logs that end early"
+        );
+    }
+}
