@@ -265,6 +265,12 @@ impl Episode {
         Ok(episode)
     }
 
+    /// Makes `rng` the laser noise's stream (a team's robot's own, fresh before its first
+    /// sensing among the team).
+    pub(crate) fn set_noise_stream(&mut self, rng: Rng) {
+        self.noise_rng = rng;
+    }
+
     /// Reads the laser and goal sensors at the current pose and refreshes the observation.
     fn sense(&mut self) {
         let movers = self.movers.take();

@@ -37,6 +37,16 @@ pub fn stream(seed: u64, purpose: Stream) -> Rng {
     rng
 }
 
+/// The generator for `purpose` of robot `robot` of a team in the episode with `seed`: robot 0's
+/// is the lone robot's ([`stream`]), so a team of one draws what a lone robot draws; each other
+/// robot has streams of its own.
+pub fn robot_stream(seed: u64, purpose: Stream, robot: usize) -> Rng {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    // Purposes are below 256: robot k's streams sit k * 256 above robot 0's.
+    rng.set_stream(purpose as u64 + ((robot as u64) << 8));
+    rng
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -51,5 +61,14 @@ mod tests {
         assert_eq!(a, b);
         assert_ne!(a, c);
         assert_ne!(a, d);
+        let mut robot_0 = robot_stream(7, Stream::Noise, 0);
+        assert_eq!(robot_0.random::<u64>(), c);
+        let robots: Vec<u64> = (0..4)
+            .map(|k| robot_stream(7, Stream::Noise, k).random())
+            .collect();
+        for (i, x) in robots.iter().enumerate() {
+            assert!(robots[..i].iter().all(|y| y != x), "{robots:?}");
+            assert_ne!(*x, a);
+        }
     }
 }

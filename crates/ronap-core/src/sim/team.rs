@@ -8,7 +8,8 @@
 //! and count a robot collision; that repeats until no motion touches, so no robot passes through
 //! another at any speed. Each laser sees the other robots as discs. A robot that reached its goal
 //! stops there and stays an obstacle, or leaves the scene with `on_arrival = "vanish"`. When no
-//! robot has moved for `episode.deadlock_steps` steps, the running ones end as a deadlock.
+//! robot has moved for `episode.deadlock_steps` steps, the running ones of a team of two or more
+//! end as a deadlock. A team of one steps exactly as the lone robot of the same configuration.
 //!
 //! The first robot's start and goal are drawn as a lone robot's are (the same stream), the
 //! others' from a stream of their own, each clear of the robots placed before it.
@@ -19,7 +20,7 @@ use crate::geometry::{point_segment_distance_squared, Point};
 use crate::sim::episode::{Episode, Status};
 use crate::sim::moving::{Disc, Movers};
 use crate::sim::placement::{needs_region_grid, sample_placement_with, EpisodeError};
-use crate::sim::rng::{stream, Stream};
+use crate::sim::rng::{robot_stream, stream, Stream};
 use crate::sim::robot::{Action, Motion, Pose};
 use crate::sim::world::World;
 use std::sync::Arc;
@@ -300,8 +301,11 @@ impl Team {
             .map(|r| r.config().robot.radius_px)
             .fold(0.0, f64::max);
         let among = team.movers.is_some();
-        for r in &mut team.robots {
+        for (k, r) in team.robots.iter_mut().enumerate() {
             r.set_among_movers(among);
+            // Each robot's laser noise from its own stream, fresh for its first sensing among
+            // the team below (its placement sensed alone): robot 0's is a lone robot's.
+            r.set_noise_stream(robot_stream(seed, Stream::Noise, k));
         }
         team.sense_all();
         Ok(team)
@@ -558,7 +562,9 @@ impl Team {
         }
         self.collided = collided;
         self.still_for = if moved_any { 0 } else { self.still_for + 1 };
-        if self.still_for >= self.deadlock_steps {
+        // A deadlock takes two: a team of one that stands still is a lone robot that does, and
+        // runs on as one would (to its time-out, or until its policy gives up).
+        if n > 1 && self.still_for >= self.deadlock_steps {
             for k in 0..n {
                 if self.running(k) {
                     self.robots[k].end(Status::Deadlock);
@@ -762,6 +768,96 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A lone robot's configuration and the same robot as a team of one (`[[robots]]` with one
+    /// robot of one entry), with `moving` obstacles and laser noise `sigma`.
+    fn lone_and_one(
+        moving: Vec<crate::config::MovingConfig>,
+        sigma: f64,
+    ) -> (ValidConfig, ValidConfig) {
+        let mut lone = crate::SimConfig {
+            moving,
+            ..Default::default()
+        };
+        lone.laser.noise_sigma_px = sigma;
+        lone.episode.max_steps = 400;
+        let mut one = lone.clone();
+        one.robots = vec![TeamRobotConfig::default()];
+        (
+            lone.validate().expect("valid"),
+            one.validate().expect("valid"),
+        )
+    }
+
+    #[test]
+    fn a_team_of_one_steps_as_a_lone_robot_bit_for_bit() {
+        use crate::config::{MotionKind, MovingConfig};
+        use rand::Rng as _;
+        let walkers = MovingConfig {
+            count: 25,
+            motion: MotionKind::RandomWalk,
+            ..Default::default()
+        };
+        let appearing = MovingConfig {
+            count: 10,
+            motion: MotionKind::Appear,
+            then: MotionKind::Linear,
+            from_step: 5,
+            to_step: 60,
+            ..Default::default()
+        };
+        let cases = [
+            lone_and_one(Vec::new(), 0.0),
+            lone_and_one(vec![walkers, appearing], 0.0),
+            lone_and_one(Vec::new(), 1.5),
+        ];
+        let mut steps = 0;
+        for (case, (lone_config, one_config)) in cases.iter().enumerate() {
+            for seed in 0..12 {
+                let mut lone = World::maze(lone_config.clone(), seed)
+                    .episode(seed)
+                    .expect("placed");
+                let mut team =
+                    Team::new(one_config, &worlds(one_config, seed), seed).expect("placed");
+                // Mostly ahead, so the robot goes places, meets walls and obstacles.
+                let mut rng = crate::sim::rng::stream(seed, crate::sim::rng::Stream::Policy);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                while !lone.status().is_done() {
+                    let action = if rng.random_bool(0.6) {
+                        Action::from(DiscreteAction::Ahead)
+                    } else if rng.random_bool(0.5) {
+                        DiscreteAction::Left.into()
+                    } else {
+                        DiscreteAction::Right.into()
+                    };
+                    let r = lone.step(action);
+                    let (pose, reward, collided, status) = (r.pose, r.reward, r.collided, r.status);
+                    team.step(&[Some(action)]);
+                    let t = team.robot(0);
+                    let at = format!("case {case}, seed {seed}, step {}", lone.steps());
+                    assert_eq!(t.pose(), pose, "{at}");
+                    assert_eq!(team.rewards()[0].to_bits(), reward.to_bits(), "{at}");
+                    assert_eq!(team.collided(0), collided, "{at}");
+                    assert_eq!(t.status(), status, "{at}");
+                    assert_eq!(bits(t.readings()), bits(lone.readings()), "{at}");
+                    assert_eq!(t.observation(), lone.observation(), "{at}");
+                    steps += 1;
+                }
+                assert!(team.is_done());
+                assert_eq!(team.robot(0).collisions(), lone.collisions());
+                assert_eq!(team.robot(0).dynamic_metrics(), lone.dynamic_metrics());
+                assert_eq!(
+                    team.robot(0).path_length_px().to_bits(),
+                    lone.path_length_px().to_bits()
+                );
+                assert_eq!(
+                    team.robot(0).total_reward().to_bits(),
+                    lone.total_reward().to_bits()
+                );
+            }
+        }
+        assert!(steps > 5000, "only {steps} steps compared");
     }
 
     #[test]
