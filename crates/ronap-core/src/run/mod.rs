@@ -1,6 +1,6 @@
 //! Running policies, above `policy`: one episode driven by one policy ([`rollout`]), and many
 //! episodes stepped side by side with automatic resets ([`batch`]), the engine of the vectorised
-//! Python environment and of DQN, and a team of robots each with its own policy ([`team`]). Uses
+//! Python environment and of DQN, and a team of robots driven by a team policy ([`team`]). Uses
 //! every layer up to `policy`.
 
 pub mod batch;

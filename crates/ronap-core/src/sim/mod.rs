@@ -1,6 +1,8 @@
-//! The simulation: the robot and its actions, the laser, the random streams, placement of start
-//! and goal, the episode that steps and scores them, a team of several robots, and the worlds
-//! episodes run in. Uses `config`, `geometry` and `scene`.
+//! The simulation: poses and actions, the robot and its kinematics (a trait, one file per kind),
+//! the laser, the random streams, placement of start and goal, the episode that steps and scores
+//! a robot, moving obstacles (their behaviours a trait, one file each), a team of several robots
+//! (a team of one steps as a lone robot), and the worlds episodes run in. Uses `config`,
+//! `geometry` and `scene`.
 
 pub mod action;
 pub mod episode;
