@@ -216,7 +216,7 @@ mod tests {
 #[cfg(test)]
 mod expert_data {
     use super::*;
-    use ronap_core::collect::expert::{collect, Posing};
+    use ronap_core::collect::expert::{collect, Collection, Posing};
     use ronap_core::eval::Evaluator;
     use ronap_core::{Scenes, SimConfig};
     use std::sync::atomic::AtomicBool;
@@ -230,22 +230,22 @@ mod expert_data {
             Scenes::MazePerSeed,
         );
         let mut data = DataSet::new(18);
-        collect(
-            &evaluator,
-            1_000_000..,
-            500,
-            6000,
-            Posing::Repose,
-            None,
-            0,
-            &AtomicBool::new(false),
-            &mut |_, samples| {
-                for s in samples {
-                    data.push(&s.observation(50.0), s.action);
-                }
-                true
-            },
-        )
+        let cancel = AtomicBool::new(false);
+        let request = Collection {
+            evaluator: &evaluator,
+            per_episode: 500,
+            max_samples: 6000,
+            posing: Posing::Repose,
+            driver: None,
+            threads: 0,
+            cancel: &cancel,
+        };
+        collect(&request, 1_000_000.., &mut |_, samples| {
+            for s in samples {
+                data.push(&s.observation(50.0), s.action);
+            }
+            true
+        })
         .unwrap();
         assert_eq!(data.len(), 6000);
         let majority = *data.action_counts().iter().max().unwrap() as f64 / data.len() as f64;

@@ -7,7 +7,7 @@ use crate::args::{count, seed, SceneArgs, SimArgs, ThreadArgs};
 use crate::output::cancel_on_ctrl_c;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
-use ronap_core::collect::expert::{collect, Posing};
+use ronap_core::collect::expert::{collect, Collection, Posing};
 use ronap_core::eval::Evaluator;
 use ronap_core::io::atomic::write_atomic;
 use ronap_core::io::datalog::DataLogWriter;
@@ -121,28 +121,27 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
     write_atomic(&out, |w| {
         let mut log = DataLogWriter::new(std::io::BufWriter::new(w), beams)?;
         let mut io_error = None;
-        let result = collect(
-            &evaluator,
-            first..u64::MAX,
-            args.per_episode as usize,
-            args.samples as usize,
+        let request = Collection {
+            evaluator: &evaluator,
+            per_episode: args.per_episode as usize,
+            max_samples: args.samples as usize,
             posing,
-            driver.as_deref(),
+            driver: driver.as_deref(),
             threads,
-            &cancel,
-            &mut |_, samples| {
-                for s in samples {
-                    if let Err(e) = log.write(s) {
-                        io_error = Some(e);
-                        return false;
-                    }
+            cancel: &cancel,
+        };
+        let result = collect(&request, first..u64::MAX, &mut |_, samples| {
+            for s in samples {
+                if let Err(e) = log.write(s) {
+                    io_error = Some(e);
+                    return false;
                 }
-                episodes += 1;
-                rows += samples.len();
-                bar.inc(samples.len() as u64);
-                true
-            },
-        );
+            }
+            episodes += 1;
+            rows += samples.len();
+            bar.inc(samples.len() as u64);
+            true
+        });
         if let Some(e) = io_error {
             return Err(e);
         }

@@ -100,21 +100,43 @@ pub fn collect_episode(
     Ok(samples)
 }
 
+/// A collection of labelled samples to make: where the episodes take place, how much to take,
+/// how states are visited, and on how many threads.
+#[derive(Clone, Copy)]
+pub struct Collection<'a> {
+    /// The episodes' configuration and scenes.
+    pub evaluator: &'a Evaluator,
+    /// Samples taken from each episode at most.
+    pub per_episode: usize,
+    /// Samples in all at most.
+    pub max_samples: usize,
+    /// How states are visited (re-posing, or driving).
+    pub posing: Posing,
+    /// Who drives (with [`Posing::Drive`]; `None`: the expert).
+    pub driver: Option<&'a dyn PolicyFactory>,
+    /// Worker threads (0: all cores).
+    pub threads: usize,
+    /// Set to stop between episodes, keeping every sample taken.
+    pub cancel: &'a AtomicBool,
+}
+
 /// Collects from `seeds` in order on `threads` threads (0: all cores), handing each episode's
 /// samples to `on_samples` in seed order, so the output is the same on any thread count. Stops
 /// after `max_samples` samples in all, when `on_samples` returns `false`, or when `cancel` is set.
-#[allow(clippy::too_many_arguments)]
 pub fn collect(
-    evaluator: &Evaluator,
+    request: &Collection<'_>,
     seeds: impl Iterator<Item = u64>,
-    per_episode: usize,
-    max_samples: usize,
-    posing: Posing,
-    driver: Option<&dyn PolicyFactory>,
-    threads: usize,
-    cancel: &AtomicBool,
     on_samples: &mut dyn FnMut(u64, &[Sample]) -> bool,
 ) -> Result<usize, CollectError> {
+    let Collection {
+        evaluator,
+        per_episode,
+        max_samples,
+        posing,
+        driver,
+        threads,
+        cancel,
+    } = *request;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
@@ -192,20 +214,20 @@ mod tests {
         );
         let gather = |threads| {
             let mut all = Vec::new();
-            collect(
-                &evaluator(),
-                0..6,
-                50,
-                usize::MAX,
-                Posing::Repose,
-                None,
+            let (evaluator, cancel) = (evaluator(), AtomicBool::new(false));
+            let request = Collection {
+                evaluator: &evaluator,
+                per_episode: 50,
+                max_samples: usize::MAX,
+                posing: Posing::Repose,
+                driver: None,
                 threads,
-                &AtomicBool::new(false),
-                &mut |_, s| {
-                    all.extend_from_slice(s);
-                    true
-                },
-            )
+                cancel: &cancel,
+            };
+            collect(&request, 0..6, &mut |_, s| {
+                all.extend_from_slice(s);
+                true
+            })
             .unwrap();
             all
         };

@@ -314,6 +314,14 @@ pub fn compare(
         std::fs::create_dir_all(&runs).map_err(|source| OutputError::Io { path: runs, source })?;
         report::remove_earlier(dir)?;
     }
+    let setting = Setting {
+        evaluator,
+        options,
+        info,
+        out,
+        cancel,
+        progress,
+    };
     let mut policies = Vec::new();
     for (index, (c, reuse)) in contenders.iter().zip(reused).enumerate() {
         let label = labels[index].clone();
@@ -326,9 +334,7 @@ pub fn compare(
                 summary: manifest.summary,
                 seeds,
             },
-            None => run_one(
-                evaluator, c, &label, options, info, out, cancel, index, progress,
-            )?,
+            None => run_one(&setting, c, &label, index)?,
         };
         policies.push(result);
     }
@@ -370,19 +376,32 @@ pub fn compare(
     Ok(comparison)
 }
 
-/// Runs contender `c` into `out/runs/<label>` (when there is an `out`).
-#[allow(clippy::too_many_arguments)]
+/// What every contender of a comparison runs in: the episodes, the options, where runs go, the
+/// cancel flag and who hears the progress.
+struct Setting<'a> {
+    evaluator: &'a Evaluator,
+    options: &'a CompareOptions,
+    info: &'a CompareInfo,
+    out: Option<&'a Path>,
+    cancel: &'a AtomicBool,
+    progress: &'a (dyn Fn(Progress) + Sync),
+}
+
+/// Runs contender `c` (the `index`-th) into `out/runs/<label>` (when there is an `out`).
 fn run_one(
-    evaluator: &Evaluator,
+    setting: &Setting<'_>,
     c: &Contender,
     label: &str,
-    options: &CompareOptions,
-    info: &CompareInfo,
-    out: Option<&Path>,
-    cancel: &AtomicBool,
     index: usize,
-    progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<PolicyResult, CompareError> {
+    let Setting {
+        evaluator,
+        options,
+        info,
+        out,
+        cancel,
+        progress,
+    } = *setting;
     let dir = out.map(|d| d.join("runs").join(label));
     let writer = dir
         .as_deref()
