@@ -21,7 +21,7 @@
 //! | [`eval`] | the batch evaluator, its records and summary |
 //! | [`render`] | pictures: canvas, first-person view, trajectories, GIFs |
 //! | [`io`] | files: atomic writes, run directories and their manifest, data logs, step logs |
-//! | [`job`] | use-cases: an evaluation (lone or team) run into a run directory |
+//! | [`job`] | use-cases: an evaluation (lone or team) into a run directory, a team replayed from its logs |
 //! | [`collect`] | labelled data: expert and human collection |
 //! | [`compare`] | several policies on the same seeds: paired statistics, pictures, a report |
 

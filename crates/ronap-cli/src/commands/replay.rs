@@ -97,12 +97,15 @@ pub fn run(args: ReplayArgs) -> Result<ExitCode> {
     let out = args.out.clone().unwrap_or_else(|| {
         // A team's logs are one per robot; its animation is the team's: seed-<seed>-team-top.gif.
         let stem = args.steps.with_extension("");
-        let stem = stem.to_string_lossy();
-        let stem = match stem.rsplit_once("-robot-") {
+        let name = stem
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let name = match name.rsplit_once("-robot-") {
             Some((seed, _)) if config.team_size() > 0 => format!("{seed}-team"),
-            _ => stem.into_owned(),
+            _ => name,
         };
-        PathBuf::from(format!("{stem}-{}.gif", args.view.name()))
+        stem.with_file_name(format!("{name}-{}.gif", args.view.name()))
     });
     if out.extension().and_then(|e| e.to_str()) != Some("gif") {
         bail!("--out {}: the file name must end in .gif", out.display());

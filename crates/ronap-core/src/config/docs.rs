@@ -44,7 +44,7 @@ const FIELD_DOCS: &[(&str, &str, &str, Option<&str>)] = &[
     ("episode", "goal", "Fixed goal [x px, y px]. Unset: drawn from the seed.", Some("[850.0, 850.0]")),
     ("episode", "grid_px", "Cell side of the free-space grid for connected regions and planners, px.", None),
     ("episode", "safety_radius_px", "A step is near a moving obstacle when the gap to one is below this, px. Unset: two robot radii.", Some("10.0")),
-    ("episode", "deadlock_steps", "Several robots: the episode ends as a deadlock when no robot has moved for this many steps.", None),
+    ("episode", "deadlock_steps", "Several robots: the episode ends as a deadlock when no robot of a team of two or more has moved for this many steps.", None),
     ("team", "comm_range_px", "Several robots: range of each robot's broadcast (pose, goal, message), px.", None),
     ("team", "message_size", "Several robots: floats in the message a policy broadcasts each step (0: pose and goal only).", None),
     ("team", "neighbours", "Several robots: nearest senders in the observation, after the paper's values (0: the paper's observation).", None),

@@ -27,8 +27,8 @@ pub struct EpisodeConfig {
     /// A step counts as near a moving obstacle when the gap to one is below this, px.
     /// Default: two robot radii.
     pub safety_radius_px: Option<f64>,
-    /// Several robots: the episode ends as a deadlock when no robot has moved for this many
-    /// steps. Default 100.
+    /// Several robots: the episode ends as a deadlock when no robot of a team of two or more has
+    /// moved for this many steps. Default 100.
     pub deadlock_steps: u32,
 }
 
@@ -187,7 +187,7 @@ impl EpisodeConfig {
     pub(super) fn validate_team_fields(&self) -> Result<(), ConfigError> {
         check(
             self.deadlock_steps >= 1,
-            "episodself.deadlock_steps",
+            "episode.deadlock_steps",
             self.deadlock_steps,
             "must be at least 1",
         )?;

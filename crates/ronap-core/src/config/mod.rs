@@ -338,6 +338,38 @@ mod tests {
     }
 
     #[test]
+    fn every_section_names_its_own_fields() {
+        // One field a section, each checked in that section's file: the error names the field
+        // as the TOML file spells it (so a scenario's error finds its line).
+        type Set = fn(&mut SimConfig);
+        let cases: [(Set, &str); 12] = [
+            (|c| c.maze.wall_thickness_px = 0.0, "maze.wall_thickness_px"),
+            (|c| c.map.resolution_px = -1.0, "map.resolution_px"),
+            (|c| c.robot.radius_px = 0.0, "robot.radius_px"),
+            (|c| c.laser.fov_deg = 400.0, "laser.fov_deg"),
+            (|c| c.episode.max_steps = 0, "episode.max_steps"),
+            (|c| c.reward.turn = f64::NAN, "reward.turn"),
+            (|c| c.reward.shaping_gamma = 2.0, "reward.shaping_gamma"),
+            (|c| c.apf.lattice_px = 0.0, "apf.lattice_px"),
+            (|c| c.episode.deadlock_steps = 0, "episode.deadlock_steps"),
+            (
+                |c| c.episode.safety_radius_px = Some(-1.0),
+                "episode.safety_radius_px",
+            ),
+            (|c| c.warehouse.aisle_px = 0.0, "warehouse.aisle_px"),
+            (|c| c.team.message_size = 65, "team.message_size"),
+        ];
+        for (set, field) in cases {
+            let mut c = SimConfig::default();
+            set(&mut c);
+            match c.validate() {
+                Err(ConfigError::OutOfRange { field: named, .. }) => assert_eq!(named, field),
+                other => panic!("{field}: {other:?}"),
+            }
+        }
+    }
+
+    #[test]
     fn toml_unknown_key_is_named() {
         let e = SimConfig::from_toml_str("[maze]\ncolz = 3\n").unwrap_err();
         assert!(

@@ -74,9 +74,9 @@ pub enum ReplayError {
     Animation(#[from] AnimationError),
 }
 
-/// Replays team episode `seed` of `evaluator` from `logs` (one per robot that has one; a robot
-/// without a log does nothing) and draws it from above every `options.stride` steps at
-/// `options.scale`. A robot whose log ends while it still runs gives up there, as its policy did.
+/// Replays team episode `seed` of `evaluator` from `logs` (one for every robot of the team) and
+/// draws it from above every `options.stride` steps at `options.scale`, as the run's `--gif`
+/// drew it. A robot whose log ends while it still runs gives up there, as its policy did.
 pub fn replay_team(
     evaluator: &Evaluator,
     seed: u64,
@@ -100,6 +100,14 @@ pub fn replay_team(
                 message: "two logs given".into(),
             });
         }
+    }
+    if let Some(robot) = by_robot.iter().position(Option::is_none) {
+        return Err(ReplayError::Robot {
+            robot,
+            message: format!(
+                "no log given: a team episode is replayed from every robot's log ({n} robots)"
+            ),
+        });
     }
     let last = logs
         .iter()
@@ -161,12 +169,26 @@ pub fn replay_team(
                 path.push(p);
             }
         }
-        if step % stride == 0 || step == last {
+        // The run drew its last frame when the team was done; robots that gave up after the
+        // last logged step leave it running here, and the run drew no frame for that step.
+        if step % stride == 0 || (step == last && rollout.finished()) {
             let frame = team_frame(team, &paths, options.scale);
             writer
                 .add(&pending, options.frame_delay_cs)
                 .map_err(AnimationError::from)?;
             pending = frame;
+        }
+    }
+    for (k, log) in by_robot.iter().enumerate() {
+        let left = log.map_or(0, |l| l.len() - next[k].min(l.len()));
+        if left > 0 {
+            return Err(ReplayError::Robot {
+                robot: k,
+                message: format!(
+                    "{left} logged steps were not replayed: a log's steps are numbered by team \
+                     step, 1, 2, 3, ... while the robot runs"
+                ),
+            });
         }
     }
     writer
@@ -286,6 +308,13 @@ mod tests {
                 replayed.bytes == rerun.bytes,
                 "seed {seed}: the frames differ"
             );
+            // Every robot's log is needed.
+            let mut missing = logs.clone();
+            missing.remove(2);
+            assert!(matches!(
+                replay_team(&evaluator, seed, &missing, &options),
+                Err(ReplayError::Robot { robot: 2, .. })
+            ));
             // A log moved by a hair at one step is caught there, naming the robot.
             let mut bent = logs.clone();
             let step = &mut bent[3].steps[5];

@@ -252,6 +252,16 @@ impl TeamRollout {
                     self.gave_up[k] = Some(why);
                     self.team.retire(k);
                 }
+                // A running robot left without a decision would never step nor end.
+                None if self.team.running(k) => {
+                    return Err(RunError::Policy {
+                        seed,
+                        step,
+                        source: crate::policy::PolicyError::Failed(format!(
+                            "the team policy decided nothing for robot {k}, which is running"
+                        )),
+                    });
+                }
                 _ => {}
             }
         }

@@ -562,8 +562,9 @@ impl Team {
         }
         self.collided = collided;
         self.still_for = if moved_any { 0 } else { self.still_for + 1 };
-        // A deadlock takes two: a team of one that stands still is a lone robot that does, and
-        // runs on as one would (to its time-out, or until its policy gives up).
+        // A deadlock is a team's: a team of one that stands still is a lone robot that does,
+        // and runs on as one would (to its time-out, or until its policy gives up). In a team of
+        // two or more, the robots still running deadlock even when the others are done.
         if n > 1 && self.still_for >= self.deadlock_steps {
             for k in 0..n {
                 if self.running(k) {

@@ -28,6 +28,30 @@ pub struct Motion {
     pub(crate) w_deg: f64,
 }
 
+impl Motion {
+    /// The motion to `end` of a step that moves `v` px along the way (signed) while turning
+    /// `w_deg` degrees, `turn_fraction` of a full turn command (for the turning penalty): what a
+    /// [`Kinematics`] of one's own returns.
+    pub fn new(end: Pose, turn_fraction: f64, v: f64, w_deg: f64) -> Self {
+        Self {
+            end,
+            turn_fraction,
+            v,
+            w_deg,
+        }
+    }
+
+    /// Linear speed over the step, px (signed).
+    pub fn v(&self) -> f64 {
+        self.v
+    }
+
+    /// Heading change over the step, degrees (signed).
+    pub fn w_deg(&self) -> f64 {
+        self.w_deg
+    }
+}
+
 /// A robot's body in motion: what an action does to its pose, and what the step sweeps.
 pub trait Kinematics: Send + Sync + Debug {
     /// Where `action` takes the body from `pose` in free space (no collision check); `facing`

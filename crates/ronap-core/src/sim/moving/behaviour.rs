@@ -31,7 +31,8 @@ pub struct Neighbours<'a> {
 
 impl Neighbours<'_> {
     /// Calls `f` with the index, centre and body of every present obstacle whose centre lies
-    /// within `distance_px` of `p`, in no particular order.
+    /// within `distance_px` of `p`, in no particular order (the asking obstacle too: compare
+    /// the index with its [`Agent::index`]).
     pub fn obstacles_within(
         &self,
         p: Point,
@@ -60,7 +61,8 @@ impl Neighbours<'_> {
 /// obstacle stays and the robot is charged a dynamic collision.
 pub trait Behaviour: Send + Sync + Debug {
     /// Where the obstacle `me` goes this step: a point at most `me.speed_px` from
-    /// `me.position`, or `None` to stay without a contact check. `rng` is the episode's
+    /// `me.position` (one further is brought back to that distance along the same line), or
+    /// `None` to stay without a contact check. `rng` is the episode's
     /// moving-obstacle stream, drawn from in obstacle order.
     fn next(
         &mut self,

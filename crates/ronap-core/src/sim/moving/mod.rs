@@ -325,13 +325,15 @@ impl Movers {
     /// Gives obstacle `index` (in entry order) a behaviour of one's own in place of the motion
     /// its entry configured (a motion no configuration names, a library user's): from the next
     /// step it goes where `behaviour` says, under the same contact rules.
-    pub fn set_behaviour(&mut self, index: usize, behaviour: Box<dyn Behaviour>) {
+    /// Returns `false`, changing nothing, when there is no obstacle `index`.
+    pub fn set_behaviour(&mut self, index: usize, behaviour: Box<dyn Behaviour>) -> bool {
         let Some(e) = self.entries.get_mut(index) else {
-            return;
+            return false;
         };
         e.motion = Motion::Behaves;
         (self.state.walks[index], self.state.sigma[index]) = e.walk();
         self.behaviours[index] = Some(Behave::Other(behaviour));
+        true
     }
 
     /// The obstacles, present or not.
@@ -420,6 +422,11 @@ impl Movers {
                 self.waiting -= 1;
             }
         }
+        // A behaviour asks for its neighbours during the moves: an obstacle that just appeared
+        // must be where the order says (the order is brought up to date again at the end).
+        if appeared && self.behaviours.iter().any(Option::is_some) {
+            state.sort_keys();
+        }
         state.wide.clear();
         for i in 0..state.sigma.len() {
             let sigma = state.sigma[i];
@@ -469,6 +476,10 @@ impl Movers {
                         Behave::Other(b) => b.next(&me, &near, scene, &mut self.rng),
                     };
                     match to {
+                        // No behaviour moves further than its speed: scans rely on it.
+                        Some(to) if (to - from).norm() > speed => {
+                            from + (to - from) * (speed / (to - from).norm())
+                        }
                         Some(to) => to,
                         None => continue,
                     }
@@ -783,7 +794,8 @@ mod tests {
         let mut movers = Movers::new(&config, &scene, robot, Point::new(20.0, 20.0), 5)
             .expect("places")
             .expect("has movers");
-        movers.set_behaviour(0, Box::new(Chase));
+        assert!(movers.set_behaviour(0, Box::new(Chase)));
+        assert!(!movers.clone().set_behaviour(6, Box::new(Chase)));
         let start = movers.items().next().expect("six").position();
         let still: Vec<Point> = movers.items().skip(1).map(|m| m.position()).collect();
         let radius = config.robot.radius_px;
