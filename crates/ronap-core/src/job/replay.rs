@@ -5,8 +5,8 @@
 use crate::eval::Evaluator;
 use crate::geometry::Point;
 use crate::io::steplog::LoggedStep;
-use crate::render::gif::{same_pose, Animation, AnimationError, GifOptions, GifWriter};
-use crate::render::team::{team_frame, team_palette};
+use crate::render::gif::{same_pose, Animation, AnimationError, GifOptions};
+use crate::render::team::{team_frame, team_gif_writer};
 use crate::run::team::TeamRollout;
 use crate::run::RunError;
 use crate::sim::robot::{Action, Pose};
@@ -120,14 +120,7 @@ pub fn replay_team(
         .collect();
     let first = team_frame(rollout.team(), &paths, options.scale);
     let (width, height) = first.dimensions();
-    let too_large = || AnimationError::TooLarge { width, height };
-    let mut writer = GifWriter::with_palette(
-        Vec::new(),
-        u16::try_from(width).map_err(|_| too_large())?,
-        u16::try_from(height).map_err(|_| too_large())?,
-        &team_palette(),
-    )
-    .map_err(AnimationError::from)?;
+    let mut writer = team_gif_writer(width, height)?;
     // Each frame is written when the next one is known, so the last can be held longer.
     let mut pending = first;
     let mut next = vec![0usize; n];

@@ -107,6 +107,17 @@ pub fn team_palette() -> Vec<Rgb<u8>> {
     palette
 }
 
+/// A GIF encoder for team frames of `width` x `height` pixels, in the team palette.
+pub fn team_gif_writer(width: u32, height: u32) -> Result<GifWriter<Vec<u8>>, AnimationError> {
+    let too_large = || AnimationError::TooLarge { width, height };
+    Ok(GifWriter::with_palette(
+        Vec::new(),
+        u16::try_from(width).map_err(|_| too_large())?,
+        u16::try_from(height).map_err(|_| too_large())?,
+        &team_palette(),
+    )?)
+}
+
 /// A team episode that could not be animated.
 #[derive(Debug, thiserror::Error)]
 pub enum TeamAnimationError {
@@ -140,14 +151,7 @@ pub fn animate_team(
     let (width, height) = Canvas::new(world.scene(), options.scale)
         .into_image()
         .dimensions();
-    let too_large = || AnimationError::TooLarge { width, height };
-    let mut writer = GifWriter::with_palette(
-        Vec::new(),
-        u16::try_from(width).map_err(|_| too_large())?,
-        u16::try_from(height).map_err(|_| too_large())?,
-        &team_palette(),
-    )
-    .map_err(AnimationError::from)?;
+    let mut writer = team_gif_writer(width, height)?;
     let mut paths: Vec<Vec<Point>> = Vec::new();
     let mut pending: Option<RgbImage> = None;
     let mut failed: Option<gif::EncodingError> = None;
