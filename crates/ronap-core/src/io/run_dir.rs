@@ -271,8 +271,9 @@ impl RunWriter {
     /// Locks `dir`, a run stopped short (killed, interrupted or out of disk), to finish it: reads
     /// its plan (`run.json`) and counts the episodes it finished (the whole rows every one of its
     /// run files holds; a row torn by a crash is dropped). The caller rebuilds the run from the
-    /// plan and hands this writer to [`evaluate_into`] or [`evaluate_team_into`], which run only
-    /// the seeds left. Pictures and step logs already written are kept.
+    /// plan and hands this writer to [`crate::job::evaluate_into`] or
+    /// [`crate::job::evaluate_team_into`], which run only the seeds left. Pictures and step logs
+    /// already written are kept.
     pub fn resume(dir: &Path) -> Result<(Self, RunPlan), ResumeError> {
         let plan_path = dir.join(PLAN_FILE);
         if !dir.is_dir() {
@@ -739,8 +740,8 @@ impl EpisodeRows {
 }
 
 /// A lone robot's run whose episodes were evaluated elsewhere (seed blocks on other machines)
-/// and come back as [`EpisodeRows`], written into the files [`evaluate_into`] writes for the
-/// same run: the same `episodes.csv` bytes, the same summary figures, the same plan (so a
+/// and come back as [`EpisodeRows`], written into the files [`crate::job::evaluate_into`] writes
+/// for the same run: the same `episodes.csv` bytes, the same summary figures, the same plan (so a
 /// killed run can be taken up again with [`RunWriter::resume`]).
 pub struct BlockRun {
     writer: RunWriter,

@@ -1,5 +1,5 @@
 //! The robot: a disc with a pose `[x px, y px, z deg]`, its discrete and continuous actions, and
-//! its [kinematics](crate::sim::kinematics), which say where an action takes it. The whole
+//! its kinematics ([`crate::sim::kinematics`]), which say where an action takes it. The whole
 //! motion of a step is swept against the scene, so no speed carries the disc through a wall.
 
 pub use crate::sim::action::{Action, DiscreteAction, Pose};
