@@ -5,7 +5,7 @@
 
 use ronap_core::eval::{Evaluator, Recording};
 use ronap_core::policy::name::Builtin;
-use ronap_core::policy::{Policy, PolicyFactory};
+use ronap_core::policy::{PerRobot, Policy, PolicyFactory};
 use ronap_core::{Scenes, SimConfig, ValidConfig};
 
 /// Steps each fuzzed episode runs at most.
@@ -71,9 +71,13 @@ pub fn drive(config: ValidConfig, scenes: Scenes) {
     let evaluator = Evaluator::new(config, scenes);
     for seed in 0..2 {
         if team > 0 {
-            let mut policies: Vec<Box<dyn Policy>> =
-                names.iter().map(|n| policy(Some(n))).collect();
-            if let Ok(record) = evaluator.run_team_episode(&mut policies, &names, seed, true) {
+            let policies: Vec<Box<dyn Policy>> = names.iter().map(|n| policy(Some(n))).collect();
+            let mut team = PerRobot::new(policies);
+            let recording = Recording {
+                trajectory: true,
+                steps: true,
+            };
+            if let Ok(record) = evaluator.run_team_episode(&mut team, &names, seed, recording) {
                 // The figures every output file is written from.
                 let _ = ronap_core::eval::TeamFigures::of(&record);
                 for robot in &record.robots {
