@@ -344,29 +344,14 @@ impl Recorder {
 
     /// Takes `action` in `rollout`, keeping what the recording asks for.
     pub(crate) fn take(&mut self, rollout: &mut Rollout, action: Action) {
-        let before = self.recording.steps.then(|| {
-            let e = rollout.episode();
-            (
-                e.pose(),
-                e.readings().to_vec(),
-                e.bearing_deg(),
-                e.distance_px(),
-                e.direction_deg(),
-            )
-        });
+        let before = self
+            .recording
+            .steps
+            .then(|| record::Before::of(rollout.episode()));
         let s = rollout.take(action);
-        if let Some((pose, readings, bearing_deg, distance_px, direction_deg)) = before {
-            self.step_log.push(StepLog {
-                step: s.step,
-                pose,
-                readings,
-                bearing_deg,
-                distance_px,
-                direction_deg,
-                action,
-                collided: s.collided,
-                reward: s.reward,
-            });
+        if let Some(b) = before {
+            self.step_log
+                .push(b.logged(s.step, action, s.collided, s.reward));
         }
         if self.recording.trajectory {
             self.trajectory.push(s.pose);

@@ -91,6 +91,43 @@ pub struct StepLog {
     pub reward: f64,
 }
 
+/// A robot's state before a step, as its step log keeps it.
+pub(crate) struct Before {
+    pose: Pose,
+    readings: Vec<f64>,
+    bearing_deg: f64,
+    distance_px: f64,
+    direction_deg: f64,
+}
+
+impl Before {
+    /// What `robot` senses now, before it steps.
+    pub(crate) fn of(robot: &crate::sim::episode::Episode) -> Self {
+        Self {
+            pose: robot.pose(),
+            readings: robot.readings().to_vec(),
+            bearing_deg: robot.bearing_deg(),
+            distance_px: robot.distance_px(),
+            direction_deg: robot.direction_deg(),
+        }
+    }
+
+    /// The step log row of step `step`, taken from this state with `action`.
+    pub(crate) fn logged(self, step: u32, action: Action, collided: bool, reward: f64) -> StepLog {
+        StepLog {
+            step,
+            pose: self.pose,
+            readings: self.readings,
+            bearing_deg: self.bearing_deg,
+            distance_px: self.distance_px,
+            direction_deg: self.direction_deg,
+            action,
+            collided,
+            reward,
+        }
+    }
+}
+
 /// What to keep of each episode beyond its figures.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Recording {

@@ -3,6 +3,7 @@
 //! deadlocks), and their summary.
 
 use crate::eval::ordered::{run_in_order, Window};
+use crate::eval::record::Before;
 use crate::eval::summary::wilson95;
 use crate::eval::{
     worker_pool, EvalOptions, Evaluator, Failure, Outcome, Recording, RunEnd, StepLog,
@@ -386,47 +387,6 @@ impl TeamSummary {
     }
 }
 
-/// A robot's state before a step, as its step log keeps it.
-struct Before {
-    pose: crate::sim::robot::Pose,
-    readings: Vec<f64>,
-    bearing_deg: f64,
-    distance_px: f64,
-    direction_deg: f64,
-}
-
-impl Before {
-    fn of(robot: &crate::sim::episode::Episode) -> Self {
-        Self {
-            pose: robot.pose(),
-            readings: robot.readings().to_vec(),
-            bearing_deg: robot.bearing_deg(),
-            distance_px: robot.distance_px(),
-            direction_deg: robot.direction_deg(),
-        }
-    }
-
-    /// Robot `k`'s step log row for the step it just took with `action` in `team`.
-    fn logged(
-        self,
-        team: &crate::sim::team::Team,
-        k: usize,
-        action: crate::sim::robot::Action,
-    ) -> StepLog {
-        StepLog {
-            step: team.robot(k).steps(),
-            pose: self.pose,
-            readings: self.readings,
-            bearing_deg: self.bearing_deg,
-            distance_px: self.distance_px,
-            direction_deg: self.direction_deg,
-            action,
-            collided: team.collided(k),
-            reward: team.rewards()[k],
-        }
-    }
-}
-
 /// What a team evaluation produced.
 #[derive(Debug)]
 pub struct TeamRunResult {
@@ -497,7 +457,8 @@ impl Evaluator {
             let team = rollout.team();
             for (k, b) in before.into_iter().enumerate() {
                 if let (Some(b), Some(action)) = (b, rollout.last_actions()[k]) {
-                    step_logs[k].push(b.logged(team, k, action));
+                    let step = team.robot(k).steps();
+                    step_logs[k].push(b.logged(step, action, team.collided(k), team.rewards()[k]));
                 }
             }
             note(team, &mut tracks);

@@ -8,24 +8,18 @@ pub use crate::sim::kinematics::Motion;
 use crate::config::RobotConfig;
 use crate::geometry::{Point, Vector};
 use crate::scene::Scene;
-use crate::sim::kinematics::{self, Kinematics, Unicycle};
+use crate::sim::kinematics::{self, Built, Kinematics};
 use std::sync::Arc;
 
 /// The robot's shape and how it moves ([`Kinematics`]).
 #[derive(Clone, Debug)]
 pub struct Robot {
     radius_px: f64,
-    kinematics: Body,
-}
-
-/// A robot's kinematics: the built-in unicycle held as itself, any other behind the trait. A
-/// step's motion and sweep then inline into the episode's step for the paper's robot, where
-/// three calls through the trait (motion, sweep, and the sweep's test) cost 4% of `ronap bench
-/// --threads 1`'s steps.
-#[derive(Clone, Debug)]
-enum Body {
-    Unicycle(Unicycle),
-    Other(Arc<dyn Kinematics>),
+    /// The built-in unicycle held as itself, any other kind behind the trait: a step's motion and
+    /// sweep then inline into the episode's step for the paper's robot, where three calls
+    /// through the trait (motion, sweep, and the sweep's test) cost 4% of `ronap bench
+    /// --threads 1`'s steps.
+    kinematics: Built,
 }
 
 impl Robot {
@@ -33,10 +27,7 @@ impl Robot {
     pub fn new(config: &RobotConfig) -> Self {
         Self {
             radius_px: config.radius_px,
-            kinematics: match kinematics::for_robot(config) {
-                kinematics::Built::Unicycle(u) => Body::Unicycle(u),
-                kinematics::Built::Other(k) => Body::Other(k),
-            },
+            kinematics: kinematics::for_robot(config),
         }
     }
 
@@ -44,7 +35,7 @@ impl Robot {
     pub fn with_kinematics(radius_px: f64, kinematics: Arc<dyn Kinematics>) -> Self {
         Self {
             radius_px,
-            kinematics: Body::Other(kinematics),
+            kinematics: Built::Other(kinematics),
         }
     }
 
@@ -56,8 +47,8 @@ impl Robot {
     /// How the robot moves.
     pub fn kinematics(&self) -> &dyn Kinematics {
         match &self.kinematics {
-            Body::Unicycle(u) => u,
-            Body::Other(k) => k.as_ref(),
+            Built::Unicycle(u) => u,
+            Built::Other(k) => k.as_ref(),
         }
     }
 
@@ -71,8 +62,8 @@ impl Robot {
     /// and sine, as the move works them out without it).
     pub fn motion_facing(&self, pose: Pose, facing: Option<Vector>, action: Action) -> Motion {
         match &self.kinematics {
-            Body::Unicycle(u) => u.motion(pose, facing, action),
-            Body::Other(k) => k.motion(pose, facing, action),
+            Built::Unicycle(u) => u.motion(pose, facing, action),
+            Built::Other(k) => k.motion(pose, facing, action),
         }
     }
 
@@ -90,8 +81,8 @@ impl Robot {
         mut sweep_clear: impl FnMut(Point, Point, f64) -> bool,
     ) -> bool {
         match &self.kinematics {
-            Body::Unicycle(u) => u.sweep_by(pose, motion, self.radius_px, &mut sweep_clear),
-            Body::Other(k) => k.sweep(pose, motion, self.radius_px, &mut sweep_clear),
+            Built::Unicycle(u) => u.sweep_by(pose, motion, self.radius_px, &mut sweep_clear),
+            Built::Other(k) => k.sweep(pose, motion, self.radius_px, &mut sweep_clear),
         }
     }
 }
