@@ -22,26 +22,85 @@ pub fn progress_bar(len: u64, template: &str, prefix: String) -> indicatif::Prog
     } else {
         ProgressBar::hidden()
     };
-    bar.set_style(
-        ProgressStyle::with_template(template).unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
+    let style =
+        ProgressStyle::with_template(template).unwrap_or_else(|_| ProgressStyle::default_bar());
+    bar.set_style(style.with_key(
+        "per_sec",
+        |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+            let _ = w.write_str(&rate(state.per_sec()));
+        },
+    ));
     bar.set_prefix(prefix);
     bar
 }
 
-/// A flag the first Ctrl-C sets (after saying `what` happens now); a second Ctrl-C exits at once
-/// with code 130. A termination request (SIGTERM, as `timeout`, schedulers and service managers
-/// send, or SIGHUP) counts as a Ctrl-C, so what is done is kept then too.
+/// A rate as a progress bar shows it: `2576/s`, `42.5/s`, `0.25/s`.
+pub fn rate(per_sec: f64) -> String {
+    match per_sec {
+        r if !r.is_finite() => "-/s".to_string(),
+        r if r >= 100.0 => format!("{r:.0}/s"),
+        r if r >= 1.0 => format!("{r:.1}/s"),
+        r => format!("{r:.2}/s"),
+    }
+}
+
+/// A flag the first interrupt sets (after saying `what` happens now), so the run stops cleanly and
+/// keeps everything. An interrupt is Ctrl-C (SIGINT) or a termination request (SIGTERM, as
+/// `timeout`, schedulers and service managers send, or SIGHUP). Signals that come together (as
+/// `timeout` sends one to the process and one to its process group) count once: a repeat quits at
+/// once, with code 130, only when it is a Ctrl-C from a terminal at least a second after the first.
 pub fn cancel_on_ctrl_c(what: &'static str) -> Arc<AtomicBool> {
     let cancel = Arc::new(AtomicBool::new(false));
     let flag = cancel.clone();
-    let _ = ctrlc::set_handler(move || {
-        if flag.swap(true, Ordering::SeqCst) {
-            std::process::exit(130);
+    #[cfg(unix)]
+    {
+        use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+        use std::io::IsTerminal;
+        if let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) {
+            let terminal = std::io::stdin().is_terminal() || std::io::stderr().is_terminal();
+            std::thread::spawn(move || {
+                let mut first = None;
+                for signal in signals.forever() {
+                    match first {
+                        None => {
+                            first = Some(std::time::Instant::now());
+                            flag.store(true, Ordering::SeqCst);
+                            let again = if terminal {
+                                " (Ctrl-C again to quit now)"
+                            } else {
+                                ""
+                            };
+                            eprintln!("\nronap: interrupted; {what}{again}");
+                        }
+                        Some(at) => {
+                            if should_quit_now(signal, terminal, at) {
+                                std::process::exit(130);
+                            }
+                        }
+                    }
+                }
+            });
         }
-        eprintln!("\nronap: interrupted; {what} (Ctrl-C again to quit now)");
-    });
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = ctrlc::set_handler(move || {
+            if flag.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+            eprintln!("\nronap: interrupted; {what} (Ctrl-C again to quit now)");
+        });
+    }
     cancel
+}
+
+/// Whether a repeated interrupt `signal`, coming after the first one (at `first`), means "quit
+/// now": only a terminal's Ctrl-C, a second or more after the first.
+#[cfg(unix)]
+fn should_quit_now(signal: i32, terminal: bool, first: std::time::Instant) -> bool {
+    signal == signal_hook::consts::SIGINT
+        && terminal
+        && first.elapsed() >= std::time::Duration::from_secs(1)
 }
 
 /// `n` and `noun`, plural but for one: "1 thread", "2 threads".
@@ -91,4 +150,30 @@ pub fn unused_dir(base: String) -> std::path::PathBuf {
         })
         .find(|p| !p.exists())
         .unwrap_or_else(|| PathBuf::from(base))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_rate_shows_whole_steps_when_fast_and_decimals_only_when_slow() {
+        assert_eq!(rate(2575.5969), "2576/s");
+        assert_eq!(rate(42.46), "42.5/s");
+        assert_eq!(rate(0.254), "0.25/s");
+        assert_eq!(rate(f64::INFINITY), "-/s");
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn only_a_terminals_ctrl_c_a_second_later_quits_at_once() {
+        use signal_hook::consts::{SIGINT, SIGTERM};
+        use std::time::{Duration, Instant};
+        let long_ago = Instant::now() - Duration::from_secs(2);
+        assert!(should_quit_now(SIGINT, true, long_ago));
+        // Signals that come together (timeout's to the process and to its group) count once.
+        assert!(!should_quit_now(SIGINT, true, Instant::now()));
+        assert!(!should_quit_now(SIGTERM, true, long_ago));
+        assert!(!should_quit_now(SIGINT, false, long_ago));
+    }
 }

@@ -251,6 +251,7 @@ fn one_seed_calls_nothing_and_an_earlier_comparison_leaves_nothing_behind() {
         "geodesic",
         "--out",
         out.to_str().unwrap(),
+        "--force",
     ]));
     assert!(o.contains("1 seeds (3 to 3)"), "{o}");
     let pair = &json(&out.join("compare.json"))["pairs"][0];

@@ -7,6 +7,7 @@
 mod args;
 mod cli;
 mod compare;
+mod keep;
 mod learn;
 mod limits;
 mod replay;

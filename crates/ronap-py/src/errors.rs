@@ -71,3 +71,22 @@ pub fn run(e: &ronap_core::run::RunError) -> PyErr {
 pub fn output(e: impl std::fmt::Display) -> PyErr {
     OutputError::new_err(e.to_string())
 }
+
+/// An output directory that cannot be written as an `OutputError`, with the ways on when it was
+/// refused for what it holds.
+pub fn out_dir(e: ronap_core::io::atomic::OutputError) -> PyErr {
+    use ronap_core::io::atomic::OutputError as E;
+    let hint = match &e {
+        E::StoppedShort { dir, .. } => format!(
+            ": `ronap run --resume {}` finishes it, force=True replaces it, or choose another out",
+            dir.display()
+        ),
+        E::Finished { .. } => ": force=True replaces it, or choose another out".to_string(),
+        E::NotARun { .. } => {
+            ": force=True writes there anyway (keeping those files), or choose another out"
+                .to_string()
+        }
+        _ => String::new(),
+    };
+    OutputError::new_err(format!("{e}{hint}"))
+}

@@ -13,7 +13,7 @@ use ronap_core::policy::batched::{BatchPolicy, Batched};
 use ronap_core::policy::{Decision, Policy, PolicyError, PolicyFactory};
 use ronap_core::sim::world::Scenes;
 use ronap_core::{Action, Episode, ValidConfig, World};
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 
 /// One call at a time into a policy that is not known to be thread-safe.
@@ -240,7 +240,7 @@ fn policy_factory(
 /// "episodes": [...]} with the figures and rows `ronap run` reports, and writes its files (the
 /// same files, `summary.json` in the same schema) into `out` when given.
 #[pyfunction]
-#[pyo3(signature = (policy, seeds, config, maze_seed = None, map_path = None, threads = 0, continuous = false, out = None, png = None, log_steps = false, thread_safe = false, batch = 0, rows = false))]
+#[pyo3(signature = (policy, seeds, config, maze_seed = None, map_path = None, threads = 0, continuous = false, out = None, png = None, log_steps = false, thread_safe = false, batch = 0, rows = false, force = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate<'py>(
     py: Python<'py>,
@@ -257,6 +257,7 @@ pub fn evaluate<'py>(
     thread_safe: bool,
     batch: usize,
     rows: bool,
+    force: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let config = config.valid();
     let first = first_seed(&seeds)?;
@@ -304,7 +305,7 @@ pub fn evaluate<'py>(
                 steps: log_steps,
                 gifs: false,
             };
-            RunWriter::create(dir, files, first).map_err(errors::output)
+            RunWriter::create(dir, files, first, force).map_err(errors::out_dir)
         })
         .transpose()?;
     let evaluator = Evaluator::new(config.clone(), scenes);
@@ -314,6 +315,8 @@ pub fn evaluate<'py>(
         ..EvalOptions::default()
     };
     let cancel = AtomicBool::new(false);
+    let main = std::thread::current().id();
+    let interrupt = std::sync::Mutex::new(None);
     let evaluation = py
         .allow_threads(|| {
             let request = RunRequest {
@@ -323,11 +326,28 @@ pub fn evaluate<'py>(
                 writer,
                 cancel: &cancel,
             };
-            evaluate_into(request, factory.as_ref(), &|_| {}, &|_| true)
+            // A Ctrl-C (Python's KeyboardInterrupt) stops the run as `ronap run`'s does: the
+            // episodes under way finish, the files are written, then the interrupt is raised.
+            // Python hears signals on its main thread, which takes the records in order here.
+            let keep = |_: &_| {
+                if std::thread::current().id() == main && !cancel.load(Ordering::SeqCst) {
+                    if let Err(e) = Python::with_gil(|py| py.check_signals()) {
+                        cancel.store(true, Ordering::SeqCst);
+                        if let Ok(mut i) = interrupt.lock() {
+                            *i = Some(e);
+                        }
+                    }
+                }
+                true
+            };
+            evaluate_into(request, factory.as_ref(), &|_| {}, &keep)
         })
         .map_err(|e| errors::PolicyError::new_err(e.to_string()))?;
     if let Some(e) = &evaluation.write_error {
         return Err(errors::output(e));
+    }
+    if let Some(e) = interrupt.into_inner().ok().flatten() {
+        return Err(e);
     }
     if let Some(e) = &evaluation.result.error {
         return Err(errors::run(e));
@@ -367,7 +387,7 @@ pub fn policy_name(policy: &Bound<'_, PyAny>) -> String {
 /// returns the figures of `compare.json` as a dict, and writes every file of `ronap compare` into
 /// `out` when given. `runs`: finished run directories to reuse.
 #[pyfunction]
-#[pyo3(signature = (policies, seeds, config, maze_seed = None, map_path = None, threads = 0, continuous = false, out = None, runs = Vec::new(), by_difficulty = false, bins = 3, resamples = 10_000, sheet = 6, thread_safe = false, command = None))]
+#[pyo3(signature = (policies, seeds, config, maze_seed = None, map_path = None, threads = 0, continuous = false, out = None, runs = Vec::new(), by_difficulty = false, bins = 3, resamples = 10_000, sheet = 6, thread_safe = false, command = None, force = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn compare<'py>(
     py: Python<'py>,
@@ -386,6 +406,7 @@ pub fn compare<'py>(
     sheet: usize,
     thread_safe: bool,
     command: Option<String>,
+    force: bool,
 ) -> PyResult<PyObject> {
     use ronap_core::compare::{self as cmp, CompareInfo, CompareOptions, Contender};
     let config = config.valid();
@@ -428,6 +449,7 @@ pub fn compare<'py>(
         difficulty_bins: bins,
         resamples,
         sheet_rows: sheet,
+        replace: force,
     };
     let info = CompareInfo {
         scenes: spec,
@@ -448,7 +470,7 @@ pub fn compare<'py>(
             )
         })
         .map_err(|e| match e {
-            cmp::CompareError::Output(e) => errors::output(e),
+            cmp::CompareError::Output(e) => errors::out_dir(e),
             cmp::CompareError::Policy { .. } | cmp::CompareError::Run { .. } => {
                 errors::PolicyError::new_err(e.to_string())
             }
@@ -500,7 +522,7 @@ impl PyBlockRun {
     /// Starts the run of `policy` (a name or a callable, for its name) over `seeds` under
     /// `config` in directory `out` (made, locked, cleared of an earlier run's files).
     #[new]
-    #[pyo3(signature = (out, policy, seeds, config, maze_seed = None, map_path = None, threads = 0))]
+    #[pyo3(signature = (out, policy, seeds, config, maze_seed = None, map_path = None, threads = 0, force = false))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         out: std::path::PathBuf,
@@ -510,10 +532,12 @@ impl PyBlockRun {
         maze_seed: Option<u64>,
         map_path: Option<&str>,
         threads: usize,
+        force: bool,
     ) -> PyResult<Self> {
         let first = first_seed(&seeds)?;
         let (info, _) = run_info(policy_name(policy), config.valid(), maze_seed, map_path)?;
-        let writer = RunWriter::create(&out, RunFiles::default(), first).map_err(errors::output)?;
+        let writer =
+            RunWriter::create(&out, RunFiles::default(), first, force).map_err(errors::out_dir)?;
         let options = EvalOptions {
             seeds: seeds.into(),
             threads,

@@ -1,5 +1,6 @@
 """The batch evaluator from Python (the CLI side of the same runs is in the top-level tests/)."""
 
+import json
 import pathlib
 import threading
 import time
@@ -173,3 +174,63 @@ def test_batch_is_for_callables_and_counted():
         ronap.evaluate("apf", range(4), batch=4)
     with pytest.raises(ronap.ConfigError, match="batch = -1"):
         ronap.evaluate(toward_goal, range(4), batch=-1)
+
+
+def _files(directory):
+    root = pathlib.Path(directory)
+    return {p.relative_to(root): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+def test_out_holding_a_run_or_other_files_needs_force(tmp_path):
+    out = tmp_path / "run"
+    ronap.evaluate("apf", range(3), out=str(out))
+    assert sorted(p.name for p in out.iterdir()) == ["episodes.csv", "run.json", "summary.json", "timing.csv"]
+    before = _files(out)
+    with pytest.raises(ronap.OutputError, match="holds a finished run.*force=True"):
+        ronap.evaluate("geodesic", range(3), out=str(out))
+    assert _files(out) == before
+    ronap.evaluate("geodesic", range(2), out=str(out), force=True)
+    assert json.loads((out / "summary.json").read_text())["policy"] == "geodesic"
+
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("keep me")
+    with pytest.raises(ronap.OutputError, match="notes.txt.*force=True"):
+        ronap.evaluate("apf", range(2), out=str(mine))
+    ronap.evaluate("apf", range(2), out=str(mine), force=True)
+    assert (mine / "notes.txt").read_text() == "keep me"
+
+
+def test_a_forced_run_failing_at_once_leaves_the_old_run(tmp_path):
+    out = tmp_path / "run"
+    ronap.evaluate("apf", range(3), out=str(out))
+    before = _files(out)
+
+    def broken(obs):
+        raise ValueError("broken")
+
+    with pytest.raises(ronap.PolicyError, match="broken"):
+        ronap.evaluate(broken, range(3), out=str(out), force=True, threads=1)
+    assert _files(out) == before
+
+
+def test_ctrl_c_stops_the_run_keeping_its_files_then_raises(tmp_path):
+    import _thread
+
+    def slow(obs):
+        time.sleep(0.002)
+        return 1
+
+    out = tmp_path / "run"
+    timer = threading.Timer(1.0, _thread.interrupt_main)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            ronap.evaluate(slow, range(1_000_000), out=str(out), threads=1)
+    finally:
+        timer.cancel()
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["interrupted"] is True
+    rows = (out / "episodes.csv").read_text().splitlines()
+    assert summary["summary"]["episodes"] == len(rows) - 1 > 0
+    assert not list(out.glob("*.partial")) and not (out / ".ronap.lock").exists()

@@ -123,3 +123,35 @@ def test_the_command_line(cluster, ronap_bin, tmp_path):
     assert (tmp_path / "ray" / "episodes.csv").read_bytes() == (tmp_path / "one" / "episodes.csv").read_bytes()
     bad = subprocess.run([sys.executable, "-m", "ronap.ray", "--policy", "nope", "--seeds", "2", "--out", str(tmp_path / "b"), "--address", cluster], capture_output=True, text=True)
     assert bad.returncode == 2 and bad.stderr.startswith("error") and "nope" in bad.stderr
+
+
+def _files(directory):
+    root = pathlib.Path(directory)
+    return {p.relative_to(root): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+def test_a_failed_run_or_resume_leaves_the_directory_as_it_was(cluster, ronap_bin, tmp_path):
+    out = tmp_path / "ray"
+    ronap.ray.evaluate("apf", range(10), out=out, block=5)
+    before = _files(out)
+    with pytest.raises(ronap.OutputError, match="force=True"):
+        ronap.ray.evaluate("apf", range(10), out=out, block=5)
+
+    def bad(obs):
+        raise ValueError("no")
+
+    # Forced over a finished run, a run whose first task fails replaces nothing.
+    with pytest.raises(ronap.PolicyError, match="no"):
+        ronap.ray.evaluate(bad, range(10), out=out, block=5, force=True)
+    assert _files(out) == before
+
+    # A run of a Python function stopped short, which `ronap run --resume` cannot rebuild: the
+    # failed resume leaves every file (its summary.json too).
+    stopped = tmp_path / "stopped"
+    with pytest.raises(ronap.PolicyError, match="no"):
+        ronap.ray.evaluate(bad, range(10), out=stopped, block=5)
+    before = _files(stopped)
+    assert "summary.json" in {p.name for p in before}
+    r = subprocess.run([ronap_bin, "run", "--resume", str(stopped)], capture_output=True, text=True, cwd=ROOT)
+    assert r.returncode != 0 and "panicked" not in r.stderr, r.stderr
+    assert _files(stopped) == before

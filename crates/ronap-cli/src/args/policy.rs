@@ -8,15 +8,17 @@ use ronap_core::ValidConfig;
 
 /// The policy `name` names: a built-in, `mlp:FILE[@RULE]` or `py:FILE:FUNCTION`.
 pub fn policy_factory(name: &str, config: &ValidConfig) -> Result<Box<dyn PolicyFactory>> {
-    named_policy("policy", name, config)
+    named_policy("--policy", name, config)
 }
 
-/// [`policy_factory`] for the policy that flag `--flag` names (the flag errors name).
+/// [`policy_factory`] for the policy that `label` gives (a flag, `--driver`, or a file's field,
+/// `robots[0].policy`; errors name it).
 pub fn named_policy(
-    flag: &str,
+    label: &str,
     name: &str,
     config: &ValidConfig,
 ) -> Result<Box<dyn PolicyFactory>> {
+    let flag = label;
     if let Some(spec) = name.strip_prefix("py:") {
         return Ok(Box::new(
             crate::py_policy::PyPolicyFactory::new(spec).map_err(anyhow::Error::msg)?,
@@ -26,16 +28,16 @@ pub fn named_policy(
         PolicyNameError::Unknown { .. } => {
             let known: Vec<&str> = Builtin::ALL.iter().map(|(_, n, _)| *n).collect();
             anyhow::anyhow!(
-                "--{flag} {name:?}: unknown policy (expected one of: {}, mlp:FILE[@RULE], \
+                "{flag} {name:?}: unknown policy (expected one of: {}, mlp:FILE[@RULE], \
                  py:FILE:FUNCTION)",
                 known.join(", ")
             )
         }
         PolicyNameError::Rule { .. } => {
             let text = e.to_string();
-            anyhow::anyhow!("--{flag} {}", text.strip_prefix("policy ").unwrap_or(&text))
+            anyhow::anyhow!("{flag} {}", text.strip_prefix("policy ").unwrap_or(&text))
         }
-        PolicyNameError::Network(e) => anyhow::Error::from(e).context(format!("--{flag} {name:?}")),
+        PolicyNameError::Network(e) => anyhow::Error::from(e).context(format!("{flag} {name:?}")),
     })
 }
 

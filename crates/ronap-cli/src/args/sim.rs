@@ -101,7 +101,7 @@ impl SimArgs {
         m.loops = self.loops.unwrap_or(m.loops);
         m.wall_thickness_px = self.wall_thickness.unwrap_or(m.wall_thickness_px);
         more(&mut sim);
-        sim.validate().map_err(|e| match &file {
+        let valid = sim.validate().map_err(|e| match &file {
             Some(file) => match file.locate(e) {
                 located @ ConfigError::File { .. } => anyhow::Error::new(located),
                 other => anyhow::Error::new(other).context(format!(
@@ -110,8 +110,38 @@ impl SimArgs {
                 )),
             },
             None => anyhow::Error::new(e).context("invalid configuration from flags"),
-        })
+        })?;
+        if let Some(file) = &file {
+            check_team_policies(file, &valid)?;
+        }
+        Ok(valid)
     }
+}
+
+/// The policies a scenario's `[[robots]]` entries name, checked as the run will make them (a
+/// `py:` policy is checked when it starts), an error naming the file and the line.
+fn check_team_policies(file: &ConfigFile, config: &ValidConfig) -> Result<()> {
+    let mut first_robot = 0;
+    for (i, entry) in config.robots.iter().enumerate() {
+        let k = first_robot;
+        first_robot += entry.count as usize;
+        let Some(name) = entry.policy.as_deref() else {
+            continue;
+        };
+        if name.starts_with("py:") {
+            continue;
+        }
+        let field = format!("robots[{i}].policy");
+        if let Err(e) = crate::args::named_policy(&field, name, &config.team_robot(k)) {
+            let message = e.chain().map(|c| c.to_string()).collect::<Vec<_>>();
+            return Err(anyhow::Error::new(ConfigError::File {
+                path: file.path().to_path_buf(),
+                line: ronap_core::config::key_line(file.text(), &field),
+                message: message.join(": "),
+            }));
+        }
+    }
+    Ok(())
 }
 
 /// Where episodes take place.

@@ -88,7 +88,7 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
     let (scenes, _) = args.scenes.scenes(&args.sim, &config)?;
     let driver = match (&args.driver, args.mode) {
         (Some(_), Mode::Repose) => bail!("--driver needs --mode drive"),
-        (Some(name), Mode::Drive) => Some(named_policy("driver", name, &config)?),
+        (Some(name), Mode::Drive) => Some(named_policy("--driver", name, &config)?),
         (None, _) => None,
     };
     let evaluator = Evaluator::new(config.clone(), scenes);

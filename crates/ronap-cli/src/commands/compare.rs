@@ -9,6 +9,7 @@ use ronap_core::compare::{
     compare, with_runs, CompareError, CompareInfo, CompareOptions, Contender, Progress,
 };
 use ronap_core::eval::Evaluator;
+use ronap_core::io::atomic::OutputError;
 use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -47,6 +48,10 @@ pub struct CompareArgs {
     /// Output directory [default: runs/compare-<UTC time>].
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+    /// Write into --out even if it holds a comparison (its runs and report are replaced) or
+    /// other files (kept).
+    #[arg(long)]
+    force: bool,
     /// Also break results down by this [default: none].
     #[arg(long, value_name = "WHAT")]
     by: Option<By>,
@@ -92,6 +97,7 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
         difficulty_bins: args.bins as usize,
         resamples: args.resamples as usize,
         sheet_rows: args.sheet as usize,
+        replace: args.force,
     };
     let info = CompareInfo {
         scenes: args.episodes.scenes.spec(&config),
@@ -127,6 +133,15 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
         Err(e @ CompareError::Cancelled { .. }) => {
             eprintln!("ronap compare: {e}");
             return Ok(ExitCode::from(130));
+        }
+        Err(CompareError::Output(e)) => {
+            let dir = match &e {
+                OutputError::Finished { dir, .. }
+                | OutputError::NotARun { dir, .. }
+                | OutputError::StoppedShort { dir, .. } => dir.clone(),
+                _ => out_dir.clone(),
+            };
+            return Err(crate::commands::run::refusal_without_resume(e, &dir));
         }
         Err(e) => return Err(e.into()),
     };

@@ -44,6 +44,10 @@ pub struct RunArgs {
     /// killed run keeps its finished episodes; one run at a time per directory.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+    /// Write into --out even if it holds a finished run (replaced once this run's first episode
+    /// is done), a run stopped short, or other files (kept; only a run's own files are replaced).
+    #[arg(long)]
+    force: bool,
     /// Finish the run in DIR that was stopped short (killed, Ctrl-C, disk full) with the settings
     /// it was started with (DIR/run.json), running only the seeds it had not finished; the
     /// results are the same as an uninterrupted run's. Run it from the directory the run was
@@ -105,6 +109,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         gif: args.gif,
         min_success: args.min_success,
         batch: usize::from(args.batch),
+        force: args.force,
     };
     if job.batch > 0 && !job.policy.starts_with("py:") {
         bail!(
@@ -137,6 +142,8 @@ struct Job {
     min_success: Option<f64>,
     /// Episodes a py: policy decides for at once (0: one at a time).
     batch: usize,
+    /// Replace what `out_dir` holds.
+    force: bool,
 }
 
 impl Job {
@@ -158,17 +165,40 @@ impl Job {
     /// The writer of a new run into `out_dir`.
     fn writer(&self, files: RunFiles) -> Result<RunWriter> {
         let dir = &self.out_dir;
-        let writer = match RunWriter::create(dir, files, self.seeds.first().unwrap_or(0)) {
+        let first = self.seeds.first().unwrap_or(0);
+        let writer = match RunWriter::create(dir, files, first, self.force) {
             Ok(w) => w,
-            Err(e @ OutputError::StoppedShort { .. }) => {
-                bail!("{e} (ronap run --resume {} finishes it)", dir.display())
-            }
-            Err(e) => {
-                return Err(anyhow::Error::from(e)
-                    .context(format!("cannot prepare output directory {}", dir.display())))
-            }
+            Err(e) => return Err(refusal(e, dir, "--out")),
         };
         Ok(writer.with_front_end(self.front_end()))
+    }
+}
+
+/// The error of an output directory `dir` (given with `flag`) that cannot be written, with the
+/// ways on when it was refused for what it holds.
+pub(crate) fn refusal(e: OutputError, dir: &Path, flag: &str) -> anyhow::Error {
+    let resume = format!("ronap run --resume {} finishes it, ", dir.display());
+    refused(e, dir, flag, &resume)
+}
+
+/// [`refusal`] for `ronap compare`, whose runs are not resumed.
+pub(crate) fn refusal_without_resume(e: OutputError, dir: &Path) -> anyhow::Error {
+    refused(e, dir, "--out", "")
+}
+
+fn refused(e: OutputError, dir: &Path, flag: &str, resume: &str) -> anyhow::Error {
+    match e {
+        e @ OutputError::StoppedShort { .. } => {
+            anyhow::anyhow!("{e}: {resume}--force replaces it, or choose another {flag}")
+        }
+        e @ OutputError::Finished { .. } => {
+            anyhow::anyhow!("{e}: --force replaces it, or choose another {flag}")
+        }
+        e @ OutputError::NotARun { .. } => anyhow::anyhow!(
+            "{e}: --force writes there anyway (keeping those files), or choose another {flag}"
+        ),
+        e => anyhow::Error::from(e)
+            .context(format!("cannot prepare output directory {}", dir.display())),
     }
 }
 
@@ -226,6 +256,7 @@ fn resume(dir: &Path) -> Result<ExitCode> {
         gif,
         min_success,
         batch,
+        force: false,
     };
     eprintln!(
         "ronap run: resuming {}: {} of {} episodes were done",
@@ -480,15 +511,28 @@ fn run_team(
     Ok(ExitCode::SUCCESS)
 }
 
-/// The error of a run whose files could not be written (a full disk): what is kept, and how to
-/// go on.
+/// The error of a run whose files could not be written (a full disk, a read-only directory):
+/// what is kept, and how to go on (space to free only when the disk is full).
 fn stopped_writing(e: ronap_core::io::atomic::OutputError, dir: &Path) -> anyhow::Error {
-    anyhow::Error::new(e).context(format!(
-        "run stopped: the episodes written so far are kept in {} (as *.partial); free some \
-         space, then ronap run --resume {}",
-        dir.display(),
-        dir.display()
-    ))
+    use ronap_core::io::atomic::OutputError;
+    let full = matches!(&e, OutputError::Io { source, .. }
+        if source.kind() == std::io::ErrorKind::StorageFull);
+    let fix = if full {
+        "free some space"
+    } else {
+        "fix the cause"
+    };
+    let plan = dir.join(ronap_core::io::manifest::PLAN_FILE);
+    let next = if plan.exists() {
+        format!(
+            "the finished episodes are kept in {}; {fix}, then ronap run --resume {}",
+            dir.display(),
+            dir.display()
+        )
+    } else {
+        format!("nothing was written; {fix}, then run again")
+    };
+    anyhow::Error::new(e).context(format!("run stopped: {next}"))
 }
 
 /// `8 x geodesic` or `4 x apf, 4 x geodesic`: the policies of a team, counted.

@@ -6,8 +6,9 @@
 //! A loop that stops polling cannot see the flag: a Python policy that blocks, or crossterm
 //! itself, whose reader spins on a terminal that hung up (a closed SSH connection or tmux pane
 //! reads end-of-file forever). So a watchdog thread gives the caller [`GRACE`] to end after a
-//! signal, then restores the terminal and exits with 128 + the signal; a second signal exits at
-//! once.
+//! signal, then restores the terminal and exits with 128 + the signal. A second signal changes
+//! nothing (signals come in pairs: `timeout` signals the process and its group), so the session
+//! always ends by the loop or by the watchdog, with the terminal restored.
 
 use anyhow::{bail, Context, Result};
 use ratatui::backend::CrosstermBackend;
@@ -76,16 +77,8 @@ impl Session {
         let handlers = {
             use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
             let mut ids = Vec::new();
-            let armed = Arc::new(std::sync::atomic::AtomicBool::new(false));
             let context = "cannot install signal handlers";
             for sig in [SIGINT, SIGTERM, SIGHUP] {
-                // Handlers run in the order registered: the first signal finds `armed` unset and
-                // only sets the flags; a later one exits at once with the shell's 128 + signal.
-                ids.push(
-                    signal_hook::flag::register_conditional_shutdown(sig, 128 + sig, armed.clone())
-                        .context(context)?,
-                );
-                ids.push(signal_hook::flag::register(sig, armed.clone()).context(context)?);
                 ids.push(
                     signal_hook::flag::register_usize(sig, signal.clone(), sig as usize)
                         .context(context)?,

@@ -57,6 +57,9 @@ pub struct CompareOptions {
     pub resamples: usize,
     /// Seeds in the contact sheet of disagreements.
     pub sheet_rows: usize,
+    /// Write into an output directory that holds a comparison or other files (an earlier
+    /// comparison's runs and report are replaced; other files kept).
+    pub replace: bool,
 }
 
 impl Default for CompareOptions {
@@ -68,6 +71,7 @@ impl Default for CompareOptions {
             difficulty_bins: 3,
             resamples: 10_000,
             sheet_rows: 6,
+            replace: false,
         }
     }
 }
@@ -310,9 +314,11 @@ pub fn compare(
                 )));
             }
         }
+        if !options.replace {
+            report::check_empty(dir)?;
+        }
         let runs = dir.join("runs");
         std::fs::create_dir_all(&runs).map_err(|source| OutputError::Io { path: runs, source })?;
-        report::remove_earlier(dir)?;
     }
     let setting = Setting {
         evaluator,
@@ -371,6 +377,7 @@ pub fn compare(
     if let Some(dir) = out {
         progress(Progress::Report);
         let sheet = disagreement_sheet(evaluator, contenders, &comparison, options.sheet_rows)?;
+        report::remove_earlier(dir)?;
         report::write_all(dir, &comparison, sheet.as_ref())?;
     }
     Ok(comparison)
@@ -405,7 +412,7 @@ fn run_one(
     let dir = out.map(|d| d.join("runs").join(label));
     let writer = dir
         .as_deref()
-        .map(|d| RunWriter::create(d, RunFiles::default(), options.seeds[0]))
+        .map(|d| RunWriter::create(d, RunFiles::default(), options.seeds[0], options.replace))
         .transpose()?;
     progress(Progress::Running {
         index,

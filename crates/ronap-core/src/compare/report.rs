@@ -460,6 +460,31 @@ pub const FILES: [&str; 8] = [
     "report.html",
 ];
 
+/// Refuses `dir` when it holds a comparison ([`OutputError::Finished`]) or files of something else
+/// ([`OutputError::NotARun`]): a comparison writes only into an empty or new directory, unless
+/// told to replace.
+pub fn check_empty(dir: &Path) -> Result<(), OutputError> {
+    if dir.join("compare.json").exists() {
+        return Err(OutputError::Finished {
+            dir: dir.to_path_buf(),
+            file: "compare.json",
+        });
+    }
+    let mut entries = std::fs::read_dir(dir).into_iter().flatten().flatten();
+    let other = entries.find(|e| {
+        let name = e.file_name();
+        // An interrupted comparison's runs/ (each run there guards itself).
+        name != "runs" && name != crate::io::lock::LOCK_FILE
+    });
+    match other {
+        Some(e) => Err(OutputError::NotARun {
+            dir: dir.to_path_buf(),
+            file: e.file_name().to_string_lossy().into_owned(),
+        }),
+        None => Ok(()),
+    }
+}
+
 /// Removes what an earlier comparison wrote into `dir` (the files of [`FILES`], not `runs/`), so
 /// a directory never mixes two comparisons.
 pub fn remove_earlier(dir: &Path) -> Result<(), OutputError> {

@@ -40,6 +40,11 @@ impl ConfigFile {
         &self.path
     }
 
+    /// The file's text.
+    pub fn text(&self) -> &str {
+        &self.text
+    }
+
     /// The configuration the file sets (unset fields keep their defaults), with a map scene's
     /// file made relative to the directory of this file. An unknown key or a wrong type is an
     /// error naming the file, line, key and value.

@@ -1,6 +1,7 @@
 //! Writing files atomically: a temporary file beside the target, renamed into place only once
 //! complete, so an error or an interrupt never leaves a half-written file.
 
+use crate::io::fault::{self, Checked, Op};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
@@ -45,16 +46,28 @@ pub enum OutputError {
     },
     /// The directory holds a run stopped short (killed or interrupted), whose finished episodes
     /// starting a new run there would throw away.
-    #[error(
-        "{} holds a run that stopped short ({why}): resume it to finish it, or remove the \
-         directory (or choose another) to start afresh",
-        dir.display()
-    )]
+    #[error("{} holds a run that stopped short ({why})", dir.display())]
     StoppedShort {
         /// The directory.
         dir: PathBuf,
         /// How it shows.
         why: String,
+    },
+    /// The directory holds a finished run, which a new run there would replace.
+    #[error("{} holds a finished run (its {file})", dir.display())]
+    Finished {
+        /// The directory.
+        dir: PathBuf,
+        /// The file that shows it.
+        file: &'static str,
+    },
+    /// The directory holds files of no run, among which a run's files would be mixed.
+    #[error("{} is not empty and holds no ronap run (it holds {file})", dir.display())]
+    NotARun {
+        /// The directory.
+        dir: PathBuf,
+        /// An entry found there.
+        file: String,
     },
     /// The file name has an extension no writer knows.
     #[error("cannot write {}: {message}", path.display())]
@@ -105,6 +118,7 @@ pub fn write_atomic(
     #[cfg(unix)]
     builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));
     // tempfile's own error names its temporary path; the target path says more to a user.
+    fault::check(Op::Create).map_err(io)?;
     let mut temp = builder.tempfile_in(dir).map_err(|e| {
         let message = e.to_string();
         let message = message
@@ -115,10 +129,11 @@ pub fn write_atomic(
         io(std::io::Error::new(e.kind(), message))
     })?;
     {
-        let mut out = BufWriter::new(temp.as_file_mut());
+        let mut out = BufWriter::new(Checked(temp.as_file_mut()));
         write(&mut out).map_err(io)?;
         out.flush().map_err(io)?;
     }
+    fault::check(Op::Rename).map_err(io)?;
     temp.persist(path).map_err(|e| io(e.error))?;
     Ok(())
 }

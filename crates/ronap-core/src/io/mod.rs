@@ -3,6 +3,7 @@
 
 pub mod atomic;
 pub mod datalog;
+pub(crate) mod fault;
 pub mod figures;
 pub mod lock;
 pub mod manifest;

@@ -4,6 +4,7 @@
 //! torn by the crash is dropped when the file is reopened.
 
 use crate::io::atomic::OutputError;
+use crate::io::fault::{self, Checked, Op};
 use std::fs::File;
 use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
@@ -20,17 +21,19 @@ pub fn partial_path(path: &Path) -> PathBuf {
 pub struct PartialCsv {
     path: PathBuf,
     partial: PathBuf,
-    writer: csv::Writer<File>,
+    writer: csv::Writer<Checked<File>>,
 }
 
 impl PartialCsv {
     /// Starts `path` (as `NAME.partial`, replacing any) with `header`.
     pub fn create(path: &Path, header: &[&str]) -> Result<Self, OutputError> {
         let partial = partial_path(path);
-        let file = File::create(&partial).map_err(|source| OutputError::Io {
-            path: partial.clone(),
-            source,
-        })?;
+        let file = fault::check(Op::Create)
+            .and_then(|()| File::create(&partial))
+            .map_err(|source| OutputError::Io {
+                path: partial.clone(),
+                source,
+            })?;
         let mut this = Self::over(path, partial, file);
         this.row(header)?;
         Ok(this)
@@ -49,7 +52,9 @@ impl PartialCsv {
             if !path.exists() {
                 return Self::create(path, header);
             }
-            std::fs::rename(path, &partial).map_err(io(path))?;
+            fault::check(Op::Rename)
+                .and_then(|()| std::fs::rename(path, &partial))
+                .map_err(io(path))?;
         }
         let end = row_end(&partial, rows + 1)?;
         let mut file = std::fs::OpenOptions::new()
@@ -71,14 +76,23 @@ impl PartialCsv {
             partial,
             writer: csv::WriterBuilder::new()
                 .buffer_capacity(64 * 1024)
-                .from_writer(file),
+                .from_writer(Checked(file)),
         }
     }
 
     fn fail(&self, e: csv::Error) -> OutputError {
+        // The operating system's own error when there is one (its kind says "disk full").
+        let source = if e.is_io_error() {
+            match e.into_kind() {
+                csv::ErrorKind::Io(io) => io,
+                other => std::io::Error::other(format!("{other:?}")),
+            }
+        } else {
+            std::io::Error::other(e)
+        };
         OutputError::Io {
             path: self.partial.clone(),
-            source: e.into(),
+            source,
         }
     }
 
@@ -106,13 +120,15 @@ impl PartialCsv {
             let path = path.to_path_buf();
             move |source| OutputError::Io { path, source }
         };
-        let file = self
+        let Checked(file) = self
             .writer
             .into_inner()
             .map_err(|e| io(&self.partial)(e.into_error()))?;
         file.sync_data().map_err(io(&self.partial))?;
         drop(file);
-        std::fs::rename(&self.partial, &self.path).map_err(io(&self.path))
+        fault::check(Op::Rename)
+            .and_then(|()| std::fs::rename(&self.partial, &self.path))
+            .map_err(io(&self.path))
     }
 }
 

@@ -14,8 +14,9 @@ use crate::eval::{
     TeamRecord,
 };
 use crate::io::atomic::{save_image, write_atomic, OutputError};
+use crate::io::fault::{self, Op};
 use crate::io::figures::{self, FIGURES_FILE};
-use crate::io::lock::RunLock;
+use crate::io::lock::{RunLock, LOCK_FILE};
 use crate::io::manifest::{
     ManifestError, RunManifest, RunPlan, PLAN_FILE, PLAN_SCHEMA_VERSION, SCHEMA_VERSION,
 };
@@ -26,6 +27,7 @@ use crate::scene::map::MapSource;
 use crate::sim::world::SceneSpec;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -194,8 +196,9 @@ pub struct RunFiles {
 const RUN_FILES: [&str; 4] = ["episodes.csv", "timing.csv", "robots.csv", FIGURES_FILE];
 
 /// A run directory being written, locked against other runs for as long as this lives: made
-/// (with the sub-directories its files need) and cleared of an earlier run's files before the
-/// first episode, or taken up again to finish a run stopped short ([`RunWriter::resume`]).
+/// (with the sub-directories its files need) for a new run, or taken up again to finish a run
+/// stopped short ([`RunWriter::resume`]). Nothing already in the directory is removed or changed
+/// before the first episode finishes, so a run that fails to start leaves it as it was.
 #[derive(Debug)]
 pub struct RunWriter {
     pub(crate) dir: PathBuf,
@@ -204,7 +207,24 @@ pub struct RunWriter {
     errors: Mutex<Vec<String>>,
     front_end: serde_json::Value,
     resumed: Option<Resumed>,
-    _lock: RunLock,
+    /// The directory held something (an earlier run, other files) before this run.
+    held: bool,
+    /// Whether the directory has been made ready for this run's files (an earlier run's
+    /// removed), which waits for the first finished episode.
+    ready: Mutex<bool>,
+    /// The run ended cleanly: its lock file goes with the lock.
+    clean: AtomicBool,
+    lock: Option<RunLock>,
+}
+
+impl Drop for RunWriter {
+    fn drop(&mut self) {
+        if let Some(lock) = self.lock.take() {
+            if self.clean.load(Ordering::SeqCst) {
+                lock.release();
+            }
+        }
+    }
 }
 
 /// What a run stopped short had finished.
@@ -216,30 +236,88 @@ struct Resumed {
     done: usize,
 }
 
-impl RunWriter {
-    /// Makes and locks `dir` for a run whose seeds start at `first_seed`, removing the files of
-    /// an earlier run there; refuses ([`OutputError::StoppedShort`]) when that run stopped short
-    /// (killed, with its files still partial, or interrupted), whose episodes are for resuming.
-    pub fn create(dir: &Path, files: RunFiles, first_seed: u64) -> Result<Self, OutputError> {
-        make_dir(dir)?;
-        let lock = RunLock::take(dir)?;
-        let interrupted = RunManifest::read(&dir.join("summary.json")).is_ok_and(|m| m.interrupted);
+/// What a directory holds, for starting a run in it.
+#[derive(Debug)]
+enum Holding {
+    /// Nothing (or only a lock file).
+    Nothing,
+    /// A run that finished every episode.
+    Finished,
+    /// A run stopped short, and how it shows.
+    StoppedShort(String),
+    /// Something that is no run: the first entry found.
+    Other(String),
+}
+
+impl Holding {
+    fn of(dir: &Path) -> Self {
         let killed = RUN_FILES
             .iter()
             .find(|name| partial_path(&dir.join(name)).exists());
-        let why = match (interrupted, killed) {
-            (true, _) => Some("its summary.json says it was interrupted".to_string()),
-            (false, Some(name)) => Some(format!(
+        if let Some(name) = killed {
+            return Self::StoppedShort(format!(
                 "{} is still there",
                 partial_path(Path::new(name)).display()
-            )),
-            (false, None) => None,
-        };
-        if let Some(why) = why {
-            return Err(OutputError::StoppedShort {
+            ));
+        }
+        if let Ok(m) = RunManifest::read(&dir.join("summary.json")) {
+            return if m.interrupted {
+                Self::StoppedShort("its summary.json says it was interrupted".into())
+            } else if m.error.is_some() && m.summary.episodes > 0 {
+                Self::StoppedShort(format!(
+                    "its summary.json says it failed after {} episodes",
+                    m.summary.episodes
+                ))
+            } else {
+                Self::Finished
+            };
+        }
+        if dir.join(PLAN_FILE).exists() {
+            return Self::StoppedShort(format!("its {PLAN_FILE} has no summary.json beside it"));
+        }
+        let mut entries = std::fs::read_dir(dir).into_iter().flatten().flatten();
+        match entries.find(|e| e.file_name() != LOCK_FILE) {
+            Some(e) => Self::Other(e.file_name().to_string_lossy().into_owned()),
+            None => Self::Nothing,
+        }
+    }
+}
+
+impl RunWriter {
+    /// Makes and locks `dir` for a run whose seeds start at `first_seed`. A directory already
+    /// holding something is refused unless `replace`: a finished run
+    /// ([`OutputError::Finished`]), a run stopped short, whose episodes are for resuming
+    /// ([`OutputError::StoppedShort`]), or files of no run ([`OutputError::NotARun`]). Replacing
+    /// waits for this run's first finished episode: then the earlier run's files go (and its
+    /// pictures, step logs and GIFs); nothing else in the directory is touched.
+    pub fn create(
+        dir: &Path,
+        files: RunFiles,
+        first_seed: u64,
+        replace: bool,
+    ) -> Result<Self, OutputError> {
+        make_dir(dir)?;
+        let lock = RunLock::take(dir)?;
+        let holding = Holding::of(dir);
+        let held = !matches!(holding, Holding::Nothing);
+        let refusal = match holding {
+            Holding::Nothing => None,
+            _ if replace => None,
+            Holding::Finished => Some(OutputError::Finished {
+                dir: dir.to_path_buf(),
+                file: "summary.json",
+            }),
+            Holding::StoppedShort(why) => Some(OutputError::StoppedShort {
                 dir: dir.to_path_buf(),
                 why,
-            });
+            }),
+            Holding::Other(file) => Some(OutputError::NotARun {
+                dir: dir.to_path_buf(),
+                file,
+            }),
+        };
+        if let Some(e) = refusal {
+            return Err(e);
         }
         let subs = [
             (files.pictures.is_some(), "png"),
@@ -251,12 +329,6 @@ impl RunWriter {
                 make_dir(&dir.join(sub))?;
             }
         }
-        remove_stale_files(dir)?;
-        for name in RUN_FILES.iter().chain(&["summary.json", PLAN_FILE]) {
-            let path = dir.join(name);
-            remove_if_there(&path)?;
-            remove_if_there(&partial_path(&path))?;
-        }
         Ok(Self {
             dir: dir.to_path_buf(),
             files,
@@ -264,8 +336,31 @@ impl RunWriter {
             errors: Mutex::new(Vec::new()),
             front_end: serde_json::Value::Null,
             resumed: None,
-            _lock: lock,
+            held,
+            ready: Mutex::new(false),
+            clean: AtomicBool::new(false),
+            lock: Some(lock),
         })
+    }
+
+    /// Makes the directory ready for this run's files, once: a new run removes an earlier run's
+    /// files there (run files, summary, plan, pictures, step logs, GIFs); a resumed run keeps
+    /// everything.
+    pub(crate) fn make_ready(&self) -> Result<(), OutputError> {
+        let mut ready = self.ready.lock().unwrap_or_else(|e| e.into_inner());
+        if *ready {
+            return Ok(());
+        }
+        if self.resumed.is_none() && self.held {
+            remove_stale_files(&self.dir)?;
+            for name in RUN_FILES.iter().chain(&["summary.json", PLAN_FILE]) {
+                let path = self.dir.join(name);
+                remove_if_there(&path)?;
+                remove_if_there(&partial_path(&path))?;
+            }
+        }
+        *ready = true;
+        Ok(())
     }
 
     /// Locks `dir`, a run stopped short (killed, interrupted or out of disk), to finish it: reads
@@ -276,6 +371,8 @@ impl RunWriter {
     /// already written are kept.
     pub fn resume(dir: &Path) -> Result<(Self, RunPlan), ResumeError> {
         let plan_path = dir.join(PLAN_FILE);
+        // Nothing is changed before the first episode of the rest finishes: a resume that fails
+        // to start leaves the directory as it was.
         if !dir.is_dir() {
             return Err(ResumeError::NoRun {
                 dir: dir.to_path_buf(),
@@ -300,6 +397,9 @@ impl RunWriter {
             || !summary.exists()
             || RunManifest::read(&summary).map_or(true, |m| m.interrupted || m.error.is_some());
         if !stopped_short {
+            // A run killed after its summary but before its last clean-up: finish that.
+            remove_if_there(&dir.join(FIGURES_FILE))?;
+            lock.release();
             return Err(ResumeError::Complete {
                 dir: dir.to_path_buf(),
                 episodes: seeds,
@@ -327,7 +427,6 @@ impl RunWriter {
             let rows = whole_rows(&at)?.saturating_sub(1);
             done = done.min(rows / per_episode);
         }
-        remove_if_there(&summary)?;
         let files = RunFiles {
             pictures: plan
                 .pictures
@@ -353,7 +452,10 @@ impl RunWriter {
                 plan: plan.clone(),
                 done,
             }),
-            _lock: lock,
+            held: true,
+            ready: Mutex::new(false),
+            clean: AtomicBool::new(false),
+            lock: Some(lock),
         };
         Ok((writer, plan))
     }
@@ -385,6 +487,9 @@ impl RunWriter {
     /// Writes the per-episode files of `record`; a failure is kept for the end so the run goes
     /// on (and its other results are saved).
     pub fn episode(&self, record: &EpisodeRecord) {
+        if let Err(e) = self.make_ready() {
+            return self.note(e);
+        }
         let picture = self
             .files
             .pictures
@@ -398,6 +503,9 @@ impl RunWriter {
     /// robot, `steps/seed-SEED-robot-K.csv`, robot `k`'s laser having `beams[k]` beams); a
     /// failure is kept for the end, as [`RunWriter::episode`] does.
     pub fn team_episode(&self, record: &TeamRecord, beams: &[usize]) {
+        if let Err(e) = self.make_ready() {
+            return self.note(e);
+        }
         let picture = self
             .files
             .pictures
@@ -449,13 +557,24 @@ impl RunWriter {
         }
     }
 
-    /// Opens the run files (`headers[k]` for `RUN_FILES[k]`; `None`: not written), writing the
-    /// plan first for a new run, or reopening them after the finished episodes for a resumed one.
-    pub(crate) fn open(
+    /// The run files, to be opened (`headers[k]` for `RUN_FILES[k]`; `None`: not written) when
+    /// the first episode's rows come: the plan written first for a new run, or the files
+    /// reopened after the finished episodes for a resumed one.
+    pub(crate) fn open(&self, plan: &RunPlan, headers: [Option<Vec<String>>; 4]) -> Streams {
+        Streams {
+            files: Vec::new(),
+            flushed: Instant::now(),
+            pending: Some((plan.clone(), headers)),
+        }
+    }
+
+    /// Opens the run files [`RunWriter::open`] set up.
+    fn open_now(
         &self,
         plan: &RunPlan,
         headers: [Option<Vec<String>>; 4],
-    ) -> Result<Streams, OutputError> {
+    ) -> Result<Vec<PartialCsv>, OutputError> {
+        self.make_ready()?;
         let done = self.done();
         if self.resumed.is_none() {
             plan.write(&self.dir.join(PLAN_FILE))?;
@@ -477,10 +596,7 @@ impl RunWriter {
                 PartialCsv::create(&path, &header)?
             });
         }
-        Ok(Streams {
-            files,
-            flushed: Instant::now(),
-        })
+        Ok(files)
     }
 
     /// The errors of per-episode files, as one.
@@ -505,7 +621,8 @@ fn make_dir(dir: &Path) -> Result<(), OutputError> {
             source: std::io::Error::other("it is a file, not a directory"),
         });
     }
-    std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
+    let made = fault::check(Op::Create).and_then(|()| std::fs::create_dir_all(dir));
+    made.map_err(|source| OutputError::Io {
         path: dir.to_path_buf(),
         source,
     })
@@ -513,7 +630,7 @@ fn make_dir(dir: &Path) -> Result<(), OutputError> {
 
 /// Removes `path` if it is there.
 fn remove_if_there(path: &Path) -> Result<(), OutputError> {
-    match std::fs::remove_file(path) {
+    match fault::check(Op::Remove).and_then(|()| std::fs::remove_file(path)) {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(OutputError::Io {
             path: path.to_path_buf(),
             source: e,
@@ -522,19 +639,35 @@ fn remove_if_there(path: &Path) -> Result<(), OutputError> {
     }
 }
 
-/// The run files under way, in the order of [`RUN_FILES`] (those the run writes).
+/// The run files under way, in the order of [`RUN_FILES`] (those the run writes), opened with
+/// the first episode's rows.
 #[derive(Debug)]
 pub(crate) struct Streams {
     files: Vec<PartialCsv>,
     flushed: Instant,
+    /// The plan and headers, until the files are opened.
+    pending: Option<(RunPlan, [Option<Vec<String>>; 4])>,
 }
 
 impl Streams {
     /// How often what is buffered goes to the files, so a killed run loses at most this much.
     const FLUSH_EVERY: Duration = Duration::from_secs(1);
 
+    /// Opens the files, if not yet.
+    fn ensure_open(&mut self, writer: &RunWriter) -> Result<(), OutputError> {
+        if let Some((plan, headers)) = self.pending.take() {
+            self.files = writer.open_now(&plan, headers)?;
+        }
+        Ok(())
+    }
+
     /// Adds one episode's rows (`rows[k]` to file `k`).
-    pub(crate) fn add(&mut self, rows: &[Vec<Vec<String>>]) -> Result<(), OutputError> {
+    pub(crate) fn add(
+        &mut self,
+        writer: &RunWriter,
+        rows: &[Vec<Vec<String>>],
+    ) -> Result<(), OutputError> {
+        self.ensure_open(writer)?;
         for (file, rows) in self.files.iter_mut().zip(rows) {
             for row in rows {
                 file.row(row)?;
@@ -549,21 +682,12 @@ impl Streams {
         Ok(())
     }
 
-    /// Renames the files to their final names; the exact figures are kept (for a later
-    /// `--resume`) unless the run is `complete`.
-    fn finish(self, dir: &Path, complete: bool) -> Result<(), OutputError> {
+    /// Renames the files to their final names.
+    fn finish(self) -> Result<(), OutputError> {
         for file in self.files {
             file.finish()?;
         }
-        let figures = dir.join(FIGURES_FILE);
-        if complete {
-            remove_if_there(&figures)
-        } else {
-            std::fs::rename(&figures, partial_path(&figures)).map_err(|source| OutputError::Io {
-                path: figures,
-                source,
-            })
-        }
+        Ok(())
     }
 }
 
@@ -639,7 +763,9 @@ fn remove_stale_files(dir: &Path) -> Result<(), OutputError> {
             let name = entry.file_name();
             let name = name.to_string_lossy();
             if name.starts_with("seed-") && name.ends_with(ext) {
-                std::fs::remove_file(entry.path()).map_err(|source| OutputError::Io {
+                let removed =
+                    fault::check(Op::Remove).and_then(|()| std::fs::remove_file(entry.path()));
+                removed.map_err(|source| OutputError::Io {
                     path: entry.path(),
                     source,
                 })?;
@@ -765,7 +891,7 @@ impl BlockRun {
         info: &RunInfo,
     ) -> Result<Self, OutputError> {
         let plan = writer.plan(config, options, info);
-        let streams = writer.open(&plan, lone_headers(!config.moving.is_empty()))?;
+        let streams = writer.open(&plan, lone_headers(!config.moving.is_empty()));
         let mut tally = Tally::default();
         let done = writer.done();
         if done > 0 {
@@ -811,7 +937,7 @@ impl BlockRun {
                 path: self.writer.dir.join(FIGURES_FILE),
                 message: format!("seed {}: {message}", r.seed),
             })?;
-            self.streams.add(&r.files())?;
+            self.streams.add(&self.writer, &r.files())?;
             self.tally.add(&f);
             self.next += 1;
         }
@@ -855,6 +981,11 @@ pub(crate) fn restore(
     add: &mut dyn FnMut(&csv::StringRecord) -> Result<(), String>,
 ) -> Result<(), OutputError> {
     let path = partial_path(&dir.join(FIGURES_FILE));
+    let path = if path.exists() {
+        path
+    } else {
+        dir.join(FIGURES_FILE)
+    };
     let bad = |message: String| OutputError::Format {
         path: path.clone(),
         message,
@@ -876,7 +1007,8 @@ pub(crate) fn restore(
 }
 
 /// Ends a run's files: the run files to their final names, then `summary.json`, then whether
-/// any per-episode file failed.
+/// any per-episode file failed. A run that changed nothing (no episode finished) and did not
+/// complete leaves a directory that held something as it was, writing nothing.
 pub(crate) fn finish(
     writer: &RunWriter,
     streams: Option<Streams>,
@@ -884,13 +1016,26 @@ pub(crate) fn finish(
     result: &RunResult,
 ) -> Result<(), OutputError> {
     let complete = !result.cancelled && result.error.is_none();
-    if let Some(s) = streams {
-        s.finish(&writer.dir, complete)?;
+    if let Some(mut s) = streams {
+        if s.pending.is_some() && writer.held && !complete {
+            writer.clean.store(true, Ordering::SeqCst);
+            return Ok(());
+        }
+        s.ensure_open(writer)?;
+        s.finish()?;
     }
     manifest.write(&writer.dir.join("summary.json"))?;
+    // The exact figures stay for a later `--resume` of a run stopped short; a complete run's
+    // summary holds what they made (a run stopped by this removal failing resumes to the end).
+    if complete {
+        remove_if_there(&writer.dir.join(FIGURES_FILE))?;
+    }
     match writer.episode_errors() {
         Some(e) => Err(e),
-        None => Ok(()),
+        None => {
+            writer.clean.store(true, Ordering::SeqCst);
+            Ok(())
+        }
     }
 }
 
@@ -977,7 +1122,7 @@ mod tests {
         let (config, evaluator, info) = setting();
         let tmp = tempfile::tempdir().unwrap();
         let (one, blocks) = (tmp.path().join("one"), tmp.path().join("blocks"));
-        let writer = RunWriter::create(&one, RunFiles::default(), 0).unwrap();
+        let writer = RunWriter::create(&one, RunFiles::default(), 0, false).unwrap();
         // The whole run as the job layer writes it, for the blocks to be held to.
         let request = crate::job::RunRequest {
             evaluator: &evaluator,
@@ -987,7 +1132,7 @@ mod tests {
             cancel: &AtomicBool::new(false),
         };
         let whole = crate::job::evaluate_into(request, &Builtin::Apf, &|_| {}, &|_| false).unwrap();
-        let writer = RunWriter::create(&blocks, RunFiles::default(), 0).unwrap();
+        let writer = RunWriter::create(&blocks, RunFiles::default(), 0, false).unwrap();
         let mut run = BlockRun::create(writer, &config, &options(0, 30), &info).unwrap();
         for start in [0, 12, 24] {
             run.add(&block(&evaluator, start, (30 - start).min(12)))
@@ -1018,7 +1163,7 @@ mod tests {
             std::fs::create_dir_all(path.parent().unwrap()).unwrap();
             std::fs::write(path, b"x").unwrap();
         }
-        drop(RunWriter::create(&dir, RunFiles::default(), 0).unwrap());
+        drop(RunWriter::create(&dir, RunFiles::default(), 0, true).unwrap());
         for f in stale {
             assert!(!dir.join(f).exists(), "{f} left");
         }
@@ -1032,7 +1177,7 @@ mod tests {
         let (config, evaluator, info) = setting();
         let tmp = tempfile::tempdir().unwrap();
         let dir = tmp.path().join("run");
-        let writer = RunWriter::create(&dir, RunFiles::default(), 5).unwrap();
+        let writer = RunWriter::create(&dir, RunFiles::default(), 5, false).unwrap();
         let mut run = BlockRun::create(writer, &config, &options(5, 20), &info).unwrap();
         let e = run.add(&block(&evaluator, 15, 5)).unwrap_err();
         assert!(
@@ -1052,7 +1197,7 @@ mod tests {
         let stopped = run.finish(1.0).unwrap();
         assert!(stopped.interrupted);
         // A new run there would throw them away: refused, naming what shows it stopped short.
-        let refused = RunWriter::create(&dir, RunFiles::default(), 5).unwrap_err();
+        let refused = RunWriter::create(&dir, RunFiles::default(), 5, false).unwrap_err();
         assert!(
             matches!(&refused, OutputError::StoppedShort { why, .. } if why.contains("interrupted")),
             "{refused}"
@@ -1065,7 +1210,7 @@ mod tests {
         let resumed = run.finish(1.0).unwrap();
         let whole = tmp.path().join("whole");
         let mut run = BlockRun::create(
-            RunWriter::create(&whole, RunFiles::default(), 5).unwrap(),
+            RunWriter::create(&whole, RunFiles::default(), 5, false).unwrap(),
             &config,
             &options(5, 20),
             &info,

@@ -56,11 +56,8 @@ pub fn evaluate_into(
     let done = writer.as_ref().map_or(0, RunWriter::done);
     if let Some(w) = &writer {
         let plan = w.plan(config, &options, info);
-        match w.open(&plan, lone_headers(!config.moving.is_empty())) {
-            Ok(s) => streams = Some(s),
-            Err(e) => write_error = Some(e),
-        }
-        if write_error.is_none() && done > 0 {
+        streams = Some(w.open(&plan, lone_headers(!config.moving.is_empty())));
+        if done > 0 {
             if let Err(e) = restore(&w.dir, done, &mut |row| {
                 let (_, f) = figures::parse_lone(row)?;
                 tally.add(&f);
@@ -93,8 +90,8 @@ pub fn evaluate_into(
         };
         evaluator.stream(factory, &rest, cancel, &on_finish, &mut |r| {
             let f = Figures::of(&r);
-            if let Some(s) = &mut streams {
-                if let Err(e) = s.add(&EpisodeRows::with(&r, &f, dynamic).files()) {
+            if let (Some(s), Some(w)) = (&mut streams, &writer) {
+                if let Err(e) = s.add(w, &EpisodeRows::with(&r, &f, dynamic).files()) {
                     write_error = Some(e);
                     return false;
                 }

@@ -60,11 +60,8 @@ pub fn evaluate_team_into(
             strings(&ROBOT_COLUMNS),
             Some(figures::team_columns(size)),
         ];
-        match w.open(&plan, headers) {
-            Ok(s) => streams = Some(s),
-            Err(e) => write_error = Some(e),
-        }
-        if write_error.is_none() && done > 0 {
+        streams = Some(w.open(&plan, headers));
+        if done > 0 {
             if let Err(e) = restore(&w.dir, done, &mut |row| {
                 let (_, t, lone) = figures::parse_team(row, size)?;
                 team.add(&t);
@@ -107,14 +104,14 @@ pub fn evaluate_team_into(
                 .iter()
                 .map(|x| Figures::of(&x.as_episode(r.seed)))
                 .collect();
-            if let Some(s) = &mut streams {
+            if let (Some(s), Some(w)) = (&mut streams, &writer) {
                 let rows = [
                     vec![team_episode_row(&r)],
                     vec![timing_row(r.seed, r.wall_time_s).to_vec()],
                     robot_rows(&r),
                     vec![figures::team_row(r.seed, &t, &lone)],
                 ];
-                if let Err(e) = s.add(&rows) {
+                if let Err(e) = s.add(w, &rows) {
                     write_error = Some(e);
                     return false;
                 }

@@ -26,7 +26,8 @@ pub enum EpisodeError {
     /// message leaves the seed to its callers, which name it).
     #[error(
         "found no start and goal {min_goal_distance_px} px apart in one free region of the scene \
-         (which is {span_px:.0} px corner to corner); lower episode.min_goal_distance_px"
+         (which is {span_px:.0} px corner to corner){}",
+        if *min_goal_distance_px > 0.05 * span_px { "; lower episode.min_goal_distance_px" } else { "" }
     )]
     NoPlacement {
         /// The episode seed.
@@ -35,6 +36,18 @@ pub enum EpisodeError {
         min_goal_distance_px: f64,
         /// Diagonal of the scene, px.
         span_px: f64,
+    },
+    /// A team's robot found no start and goal clear of the robots placed before it.
+    #[error(
+        "no room for robot {robot} of a team of {robots}: found no start and goal clear of the \
+         {robot} robots placed before it (fewer robots, a smaller robots radius_px or a larger \
+         scene)"
+    )]
+    Crowded {
+        /// The robot (from 0).
+        robot: usize,
+        /// Robots in the team.
+        robots: usize,
     },
     /// The moving obstacles could not be placed.
     #[error("{0}")]

@@ -221,7 +221,14 @@ impl Team {
                 } else {
                     sample_placement_with(cfg, scene, grid, seed, &mut others, clear)
                 }
-                .map_err(of_entry)?;
+                .map_err(|err| match err {
+                    // The scene had room for one robot (robot 0 was placed): the team is crowded.
+                    EpisodeError::NoPlacement { .. } if k > 0 => EpisodeError::Crowded {
+                        robot: k,
+                        robots: config.team_size(),
+                    },
+                    err => of_entry(err),
+                })?;
                 let mut robot = Episode::placed(cfg, scene.clone(), seed, placement, false)
                     .map_err(of_entry)?;
                 let goals: Vec<Point> = if !entry.goals.is_empty() {

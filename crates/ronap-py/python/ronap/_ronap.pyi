@@ -119,6 +119,7 @@ def evaluate(
     thread_safe: bool = False,
     batch: int = 0,
     rows: bool = False,
+    force: bool = False,
 ) -> dict[str, Any]: ...
 def compare(
     policies: list[Any],
@@ -136,6 +137,7 @@ def compare(
     sheet: int = 6,
     thread_safe: bool = False,
     command: str | None = None,
+    force: bool = False,
 ) -> dict[str, Any]: ...
 
 def write_mlp(
@@ -154,6 +156,7 @@ class BlockRun:
         maze_seed: int | None = None,
         map_path: str | None = None,
         threads: int = 0,
+        force: bool = False,
     ) -> None: ...
     def add(self, rows: list[tuple[int, list[str], list[str], list[str]]]) -> None: ...
     def finish(self, wall_time_s: float) -> tuple[dict[str, Any], str]: ...

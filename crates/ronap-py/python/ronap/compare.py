@@ -25,6 +25,7 @@ def compare(
     resamples: int = 10_000,
     sheet: int = 6,
     thread_safe: bool = False,
+    force: bool = False,
     **fields: Any,
 ) -> dict[str, Any]:
     """Runs every policy in ``policies`` on the same ``seeds`` and scenes and compares them, as
@@ -48,7 +49,8 @@ def compare(
     must record the same configuration, scenes and seeds. With ``out``, writes everything
     ``ronap compare --out`` writes: ``runs/<policy>/``, ``compare.png``, ``outcomes.png``,
     ``disagreements.png``, ``seeds.csv``, ``compare.json``, ``report.md`` and ``report.html``.
-    The configuration is given as for ``evaluate``.
+    ``out`` must be new or empty unless ``force=True`` (as ``ronap compare --force``). The
+    configuration is given as for ``evaluate``.
     """
     seeds = checked_seeds(seeds)
     command = _call(policies, seeds, scenario=scenario, config=config, maze_seed=maze_seed, map=map,
@@ -70,6 +72,7 @@ def compare(
         sheet,
         thread_safe,
         command,
+        force,
     )
     try:
         import pandas

@@ -23,6 +23,7 @@ def evaluate(
     log_steps: bool = False,
     thread_safe: bool = False,
     batch: int = 0,
+    force: bool = False,
     **fields: Any,
 ) -> dict[str, Any]:
     """Runs ``policy`` over the episodes of ``seeds`` in parallel and returns
@@ -36,7 +37,10 @@ def evaluate(
     them at a time, even when it releases the GIL inside (torch, SB3's ``predict``), unless it is
     declared ``thread_safe=True`` (a pure function of the observation, say). With ``out``, writes ``episodes.csv``,
     ``timing.csv``, ``summary.json`` and, as asked, ``png/`` pictures (``png``: a count, ``"failures"``
-    or ``"all"``) and ``steps/`` logs, as ``ronap run`` does.
+    or ``"all"``) and ``steps/`` logs, as ``ronap run`` does. ``out`` must be new or empty unless
+    ``force=True`` (as ``ronap run --force``): a finished run there is replaced once the first
+    episode is done, other files are kept. A Ctrl-C stops the run as ``ronap run``'s does (the files
+    keep every finished episode), then raises ``KeyboardInterrupt``.
 
     The configuration: ``scenario`` (the path of a TOML scenario file, as ``ronap run --scenario``
     takes, or a dict nested like one) gives the base and the scene; ``config`` and keyword
@@ -76,4 +80,6 @@ def evaluate(
         log_steps,
         thread_safe,
         batch,
+        False,
+        force,
     )

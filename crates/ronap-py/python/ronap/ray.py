@@ -86,13 +86,15 @@ def evaluate(
     maze_seed: int | None = None,
     map: str | None = None,
     progress: bool = False,
+    force: bool = False,
     **fields: Any,
 ) -> dict[str, Any]:
     """Runs ``policy`` over ``seeds`` as Ray tasks of ``block`` seeds each (``cpus_per_task``
     CPUs each) and writes the run into ``out`` as ``ronap run --out`` does (a temporary directory,
     removed, when None). Connects to the Ray cluster at ``address`` (``"auto"``: the one this
     machine belongs to), or uses the one this process already started, or starts a local one.
-    Returns ``{"summary": ..., "table": ..., "out": ...}``. The configuration keywords are
+    Returns ``{"summary": ..., "table": ..., "out": ...}``. ``out`` must be new or empty unless
+    ``force=True``, as for ``ronap.evaluate``. The configuration keywords are
     ``ronap.evaluate``'s."""
     import ray
 
@@ -113,7 +115,7 @@ def evaluate(
     temporary = tempfile.TemporaryDirectory(prefix="ronap-ray-") if out is None else None
     directory = temporary.name if temporary is not None else os.fspath(out)  # type: ignore[arg-type]
     threads = max(1, int(ray.cluster_resources().get("CPU", 1)))
-    run = _ronap.BlockRun(directory, policy, seeds, checked, maze_seed, map, threads)
+    run = _ronap.BlockRun(directory, policy, seeds, checked, maze_seed, map, threads, force)
     start = time.perf_counter()
     # A window of tasks under way: enough to keep every CPU busy, few enough that finished blocks
     # waiting for an earlier one stay few.
