@@ -1,7 +1,7 @@
 //! End-to-end tests of `ronap compare`: the table and every file read back, the same episodes as
 //! separate `ronap run`s, identical policies, reused runs, difficulty bins and bad input.
 
-use crate::util::{assert_rejected, json, ok, ronap, rows};
+use crate::util::{assert_rejected, json, ok, repo_root, ronap, rows};
 use std::path::Path;
 
 fn compare(out: &Path, extra: &[&str]) -> String {
@@ -294,4 +294,79 @@ fn a_fresh_run_never_overwrites_a_reused_one() {
         &["--run", "give another --out"],
     );
     assert_eq!(std::fs::read(apf.join("episodes.csv")).unwrap(), before);
+}
+
+#[test]
+fn a_team_scenario_is_compared_on_team_success_with_a_table_per_robot() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cmp");
+    let scenario = repo_root().join("scenarios/warehouse-team.toml");
+    let o = ok(&ronap(&[
+        "compare",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--policy",
+        "geodesic",
+        "--policy",
+        "random",
+        "--seeds",
+        "6",
+        "--max-steps",
+        "600",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    for part in [
+        "team success = each of the 8 robots",
+        "Teams (a success: every robot arrived)",
+        "Robots (every robot of every team episode)",
+        "team success a-b",
+        "geodesic vs random",
+    ] {
+        assert!(o.contains(part), "{part:?} not in {o}");
+    }
+    let c = json(&out.join("compare.json"));
+    let geodesic = &c["policies"][0];
+    assert_eq!(geodesic["team"]["robots"], 8);
+    assert_eq!(geodesic["team"]["episodes"], 6);
+    assert_eq!(geodesic["summary"]["episodes"], 48, "every robot's episode");
+    // The pairs count team successes: only-a + both = geodesic's team successes.
+    let pair = &c["pairs"][0];
+    let (a_only, b_only) = (
+        pair["a_only"].as_u64().unwrap(),
+        pair["b_only"].as_u64().unwrap(),
+    );
+    let team_a = geodesic["team"]["team_successes"].as_u64().unwrap();
+    let team_b = c["policies"][1]["team"]["team_successes"].as_u64().unwrap();
+    assert_eq!(
+        team_a as i64 - team_b as i64,
+        a_only as i64 - b_only as i64,
+        "{pair}"
+    );
+    // Each policy's run is an ordinary team run directory.
+    for label in ["geodesic", "random"] {
+        let run = out.join("runs").join(label);
+        assert_eq!(rows(&run.join("robots.csv")).len(), 1 + 6 * 8, "{label}");
+        assert_eq!(rows(&run.join("episodes.csv")).len(), 1 + 6, "{label}");
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("## Teams"), "{report}");
+    assert!(out.join("compare.png").exists() && out.join("outcomes.png").exists());
+    // What a team comparison cannot do yet is refused by name.
+    assert_rejected(
+        &[
+            "compare",
+            "--scenario",
+            scenario.to_str().unwrap(),
+            "--policy",
+            "geodesic",
+            "--policy",
+            "random",
+            "--seeds",
+            "2",
+            "--by",
+            "difficulty",
+        ],
+        &["--by difficulty", "team scenarios"],
+    );
 }

@@ -109,18 +109,24 @@ fn goal_lists_report_every_order_s_tour() {
 fn one_robot_commands_refuse_a_team_by_name() {
     let swap = repo_root().join("scenarios/corridor-swap.toml");
     let s = swap.to_str().unwrap();
+    // Expert demonstrations are one robot's (compare and run take teams).
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("rows.csv");
     assert_rejected(
         &[
-            "compare",
-            "--policy",
-            "apf",
-            "--policy",
+            "collect",
+            "--expert",
             "geodesic",
+            "--samples",
+            "10",
             "--scenario",
             s,
+            "--out",
+            out.to_str().unwrap(),
         ],
         &["2 robots", "ronap run --scenario"],
     );
+    assert!(!out.exists());
 }
 
 #[test]

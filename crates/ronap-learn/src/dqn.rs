@@ -234,6 +234,7 @@ fn validate(
         seeds: v.seeds.clone(),
         threads,
         recording: Recording::default(),
+        steps_of: Vec::new(),
     };
     let run = evaluator
         .run(&factory, &options, &AtomicBool::new(false), &|_| {})

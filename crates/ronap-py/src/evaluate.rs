@@ -419,6 +419,7 @@ pub fn compare<'py>(
         contenders.push(Contender {
             name,
             factory,
+            team: None,
             reuse: None,
         });
     }
@@ -435,6 +436,7 @@ pub fn compare<'py>(
                 contenders.push(Contender {
                     name,
                     factory,
+                    team: None,
                     reuse,
                 });
             }

@@ -1,7 +1,7 @@
 //! `ronap compare`: several policies on the same seeds, with paired statistics, pictures and a
 //! report.
 
-use crate::args::{count, policy_factory, seed, seed_range, EpisodeArgs, ThreadArgs};
+use crate::args::{count, policy_factory, seed, seed_range, EpisodeArgs, TeamPolicies, ThreadArgs};
 use crate::output::cancel_on_ctrl_c;
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
@@ -10,6 +10,7 @@ use ronap_core::compare::{
 };
 use ronap_core::eval::Evaluator;
 use ronap_core::io::atomic::OutputError;
+use ronap_core::policy::TeamPolicyFactory;
 use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -73,9 +74,17 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
     let chosen = with_runs(&args.policy, &args.run)?;
     let names: Vec<String> = chosen.iter().map(|(n, _)| n.clone()).collect();
     let mut contenders = Vec::new();
+    let team = config.team_size() > 0;
     for (name, reuse) in chosen {
+        // In a team scenario, `name` drives the robots of entries without a policy of their own.
+        let team = if team {
+            Some(Box::new(TeamPolicies::new(&config, &name)?) as Box<dyn TeamPolicyFactory>)
+        } else {
+            None
+        };
         contenders.push(Contender {
-            factory: policy_factory(&name, &config)?,
+            factory: policy_factory(&name, &config.team_robot(0))?,
+            team,
             name,
             reuse,
         });
@@ -84,10 +93,16 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
     let seeds = seed_range(first, args.seeds)?;
     let end = first + args.seeds;
     let evaluator = Evaluator::new(config.clone(), scenes);
-    evaluator
-        .worlds()
-        .check_start(first)
-        .with_context(|| format!("cannot start episodes in this scene (seed {first})"))?;
+    if team {
+        // A team that cannot be placed fails the same way for every seed: say so now.
+        ronap_core::sim::team::Team::new(&config, &evaluator.worlds().team(first), first)
+            .with_context(|| format!("cannot start team episodes in this scene (seed {first})"))?;
+    } else {
+        evaluator
+            .worlds()
+            .check_start(first)
+            .with_context(|| format!("cannot start episodes in this scene (seed {first})"))?;
+    }
     let out_dir = args.out.clone().unwrap_or_else(default_out_dir);
     let threads = args.threads.count();
     let options = CompareOptions {

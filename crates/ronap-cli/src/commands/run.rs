@@ -5,7 +5,7 @@ use crate::args::{count, fraction, policy_factory, seed, EpisodeArgs, ThreadArgs
 use crate::output::cancel_on_ctrl_c;
 use anyhow::{bail, Context, Result};
 use clap::Args;
-use ronap_core::eval::{EpisodeRecord, EvalOptions, Evaluator, Recording, Seeds};
+use ronap_core::eval::{EvalOptions, Evaluator, Recording, Seeds};
 use ronap_core::io::atomic::OutputError;
 use ronap_core::io::manifest::PLAN_FILE;
 use ronap_core::io::run_dir::{Pictures, ResumeError, RunFiles, RunInfo, RunWriter};
@@ -301,12 +301,14 @@ fn run_lone(
     let files = RunFiles {
         pictures: job.png,
         steps: job.log_steps,
-        gifs: !job.gif.is_empty(),
+        gifs: false,
     };
     let writer = match writer {
         Some(w) => w,
         None => job.writer(files)?,
     };
+    // The --gif seeds' steps are recorded as they run and animated as they finish.
+    let writer = writer.animating(job.gif.clone())?;
     let done = writer.done() as u64;
 
     let cancel = cancel_on_ctrl_c("finishing running episodes and writing what is done");
@@ -319,6 +321,7 @@ fn run_lone(
         seeds: job.seeds.clone(),
         threads,
         recording: Recording::default(),
+        steps_of: Vec::new(),
     };
     let info = RunInfo {
         policy: job.policy.clone(),
@@ -332,26 +335,9 @@ fn run_lone(
         writer: Some(writer),
         cancel: &cancel,
     };
-    let evaluation = evaluate_into(request, factory.as_ref(), &|_| bar.inc(1), &|r| {
-        job.gif.contains(&r.seed)
-    })?;
+    let evaluation = evaluate_into(request, factory.as_ref(), &|_| bar.inc(1), &|_| false)?;
     bar.finish_and_clear();
     let (result, summary) = (&evaluation.result, &evaluation.summary);
-    let mut gif_notes = Vec::new();
-    if evaluation.write_error.is_none() {
-        for &seed in &job.gif {
-            if (seed - first) < summary.episodes as u64 {
-                let record = result.records.iter().find(|r| r.seed == seed);
-                gif_notes.extend(write_gif(
-                    &evaluator,
-                    factory.as_ref(),
-                    seed,
-                    record,
-                    &job.out_dir,
-                )?);
-            }
-        }
-    }
 
     let mut stdout = std::io::stdout().lock();
     writeln!(
@@ -366,9 +352,6 @@ fn run_lone(
     )?;
     write!(stdout, "{}", summary.table())?;
     writeln!(stdout, "outputs in {}", job.out_dir.display())?;
-    for note in gif_notes {
-        eprintln!("ronap run: {note}");
-    }
     if let Some(e) = evaluation.write_error {
         return Err(stopped_writing(e, &job.out_dir));
     }
@@ -430,6 +413,7 @@ fn run_team(
         Some(w) => w,
         None => job.writer(files)?,
     };
+    let writer = writer.animating(job.gif.clone())?;
     let done = writer.done() as u64;
     let cancel = cancel_on_ctrl_c("finishing running episodes and writing what is done");
     let bar = crate::output::progress_bar(
@@ -441,6 +425,7 @@ fn run_team(
         seeds: job.seeds.clone(),
         threads: job.threads,
         recording: Recording::default(),
+        steps_of: Vec::new(),
     };
     let info = RunInfo {
         policy: job.policy.clone(),
@@ -467,25 +452,7 @@ fn run_team(
     write!(stdout, "{}", evaluation.team.table())?;
     writeln!(stdout, "per robot:")?;
     write!(stdout, "{}", evaluation.summary.table())?;
-    let mut gif_notes = Vec::new();
-    if evaluation.write_error.is_none() {
-        for &seed in &job.gif {
-            if (seed - first) < evaluation.team.episodes as u64 {
-                let record = evaluation.result.records.iter().find(|r| r.seed == seed);
-                gif_notes.extend(write_team_gif(
-                    &evaluator,
-                    &policies,
-                    seed,
-                    record,
-                    &job.out_dir,
-                )?);
-            }
-        }
-    }
     writeln!(stdout, "outputs in {}", job.out_dir.display())?;
-    for note in gif_notes {
-        eprintln!("ronap run: {note}");
-    }
     if let Some(e) = evaluation.write_error {
         return Err(stopped_writing(e, &job.out_dir));
     }
@@ -549,95 +516,6 @@ fn summary_of_names(names: &[String]) -> String {
         .map(|(n, c)| format!("{c} x {n}"))
         .collect::<Vec<_>>()
         .join(", ")
-}
-
-/// Runs the episode of `seed` again with a fresh policy, recording its steps, and writes its
-/// animation to `gif/`. Returns a note when the re-run differs from the run's `record` (a policy
-/// that is not deterministic), since the GIF then shows the re-run. (A resumed run has no record
-/// of the episodes its earlier process finished.)
-fn write_gif(
-    evaluator: &Evaluator,
-    factory: &dyn ronap_core::policy::PolicyFactory,
-    seed: u64,
-    record: Option<&EpisodeRecord>,
-    out_dir: &std::path::Path,
-) -> Result<Option<String>> {
-    let mut policy = factory.make()?;
-    let recording = Recording {
-        trajectory: false,
-        steps: true,
-    };
-    let rerun = evaluator
-        .run_episode(policy.as_mut(), seed, recording)
-        .with_context(|| format!("--gif {seed}: cannot run the episode again"))?;
-    let episode = evaluator.worlds().episode(seed)?;
-    let actions: Vec<_> = rerun.step_log.iter().map(|s| s.action).collect();
-    let options = ronap_core::render::gif::GifOptions::default();
-    let animation = ronap_core::render::gif::animate(episode, &actions, None, &options)
-        .with_context(|| format!("--gif {seed}"))?;
-    let path = out_dir
-        .join("gif")
-        .join(format!("seed-{seed:06}-{}.gif", rerun.outcome.name()));
-    ronap_core::io::atomic::write_atomic(&path, |w| w.write_all(&animation.bytes))?;
-    Ok(record
-        .filter(|r| rerun.steps != r.steps || rerun.outcome != r.outcome)
-        .map(|record| {
-            format!(
-                "--gif {seed}: the policy is not deterministic; the GIF shows a re-run ({} steps, \
-                 {}), episodes.csv the run ({} steps, {})",
-                rerun.steps,
-                rerun.outcome.name(),
-                record.steps,
-                record.outcome.name()
-            )
-        }))
-}
-
-/// Runs team episode `seed` again with fresh policies and writes its animation to `gif/`.
-/// Returns a note when the re-run differs from `record` (when the run kept it) (a policy that is not
-/// deterministic), since the GIF then shows the re-run.
-fn write_team_gif(
-    evaluator: &Evaluator,
-    policies: &crate::args::TeamPolicies,
-    seed: u64,
-    record: Option<&ronap_core::eval::TeamRecord>,
-    out_dir: &std::path::Path,
-) -> Result<Option<String>> {
-    let mut policy = ronap_core::policy::TeamPolicyFactory::make(policies)?;
-    // About 500 pixels along the scene's longer side.
-    let scene_side = evaluator
-        .worlds()
-        .team(seed)
-        .first()
-        .map_or(1000.0, |w| w.scene().width().max(w.scene().height()));
-    let options = ronap_core::render::gif::GifOptions {
-        scale: (500.0 / scene_side).clamp(0.1, 4.0),
-        ..Default::default()
-    };
-    let (animation, rerun) = ronap_core::render::team::animate_team(
-        evaluator,
-        policy.as_mut(),
-        &policies.names,
-        seed,
-        &options,
-    )
-    .with_context(|| format!("--gif {seed}"))?;
-    let dir = out_dir.join("gif");
-    std::fs::create_dir_all(&dir).with_context(|| format!("cannot make {}", dir.display()))?;
-    let path = dir.join(format!("seed-{seed:06}-{}.gif", rerun.outcome.name()));
-    ronap_core::io::atomic::write_atomic(&path, |w| w.write_all(&animation.bytes))?;
-    Ok(record
-        .filter(|r| rerun.steps != r.steps || rerun.outcome != r.outcome)
-        .map(|r| {
-            format!(
-                "--gif {seed}: a policy is not deterministic; the GIF shows a re-run ({} steps, \
-                 {}), episodes.csv the run ({} steps, {})",
-                rerun.steps,
-                rerun.outcome.name(),
-                r.steps,
-                r.outcome.name()
-            )
-        }))
 }
 
 /// `runs/<policy>-<UTC time>`, with `-2`, `-3`... when a run started in the same second has it.

@@ -17,8 +17,8 @@ use crate::eval::{EvalOptions, Evaluator, Recording};
 use crate::io::atomic::OutputError;
 use crate::io::manifest::{ManifestError, RunManifest};
 use crate::io::run_dir::{RunFiles, RunInfo, RunWriter};
-use crate::job::{evaluate_into, RunRequest};
-use crate::policy::{PolicyError, PolicyFactory};
+use crate::job::{evaluate_into, evaluate_team_into, RunRequest};
+use crate::policy::{PolicyError, PolicyFactory, TeamPolicyFactory};
 use crate::render::chart;
 use crate::scene::map::MapSource;
 use crate::sim::world::SceneSpec;
@@ -38,6 +38,9 @@ pub struct Contender {
     pub name: String,
     /// Makes it.
     pub factory: Box<dyn PolicyFactory>,
+    /// Makes the team policy a team scenario (`[[robots]]`) runs under this contender's name
+    /// (the robots of entries without a policy of their own driven by `factory`'s).
+    pub team: Option<Box<dyn TeamPolicyFactory>>,
     /// A run directory of this policy to read instead of running it again.
     pub reuse: Option<PathBuf>,
 }
@@ -149,10 +152,17 @@ pub fn success_rule(config: &ValidConfig) -> String {
         .reward_min
         .map(|r| format!("; a summed reward down to {r} ends it as a failure"))
         .unwrap_or_default();
-    format!(
-        "success = the robot's centre comes within {} px of the goal within {} steps ({collisions}{reward}; a policy that gives up fails)",
+    let robot = format!(
+        "the robot's centre comes within {} px of the goal within {} steps ({collisions}{reward}; a policy that gives up fails)",
         e.goal_tolerance_px, e.max_steps
-    )
+    );
+    match config.team_size() {
+        0 => format!("success = {robot}"),
+        n => format!(
+            "team success = each of the {n} robots reaches its goals, where a robot's success = \
+             {robot}; a deadlock fails the team"
+        ),
+    }
 }
 
 /// Short, unique, file-safe labels for policy names: `mlp:policies/bc.safetensors` -> `bc`, and
@@ -284,6 +294,25 @@ pub fn compare(
         ));
     }
     let config = evaluator.config();
+    if config.team_size() > 0 {
+        let refuse = |what: &str| {
+            Err(CompareError::Input(format!(
+                "{what}: not for team scenarios ([[robots]]) yet"
+            )))
+        };
+        if options.by_difficulty {
+            return refuse("--by difficulty");
+        }
+        if let Some(c) = contenders.iter().find(|c| c.reuse.is_some()) {
+            return refuse(&format!("--run (of {})", c.name));
+        }
+        if let Some(c) = contenders.iter().find(|c| c.team.is_none()) {
+            return Err(CompareError::Input(format!(
+                "policy {}: no team policy was given for this team scenario",
+                c.name
+            )));
+        }
+    }
     let names: Vec<String> = contenders.iter().map(|c| c.name.clone()).collect();
     let labels = labels(&names);
     // Every reused run is checked before anything runs or is written.
@@ -338,6 +367,7 @@ pub fn compare(
                 run_dir: Some(dir),
                 reused: true,
                 summary: manifest.summary,
+                team: manifest.team,
                 seeds,
             },
             None => run_one(&setting, c, &label, index)?,
@@ -376,7 +406,13 @@ pub fn compare(
     };
     if let Some(dir) = out {
         progress(Progress::Report);
-        let sheet = disagreement_sheet(evaluator, contenders, &comparison, options.sheet_rows)?;
+        // The contact sheet redraws one robot's episodes; a team's pictures are its run's.
+        let rows = if config.team_size() > 0 {
+            0
+        } else {
+            options.sheet_rows
+        };
+        let sheet = disagreement_sheet(evaluator, contenders, &comparison, rows)?;
         report::remove_earlier(dir)?;
         report::write_all(dir, &comparison, sheet.as_ref())?;
     }
@@ -423,6 +459,7 @@ fn run_one(
         seeds: options.seeds.clone().into(),
         threads: options.threads,
         recording: Recording::default(),
+        steps_of: Vec::new(),
     };
     let run_info = RunInfo {
         policy: c.name.clone(),
@@ -436,6 +473,9 @@ fn run_one(
         writer,
         cancel,
     };
+    if let (Some(team), true) = (&c.team, evaluator.config().team_size() > 0) {
+        return run_team(setting, c, team.as_ref(), label, request);
+    }
     let evaluation = evaluate_into(
         request,
         c.factory.as_ref(),
@@ -468,12 +508,62 @@ fn run_one(
         run_dir: dir,
         reused: false,
         summary: evaluation.summary,
+        team: None,
         seeds: evaluation
             .result
             .records
             .iter()
             .map(SeedResult::of)
             .collect(),
+    })
+}
+
+/// Runs contender `c` of a team comparison with `team`, its team policy, as `request` asks: the
+/// paired figures are the team's (a seed's success is the team's success).
+fn run_team(
+    setting: &Setting<'_>,
+    c: &Contender,
+    team: &dyn TeamPolicyFactory,
+    label: &str,
+    request: RunRequest<'_>,
+) -> Result<PolicyResult, CompareError> {
+    let dir = request.writer.as_ref().map(|w| w.dir().to_path_buf());
+    let seeds = std::sync::Mutex::new(Vec::new());
+    let evaluation = evaluate_team_into(request, team, &|r| {
+        if let Ok(mut s) = seeds.lock() {
+            s.push(SeedResult::of_team(r));
+        }
+        (setting.progress)(Progress::Episode);
+    })
+    .map_err(|source| CompareError::Policy {
+        policy: c.name.clone(),
+        source,
+    })?;
+    if let Some(e) = evaluation.write_error {
+        return Err(e.into());
+    }
+    if let Some(e) = &evaluation.result.error {
+        return Err(CompareError::Run {
+            policy: c.name.clone(),
+            message: e.to_string(),
+            dir: dir.unwrap_or_default(),
+        });
+    }
+    if evaluation.result.cancelled {
+        return Err(CompareError::Cancelled {
+            dir: setting.out.map(|d| d.join("runs")).unwrap_or_default(),
+        });
+    }
+    let mut seeds = seeds.into_inner().unwrap_or_default();
+    seeds.sort_by_key(|s| s.seed);
+    Ok(PolicyResult {
+        name: c.name.clone(),
+        label: label.to_string(),
+        run_dir: dir,
+        reused: false,
+        summary: evaluation.summary,
+        team: Some(evaluation.team),
+        seeds,
     })
 }
 

@@ -205,11 +205,73 @@ impl Comparison {
         Table { header, rows }
     }
 
+    /// The team table of a team comparison (none otherwise).
+    pub fn team_table(&self) -> Option<Table> {
+        if self.policies.iter().all(|p| p.team.is_none()) {
+            return None;
+        }
+        let header = [
+            "policy",
+            "team success (95% CI)",
+            "robots arrived",
+            "deadlocks",
+            "mean makespan",
+            "robot contacts/ep",
+            "wall collisions/ep",
+            "mean path px (team)",
+            "SPL",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        let rows = self
+            .policies
+            .iter()
+            .map(|p| match &p.team {
+                Some(t) => vec![
+                    p.label.clone(),
+                    format!(
+                        "{} ({}-{})",
+                        pct(t.team_success_rate),
+                        pct(t.team_success_ci95[0]),
+                        pct(t.team_success_ci95[1])
+                    ),
+                    pct(t.robot_success_rate),
+                    t.deadlocks.to_string(),
+                    if t.team_successes > 0 {
+                        format!("{:.1}", t.mean_makespan)
+                    } else {
+                        "-".to_string()
+                    },
+                    format!("{:.2}", t.robot_collisions_per_episode),
+                    format!("{:.2}", t.collisions_per_episode),
+                    format!("{:.1}", t.mean_path_length_px),
+                    format!("{:.3}", t.spl),
+                ],
+                None => vec![p.label.clone()],
+            })
+            .collect();
+        Some(Table { header, rows })
+    }
+
+    /// The headings of the policy tables: the team's and the robots', or the policies'.
+    fn policy_headings(&self) -> (&'static str, &'static str) {
+        (
+            "Teams (a success: every robot arrived)",
+            "Robots (every robot of every team episode)",
+        )
+    }
+
     /// The per-pair table.
     pub fn pair_table(&self) -> Table {
+        let team = self.policies.iter().any(|p| p.team.is_some());
         let header = [
             "pair (a vs b)",
-            "success a-b, pp (95% CI)",
+            if team {
+                "team success a-b, pp (95% CI)"
+            } else {
+                "success a-b, pp (95% CI)"
+            },
             "only a / only b",
             "McNemar p",
             "Holm p",
@@ -292,6 +354,10 @@ impl Comparison {
             self.scenes,
             self.success_rule
         );
+        if let Some(t) = self.team_table() {
+            let (team, robots) = self.policy_headings();
+            let _ = write!(out, "{team}\n{}\n{robots}\n", t.text());
+        }
         out.push_str(&self.policy_table().text());
         out.push('\n');
         out.push_str(&self.pair_table().text());
@@ -376,18 +442,31 @@ fn pictures(
     let bars: Vec<chart::PolicyBars> = c
         .policies
         .iter()
-        .map(|p: &PolicyResult| chart::PolicyBars {
-            name: p.label.clone(),
-            success_rate: p.summary.success_rate,
-            success_ci95: p.summary.success_ci95,
-            spl: p.seeds.iter().map(|s| s.spl).collect(),
+        .map(|p: &PolicyResult| {
+            // A team comparison's bars are the team's success (what the pairs test).
+            let (rate, ci) = match &p.team {
+                Some(t) => (t.team_success_rate, t.team_success_ci95),
+                None => (p.summary.success_rate, p.summary.success_ci95),
+            };
+            chart::PolicyBars {
+                name: p.label.clone(),
+                success_rate: rate,
+                success_ci95: ci,
+                spl: p.seeds.iter().map(|s| s.spl).collect(),
+            }
         })
         .collect();
     let e = &c.config.episode;
-    let title = format!(
-        "{} seeds, {}; success: within {} px of the goal in {} steps",
-        c.seed_count, c.scenes, e.goal_tolerance_px, e.max_steps
-    );
+    let title = match c.config.team_size() {
+        0 => format!(
+            "{} seeds, {}; success: within {} px of the goal in {} steps",
+            c.seed_count, c.scenes, e.goal_tolerance_px, e.max_steps
+        ),
+        n => format!(
+            "{} seeds, {}; team success: all {n} robots arrive in {} steps",
+            c.seed_count, c.scenes, e.max_steps
+        ),
+    };
     let names: Vec<String> = c.policies.iter().map(|p| p.label.clone()).collect();
     let seeds: Vec<u64> = c.policies[0].seeds.iter().map(|s| s.seed).collect();
     let outcomes: Vec<Vec<Outcome>> = c
@@ -574,7 +653,16 @@ fn runs_note(c: &Comparison) -> Vec<String> {
 fn markdown(c: &Comparison, pictures: &[Picture], config: &str) -> String {
     let mut md = String::from("# ronap compare\n\n");
     let _ = writeln!(md, "{}\n\n**{}**\n", intro(c), c.success_rule);
-    let _ = writeln!(md, "## Policies\n\n{}", c.policy_table().markdown());
+    match c.team_table() {
+        Some(t) => {
+            let (team, robots) = c.policy_headings();
+            let _ = writeln!(md, "## {team}\n\n{}", t.markdown());
+            let _ = writeln!(md, "## {robots}\n\n{}", c.policy_table().markdown());
+        }
+        None => {
+            let _ = writeln!(md, "## Policies\n\n{}", c.policy_table().markdown());
+        }
+    }
     let _ = writeln!(md, "## Pairs\n\n{}", c.pair_table().markdown());
     for p in pictures {
         let _ = writeln!(md, "![{}]({})\n", p.alt, p.file);
@@ -614,7 +702,16 @@ fn html(c: &Comparison, pictures: &[Picture], config: &str) -> String {
         escape(&intro(c)),
         escape(&c.success_rule)
     );
-    let _ = writeln!(h, "<h2>Policies</h2>\n{}", c.policy_table().html());
+    match c.team_table() {
+        Some(t) => {
+            let (team, robots) = c.policy_headings();
+            let _ = writeln!(h, "<h2>{team}</h2>\n{}", t.html());
+            let _ = writeln!(h, "<h2>{robots}</h2>\n{}", c.policy_table().html());
+        }
+        None => {
+            let _ = writeln!(h, "<h2>Policies</h2>\n{}", c.policy_table().html());
+        }
+    }
     let _ = writeln!(h, "<h2>Pairs</h2>\n{}", c.pair_table().html());
     let b64 = base64::engine::general_purpose::STANDARD;
     for p in pictures {

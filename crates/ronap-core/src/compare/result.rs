@@ -3,7 +3,7 @@
 
 use super::difficulty::{Bin, Difficulty, Figure};
 use crate::config::ValidConfig;
-use crate::eval::{EpisodeRecord, Outcome, Summary};
+use crate::eval::{EpisodeRecord, Outcome, Summary, TeamRecord, TeamSummary};
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -39,6 +39,23 @@ impl SeedResult {
         }
     }
 
+    /// The result of team episode `r`: the team's outcome, steps, summed wall collisions and
+    /// path length, and its robots' mean SPL (rounded as `episodes.csv` and `robots.csv` write
+    /// them).
+    pub(crate) fn of_team(r: &TeamRecord) -> Self {
+        let round = |x: f64, digits: usize| format!("{x:.digits$}").parse().unwrap_or(x);
+        let spl =
+            r.robots.iter().map(|x| round(x.spl, 4)).sum::<f64>() / r.robots.len().max(1) as f64;
+        Self {
+            seed: r.seed,
+            outcome: r.outcome,
+            steps: r.steps,
+            collisions: r.collisions,
+            path_length_px: round(r.path_length_px, 3),
+            spl,
+        }
+    }
+
     /// Whether the episode succeeded.
     pub fn success(&self) -> bool {
         self.outcome == Outcome::Success
@@ -56,8 +73,11 @@ pub struct PolicyResult {
     pub run_dir: Option<PathBuf>,
     /// Whether the run was read from `--run` rather than run again.
     pub reused: bool,
-    /// The figures.
+    /// The figures (of every robot, in a team comparison).
     pub summary: Summary,
+    /// The team figures, in a team comparison.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub team: Option<TeamSummary>,
     /// Each seed's result, in seed order.
     #[serde(skip)]
     pub seeds: Vec<SeedResult>,

@@ -117,6 +117,17 @@ pub struct EvalOptions {
     pub threads: usize,
     /// What to keep of each episode beyond its figures.
     pub recording: Recording,
+    /// Seeds whose every step is kept whatever `recording` says (the episodes a run animates).
+    pub steps_of: Vec<u64>,
+}
+
+impl EvalOptions {
+    /// What to keep of episode `seed`.
+    pub fn recording_of(&self, seed: u64) -> Recording {
+        let mut r = self.recording;
+        r.steps |= self.steps_of.contains(&seed);
+        r
+    }
 }
 
 /// What an evaluation produced: every finished record in seed order, and how it stopped.
@@ -291,7 +302,7 @@ impl Evaluator {
             // `i` is below `options.seeds.len()`, the number of jobs.
             let seed = options.seeds.get(i).unwrap_or_default();
             let mut record = self
-                .run_episode(policy.as_mut(), seed, options.recording)
+                .run_episode(policy.as_mut(), seed, options.recording_of(seed))
                 .map_err(Failure::Run)?;
             on_finish(&record);
             record.strip();

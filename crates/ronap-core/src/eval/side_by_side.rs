@@ -50,7 +50,7 @@ impl Evaluator {
         policy: &mut dyn Policy,
         seeds: &[u64],
         lanes: usize,
-        recording: Recording,
+        recording: &dyn Fn(u64) -> Recording,
         finished: &mut dyn FnMut(usize, EpisodeRecord),
     ) -> Option<(usize, RunError)> {
         let lanes = lanes.max(1);
@@ -78,7 +78,7 @@ impl Evaluator {
                 let clock = Instant::now();
                 match Rollout::start_lane(self.world(seed), seed, policy, lane) {
                     Ok(rollout) => {
-                        let recorder = Recorder::start(recording, clock, &rollout);
+                        let recorder = Recorder::start(recording(seed), clock, &rollout);
                         live.push(Live {
                             index,
                             lane,
@@ -186,7 +186,7 @@ impl Evaluator {
                 policy.as_mut(),
                 &seeds,
                 lanes,
-                options.recording,
+                &|seed| options.recording_of(seed),
                 &mut |i, mut record| {
                     on_finish(&record);
                     record.strip();
@@ -365,7 +365,7 @@ mod tests {
                 policy.as_mut(),
                 &seeds,
                 lanes,
-                recording,
+                &|_| recording,
                 &mut |i, r| {
                     assert!(records[i].is_none(), "seed {i} twice");
                     records[i] = Some(r);

@@ -589,13 +589,9 @@ impl Evaluator {
         // A team's policy is made afresh for every episode.
         let work = |_: &mut Option<()>, i: usize| {
             let mut policy = factory.make().map_err(Failure::Policy)?;
+            let seed = options.seeds.get(i).unwrap_or_default();
             let mut r = self
-                .run_team_episode(
-                    policy.as_mut(),
-                    &names,
-                    options.seeds.get(i).unwrap_or_default(),
-                    options.recording,
-                )
+                .run_team_episode(policy.as_mut(), &names, seed, options.recording_of(seed))
                 .map_err(Failure::Run)?;
             on_finish(&r);
             r.paths = Vec::new();

@@ -214,6 +214,8 @@ pub struct RunWriter {
     ready: Mutex<bool>,
     /// The run ended cleanly: its lock file goes with the lock.
     clean: AtomicBool,
+    /// The seeds whose episodes are animated into `gif/`.
+    gif_seeds: Vec<u64>,
     lock: Option<RunLock>,
 }
 
@@ -339,6 +341,7 @@ impl RunWriter {
             held,
             ready: Mutex::new(false),
             clean: AtomicBool::new(false),
+            gif_seeds: Vec::new(),
             lock: Some(lock),
         })
     }
@@ -455,9 +458,44 @@ impl RunWriter {
             held: true,
             ready: Mutex::new(false),
             clean: AtomicBool::new(false),
+            gif_seeds: Vec::new(),
             lock: Some(lock),
         };
         Ok((writer, plan))
+    }
+
+    /// Animates the episodes of `seeds` into `gif/seed-SEED-OUTCOME.gif` as they finish
+    /// ([`crate::job::evaluate_into`] and [`crate::job::evaluate_team_into`] record their steps).
+    pub fn animating(mut self, seeds: Vec<u64>) -> Result<Self, OutputError> {
+        if !seeds.is_empty() {
+            make_dir(&self.dir.join("gif"))?;
+            self.files.gifs = true;
+        }
+        self.gif_seeds = seeds;
+        Ok(self)
+    }
+
+    /// The seeds whose episodes are animated.
+    pub fn gif_seeds(&self) -> &[u64] {
+        &self.gif_seeds
+    }
+
+    /// Writes the animation of episode `seed`, which ended as `outcome` (`bytes`, a GIF, or why
+    /// it could not be drawn); a failure is kept for the end, as [`RunWriter::episode`] does.
+    pub fn animation(&self, seed: u64, outcome: Outcome, bytes: Result<&[u8], String>) {
+        let path = self
+            .dir
+            .join("gif")
+            .join(format!("seed-{seed:06}-{}.gif", outcome.name()));
+        let written = match bytes {
+            Ok(b) => self
+                .make_ready()
+                .and_then(|()| write_atomic(&path, |w| w.write_all(b))),
+            Err(message) => Err(OutputError::Format { path, message }),
+        };
+        if let Err(e) = written {
+            self.note(e);
+        }
     }
 
     /// Records the front end's own options in the run's plan, for a later `--resume`.
@@ -1163,7 +1201,14 @@ mod tests {
             std::fs::create_dir_all(path.parent().unwrap()).unwrap();
             std::fs::write(path, b"x").unwrap();
         }
-        drop(RunWriter::create(&dir, RunFiles::default(), 0, true).unwrap());
+        let writer = RunWriter::create(&dir, RunFiles::default(), 0, true).unwrap();
+        // Nothing goes before the new run's first episode...
+        for f in stale.iter().chain(&kept) {
+            assert!(dir.join(f).exists(), "{f} removed before the first episode");
+        }
+        // ...which makes the directory ready.
+        writer.make_ready().unwrap();
+        drop(writer);
         for f in stale {
             assert!(!dir.join(f).exists(), "{f} left");
         }

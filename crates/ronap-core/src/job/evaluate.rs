@@ -7,7 +7,7 @@ use crate::io::atomic::OutputError;
 use crate::io::figures;
 use crate::io::manifest::RunManifest;
 use crate::io::run_dir::{finish, lone_headers, manifest, restore, EpisodeRows, RunWriter};
-use crate::job::RunRequest;
+use crate::job::{animate, RunRequest};
 use crate::policy::{PolicyError, PolicyFactory};
 
 /// A finished evaluation: the records kept, the summary of every episode of the run and the
@@ -26,7 +26,8 @@ pub struct Evaluation {
 
 /// Runs an evaluation and, given a `writer`, writes it into its directory as it goes:
 /// `episodes.csv`, `timing.csv` (and the exact figures a resume needs) row by row in seed order
-/// under their partial names, per-episode files as episodes finish, `summary.json` at the end,
+/// under their partial names, per-episode files (and the animations the writer asks for, from
+/// the steps recorded) as episodes finish, `summary.json` at the end,
 /// when the run files take their final names (also after an interruption or a failing episode,
 /// so finished episodes are never lost; not after a write error, so no file under a final name
 /// is ever half-written). Memory stays flat however many episodes: only the records `keep`
@@ -48,6 +49,7 @@ pub fn evaluate_into(
     let mut options = options.clone();
     if let Some(w) = &writer {
         options.recording = w.recording();
+        options.steps_of = w.gif_seeds().to_vec();
     }
     let config = evaluator.config();
     let mut tally = Tally::default();
@@ -85,6 +87,14 @@ pub fn evaluate_into(
         let on_finish = |r: &EpisodeRecord| {
             if let Some(w) = &writer {
                 w.episode(r);
+                if w.gif_seeds().contains(&r.seed) {
+                    let gif = animate::lone(evaluator, r);
+                    w.animation(
+                        r.seed,
+                        r.outcome,
+                        gif.as_ref().map(|a| &a.bytes[..]).map_err(Clone::clone),
+                    );
+                }
             }
             on_record(r);
         };

@@ -1,10 +1,12 @@
 //! Use-cases, above `io`: running an evaluation into a run directory, a lone robot's
 //! ([`evaluate_into`]) or a team's ([`evaluate_team_into`]), and replaying a team episode from
-//! its robots' step logs ([`replay_team`]): the sequences the command line,
+//! its robots' step logs ([`replay_team`]), animating a run's chosen episodes from the steps it
+//! recorded: the sequences the command line,
 //! Python and `compare` share. A use-case takes one [`RunRequest`] (what to run, where its
 //! results go, how to stop it) rather than a long list of arguments. Uses every layer up to `io`;
 //! `io` reads and writes formats, `render` draws, and neither runs an episode for this layer.
 
+mod animate;
 mod evaluate;
 mod replay;
 mod team;

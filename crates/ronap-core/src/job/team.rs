@@ -9,7 +9,7 @@ use crate::io::atomic::OutputError;
 use crate::io::figures;
 use crate::io::run_dir::{finish, manifest, restore, timing_row, RunWriter, TIMING_COLUMNS};
 use crate::io::team_rows::{robot_rows, team_episode_row, ROBOT_COLUMNS, TEAM_COLUMNS};
-use crate::job::RunRequest;
+use crate::job::{animate, RunRequest};
 use crate::policy::{PolicyError, TeamPolicyFactory};
 
 /// A finished team evaluation.
@@ -44,6 +44,7 @@ pub fn evaluate_team_into(
     let mut options = options.clone();
     if let Some(w) = &writer {
         options.recording = w.recording();
+        options.steps_of = w.gif_seeds().to_vec();
     }
     let config = evaluator.config();
     let (mut team, mut robots) = (TeamTally::default(), Tally::default());
@@ -93,7 +94,22 @@ pub fn evaluate_team_into(
             .collect();
         let on_finish = |r: &TeamRecord| {
             if let Some(w) = &writer {
-                w.team_episode(r, &beams);
+                if w.gif_seeds().contains(&r.seed) {
+                    let gif = animate::team(evaluator, r);
+                    w.animation(
+                        r.seed,
+                        r.outcome,
+                        gif.as_ref().map(|a| &a.bytes[..]).map_err(Clone::clone),
+                    );
+                }
+                // A GIF's steps are not a step log unless the run asked for step logs.
+                if w.recording().steps || r.step_logs.is_empty() {
+                    w.team_episode(r, &beams);
+                } else {
+                    let mut r = r.clone();
+                    r.step_logs = Vec::new();
+                    w.team_episode(&r, &beams);
+                }
             }
             on_record(r);
         };

@@ -1,13 +1,11 @@
 //! Pictures of team episodes: the whole scene with every robot's path, start and goal in its own
 //! colour (the colours of [`crate::render::chart::policy_colour`], repeating after ten).
 
-use crate::eval::{Evaluator, TeamRecord};
+use crate::eval::TeamRecord;
 use crate::geometry::Point;
-use crate::policy::TeamPolicy;
 use crate::render::chart::{policy_colour, POLICY_COUNT};
-use crate::render::gif::{Animation, AnimationError, GifOptions, GifWriter};
+use crate::render::gif::{AnimationError, GifWriter};
 use crate::render::Canvas;
-use crate::run::RunError;
 use crate::sim::team::Team;
 use image::{Rgb, RgbImage};
 
@@ -116,85 +114,4 @@ pub fn team_gif_writer(width: u32, height: u32) -> Result<GifWriter<Vec<u8>>, An
         u16::try_from(height).map_err(|_| too_large())?,
         &team_palette(),
     )?)
-}
-
-/// A team episode that could not be animated.
-#[derive(Debug, thiserror::Error)]
-pub enum TeamAnimationError {
-    /// The episode could not be run again.
-    #[error(transparent)]
-    Run(#[from] RunError),
-    /// The frames could not be encoded.
-    #[error(transparent)]
-    Animation(#[from] AnimationError),
-}
-
-/// Runs team episode `seed` again with `policy` (fresh from its factory; robot `k`'s named
-/// `names[k]`)
-/// and draws it from above ([`team_frame`] at `options.scale`) every `options.stride` steps.
-/// Returns the animation and the re-run's record (a policy that is not deterministic may play
-/// the episode otherwise than the run did).
-pub fn animate_team(
-    evaluator: &Evaluator,
-    policy: &mut dyn TeamPolicy,
-    names: &[String],
-    seed: u64,
-    options: &GifOptions,
-) -> Result<(Animation, TeamRecord), TeamAnimationError> {
-    let stride = options.stride.max(1);
-    let worlds = evaluator.worlds().team(seed);
-    let Some(world) = worlds.first() else {
-        let source =
-            crate::sim::placement::EpisodeError::Moving("a team needs at least one robot".into());
-        return Err(RunError::Episode { seed, source }.into());
-    };
-    let (width, height) = Canvas::new(world.scene(), options.scale)
-        .into_image()
-        .dimensions();
-    let mut writer = team_gif_writer(width, height)?;
-    let mut paths: Vec<Vec<Point>> = Vec::new();
-    let mut pending: Option<RgbImage> = None;
-    let mut failed: Option<gif::EncodingError> = None;
-    let mut watch = |team: &Team| {
-        if paths.is_empty() {
-            paths = vec![Vec::new(); team.robots().len()];
-        }
-        for (k, path) in paths.iter_mut().enumerate() {
-            let p = team.robot(k).pose().position();
-            if team.present(k) && path.last() != Some(&p) {
-                path.push(p);
-            }
-        }
-        if failed.is_some() || (team.steps() % stride != 0 && !team.is_done()) {
-            return;
-        }
-        if let Some(before) = pending.take() {
-            if let Err(e) = writer.add(&before, options.frame_delay_cs) {
-                failed = Some(e);
-                return;
-            }
-        }
-        pending = Some(team_frame(team, &paths, options.scale));
-    };
-    let record =
-        evaluator.watch_team_episode(policy, names, seed, Default::default(), &mut watch)?;
-    if let Some(e) = failed {
-        return Err(AnimationError::from(e).into());
-    }
-    if let Some(last) = pending {
-        writer
-            .add(&last, options.last_frame_delay_cs)
-            .map_err(AnimationError::from)?;
-    }
-    let frames = writer.frames();
-    let bytes = writer.finish().map_err(AnimationError::from)?;
-    Ok((
-        Animation {
-            bytes,
-            frames,
-            steps: record.steps as usize,
-            size: (width, height),
-        },
-        record,
-    ))
 }

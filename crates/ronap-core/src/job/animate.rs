@@ -1,0 +1,52 @@
+//! Animations of a run's own episodes (`ronap run --gif SEED`), drawn from the steps the run
+//! recorded for those seeds ([`crate::eval::EvalOptions::steps_of`]): the recorded actions are
+//! stepped again in the model, no policy is asked again, so a GIF always shows the episode its
+//! row in `episodes.csv` describes.
+
+use crate::eval::{EpisodeRecord, Evaluator, TeamRecord};
+use crate::io::steplog::LoggedStep;
+use crate::job::{replay_team, RobotLog};
+use crate::render::gif::{animate, Animation, GifOptions};
+
+/// The top-view animation of lone episode `record`, whose steps were recorded.
+pub(crate) fn lone(evaluator: &Evaluator, record: &EpisodeRecord) -> Result<Animation, String> {
+    let episode = evaluator
+        .worlds()
+        .episode(record.seed)
+        .map_err(|e| e.to_string())?;
+    let actions: Vec<_> = record.step_log.iter().map(|s| s.action).collect();
+    animate(episode, &actions, None, &GifOptions::default()).map_err(|e| e.to_string())
+}
+
+/// The top-view animation of team episode `record`, whose robots' steps were recorded (about 500
+/// pixels along the scene's longer side).
+pub(crate) fn team(evaluator: &Evaluator, record: &TeamRecord) -> Result<Animation, String> {
+    let seed = record.seed;
+    let scene_side = evaluator
+        .worlds()
+        .team(seed)
+        .first()
+        .map_or(1000.0, |w| w.scene().width().max(w.scene().height()));
+    let options = GifOptions {
+        scale: (500.0 / scene_side).clamp(0.1, 4.0),
+        ..GifOptions::default()
+    };
+    let logs: Vec<RobotLog> = record
+        .step_logs
+        .iter()
+        .enumerate()
+        .map(|(robot, steps)| RobotLog {
+            robot,
+            steps: steps
+                .iter()
+                .map(|s| LoggedStep {
+                    seed,
+                    step: s.step,
+                    pose: s.pose,
+                    action: s.action,
+                })
+                .collect(),
+        })
+        .collect();
+    replay_team(evaluator, seed, &logs, &options).map_err(|e| e.to_string())
+}
