@@ -323,12 +323,13 @@ pub fn train(
         options.replay_capacity.max(options.batch),
         options.prioritized.map(|p| p.alpha),
     );
-    let mut pending: Vec<NStep> = (0..batch.len()).map(|_| NStep::default()).collect();
+    let mut pending: Vec<NStep> = (0..batch.len())
+        .map(|_| NStep::new(options.n_step, options.gamma))
+        .collect();
     let mut recent: VecDeque<(f64, bool)> = VecDeque::with_capacity(100);
     let (mut steps, mut episodes, mut updates) = (0u64, 0u64, 0usize);
     let (mut loss_sum, mut loss_count) = (0.0, 0usize);
     let mut next_report = report_every.max(1);
-    let gamma = options.gamma;
     let progress = |steps: u64| (steps as f64 / options.steps.max(1) as f64).min(1.0);
     let epsilon_at = |steps: u64| {
         let f = (steps as f64 / options.epsilon_decay_steps.max(1) as f64).min(1.0);
@@ -390,8 +391,6 @@ pub fn train(
                 &next[row],
                 done,
                 s.status.is_terminated(),
-                options.n_step,
-                gamma,
             ) {
                 replay.push(&t);
             }

@@ -226,17 +226,28 @@ impl SumTree {
     }
 }
 
-/// The last steps of one environment's episode, turned into n-step transitions.
-#[derive(Debug, Default)]
+/// The last steps of one environment's episode, turned into n-step transitions of `n` steps
+/// discounted by `gamma`.
+#[derive(Debug)]
 pub struct NStep {
     steps: VecDeque<(Vec<f32>, u32, f32)>,
+    n: usize,
+    gamma: f64,
 }
 
 impl NStep {
+    /// Transitions of `n` steps (at least 1), rewards discounted by `gamma`.
+    pub fn new(n: usize, gamma: f64) -> Self {
+        Self {
+            steps: VecDeque::new(),
+            n,
+            gamma,
+        }
+    }
+
     /// Adds the step from `observation` by `action` with `reward`, to `next`; returns the
     /// transitions that are complete: the one starting `n` steps back, or, when the episode
     /// ended (`done`, `terminated` if not by a time-out), every one still pending.
-    #[allow(clippy::too_many_arguments)]
     pub fn add(
         &mut self,
         observation: &[f32],
@@ -245,9 +256,8 @@ impl NStep {
         next: &[f32],
         done: bool,
         terminated: bool,
-        n: usize,
-        gamma: f64,
     ) -> Vec<Transition> {
+        let (n, gamma) = (self.n, self.gamma);
         self.steps.push_back((observation.to_vec(), action, reward));
         let mut out = Vec::new();
         let make = |steps: &VecDeque<(Vec<f32>, u32, f32)>, terminal: bool| {
@@ -292,7 +302,7 @@ mod tests {
     fn n_step_returns_by_hand() {
         // Rewards 1, 2, 4, 8 then success: with n = 3, gamma 0.5.
         let g = 0.5;
-        let mut n = NStep::default();
+        let mut n = NStep::new(3, g);
         let mut got = Vec::new();
         for (k, r) in [1.0f32, 2.0, 4.0].iter().enumerate() {
             got.extend(n.add(
@@ -302,8 +312,6 @@ mod tests {
                 &obs(k as f32 + 1.0),
                 false,
                 false,
-                3,
-                g,
             ));
         }
         // Three steps in: the first transition, 1 + 0.5*2 + 0.25*4 = 3, bootstrapped by 0.125
@@ -316,7 +324,7 @@ mod tests {
         assert_eq!(got[0].bootstrap, 0.125);
         // The episode ends at the goal on the fourth step: the two pending and the last one,
         // none bootstrapped.
-        let end = n.add(&obs(3.0), 1, 8.0, &obs(4.0), true, true, 3, g);
+        let end = n.add(&obs(3.0), 1, 8.0, &obs(4.0), true, true);
         let rewards: Vec<f32> = end.iter().map(|t| t.reward).collect();
         assert_eq!(
             rewards,
@@ -326,14 +334,14 @@ mod tests {
             .iter()
             .all(|t| t.bootstrap == 0.0 && t.next_observation == obs(4.0)));
         // A time-out ends the episode without ending the task: the pending ones bootstrap.
-        let mut n = NStep::default();
-        n.add(&obs(0.0), 0, 1.0, &obs(1.0), false, false, 3, g);
-        let end = n.add(&obs(1.0), 0, 1.0, &obs(2.0), true, false, 3, g);
+        let mut n = NStep::new(3, g);
+        n.add(&obs(0.0), 0, 1.0, &obs(1.0), false, false);
+        let end = n.add(&obs(1.0), 0, 1.0, &obs(2.0), true, false);
         let b: Vec<f32> = end.iter().map(|t| t.bootstrap).collect();
         assert_eq!(b, vec![0.25, 0.5]);
         // One step: Algorithm 1's targets.
-        let mut n = NStep::default();
-        let t = n.add(&obs(0.0), 2, -1.0, &obs(1.0), false, false, 1, 0.9);
+        let mut n = NStep::new(1, 0.9);
+        let t = n.add(&obs(0.0), 2, -1.0, &obs(1.0), false, false);
         assert_eq!(t[0].reward, -1.0);
         assert!((t[0].bootstrap - 0.9).abs() < 1e-7);
     }

@@ -10,6 +10,15 @@ use ronap_core::sim::world::Worlds;
 use ronap_core::{Episode, Point};
 
 /// One RoNAP environment.
+/// What `Env.step` returns: observation, reward, terminated, truncated and info.
+type Stepped<'py> = (
+    Bound<'py, PyArray1<f32>>,
+    f64,
+    bool,
+    bool,
+    Bound<'py, PyDict>,
+);
+
 #[pyclass(module = "ronap._ronap")]
 pub struct Env {
     worlds: Worlds,
@@ -61,18 +70,7 @@ impl Env {
     }
 
     /// Takes one step; returns (observation, reward, terminated, truncated, info).
-    #[allow(clippy::type_complexity)]
-    fn step<'py>(
-        &mut self,
-        py: Python<'py>,
-        action: &Bound<'py, PyAny>,
-    ) -> PyResult<(
-        Bound<'py, PyArray1<f32>>,
-        f64,
-        bool,
-        bool,
-        Bound<'py, PyDict>,
-    )> {
+    fn step<'py>(&mut self, py: Python<'py>, action: &Bound<'py, PyAny>) -> PyResult<Stepped<'py>> {
         let action = conv::action(action, self.continuous)
             .map_err(|why| ActionError::new_err(format!("action {action}: {why}")))?;
         let episode = self

@@ -3,6 +3,7 @@
 
 use crate::conv::{self, Config};
 use crate::errors;
+use crate::kwargs::Options;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -240,25 +241,30 @@ fn policy_factory(
 /// "episodes": [...]} with the figures and rows `ronap run` reports, and writes its files (the
 /// same files, `summary.json` in the same schema) into `out` when given.
 #[pyfunction]
-#[pyo3(signature = (policy, seeds, config, maze_seed = None, map_path = None, threads = 0, continuous = false, out = None, png = None, log_steps = false, thread_safe = false, batch = 0, rows = false, force = false))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (policy, seeds, config, **options))]
 pub fn evaluate<'py>(
     py: Python<'py>,
     policy: &Bound<'py, PyAny>,
     seeds: Vec<u64>,
     config: &Config,
-    maze_seed: Option<u64>,
-    map_path: Option<&str>,
-    threads: usize,
-    continuous: bool,
-    out: Option<std::path::PathBuf>,
-    png: Option<String>,
-    log_steps: bool,
-    thread_safe: bool,
-    batch: usize,
-    rows: bool,
-    force: bool,
+    options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    // maze_seed, map_path, threads, continuous, out, png, log_steps, thread_safe, batch, rows and
+    // force, as ronap.evaluate names them.
+    let o = Options::new("evaluate", options);
+    let maze_seed: Option<u64> = o.take("maze_seed", None)?;
+    let map_path: Option<String> = o.take("map_path", None)?;
+    let threads: usize = o.take("threads", 0)?;
+    let continuous: bool = o.take("continuous", false)?;
+    let out: Option<std::path::PathBuf> = o.take("out", None)?;
+    let png: Option<String> = o.take("png", None)?;
+    let log_steps: bool = o.take("log_steps", false)?;
+    let thread_safe: bool = o.take("thread_safe", false)?;
+    let batch: usize = o.take("batch", 0)?;
+    let rows: bool = o.take("rows", false)?;
+    let force: bool = o.take("force", false)?;
+    o.finish()?;
+    let map_path = map_path.as_deref();
     let config = config.valid();
     let first = first_seed(&seeds)?;
     let (factory, name) = if batch > 0 {
@@ -387,27 +393,31 @@ pub fn policy_name(policy: &Bound<'_, PyAny>) -> String {
 /// returns the figures of `compare.json` as a dict, and writes every file of `ronap compare` into
 /// `out` when given. `runs`: finished run directories to reuse.
 #[pyfunction]
-#[pyo3(signature = (policies, seeds, config, maze_seed = None, map_path = None, threads = 0, continuous = false, out = None, runs = Vec::new(), by_difficulty = false, bins = 3, resamples = 10_000, sheet = 6, thread_safe = false, command = None, force = false))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (policies, seeds, config, **options))]
 pub fn compare<'py>(
     py: Python<'py>,
     policies: Vec<Bound<'py, PyAny>>,
     seeds: Vec<u64>,
     config: &Config,
-    maze_seed: Option<u64>,
-    map_path: Option<&str>,
-    threads: usize,
-    continuous: bool,
-    out: Option<std::path::PathBuf>,
-    runs: Vec<std::path::PathBuf>,
-    by_difficulty: bool,
-    bins: usize,
-    resamples: usize,
-    sheet: usize,
-    thread_safe: bool,
-    command: Option<String>,
-    force: bool,
+    options: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<PyObject> {
+    // As ronap.compare names them.
+    let o = Options::new("compare", options);
+    let maze_seed: Option<u64> = o.take("maze_seed", None)?;
+    let map_path: Option<String> = o.take("map_path", None)?;
+    let threads: usize = o.take("threads", 0)?;
+    let continuous: bool = o.take("continuous", false)?;
+    let out: Option<std::path::PathBuf> = o.take("out", None)?;
+    let runs: Vec<std::path::PathBuf> = o.take("runs", Vec::new())?;
+    let by_difficulty: bool = o.take("by_difficulty", false)?;
+    let bins: usize = o.take("bins", 3)?;
+    let resamples: usize = o.take("resamples", 10_000)?;
+    let sheet: usize = o.take("sheet", 6)?;
+    let thread_safe: bool = o.take("thread_safe", false)?;
+    let command: Option<String> = o.take("command", None)?;
+    let force: bool = o.take("force", false)?;
+    o.finish()?;
+    let map_path = map_path.as_deref();
     use ronap_core::compare::{self as cmp, CompareInfo, CompareOptions, Contender};
     let config = config.valid();
     if bins == 0 {
@@ -524,18 +534,22 @@ impl PyBlockRun {
     /// Starts the run of `policy` (a name or a callable, for its name) over `seeds` under
     /// `config` in directory `out` (made, locked, cleared of an earlier run's files).
     #[new]
-    #[pyo3(signature = (out, policy, seeds, config, maze_seed = None, map_path = None, threads = 0, force = false))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (out, policy, seeds, config, **options))]
     fn new(
         out: std::path::PathBuf,
         policy: &Bound<'_, PyAny>,
         seeds: Vec<u64>,
         config: &Config,
-        maze_seed: Option<u64>,
-        map_path: Option<&str>,
-        threads: usize,
-        force: bool,
+        options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
+        // maze_seed, map_path, threads and force.
+        let o = Options::new("BlockRun", options);
+        let maze_seed: Option<u64> = o.take("maze_seed", None)?;
+        let map_path: Option<String> = o.take("map_path", None)?;
+        let threads: usize = o.take("threads", 0)?;
+        let force: bool = o.take("force", false)?;
+        o.finish()?;
+        let map_path = map_path.as_deref();
         let first = first_seed(&seeds)?;
         let (info, _) = run_info(policy_name(policy), config.valid(), maze_seed, map_path)?;
         let writer =

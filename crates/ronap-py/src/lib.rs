@@ -9,6 +9,7 @@ mod conv;
 mod env;
 mod errors;
 mod evaluate;
+mod kwargs;
 mod mlp;
 mod multi_env;
 mod vec_env;

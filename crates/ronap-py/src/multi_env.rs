@@ -51,12 +51,34 @@ impl MultiEnv {
     }
 }
 
+/// Each robot's observation and info.
+type Observed<'py> = (Vec<Bound<'py, PyArray1<f32>>>, Vec<Bound<'py, PyDict>>);
+
+/// Each robot's message (or none) for a step.
+type Messages<'py> = Vec<Option<PyReadonlyArray1<'py, f32>>>;
+
+/// What `MultiEnv.step` returns: each robot's observation, reward, termination, truncation and
+/// info.
+type TeamStepped<'py> = (
+    Vec<Bound<'py, PyArray1<f32>>>,
+    Vec<f64>,
+    Vec<bool>,
+    Vec<bool>,
+    Vec<Bound<'py, PyDict>>,
+);
+
+/// What `VecMultiEnv.step` returns: observations, rewards, terminations and truncations (arrays
+/// of every robot of every team) and infos.
+type BatchStepped<'py> = (
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    Bound<'py, PyAny>,
+    Bound<'py, PyDict>,
+);
+
 /// Every robot's observation and info.
-#[allow(clippy::type_complexity)]
-fn observe<'py>(
-    py: Python<'py>,
-    team: &Team,
-) -> PyResult<(Vec<Bound<'py, PyArray1<f32>>>, Vec<Bound<'py, PyDict>>)> {
+fn observe<'py>(py: Python<'py>, team: &Team) -> PyResult<Observed<'py>> {
     let n = team.robots().len();
     let obs = (0..n)
         .map(|k| PyArray1::from_slice(py, team.robot(k).observation()))
@@ -97,12 +119,7 @@ impl MultiEnv {
 
     /// Starts the team episode of `seed` (the same as `ronap run` seed `seed`); returns
     /// (observations, infos), one per robot.
-    #[allow(clippy::type_complexity)]
-    fn reset<'py>(
-        &mut self,
-        py: Python<'py>,
-        seed: u64,
-    ) -> PyResult<(Vec<Bound<'py, PyArray1<f32>>>, Vec<Bound<'py, PyDict>>)> {
+    fn reset<'py>(&mut self, py: Python<'py>, seed: u64) -> PyResult<Observed<'py>> {
         let worlds = self.worlds.team(seed);
         let config = self.worlds.config().clone();
         let rollout = py
@@ -123,20 +140,13 @@ impl MultiEnv {
     /// whose episodes are over do anyway), `messages[k]` its message for the next broadcast
     /// (None or a shorter array: zeros). Returns (observations, rewards, terminated, truncated,
     /// infos), one each per robot.
-    #[allow(clippy::type_complexity)]
     #[pyo3(signature = (actions, messages = None))]
     fn step<'py>(
         &mut self,
         py: Python<'py>,
         actions: Vec<Option<Bound<'py, PyAny>>>,
-        messages: Option<Vec<Option<PyReadonlyArray1<'py, f32>>>>,
-    ) -> PyResult<(
-        Vec<Bound<'py, PyArray1<f32>>>,
-        Vec<f64>,
-        Vec<bool>,
-        Vec<bool>,
-        Vec<Bound<'py, PyDict>>,
-    )> {
+        messages: Option<Messages<'py>>,
+    ) -> PyResult<TeamStepped<'py>> {
         let continuous = self.continuous;
         let n = self.rollout("step")?.team().robots().len();
         if actions.len() != n {
@@ -345,20 +355,13 @@ impl VecMultiEnv {
     /// Steps every environment with `actions` (`N x R` indices: 0 LEFT, 1 AHEAD, 2 RIGHT) and
     /// optionally `messages` (`N x R x message_size` floats). Returns (observations, rewards,
     /// terminations, truncations, infos), the middle three `N x R`.
-    #[allow(clippy::type_complexity)]
     #[pyo3(signature = (actions, messages = None))]
     fn step<'py>(
         &mut self,
         py: Python<'py>,
         actions: PyReadonlyArray1<'py, i64>,
         messages: Option<PyReadonlyArray1<'py, f32>>,
-    ) -> PyResult<(
-        Bound<'py, PyAny>,
-        Bound<'py, PyAny>,
-        Bound<'py, PyAny>,
-        Bound<'py, PyAny>,
-        Bound<'py, PyDict>,
-    )> {
+    ) -> PyResult<BatchStepped<'py>> {
         let (n, r, m) = (
             self.batch.len(),
             self.batch.robots(),

@@ -15,6 +15,17 @@ use ronap_core::sim::world::Worlds;
 use ronap_core::{Action, Point, Status};
 
 /// Many RoNAP environments stepped together.
+/// What `VecEnv.step` returns: observations, rewards, terminations, truncations, infos and the
+/// finals of the episodes same-step autoreset restarted.
+type Stepped<'py> = (
+    Bound<'py, PyAny>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyDict>,
+    Option<Finals<'py>>,
+);
+
 #[pyclass(module = "ronap._ronap")]
 pub struct VecEnv {
     batch: Batch,
@@ -196,18 +207,22 @@ impl VecEnv {
     /// `autoreset` "next_step", "same_step" or "disabled"; `continuous` takes (v, w) actions;
     /// `render` keeps each environment's path so it can be drawn.
     #[new]
-    #[pyo3(signature = (num_envs, config, maze_seed = None, map_path = None, threads = 0, autoreset = "next_step", continuous = false, render = false))]
-    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (num_envs, config, **options))]
     fn new(
         num_envs: usize,
         config: &Config,
-        maze_seed: Option<u64>,
-        map_path: Option<&str>,
-        threads: usize,
-        autoreset: &str,
-        continuous: bool,
-        render: bool,
+        options: Option<&Bound<'_, pyo3::types::PyDict>>,
     ) -> PyResult<Self> {
+        // maze_seed, map_path, threads, autoreset, continuous and render.
+        let o = crate::kwargs::Options::new("VecEnv", options);
+        let maze_seed: Option<u64> = o.take("maze_seed", None)?;
+        let map_path: Option<String> = o.take("map_path", None)?;
+        let threads: usize = o.take("threads", 0)?;
+        let autoreset: String = o.take("autoreset", "next_step".to_string())?;
+        let continuous: bool = o.take("continuous", false)?;
+        let render: bool = o.take("render", false)?;
+        o.finish()?;
+        let (map_path, autoreset) = (map_path.as_deref(), autoreset.as_str());
         if num_envs == 0 {
             return Err(errors::ConfigError::new_err(
                 "num_envs = 0: must be at least 1",
@@ -262,19 +277,11 @@ impl VecEnv {
     /// (v px/step, w deg/step). Returns (observations, rewards, terminations, truncations,
     /// infos, finals): `finals` is None, or for the episodes same-step autoreset restarted
     /// (ended mask, their last observations, their final infos).
-    #[allow(clippy::type_complexity)]
     fn step<'py>(
         &mut self,
         py: Python<'py>,
         actions: &Bound<'py, PyAny>,
-    ) -> PyResult<(
-        Bound<'py, PyAny>,
-        Bound<'py, PyArray1<f64>>,
-        Bound<'py, PyArray1<bool>>,
-        Bound<'py, PyArray1<bool>>,
-        Bound<'py, PyDict>,
-        Option<Finals<'py>>,
-    )> {
+    ) -> PyResult<Stepped<'py>> {
         let n = self.batch.len();
         self.actions.clear();
         if self.continuous {

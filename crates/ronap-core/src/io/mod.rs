@@ -2,6 +2,7 @@
 //! logs. Uses every layer below it; the layers below never touch a file they were not handed.
 
 pub mod atomic;
+pub mod block_run;
 pub mod datalog;
 pub(crate) mod fault;
 pub mod figures;

@@ -20,6 +20,16 @@
 use crate::geometry::{Aabb, Point, Vector};
 use crate::scene::maze::Maze;
 
+/// A ray being walked: from `origin` along `dir` (`inv_dir` its component-wise inverse) up to
+/// `max_t`.
+#[derive(Clone, Copy)]
+struct Ray {
+    origin: Point,
+    dir: Vector,
+    inv_dir: Vector,
+    max_t: f64,
+}
+
 /// A maze's walls by the edges they stand on, for ray casts.
 #[derive(Clone, Debug)]
 pub struct MazeRays {
@@ -216,7 +226,13 @@ impl MazeRays {
                 return Some(NO_WALL);
             };
             if (ahead - half).abs() > off_middle {
-                self.crossing_corners(x_first, edge as usize, t, dir, inv_dir, o, max_t, &mut best);
+                let ray = Ray {
+                    origin: o,
+                    dir,
+                    inv_dir,
+                    max_t,
+                };
+                self.crossing_corners(x_first, edge as usize, t, &ray, &mut best);
                 limit = best.min(max_t);
             }
             (wall != NO_WALL || limit <= t).then_some(wall)
@@ -252,18 +268,13 @@ impl MazeRays {
     /// Tests the walls meeting at each end of the crossed edge (`edge` in [`MazeRays::edges`], a
     /// vertical one when `vertical`, crossed at `t`) that the crossing comes within reach of.
     #[cold]
-    #[allow(clippy::too_many_arguments)]
-    fn crossing_corners(
-        &self,
-        vertical: bool,
-        edge: usize,
-        t: f64,
-        dir: Vector,
-        inv: Vector,
-        origin: Point,
-        max_t: f64,
-        best: &mut f64,
-    ) {
+    fn crossing_corners(&self, vertical: bool, edge: usize, t: f64, ray: &Ray, best: &mut f64) {
+        let Ray {
+            origin,
+            dir,
+            inv_dir: inv,
+            max_t,
+        } = *ray;
         let (c, reach, stride) = (self.cell_px, 2.0 * self.reach_px, self.cols + 1);
         // The grid corner at the edge's lower or left end (the edge's index in its half of
         // `edges`), the step to its other end, and where along the edge the ray crosses.

@@ -240,12 +240,12 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         self._vec = _ronap.VecEnv(
             num_envs,
             checked,
-            maze_seed,
-            None if map is None else str(map),
-            threads,
-            _AUTORESET[mode],
-            bool(continuous),
-            render_mode is not None,
+            maze_seed=maze_seed,
+            map_path=None if map is None else str(map),
+            threads=threads,
+            autoreset=_AUTORESET[mode],
+            continuous=bool(continuous),
+            render=render_mode is not None,
         )
         self.metadata = {**type(self).metadata, "autoreset_mode": mode}
         self.num_envs = num_envs

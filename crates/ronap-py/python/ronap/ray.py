@@ -53,7 +53,7 @@ def _block(payload: Any, seeds: list[int], config_json: str, maze_seed: int | No
             policy: Any = f"mlp:{path}" + (f"@{rule}" if rule else "")
         else:
             policy = value
-        result = _ronap.evaluate(policy, seeds, config, maze_seed, map, max(1, int(cpus)), rows=True)
+        result = _ronap.evaluate(policy, seeds, config, maze_seed=maze_seed, map_path=map, threads=max(1, int(cpus)), rows=True)
     return result["rows"]
 
 
@@ -115,7 +115,7 @@ def evaluate(
     temporary = tempfile.TemporaryDirectory(prefix="ronap-ray-") if out is None else None
     directory = temporary.name if temporary is not None else os.fspath(out)  # type: ignore[arg-type]
     threads = max(1, int(ray.cluster_resources().get("CPU", 1)))
-    run = _ronap.BlockRun(directory, policy, seeds, checked, maze_seed, map, threads, force)
+    run = _ronap.BlockRun(directory, policy, seeds, checked, maze_seed=maze_seed, map_path=map, threads=threads, force=force)
     start = time.perf_counter()
     # A window of tasks under way: enough to keep every CPU busy, few enough that finished blocks
     # waiting for an earlier one stay few.
