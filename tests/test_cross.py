@@ -202,3 +202,19 @@ def test_cli_batch_gives_the_same_bytes_as_unbatched(tmp_path, ronap_bin):
     assert bad.returncode == 2 and "expected" in bad.stderr and "actions" in bad.stderr, bad.stderr
     refused = subprocess.run(base + ["--policy", "apf", "--batch", "4", "--out", str(tmp_path / "apf")], capture_output=True, text=True)
     assert refused.returncode == 2 and "--batch 4" in refused.stderr, refused.stderr
+
+
+def test_cli_team_batch_decides_a_teams_robots_in_one_call_with_the_same_episodes(tmp_path, ronap_bin, root):
+    policy = tmp_path / "policy.py"
+    policy.write_text(POLICY_FILE + BATCHED)
+    base = [ronap_bin, "run", "--scenario", str(root / "scenarios" / "warehouse-team.toml"), "--seeds", "3", "--max-steps", "150"]
+    one = subprocess.run(base + ["--policy", f"py:{policy}:act", "--out", str(tmp_path / "one")], capture_output=True, text=True)
+    many = subprocess.run(base + ["--policy", f"py:{policy}:rows", "--batch", "2", "--out", str(tmp_path / "many")], capture_output=True, text=True)
+    assert one.returncode == 0 and many.returncode == 0, one.stderr + many.stderr
+    assert "one call a step for the robots of each" in many.stdout
+    # The same episodes robot for robot; only the policy's name differs.
+    strip = lambda p: [",".join(r.split(",")[:2] + r.split(",")[3:]) for r in p.read_text().splitlines()]
+    assert strip(tmp_path / "one" / "robots.csv") == strip(tmp_path / "many" / "robots.csv")
+    assert (tmp_path / "one" / "episodes.csv").read_bytes() == (tmp_path / "many" / "episodes.csv").read_bytes()
+    bad = subprocess.run(base + ["--policy", f"py:{policy}:too_few", "--batch", "2", "--out", str(tmp_path / "bad")], capture_output=True, text=True)
+    assert bad.returncode == 2 and "actions" in bad.stderr, bad.stderr

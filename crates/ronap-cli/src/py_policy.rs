@@ -366,3 +366,161 @@ impl Policy for PyProcess {
         }
     }
 }
+
+/// Python processes kept between team episodes, so a batched team spawns one per worker, not
+/// one per episode.
+#[derive(Clone, Default)]
+pub struct ProcessPool(std::sync::Arc<std::sync::Mutex<Vec<PyProcess>>>);
+
+impl PyPolicyFactory {
+    /// A team policy for `ronap run --batch` on a team scenario: the robots `batched` marks are
+    /// decided by one call of the function a step, with the `(n, observation size)` array of
+    /// those running (n up to the team's size); robot `k` of the others by `others[k]`. Its
+    /// process comes from `pool` (or is started) and goes back there when the episode ends.
+    pub fn batched_team(
+        &self,
+        pool: &ProcessPool,
+        batched: Vec<bool>,
+        others: Vec<Option<Box<dyn Policy>>>,
+    ) -> Result<BatchedTeam, PolicyError> {
+        let idle = pool.0.lock().ok().and_then(|mut p| p.pop());
+        let process = match idle {
+            Some(p) => p,
+            None => self.spawn().map_err(PolicyError::Failed)?,
+        };
+        Ok(BatchedTeam {
+            process: Some(process),
+            pool: pool.clone(),
+            batched,
+            others,
+            rows: Vec::new(),
+            robots: Vec::new(),
+            actions: Vec::new(),
+        })
+    }
+}
+
+/// A team whose robots of one Python function are decided together, one call a step (see
+/// [`PyPolicyFactory::batched_team`]).
+pub struct BatchedTeam {
+    process: Option<PyProcess>,
+    pool: ProcessPool,
+    batched: Vec<bool>,
+    others: Vec<Option<Box<dyn Policy>>>,
+    /// The observations of this step's call, row after row.
+    rows: Vec<f32>,
+    /// The robot of each row.
+    robots: Vec<usize>,
+    actions: Vec<Action>,
+}
+
+impl Drop for BatchedTeam {
+    fn drop(&mut self) {
+        if let (Some(p), Ok(mut pool)) = (self.process.take(), self.pool.0.lock()) {
+            pool.push(p);
+        }
+    }
+}
+
+impl ronap_core::policy::TeamPolicy for BatchedTeam {
+    fn reset(
+        &mut self,
+        team: &ronap_core::sim::team::Team,
+        worlds: &[std::sync::Arc<World>],
+    ) -> Result<(), ronap_core::policy::RobotError> {
+        let n = team.robots().len();
+        if self.batched.len() != n || self.others.len() != n {
+            return Err((
+                0,
+                PolicyError::Failed(format!(
+                    "policies for {} robots, not {n}",
+                    self.batched.len()
+                )),
+            ));
+        }
+        let mut width = None;
+        for (k, world) in worlds.iter().enumerate().take(n) {
+            if let Some(policy) = &mut self.others[k] {
+                policy.reset(world, team.robot(k)).map_err(|e| (k, e))?;
+            } else if self.batched[k] {
+                let w = team.robot(k).observation().len();
+                if *width.get_or_insert(w) != w {
+                    return Err((
+                        k,
+                        PolicyError::Failed(
+                            "--batch needs every batched robot's observation to be the same size \
+                             (its laser has another beam count)"
+                                .into(),
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn act(
+        &mut self,
+        team: &ronap_core::sim::team::Team,
+        decisions: &mut [Option<Decision>],
+    ) -> Result<(), ronap_core::policy::RobotError> {
+        self.rows.clear();
+        self.robots.clear();
+        for (k, decision) in decisions.iter_mut().enumerate() {
+            if !team.running(k) {
+                continue;
+            }
+            if let Some(policy) = &mut self.others[k] {
+                policy.hear(team.inbox(k));
+                *decision = Some(policy.act(team.robot(k)).map_err(|e| (k, e))?);
+            } else if self.batched[k] {
+                self.rows.extend_from_slice(team.robot(k).observation());
+                self.robots.push(k);
+            }
+        }
+        let Some(&first) = self.robots.first() else {
+            return Ok(());
+        };
+        let width = self.rows.len() / self.robots.len();
+        let process = self
+            .process
+            .as_mut()
+            .ok_or((first, PolicyError::Failed("no Python process".into())))?;
+        self.actions.clear();
+        process
+            .act_batch(&self.rows, width, &mut self.actions)
+            .map_err(|e| (first, e))?;
+        if self.actions.len() != self.robots.len() {
+            return Err((
+                first,
+                PolicyError::Failed(format!(
+                    "returned {} actions for {} robots, expected one per row",
+                    self.actions.len(),
+                    self.robots.len()
+                )),
+            ));
+        }
+        for (&k, &a) in self.robots.iter().zip(&self.actions) {
+            decisions[k] = Some(Decision::Act(a));
+        }
+        Ok(())
+    }
+
+    fn message(&mut self, robot: usize, out: &mut [f32]) {
+        if let Some(policy) = &mut self.others[robot] {
+            policy.message(out);
+        }
+    }
+
+    fn next_goal(
+        &mut self,
+        robot: usize,
+        world: &World,
+        episode: &Episode,
+    ) -> Result<(), PolicyError> {
+        match &mut self.others[robot] {
+            Some(policy) => policy.reset(world, episode),
+            None => Ok(()),
+        }
+    }
+}

@@ -49,6 +49,13 @@ pub struct TeamPolicies {
     factories: Vec<Box<dyn PolicyFactory>>,
     /// Robot `k`'s factory, as an index into `factories`.
     of_robot: Vec<usize>,
+    /// With `--batch`: the Python function the robots without a policy of their own share, one
+    /// call a step for all of them, and its processes; `batched[k]` for those robots.
+    batch: Option<(
+        crate::py_policy::PyPolicyFactory,
+        crate::py_policy::ProcessPool,
+    )>,
+    batched: Vec<bool>,
 }
 
 impl TeamPolicies {
@@ -58,6 +65,8 @@ impl TeamPolicies {
             names: Vec::new(),
             factories: Vec::new(),
             of_robot: Vec::new(),
+            batch: None,
+            batched: Vec::new(),
         };
         for entry in &config.robots {
             let k = team.names.len();
@@ -68,9 +77,27 @@ impl TeamPolicies {
             for _ in 0..entry.count {
                 team.names.push(name.clone());
                 team.of_robot.push(team.factories.len() - 1);
+                team.batched.push(entry.policy.is_none());
             }
         }
         Ok(team)
+    }
+
+    /// The robots driven by the default policy `default`, a `py:FILE:FUNCTION` one, decided
+    /// together: one call of the function a step for every such robot of a team episode
+    /// (`ronap run --batch` on a team scenario).
+    pub fn batched(mut self, default: &str) -> Result<Self> {
+        let Some(spec) = default.strip_prefix("py:") else {
+            anyhow::bail!("--batch: batches are for py:FILE:FUNCTION policies; {default} runs in Rust already");
+        };
+        if !self.batched.contains(&true) {
+            anyhow::bail!(
+                "--batch: every [[robots]] entry names a policy of its own; none runs {default}"
+            );
+        }
+        let factory = crate::py_policy::PyPolicyFactory::new(spec).map_err(anyhow::Error::msg)?;
+        self.batch = Some((factory, crate::py_policy::ProcessPool::default()));
+        Ok(self)
     }
 
     /// A new team policy, each robot's policy fresh from its factory; an error names the
@@ -93,6 +120,19 @@ impl TeamPolicies {
 /// Each robot driven by a policy of its own ([`PerRobot`]).
 impl TeamPolicyFactory for TeamPolicies {
     fn make(&self) -> Result<Box<dyn TeamPolicy>, PolicyError> {
+        if let Some((py, pool)) = &self.batch {
+            let others = self
+                .of_robot
+                .iter()
+                .zip(&self.batched)
+                .map(|(&i, &b)| (!b).then(|| self.factories[i].make()).transpose())
+                .collect::<Result<Vec<_>, _>>()?;
+            return Ok(Box::new(py.batched_team(
+                pool,
+                self.batched.clone(),
+                others,
+            )?));
+        }
         let policies = self
             .of_robot
             .iter()

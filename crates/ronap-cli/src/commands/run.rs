@@ -68,7 +68,9 @@ pub struct RunArgs {
     gif: Vec<u64>,
     /// For a py: policy, run N episodes side by side and call the function once for all of
     /// those waiting for an action, with an (n, observation size) array (n up to N), expecting n
-    /// actions: the same episodes as unbatched, with far fewer calls (0: one call per step).
+    /// actions: the same episodes as unbatched, with far fewer calls (0: one call per step). On a
+    /// team scenario: N team episodes under way, each step of each one a single call for all its
+    /// robots that run the function.
     #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 0, value_parser = clap::value_parser!(u16))]
     batch: u16,
     /// Exit with code 1 when the success rate is below this fraction (a gate for CI).
@@ -119,9 +121,6 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         );
     }
     if config.team_size() > 0 {
-        if job.batch > 0 {
-            bail!("--batch {}: not for team runs", job.batch);
-        }
         run_team(job, config, scenes, None)
     } else {
         run_lone(job, config, scenes, None)
@@ -394,7 +393,14 @@ fn run_team(
     scenes: Scenes,
     writer: Option<RunWriter>,
 ) -> Result<ExitCode> {
-    let policies = crate::args::TeamPolicies::new(&config, &job.policy)?;
+    let mut policies = crate::args::TeamPolicies::new(&config, &job.policy)?;
+    // A batch of N is N team episodes under way, each step of each one a call for its robots.
+    let threads = if job.batch > 0 {
+        policies = policies.batched(&job.policy)?;
+        job.batch
+    } else {
+        job.threads
+    };
     let names = policies.names.clone();
     let (first, last) = job.span();
     if let Some(s) = job.gif.iter().find(|&&s| s < first || s > last) {
@@ -423,7 +429,7 @@ fn run_team(
     );
     let options = EvalOptions {
         seeds: job.seeds.clone(),
-        threads: job.threads,
+        threads,
         recording: Recording::default(),
         steps_of: Vec::new(),
     };
@@ -447,7 +453,11 @@ fn run_team(
         "ronap run: {} ({}), seeds {first}..{last}, {}",
         crate::output::counted(names.len() as u64, "robot"),
         summary_of_names(&names),
-        crate::output::counted(job.threads as u64, "thread")
+        if job.batch > 0 {
+            format!("{threads} team episodes at once, one call a step for the robots of each")
+        } else {
+            crate::output::counted(threads as u64, "thread")
+        }
     )?;
     write!(stdout, "{}", evaluation.team.table())?;
     writeln!(stdout, "per robot:")?;

@@ -13,7 +13,7 @@ pub mod random;
 pub mod team;
 
 pub use name::{factory, Builtin, PolicyNameError};
-pub use team::{PerRobot, PerRobotFactory, TeamPolicy, TeamPolicyFactory};
+pub use team::{PerRobot, PerRobotFactory, RobotError, TeamPolicy, TeamPolicyFactory};
 
 use crate::sim::episode::Episode;
 use crate::sim::robot::Action;
