@@ -2,7 +2,7 @@
 //! swap deadlocks and says so, robots.csv beside team rows, the same bytes on one and two
 //! threads, and bad entries named.
 
-use crate::util::{assert_rejected, col, ok, repo_root, ronap, rows};
+use crate::util::{assert_rejected, col, ok, repo_root, ronap, rows, summary};
 use std::path::Path;
 
 fn run_team(scenario: &Path, out: &Path, extra: &[&str]) -> String {
@@ -319,4 +319,62 @@ fn log_steps_writes_a_log_per_robot_and_replay_plays_the_team_again() {
     assert_ne!(o.status.code(), Some(0));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("robot 5, step 4"), "{err}");
+}
+
+/// A team of one (`[[robots]] count = 1`) is the lone robot, run for run: every column the two
+/// run files share holds the same text, seed by seed, and so do the summary's figures.
+#[test]
+fn a_team_of_one_runs_as_the_lone_robot_column_for_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let pedestrians =
+        std::fs::read_to_string(repo_root().join("scenarios/maze-pedestrians.toml")).unwrap();
+    for (name, base, policy) in [
+        ("maze", String::new(), "apf"),
+        ("maze", String::new(), "geodesic"),
+        ("pedestrians", pedestrians, "geodesic-wait"),
+    ] {
+        let lone_file = dir.path().join(format!("{name}-{policy}-lone.toml"));
+        let team_file = dir.path().join(format!("{name}-{policy}-team.toml"));
+        std::fs::write(&lone_file, &base).unwrap();
+        std::fs::write(&team_file, format!("{base}\n[[robots]]\ncount = 1\n")).unwrap();
+        let run = |file: &std::path::Path, out: &str| {
+            let out = dir.path().join(out);
+            ok(&ronap(&[
+                "run",
+                "--scenario",
+                file.to_str().unwrap(),
+                "--policy",
+                policy,
+                "--seeds",
+                "30",
+                "--out",
+                out.to_str().unwrap(),
+            ]));
+            out
+        };
+        let lone = run(&lone_file, &format!("{name}-{policy}-lone"));
+        let team = run(&team_file, &format!("{name}-{policy}-team"));
+        let episodes = rows(&lone.join("episodes.csv"));
+        let robots = rows(&team.join("robots.csv"));
+        assert_eq!(episodes.len(), robots.len(), "{name} {policy}");
+        let shared: Vec<&String> = episodes[0]
+            .iter()
+            .filter(|c| robots[0].contains(c))
+            .collect();
+        assert!(shared.len() >= 12, "{shared:?}");
+        for column in shared {
+            let (a, b) = (col(&episodes, column), col(&robots, column));
+            for (e, r) in episodes.iter().zip(&robots).skip(1) {
+                assert_eq!(e[a], r[b], "{name} {policy}: seed {} {column}", e[0]);
+            }
+        }
+        let figures = |dir: &std::path::Path| {
+            let mut s = summary(dir);
+            for k in ["wall_time_s", "steps_per_second"] {
+                s.as_object_mut().unwrap().remove(k);
+            }
+            s
+        };
+        assert_eq!(figures(&lone), figures(&team), "{name} {policy}: summary");
+    }
 }

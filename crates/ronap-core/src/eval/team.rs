@@ -38,8 +38,8 @@ pub struct RobotRecord {
     pub collisions: u32,
     /// Steps another robot blocked.
     pub robot_collisions: u32,
-    /// Steps with contact with a moving obstacle, when there were some.
-    pub dynamic_collisions: Option<u32>,
+    /// How it went among moving obstacles, when there were some.
+    pub dynamic: Option<crate::sim::episode::DynamicMetrics>,
     /// Distance driven, px.
     pub path_length_px: f64,
     /// Goals it had (1, or a goal list's length).
@@ -84,7 +84,7 @@ impl RobotRecord {
             last_readings: Vec::new(),
             trajectory: Vec::new(),
             mover_tracks: Vec::new(),
-            dynamic: None,
+            dynamic: self.dynamic,
             step_log: Vec::new(),
             world: None,
         }
@@ -498,7 +498,7 @@ impl Evaluator {
                 arrived_at: team.arrived_at(k),
                 collisions: r.collisions(),
                 robot_collisions: r.robot_collisions(),
-                dynamic_collisions: r.dynamic_metrics().map(|d| d.collisions),
+                dynamic: r.dynamic_metrics(),
                 goals: team.goals(k).len() as u32,
                 goals_reached: r.goals_reached(),
                 tour,

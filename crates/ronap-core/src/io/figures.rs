@@ -33,13 +33,16 @@ const TEAM_BASE: [&str; 7] = [
     "robot_collisions",
 ];
 
-const ROBOT_FIELDS: [&str; 6] = [
+const ROBOT_FIELDS: [&str; 9] = [
     "outcome",
     "steps",
     "collisions",
     "path_length_bits",
     "spl_bits",
     "return_bits",
+    "dynamic_collisions",
+    "min_clearance_bits",
+    "near_steps",
 ];
 
 /// Columns for team episodes of `robots` robots.
@@ -97,8 +100,21 @@ pub fn team_row(seed: u64, team: &TeamFigures, robots: &[Figures]) -> Vec<String
             bits(r.spl),
             bits(r.total_reward),
         ]);
+        row.extend(dynamic_fields(r.dynamic));
     }
     row
+}
+
+/// The moving-obstacle figures of an episode, empty without moving obstacles.
+fn dynamic_fields(d: Option<DynamicMetrics>) -> [String; 3] {
+    match d {
+        Some(d) => [
+            d.collisions.to_string(),
+            bits(d.min_clearance_px),
+            d.near_steps.to_string(),
+        ],
+        None => [String::new(), String::new(), String::new()],
+    }
 }
 
 /// Reads fields of a row in order, naming the column of a bad one.
@@ -136,6 +152,11 @@ impl Fields<'_> {
         let at = self.at + 1;
         let text = self.text()?;
         Outcome::from_name(text).ok_or_else(|| format!("field {at}: {text:?} is not an outcome"))
+    }
+
+    /// Passes over `n` fields.
+    fn skip(&mut self, n: usize) {
+        self.at += n;
     }
 
     fn optional<T: std::str::FromStr>(&mut self) -> Result<Option<T>, String> {
@@ -196,7 +217,17 @@ pub fn parse_team(
             path_length_px: f.bits()?,
             spl: f.bits()?,
             total_reward: f.bits()?,
-            dynamic: None,
+            dynamic: match f.optional::<u32>()? {
+                Some(collisions) => Some(DynamicMetrics {
+                    collisions,
+                    min_clearance_px: f.bits()?,
+                    near_steps: f.parse()?,
+                }),
+                None => {
+                    f.skip(2);
+                    None
+                }
+            },
         };
         team.robots.push(RobotFigures {
             outcome: r.outcome,
@@ -258,5 +289,13 @@ mod tests {
         let (seed, t, robots) = parse_team(&row, 1).expect("parses");
         assert_eq!((seed, &t, robots.as_slice()), (4, &team, &[plain][..]));
         assert!(parse_team(&row, 2).is_err());
+        // A team among moving obstacles keeps each robot's figures there too, after a robot
+        // without them.
+        let mut two = team.clone();
+        two.robots.push(two.robots[0]);
+        let row = csv::StringRecord::from(team_row(5, &two, &[plain, lone]));
+        assert_eq!(row.len(), team_columns(2).len());
+        let (_, _, robots) = parse_team(&row, 2).expect("parses");
+        assert_eq!(robots, vec![plain, lone]);
     }
 }

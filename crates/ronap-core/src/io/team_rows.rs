@@ -90,8 +90,8 @@ pub fn robot_rows(r: &TeamRecord) -> Vec<Vec<String>> {
                 x.arrived_at.map_or(String::new(), |a| a.to_string()),
                 x.collisions.to_string(),
                 x.robot_collisions.to_string(),
-                x.dynamic_collisions
-                    .map_or(String::new(), |d| d.to_string()),
+                x.dynamic
+                    .map_or(String::new(), |d| d.collisions.to_string()),
                 x.goals.to_string(),
                 x.goals_reached.to_string(),
                 x.tour
