@@ -31,6 +31,14 @@ fn turn(heading: Vector, offset: Vector) -> Vector {
     )
 }
 
+/// The few boxes within a scan's range: `picked` indexes `boxes`, `sides[k]` is box
+/// `picked[k]`'s [`Aabb::sides_from`] the scan's origin.
+struct Local<'a> {
+    boxes: &'a [Aabb],
+    picked: &'a [u32],
+    sides: &'a [[f64; 4]],
+}
+
 /// Beams go through the vectorised loops in blocks of this many.
 const BLOCK: usize = 32;
 
@@ -189,27 +197,35 @@ impl Laser {
         let range = self.range_px;
         let r2 = range * range;
         let near = scene.boxes_near(position, range);
-        // The boxes within range, when the bin lists few enough to look through and there are
-        // few enough of them.
-        let mut local = [Aabb::from_corners(Point::origin(), Point::origin()); MAX_LOCAL_BOXES];
+        // The boxes within range (their indices, and their sides seen from `position`), when
+        // the bin lists few enough to look through and there are few enough of them. (Two
+        // small arrays: a scan zeroes them every step.)
+        let mut picked = [0u32; MAX_LOCAL_BOXES];
+        let mut sides = [[0.0; 4]; MAX_LOCAL_BOXES];
         let mut count = usize::MAX;
+        let boxes = scene.boxes();
         if near.len() <= MAX_LISTED_BOXES {
-            let boxes = scene.boxes();
             count = 0;
             for &i in near {
-                let b = boxes[i as usize];
+                let b = &boxes[i as usize];
                 if b.distance_squared(position) <= r2 {
                     if count == MAX_LOCAL_BOXES {
                         count = usize::MAX;
                         break;
                     }
-                    local[count] = b;
+                    picked[count] = i;
+                    sides[count] = b.sides_from(position);
                     count += 1;
                 }
             }
         }
         if count <= MAX_LOCAL_BOXES {
-            self.local_hits(position, heading, &local[..count], out);
+            let local = Local {
+                boxes,
+                picked: &picked[..count],
+                sides: &sides[..count],
+            };
+            self.local_hits(position, heading, &local, out);
         } else {
             let beams = self.offsets.iter().map(|offset| turn(heading, *offset));
             scene
@@ -236,13 +252,9 @@ impl Laser {
     /// `range_px` where none is hit: the beams in blocks, each box against a block's beams side
     /// by side ([`least_box_hits`], the same bits as `ray_hit`). A beam along an axis (an
     /// infinite inverse component, where `ray_hit` must look for NaN) is asked of `ray_hit`.
-    fn local_hits(&self, position: Point, heading: Vector, boxes: &[Aabb], out: &mut [f64]) {
+    fn local_hits(&self, position: Point, heading: Vector, local: &Local<'_>, out: &mut [f64]) {
         let range = self.range_px;
-        let mut sides = [[0.0; 4]; MAX_LOCAL_BOXES];
-        for (s, b) in sides.iter_mut().zip(boxes) {
-            *s = b.sides_from(position);
-        }
-        let sides = &sides[..boxes.len()];
+        let sides = local.sides;
         let (mut ix, mut iy) = ([0.0; BLOCK], [0.0; BLOCK]);
         for (offsets, out) in self.offsets.chunks(BLOCK).zip(out.chunks_mut(BLOCK)) {
             let along_axis = inverse_directions(heading, offsets, &mut ix, &mut iy);
@@ -251,9 +263,10 @@ impl Laser {
                 for k in 0..offsets.len() {
                     if !(ix[k].is_finite() && iy[k].is_finite()) {
                         let inv = Vector::new(ix[k], iy[k]);
-                        out[k] = boxes
+                        out[k] = local
+                            .picked
                             .iter()
-                            .filter_map(|b| b.ray_hit(position, inv, range))
+                            .filter_map(|&i| local.boxes[i as usize].ray_hit(position, inv, range))
                             .fold(range, smaller);
                     }
                 }
