@@ -1,6 +1,7 @@
 //! Output helpers of the binary: progress bars, closed pipes, Ctrl-C, clock time for file names;
 //! atomic writing itself lives in `ronap_core::io::atomic`.
 
+use std::io::Write as _;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
@@ -70,7 +71,9 @@ pub fn cancel_on_ctrl_c(what: &'static str) -> Arc<AtomicBool> {
                             } else {
                                 ""
                             };
-                            eprintln!("\nronap: interrupted; {what}{again}");
+                            // A closed terminal (SIGHUP) must not end this thread.
+                            let _ =
+                                writeln!(std::io::stderr(), "\nronap: interrupted; {what}{again}");
                         }
                         Some(at) => {
                             if should_quit_now(signal, terminal, at) {

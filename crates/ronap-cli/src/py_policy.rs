@@ -161,7 +161,12 @@ impl PyPolicyFactory {
     }
 
     fn spawn(&self) -> Result<PyProcess, String> {
-        let mut child = Command::new(&self.python)
+        let mut command = Command::new(&self.python);
+        // A process group of its own: the signals a terminal or `timeout` sends ronap's group
+        // are ronap's to handle (it stops cleanly, then ends the process), not the policy's.
+        #[cfg(unix)]
+        std::os::unix::process::CommandExt::process_group(&mut command, 0);
+        let mut child = command
             .args(["-u", "-c", DRIVER])
             .arg(&self.file)
             .arg(&self.function)
@@ -487,9 +492,11 @@ impl ronap_core::policy::TeamPolicy for BatchedTeam {
             .as_mut()
             .ok_or((first, PolicyError::Failed("no Python process".into())))?;
         self.actions.clear();
-        process
-            .act_batch(&self.rows, width, &mut self.actions)
-            .map_err(|e| (first, e))?;
+        if let Err(e) = process.act_batch(&self.rows, width, &mut self.actions) {
+            // A process that failed (or exited) is not handed to the next episode.
+            self.process = None;
+            return Err((first, e));
+        }
         if self.actions.len() != self.robots.len() {
             return Err((
                 first,

@@ -499,6 +499,14 @@ fn stopped_writing(e: ronap_core::io::atomic::OutputError, dir: &Path) -> anyhow
     } else {
         "fix the cause"
     };
+    if let OutputError::Episodes { .. } = &e {
+        // The run itself is whole; pictures, step logs or GIFs are missing.
+        return anyhow::Error::new(e).context(format!(
+            "the run finished and its results are in {}, but some of its per-episode files are \
+             missing",
+            dir.display()
+        ));
+    }
     let plan = dir.join(ronap_core::io::manifest::PLAN_FILE);
     let next = if plan.exists() {
         format!(

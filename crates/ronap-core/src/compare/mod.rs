@@ -370,7 +370,18 @@ pub fn compare(
                 team: manifest.team,
                 seeds,
             },
-            None => run_one(&setting, c, &label, index)?,
+            None => match run_one(&setting, c, &label, index) {
+                Ok(r) => r,
+                Err(e) => {
+                    // A comparison replaced (`replace`) that stops here has replaced some of
+                    // the earlier one's runs: its report goes too, so the directory never shows
+                    // a report of runs that are not there.
+                    if let (Some(dir), true) = (out, options.replace) {
+                        let _ = report::remove_earlier(dir);
+                    }
+                    return Err(e);
+                }
+            },
         };
         policies.push(result);
     }

@@ -66,6 +66,8 @@ pub struct BlockRun {
     /// How many of the seeds have their rows.
     next: usize,
     steps_before: u64,
+    /// The run files failed to take rows: the run ends without a summary, its files partial.
+    broken: Option<String>,
 }
 
 impl BlockRun {
@@ -97,6 +99,7 @@ impl BlockRun {
             options: options.clone(),
             info: info.clone(),
             next: done,
+            broken: None,
             steps_before,
         })
     }
@@ -124,7 +127,10 @@ impl BlockRun {
                 path: self.writer.dir.join(FIGURES_FILE),
                 message: format!("seed {}: {message}", r.seed),
             })?;
-            self.streams.add(&self.writer, &r.files())?;
+            if let Err(e) = self.streams.add(&self.writer, &r.files()) {
+                self.broken = Some(e.to_string());
+                return Err(e);
+            }
             self.tally.add(&f);
             self.next += 1;
         }
@@ -134,6 +140,13 @@ impl BlockRun {
     /// Ends the run after `wall_time_s` seconds: the files to their final names (kept partial,
     /// for a resume, when seeds are missing) and `summary.json`. Returns what it holds.
     pub fn finish(self, wall_time_s: f64) -> Result<RunManifest, OutputError> {
+        if let Some(message) = &self.broken {
+            // As `evaluate_into` after a write error: no file under a final name half-written.
+            return Err(OutputError::Format {
+                path: self.writer.dir.join("summary.json"),
+                message: format!("not written: the run files could not be written ({message})"),
+            });
+        }
         let missing = self.next < self.options.seeds.len();
         let result = RunResult {
             records: Vec::new(),

@@ -209,9 +209,11 @@ pub struct RunWriter {
     resumed: Option<Resumed>,
     /// The directory held something (an earlier run, other files) before this run.
     held: bool,
-    /// Whether the directory has been made ready for this run's files (an earlier run's
-    /// removed), which waits for the first finished episode.
-    ready: Mutex<bool>,
+    /// Whether the directory has been made ready for this run's files: an earlier run's
+    /// pictures, step logs and GIFs removed (with the first finished episode, whichever
+    /// finishes first), and its run files, summary and plan (with the first episode's rows, in
+    /// seed order: a run whose first seed fails leaves them).
+    ready: Mutex<Ready>,
     /// The run ended cleanly: its lock file goes with the lock.
     clean: AtomicBool,
     /// The seeds whose episodes are animated into `gif/`.
@@ -227,6 +229,13 @@ impl Drop for RunWriter {
             }
         }
     }
+}
+
+/// How far a directory was made ready for a new run's files.
+#[derive(Debug, Default)]
+struct Ready {
+    episode_files: bool,
+    run_files: bool,
 }
 
 /// What a run stopped short had finished.
@@ -247,6 +256,8 @@ enum Holding {
     Finished,
     /// A run stopped short, and how it shows.
     StoppedShort(String),
+    /// A run that failed before finishing any episode: nothing to keep, replaced without asking.
+    Failed,
     /// Something that is no run: the first entry found.
     Other(String),
 }
@@ -270,6 +281,8 @@ impl Holding {
                     "its summary.json says it failed after {} episodes",
                     m.summary.episodes
                 ))
+            } else if m.error.is_some() {
+                Self::Failed
             } else {
                 Self::Finished
             };
@@ -277,8 +290,13 @@ impl Holding {
         if dir.join(PLAN_FILE).exists() {
             return Self::StoppedShort(format!("its {PLAN_FILE} has no summary.json beside it"));
         }
+        // The lock, and the empty folders a run that failed at once made, are nothing.
+        let empty_folder = |e: &std::fs::DirEntry| {
+            ["png", "steps", "gif"].iter().any(|n| e.file_name() == *n)
+                && std::fs::read_dir(e.path()).is_ok_and(|mut d| d.next().is_none())
+        };
         let mut entries = std::fs::read_dir(dir).into_iter().flatten().flatten();
-        match entries.find(|e| e.file_name() != LOCK_FILE) {
+        match entries.find(|e| e.file_name() != LOCK_FILE && !empty_folder(e)) {
             Some(e) => Self::Other(e.file_name().to_string_lossy().into_owned()),
             None => Self::Nothing,
         }
@@ -303,7 +321,7 @@ impl RunWriter {
         let holding = Holding::of(dir);
         let held = !matches!(holding, Holding::Nothing);
         let refusal = match holding {
-            Holding::Nothing => None,
+            Holding::Nothing | Holding::Failed => None,
             _ if replace => None,
             Holding::Finished => Some(OutputError::Finished {
                 dir: dir.to_path_buf(),
@@ -339,30 +357,40 @@ impl RunWriter {
             front_end: serde_json::Value::Null,
             resumed: None,
             held,
-            ready: Mutex::new(false),
+            ready: Mutex::new(Ready::default()),
             clean: AtomicBool::new(false),
             gif_seeds: Vec::new(),
             lock: Some(lock),
         })
     }
 
-    /// Makes the directory ready for this run's files, once: a new run removes an earlier run's
-    /// files there (run files, summary, plan, pictures, step logs, GIFs); a resumed run keeps
-    /// everything.
+    /// Makes the directory ready for this run's per-episode files, once: a new run removes an
+    /// earlier run's pictures, step logs and GIFs there; a resumed run keeps everything.
     pub(crate) fn make_ready(&self) -> Result<(), OutputError> {
         let mut ready = self.ready.lock().unwrap_or_else(|e| e.into_inner());
-        if *ready {
-            return Ok(());
-        }
-        if self.resumed.is_none() && self.held {
+        if !ready.episode_files && self.resumed.is_none() && self.held {
             remove_stale_files(&self.dir)?;
-            for name in RUN_FILES.iter().chain(&["summary.json", PLAN_FILE]) {
+        }
+        ready.episode_files = true;
+        Ok(())
+    }
+
+    /// Makes the directory ready for this run's run files, once (and for its per-episode
+    /// files): a new run removes an earlier run's summary first, then its run files, then its
+    /// plan, so a directory stopped half-way through never shows a finished run without its
+    /// episodes.
+    fn make_ready_for_rows(&self) -> Result<(), OutputError> {
+        self.make_ready()?;
+        let mut ready = self.ready.lock().unwrap_or_else(|e| e.into_inner());
+        if !ready.run_files && self.resumed.is_none() && self.held {
+            remove_if_there(&self.dir.join("summary.json"))?;
+            for name in RUN_FILES.iter().chain(&[PLAN_FILE]) {
                 let path = self.dir.join(name);
                 remove_if_there(&path)?;
                 remove_if_there(&partial_path(&path))?;
             }
         }
-        *ready = true;
+        ready.run_files = true;
         Ok(())
     }
 
@@ -456,7 +484,7 @@ impl RunWriter {
                 done,
             }),
             held: true,
-            ready: Mutex::new(false),
+            ready: Mutex::new(Ready::default()),
             clean: AtomicBool::new(false),
             gif_seeds: Vec::new(),
             lock: Some(lock),
@@ -612,7 +640,7 @@ impl RunWriter {
         plan: &RunPlan,
         headers: [Option<Vec<String>>; 4],
     ) -> Result<Vec<PartialCsv>, OutputError> {
-        self.make_ready()?;
+        self.make_ready_for_rows()?;
         let done = self.done();
         if self.resumed.is_none() {
             plan.write(&self.dir.join(PLAN_FILE))?;
@@ -693,8 +721,9 @@ impl Streams {
 
     /// Opens the files, if not yet.
     fn ensure_open(&mut self, writer: &RunWriter) -> Result<(), OutputError> {
-        if let Some((plan, headers)) = self.pending.take() {
-            self.files = writer.open_now(&plan, headers)?;
+        if let Some((plan, headers)) = &self.pending {
+            self.files = writer.open_now(plan, headers.clone())?;
+            self.pending = None;
         }
         Ok(())
     }
@@ -917,7 +946,8 @@ pub(crate) fn finish(
     let complete = !result.cancelled && result.error.is_none();
     if let Some(mut s) = streams {
         if s.pending.is_some() && writer.held && !complete {
-            writer.clean.store(true, Ordering::SeqCst);
+            // Nothing of this run reached the run files: the directory keeps what it held (its
+            // lock file too, as it was).
             return Ok(());
         }
         s.ensure_open(writer)?;

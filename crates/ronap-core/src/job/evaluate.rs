@@ -131,3 +131,102 @@ pub fn evaluate_into(
         write_error,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::{EvalOptions, Evaluator};
+    use crate::io::run_dir::{RunFiles, RunInfo, RunWriter};
+    use crate::policy::{Decision, Policy};
+    use crate::sim::world::Scenes;
+    use crate::{Episode, World};
+    use std::sync::atomic::AtomicBool;
+
+    /// Gives up at once, except on seed 0, where it fails after a while (so seed 1 finishes
+    /// first on another worker).
+    struct FailsOnSeedZero {
+        seed: u64,
+    }
+
+    impl Policy for FailsOnSeedZero {
+        fn reset(&mut self, _: &World, episode: &Episode) -> Result<(), PolicyError> {
+            self.seed = episode.seed();
+            Ok(())
+        }
+
+        fn act(&mut self, _: &Episode) -> Result<Decision, PolicyError> {
+            if self.seed == 0 {
+                std::thread::sleep(std::time::Duration::from_millis(300));
+                return Err(PolicyError::Failed("broken".into()));
+            }
+            Ok(Decision::GiveUp("test".into()))
+        }
+    }
+
+    struct Factory;
+
+    impl PolicyFactory for Factory {
+        fn make(&self) -> Result<Box<dyn Policy>, PolicyError> {
+            Ok(Box::new(FailsOnSeedZero { seed: 0 }))
+        }
+
+        fn name(&self) -> String {
+            "fails-on-seed-0".into()
+        }
+    }
+
+    fn files(dir: &std::path::Path) -> Vec<(String, Vec<u8>)> {
+        let mut out: Vec<_> = std::fs::read_dir(dir)
+            .unwrap()
+            .flatten()
+            .filter(|e| e.path().is_file())
+            .map(|e| {
+                let name = e.file_name().to_string_lossy().into_owned();
+                (name, std::fs::read(e.path()).unwrap())
+            })
+            .collect();
+        out.sort();
+        out
+    }
+
+    #[test]
+    fn a_replacing_run_whose_first_seed_fails_keeps_the_run_it_would_replace() {
+        let config = crate::SimConfig::default().validate().unwrap();
+        let evaluator = Evaluator::new(config, Scenes::MazePerSeed);
+        let tmp = tempfile::tempdir().unwrap();
+        let dir = tmp.path().join("run");
+        let options = EvalOptions {
+            seeds: vec![0u64, 1, 2, 3].into(),
+            threads: 2,
+            ..EvalOptions::default()
+        };
+        let info = RunInfo {
+            policy: "random".into(),
+            scenes: crate::sim::world::SceneSpec::MazePerSeed,
+            map: None,
+        };
+        let cancel = AtomicBool::new(false);
+        let run = |writer: RunWriter, factory: &dyn PolicyFactory| {
+            let request = RunRequest {
+                evaluator: &evaluator,
+                options: &options,
+                info: &info,
+                writer: Some(writer),
+                cancel: &cancel,
+            };
+            evaluate_into(request, factory, &|_| {}, &|_| false).unwrap()
+        };
+        let first = RunWriter::create(&dir, RunFiles::default(), 0, false).unwrap();
+        let random =
+            crate::policy::factory("random", evaluator.config().observation_size()).unwrap();
+        assert!(run(first, random.as_ref()).write_error.is_none());
+        let before = files(&dir);
+        assert!(before.iter().any(|(n, _)| n == "summary.json"));
+        // Replaced by a run whose seed 1 finishes while seed 0 fails: nothing of it reached the
+        // run files, so the finished run stays as it was.
+        let again = RunWriter::create(&dir, RunFiles::default(), 0, true).unwrap();
+        let failed = run(again, &Factory);
+        assert!(failed.result.error.is_some());
+        assert_eq!(files(&dir), before);
+    }
+}
