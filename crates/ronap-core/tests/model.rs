@@ -381,7 +381,8 @@ fn image_of_a_maze_reads_like_the_maze_within_a_pixel() {
 
 #[test]
 fn png_and_pgm_maps_load_with_threshold_and_resolution() {
-    let dir = tempfile_dir();
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
     // A 20 x 10 image: black column at x = 10, grey (128) column at x = 15.
     let mut img = image::GrayImage::from_pixel(20, 10, image::Luma([255]));
     for y in 0..10 {
@@ -421,10 +422,4 @@ fn png_and_pgm_maps_load_with_threshold_and_resolution() {
     std::fs::write(&bad, b"hello").unwrap();
     let err = Scene::load_image(&bad, &Default::default(), 50.0).unwrap_err();
     assert!(err.to_string().contains("not-an-image.png"), "{err}");
-}
-
-fn tempfile_dir() -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("ronap-core-test-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
