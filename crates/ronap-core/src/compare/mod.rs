@@ -497,22 +497,12 @@ fn run_one(
         policy: c.name.clone(),
         source,
     })?;
-    let where_ = dir.clone().unwrap_or_default();
-    if let Some(e) = evaluation.write_error {
-        return Err(e.into());
-    }
-    if let Some(e) = &evaluation.result.error {
-        return Err(CompareError::Run {
-            policy: c.name.clone(),
-            message: e.to_string(),
-            dir: where_,
-        });
-    }
-    if evaluation.result.cancelled {
-        return Err(CompareError::Cancelled {
-            dir: out.map(|d| d.join("runs")).unwrap_or_default(),
-        });
-    }
+    let end = RunEnding {
+        write_error: evaluation.write_error,
+        error: evaluation.result.error.as_ref(),
+        cancelled: evaluation.result.cancelled,
+    };
+    end.check(c, dir.as_deref(), out)?;
     Ok(PolicyResult {
         name: c.name.clone(),
         label: label.to_string(),
@@ -527,6 +517,41 @@ fn run_one(
             .map(SeedResult::of)
             .collect(),
     })
+}
+
+/// How a contender's run ended, lone or team.
+struct RunEnding<'a> {
+    write_error: Option<OutputError>,
+    error: Option<&'a crate::run::RunError>,
+    cancelled: bool,
+}
+
+impl RunEnding<'_> {
+    /// The comparison's error when contender `c`'s run (in `dir`, under `out`) did not finish
+    /// every seed: its files could not be written, an episode failed, or it was interrupted.
+    fn check(
+        self,
+        c: &Contender,
+        dir: Option<&Path>,
+        out: Option<&Path>,
+    ) -> Result<(), CompareError> {
+        if let Some(e) = self.write_error {
+            return Err(e.into());
+        }
+        if let Some(e) = self.error {
+            return Err(CompareError::Run {
+                policy: c.name.clone(),
+                message: e.to_string(),
+                dir: dir.map(Path::to_path_buf).unwrap_or_default(),
+            });
+        }
+        if self.cancelled {
+            return Err(CompareError::Cancelled {
+                dir: out.map(|d| d.join("runs")).unwrap_or_default(),
+            });
+        }
+        Ok(())
+    }
 }
 
 /// Runs contender `c` of a team comparison with `team`, its team policy, as `request` asks: the
@@ -550,21 +575,12 @@ fn run_team(
         policy: c.name.clone(),
         source,
     })?;
-    if let Some(e) = evaluation.write_error {
-        return Err(e.into());
-    }
-    if let Some(e) = &evaluation.result.error {
-        return Err(CompareError::Run {
-            policy: c.name.clone(),
-            message: e.to_string(),
-            dir: dir.unwrap_or_default(),
-        });
-    }
-    if evaluation.result.cancelled {
-        return Err(CompareError::Cancelled {
-            dir: setting.out.map(|d| d.join("runs")).unwrap_or_default(),
-        });
-    }
+    let end = RunEnding {
+        write_error: evaluation.write_error,
+        error: evaluation.result.error.as_ref(),
+        cancelled: evaluation.result.cancelled,
+    };
+    end.check(c, dir.as_deref(), setting.out)?;
     let mut seeds = seeds.into_inner().unwrap_or_default();
     seeds.sort_by_key(|s| s.seed);
     Ok(PolicyResult {

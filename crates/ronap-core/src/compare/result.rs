@@ -24,18 +24,22 @@ pub struct SeedResult {
     pub spl: f64,
 }
 
+/// `x` as a file writes it with `digits` decimals, read back.
+fn rounded(x: f64, digits: usize) -> f64 {
+    format!("{x:.digits$}").parse().unwrap_or(x)
+}
+
 impl SeedResult {
     /// The result in `r`, rounded as `episodes.csv` writes it, so a comparison gives the same
     /// figures whether a run is fresh or read back with `--run`.
     pub(crate) fn of(r: &EpisodeRecord) -> Self {
-        let round = |x: f64, digits: usize| format!("{x:.digits$}").parse().unwrap_or(x);
         Self {
             seed: r.seed,
             outcome: r.outcome,
             steps: r.steps,
             collisions: r.collisions,
-            path_length_px: round(r.path_length_px, 3),
-            spl: round(r.spl, 4),
+            path_length_px: rounded(r.path_length_px, 3),
+            spl: rounded(r.spl, 4),
         }
     }
 
@@ -43,15 +47,14 @@ impl SeedResult {
     /// path length, and its robots' mean SPL (rounded as `episodes.csv` and `robots.csv` write
     /// them).
     pub(crate) fn of_team(r: &TeamRecord) -> Self {
-        let round = |x: f64, digits: usize| format!("{x:.digits$}").parse().unwrap_or(x);
         let spl =
-            r.robots.iter().map(|x| round(x.spl, 4)).sum::<f64>() / r.robots.len().max(1) as f64;
+            r.robots.iter().map(|x| rounded(x.spl, 4)).sum::<f64>() / r.robots.len().max(1) as f64;
         Self {
             seed: r.seed,
             outcome: r.outcome,
             steps: r.steps,
             collisions: r.collisions,
-            path_length_px: round(r.path_length_px, 3),
+            path_length_px: rounded(r.path_length_px, 3),
             spl,
         }
     }

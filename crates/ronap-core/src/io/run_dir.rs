@@ -565,9 +565,9 @@ impl RunWriter {
         }
     }
 
-    /// Writes the per-episode files of team episode `record` (its picture; a step log per
-    /// robot, `steps/seed-SEED-robot-K.csv`, robot `k`'s laser having `beams[k]` beams); a
-    /// failure is kept for the end, as [`RunWriter::episode`] does.
+    /// Writes the per-episode files of team episode `record` (its picture; when the run writes
+    /// step logs, one per robot, `steps/seed-SEED-robot-K.csv`, robot `k`'s laser having
+    /// `beams[k]` beams); a failure is kept for the end, as [`RunWriter::episode`] does.
     pub fn team_episode(&self, record: &TeamRecord, beams: &[usize]) {
         if let Err(e) = self.make_ready() {
             return self.note(e);
@@ -576,7 +576,8 @@ impl RunWriter {
             .files
             .pictures
             .is_some_and(|p| p.wants_seed(record.seed, record.outcome, self.first_seed));
-        if let Err(e) = write_team_files(&self.dir, record, picture, beams) {
+        let steps = self.files.steps.then_some(beams);
+        if let Err(e) = write_team_files(&self.dir, record, picture, steps) {
             self.note(e);
         }
     }
@@ -791,7 +792,7 @@ fn write_team_files(
     dir: &Path,
     record: &TeamRecord,
     picture: bool,
-    beams: &[usize],
+    steps: Option<&[usize]>,
 ) -> Result<(), OutputError> {
     if picture {
         if let Some(img) = crate::render::team::team_image(record, 1.0) {
@@ -803,6 +804,9 @@ fn write_team_files(
             save_image(&path, &img)?;
         }
     }
+    let Some(beams) = steps else {
+        return Ok(());
+    };
     for (k, steps) in record.step_logs.iter().enumerate() {
         let path = dir
             .join("steps")

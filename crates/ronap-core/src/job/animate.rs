@@ -4,7 +4,6 @@
 //! row in `episodes.csv` describes.
 
 use crate::eval::{EpisodeRecord, Evaluator, TeamRecord};
-use crate::io::steplog::LoggedStep;
 use crate::job::{replay_team, RobotLog};
 use crate::render::gif::{animate, Animation, GifOptions};
 
@@ -31,22 +30,6 @@ pub(crate) fn team(evaluator: &Evaluator, record: &TeamRecord) -> Result<Animati
         scale: (500.0 / scene_side).clamp(0.1, 4.0),
         ..GifOptions::default()
     };
-    let logs: Vec<RobotLog> = record
-        .step_logs
-        .iter()
-        .enumerate()
-        .map(|(robot, steps)| RobotLog {
-            robot,
-            steps: steps
-                .iter()
-                .map(|s| LoggedStep {
-                    seed,
-                    step: s.step,
-                    pose: s.pose,
-                    action: s.action,
-                })
-                .collect(),
-        })
-        .collect();
+    let logs = RobotLog::of_record(record);
     replay_team(evaluator, seed, &logs, &options).map_err(|e| e.to_string())
 }

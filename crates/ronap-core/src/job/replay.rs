@@ -11,6 +11,29 @@ use crate::run::team::TeamRollout;
 use crate::run::RunError;
 use crate::sim::robot::{Action, Pose};
 
+impl RobotLog {
+    /// The logs of every robot of `record`, from the steps it recorded.
+    pub(crate) fn of_record(record: &crate::eval::TeamRecord) -> Vec<RobotLog> {
+        record
+            .step_logs
+            .iter()
+            .enumerate()
+            .map(|(robot, steps)| RobotLog {
+                robot,
+                steps: steps
+                    .iter()
+                    .map(|s| LoggedStep {
+                        seed: record.seed,
+                        step: s.step,
+                        pose: s.pose,
+                        action: s.action,
+                    })
+                    .collect(),
+            })
+            .collect()
+    }
+}
+
 /// One robot's step log, read back.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RobotLog {
@@ -206,23 +229,7 @@ mod tests {
     use crate::sim::world::Scenes;
 
     fn logs_of(record: &crate::eval::TeamRecord) -> Vec<RobotLog> {
-        record
-            .step_logs
-            .iter()
-            .enumerate()
-            .map(|(robot, steps)| RobotLog {
-                robot,
-                steps: steps
-                    .iter()
-                    .map(|s| LoggedStep {
-                        seed: record.seed,
-                        step: s.step,
-                        pose: s.pose,
-                        action: s.action,
-                    })
-                    .collect(),
-            })
-            .collect()
+        RobotLog::of_record(record)
     }
 
     #[test]

@@ -102,14 +102,7 @@ pub fn evaluate_team_into(
                         gif.as_ref().map(|a| &a.bytes[..]).map_err(Clone::clone),
                     );
                 }
-                // A GIF's steps are not a step log unless the run asked for step logs.
-                if w.recording().steps || r.step_logs.is_empty() {
-                    w.team_episode(r, &beams);
-                } else {
-                    let mut r = r.clone();
-                    r.step_logs = Vec::new();
-                    w.team_episode(&r, &beams);
-                }
+                w.team_episode(r, &beams);
             }
             on_record(r);
         };
