@@ -145,6 +145,135 @@ fn a_team_run_killed_with_sigkill_is_resumed_to_the_same_bytes() {
     );
 }
 
+/// A shipped scenario with the crowd metrics asked for, written into `dir`.
+fn measuring_crowds(dir: &Path, shipped: &str) -> PathBuf {
+    let text = std::fs::read_to_string(repo_root().join("scenarios").join(shipped)).unwrap();
+    let path = dir.join(shipped);
+    std::fs::write(&path, format!("{text}\n[metrics]\ncrowd = true\n")).unwrap();
+    path
+}
+
+#[cfg(unix)]
+#[test]
+fn runs_measuring_crowd_metrics_are_resumed_to_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    // A lone robot among pedestrians: about 2000 episodes a second on two cores here.
+    let scenario = measuring_crowds(dir.path(), "maze-pedestrians.toml");
+    kill_and_resume(
+        &[
+            "run",
+            "--scenario",
+            scenario.to_str().unwrap(),
+            "--policy",
+            "geodesic-wait",
+            "--seeds",
+            "8000",
+            "--threads",
+            "2",
+        ],
+        &["episodes.csv"],
+    );
+    // A team: each robot's metrics in robots.csv.
+    let scenario = measuring_crowds(dir.path(), "warehouse-team.toml");
+    kill_and_resume(
+        &[
+            "run",
+            "--scenario",
+            scenario.to_str().unwrap(),
+            "--policy",
+            "random",
+            "--seeds",
+            "120",
+            "--threads",
+            "2",
+        ],
+        &["episodes.csv", "robots.csv"],
+    );
+}
+
+#[test]
+fn crowd_metrics_reach_every_output_and_bad_values_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = measuring_crowds(dir.path(), "maze-pedestrians.toml");
+    let out = dir.path().join("run");
+    let o = ronap(&[
+        "run",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--policy",
+        "geodesic-wait",
+        "--seeds",
+        "12",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let table = ok(&o);
+    let names = [
+        "time_to_goal",
+        "intrusion_ratio",
+        "min_separation_px",
+        "ttc_min",
+        "path_irregularity",
+        "jerk",
+    ];
+    let episodes = rows(&out.join("episodes.csv"));
+    let summary = crate::util::summary(&out);
+    let means = summary["metrics"].as_array().unwrap();
+    for (i, name) in names.iter().enumerate() {
+        assert!(table.contains(name), "{name} missing from\n{table}");
+        let c = crate::util::col(&episodes, name);
+        assert_eq!(means[i]["name"], *name);
+        // The mean in summary.json is the mean of the column (written to a few decimals).
+        let values: Vec<f64> = episodes[1..]
+            .iter()
+            .filter(|r| !r[c].is_empty())
+            .map(|r| r[c].parse().unwrap())
+            .collect();
+        assert_eq!(means[i]["episodes"], values.len());
+        if !values.is_empty() {
+            let mean = values.iter().sum::<f64>() / values.len() as f64;
+            let written = means[i]["mean"].as_f64().unwrap();
+            assert!(
+                (mean - written).abs() < 1e-3 * written.abs().max(1.0),
+                "{name}"
+            );
+        }
+    }
+    // Without [metrics] the outputs have none of it.
+    let plain = dir.path().join("plain");
+    let shipped = repo_root().join("scenarios/maze-pedestrians.toml");
+    ok(&ronap(&[
+        "run",
+        "--scenario",
+        shipped.to_str().unwrap(),
+        "--policy",
+        "geodesic-wait",
+        "--seeds",
+        "3",
+        "--out",
+        plain.to_str().unwrap(),
+    ]));
+    assert!(!std::fs::read_to_string(plain.join("episodes.csv"))
+        .unwrap()
+        .contains("intrusion_ratio"));
+    assert!(crate::util::summary(&plain).get("metrics").is_none());
+    // A bad value: one line naming the file, the line, the key and the value.
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "[metrics]\ncrowd = true\ndiscomfort_px = -2.0\n").unwrap();
+    crate::util::assert_rejected(
+        &[
+            "run",
+            "--scenario",
+            bad.to_str().unwrap(),
+            "--policy",
+            "geodesic",
+            "--seeds",
+            "1",
+        ],
+        &["bad.toml:3", "metrics.discomfort_px", "-2"],
+    );
+}
+
 #[test]
 fn resuming_a_finished_run_says_so_and_changes_nothing() {
     let dir = tempfile::tempdir().unwrap();

@@ -349,6 +349,7 @@ pub fn json(py: Python<'_>, v: &serde_json::Value) -> PyResult<PyObject> {
 pub fn record<'py>(
     py: Python<'py>,
     r: &ronap_core::eval::EpisodeRecord,
+    metrics: &[ronap_core::eval::metric::Kind],
 ) -> PyResult<Bound<'py, PyDict>> {
     let row = PyDict::new(py);
     row.set_item("seed", r.seed)?;
@@ -371,6 +372,10 @@ pub fn record<'py>(
         row.set_item("min_clearance_px", clearance)?;
         let near = f64::from(d.near_steps) / f64::from(r.steps.max(1));
         row.set_item("near_moving_fraction", near)?;
+    }
+    // The metrics asked for beyond these (`[metrics]`), each under its column's name.
+    for (k, v) in metrics.iter().zip(&r.metrics) {
+        row.set_item(k.column.name, v.filter(|v| v.is_finite()))?;
     }
     Ok(row)
 }

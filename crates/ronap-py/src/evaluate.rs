@@ -8,7 +8,9 @@ use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use ronap_core::eval::{EvalOptions, Evaluator};
-use ronap_core::io::run_dir::{BlockRun, EpisodeRows, Pictures, RunFiles, RunInfo, RunWriter};
+use ronap_core::io::run_dir::{
+    BlockRun, EpisodeRows, Layout, Pictures, RunFiles, RunInfo, RunWriter,
+};
 use ronap_core::job::{evaluate_into, RunRequest};
 use ronap_core::policy::batched::{BatchPolicy, Batched};
 use ronap_core::policy::{Decision, Policy, PolicyError, PolicyFactory};
@@ -362,15 +364,16 @@ pub fn evaluate<'py>(
     let summary = serde_json::to_value(&evaluation.summary).unwrap_or_default();
     d.set_item("summary", conv::json(py, &summary)?)?;
     let episodes = PyList::empty(py);
+    let metrics = ronap_core::eval::metric::kinds(config);
     for r in &evaluation.result.records {
-        episodes.append(conv::record(py, r)?)?;
+        episodes.append(conv::record(py, r, metrics)?)?;
     }
     d.set_item("episodes", episodes)?;
     if rows {
-        let dynamic = !config.moving.is_empty();
+        let layout = Layout::of(config);
         let all = PyList::empty(py);
         for r in &evaluation.result.records {
-            let e = EpisodeRows::of(r, dynamic);
+            let e = EpisodeRows::of(r, layout);
             all.append((e.seed, e.episode, e.timing, e.figures))?;
         }
         d.set_item("rows", all)?;

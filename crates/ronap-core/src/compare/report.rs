@@ -168,6 +168,13 @@ impl Comparison {
         if ends_reward {
             header.push("ended by reward_min".into());
         }
+        // The metrics asked for beyond the standard ones (the same for every policy).
+        let metrics: Vec<String> = self
+            .policies
+            .first()
+            .map(|p| p.summary.metrics.iter().map(|m| m.name.clone()).collect())
+            .unwrap_or_default();
+        header.extend(metrics.iter().cloned());
         let rows = self
             .policies
             .iter()
@@ -198,6 +205,13 @@ impl Comparison {
                 }
                 if ends_reward {
                     row.push(s.reward_min_ends.to_string());
+                }
+                for name in &metrics {
+                    let m = s.metrics.iter().find(|m| &m.name == name);
+                    row.push(match m {
+                        Some(m) if m.episodes > 0 => format!("{:.3}", m.mean),
+                        _ => String::new(),
+                    });
                 }
                 row
             })

@@ -60,6 +60,8 @@ const FIELD_DOCS: &[(&str, &str, &str, Option<&str>)] = &[
     ("apf", "influence_px", "APF policy: distance d0 beyond which obstacles do not repel, px.", None),
     ("apf", "lattice_px", "APF policy: spacing of the positions the descent steps between, px.", None),
     ("apf", "repel_moving", "APF policy: also steer away from the moving obstacles within laser range.", None),
+    ("metrics", "crowd", "Measure the crowd metrics: time_to_goal, intrusion_ratio, min_separation_px, ttc_min, path_irregularity, jerk (columns in episodes.csv or a team's robots.csv, means in summary.json).", None),
+    ("metrics", "discomfort_px", "Crowd metrics: a step intrudes when a moving obstacle or another robot is closer than this beyond the two bodies, px.", None),
 ];
 
 /// Every field of a `[[moving]]` entry and what it means.
@@ -171,7 +173,12 @@ impl SimConfig {
         if let (Some(table), Ok(team)) = (value.as_table_mut(), toml::Value::try_from(&self.team)) {
             table.entry("team").or_insert(team);
         }
-        // So are [observation] and reward shaping.
+        // So are [observation], [metrics] and reward shaping.
+        if let (Some(table), Ok(metrics)) =
+            (value.as_table_mut(), toml::Value::try_from(&self.metrics))
+        {
+            table.entry("metrics").or_insert(metrics);
+        }
         if let (Some(table), Ok(observation)) = (
             value.as_table_mut(),
             toml::Value::try_from(&self.observation),
@@ -344,6 +351,7 @@ mod documented_tests {
         c.observation.history = 2;
         c.reward.shaping = Shaping::Geodesic;
         c.reward.shaping_gamma = 0.9;
+        c.metrics.crowd = true;
         let full = toml::Value::try_from(&c).unwrap();
         let mut count = 0;
         for (sec, table) in full.as_table().unwrap() {

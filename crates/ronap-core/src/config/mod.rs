@@ -6,7 +6,7 @@
 //!
 //! One file per section, each with its fields, their defaults and their checks: `scene.rs` (scene,
 //! maze, warehouse, map, static obstacles), `robot.rs` (robot, laser), `episode.rs` (episode,
-//! reward, observation), `moving.rs`, `team.rs` (robots, team), `apf.rs`. This file assembles
+//! reward, observation), `moving.rs`, `team.rs` (robots, team), `apf.rs`, `metrics.rs`. This file assembles
 //! them into [`SimConfig`] and [`ValidConfig`]; `docs.rs` writes the commented TOML and `file.rs`
 //! reads files. The sections sit here, below the layers that use them, rather than beside their
 //! code: a scene, a robot and a policy all read the one validated configuration, and a section
@@ -16,6 +16,7 @@ mod apf;
 mod docs;
 mod episode;
 mod file;
+mod metrics;
 mod moving;
 mod robot;
 mod scene;
@@ -26,6 +27,7 @@ pub use episode::{
     EpisodeConfig, ObservationConfig, RewardConfig, Shaping, ACTION_MEMORY, MAX_HISTORY,
 };
 pub use file::{key_line, ConfigFile};
+pub use metrics::MetricsConfig;
 pub use moving::{MotionKind, MovingConfig, MovingShape, Patrol, MAX_MOVING};
 pub use robot::{LaserConfig, OnCollision, RobotConfig, MAX_BEAMS};
 pub use scene::{
@@ -103,6 +105,9 @@ pub struct SimConfig {
     /// How the robots of a team talk (docs/model.md "Several robots", communication).
     #[serde(skip_serializing_if = "TeamConfig::is_default")]
     pub team: TeamConfig,
+    /// Metrics beyond the standard ones (docs/model.md "Crowd metrics").
+    #[serde(skip_serializing_if = "MetricsConfig::is_default")]
+    pub metrics: MetricsConfig,
 }
 
 /// A [`SimConfig`] whose every field has been checked. Dereferences to the `SimConfig`.
@@ -300,6 +305,7 @@ impl SimConfig {
         moving::validate_moving(&self.moving)?;
         team::validate_robots(&self.robots)?;
         self.team.validate()?;
+        self.metrics.validate()?;
         Ok(ValidConfig(self))
     }
 }

@@ -5,6 +5,7 @@
 //! the thread count; they come back in seed order. A shared cancel flag stops the run between
 //! episodes (Ctrl-C in the CLI) and keeps every finished record.
 
+pub mod metric;
 pub mod ordered;
 pub mod record;
 pub mod side_by_side;
@@ -199,6 +200,7 @@ impl Evaluator {
             trajectory,
             step_log,
             tracks,
+            gauges,
             ..
         } = recorder;
         let (world, episode, reason) = rollout.into_parts();
@@ -222,6 +224,17 @@ impl Evaluator {
             }
             _ => 0.0,
         };
+        let metrics = gauges.map_or_else(Vec::new, |g| {
+            g.values(
+                0,
+                &metric::End {
+                    outcome,
+                    steps: episode.steps(),
+                    arrived_at: (outcome == Outcome::Success).then(|| episode.steps()),
+                    path_length_px,
+                },
+            )
+        });
         EpisodeRecord {
             seed,
             outcome,
@@ -240,6 +253,7 @@ impl Evaluator {
             trajectory,
             mover_tracks: tracks,
             dynamic: episode.dynamic_metrics(),
+            metrics,
             step_log,
             world: Some(world),
         }
@@ -320,14 +334,15 @@ impl Evaluator {
     }
 }
 
-/// What an evaluation keeps of an episode as it runs: its clock, and the trajectory, obstacle
-/// tracks and step log its [`Recording`] asks for.
+/// What an evaluation keeps of an episode as it runs: its clock, the trajectory, obstacle
+/// tracks and step log its [`Recording`] asks for, and the metrics its configuration asks for.
 pub(crate) struct Recorder {
     clock: Instant,
     recording: Recording,
     trajectory: Vec<Pose>,
     step_log: Vec<StepLog>,
     tracks: Vec<Track>,
+    gauges: Option<metric::Gauges>,
 }
 
 impl Recorder {
@@ -339,7 +354,11 @@ impl Recorder {
             trajectory: Vec::new(),
             step_log: Vec::new(),
             tracks: Vec::new(),
+            gauges: metric::Gauges::start(rollout.episode().config(), 1),
         };
+        if let Some(g) = &mut recorder.gauges {
+            g.watch_episode(rollout.episode());
+        }
         if recording.trajectory {
             recorder.trajectory.push(rollout.episode().pose());
             recorder.track(rollout.episode());
@@ -367,6 +386,9 @@ impl Recorder {
         if self.recording.trajectory {
             self.trajectory.push(s.pose);
             self.track(rollout.episode());
+        }
+        if let Some(g) = &mut self.gauges {
+            g.watch_episode(rollout.episode());
         }
     }
 }

@@ -175,6 +175,9 @@ pub struct EpisodeRecord {
     pub mover_tracks: Vec<Track>,
     /// How the episode went among moving obstacles; `None` without any.
     pub dynamic: Option<DynamicMetrics>,
+    /// The value of each metric the configuration asks for beyond the standard ones, in the
+    /// order of [`crate::eval::metric::kinds`] (empty when it asks for none).
+    pub metrics: Vec<Option<f64>>,
     /// Steps, when recorded.
     pub step_log: Vec<StepLog>,
     /// The world the episode ran in; dropped by [`EpisodeRecord::strip`], since a per-seed world

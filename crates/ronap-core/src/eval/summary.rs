@@ -1,6 +1,7 @@
 //! The figures of an evaluation: success rate with its confidence interval, failures by kind,
 //! path efficiency (SPL) and speed.
 
+use crate::eval::metric::{Kind, MetricMean};
 use crate::eval::{EpisodeRecord, Outcome};
 use crate::sim::episode::DynamicMetrics;
 use serde::{Deserialize, Serialize};
@@ -41,6 +42,10 @@ pub struct Summary {
     /// Figures among moving obstacles, when the episodes had some.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub moving: Option<MovingSummary>,
+    /// The mean of each metric the configuration asked for beyond these (docs/model.md "Crowd
+    /// metrics"), in column order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub metrics: Vec<MetricMean>,
 }
 
 /// Summary figures of episodes among moving obstacles.
@@ -72,7 +77,7 @@ pub fn wilson95(k: usize, n: usize) -> [f64; 2] {
 }
 
 /// What a summary needs of one episode: its figures, exactly as the record holds them.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Figures {
     /// How it ended.
     pub outcome: Outcome,
@@ -88,6 +93,8 @@ pub struct Figures {
     pub total_reward: f64,
     /// How it went among moving obstacles.
     pub dynamic: Option<DynamicMetrics>,
+    /// Its value of each metric asked for beyond these, in column order.
+    pub metrics: Vec<Option<f64>>,
 }
 
 impl Figures {
@@ -101,6 +108,7 @@ impl Figures {
             spl: record.spl,
             total_reward: record.total_reward,
             dynamic: record.dynamic,
+            metrics: record.metrics.clone(),
         }
     }
 }
@@ -130,6 +138,10 @@ pub struct Tally {
     clearance_px: f64,
     clearances: usize,
     near_fraction: f64,
+    /// The metrics asked for beyond the standard ones, and each one's running sum and count of
+    /// episodes with a value.
+    kinds: &'static [Kind],
+    metric_sums: Vec<(f64, usize)>,
 }
 
 impl Default for Tally {
@@ -149,11 +161,23 @@ impl Default for Tally {
             clearance_px: empty_sum(),
             clearances: 0,
             near_fraction: empty_sum(),
+            kinds: &[],
+            metric_sums: Vec::new(),
         }
     }
 }
 
 impl Tally {
+    /// A tally that also sums the metrics of `kinds` (the [`Figures::metrics`] it is given hold
+    /// their values in this order).
+    pub fn measuring(kinds: &'static [Kind]) -> Self {
+        Self {
+            kinds,
+            metric_sums: vec![(empty_sum(), 0); kinds.len()],
+            ..Self::default()
+        }
+    }
+
     /// Counts the next episode (in seed order).
     pub fn add(&mut self, f: &Figures) {
         self.episodes += 1;
@@ -178,6 +202,17 @@ impl Tally {
             }
             self.near_fraction += f64::from(d.near_steps) / f64::from(f.steps.max(1));
         }
+        for (sum, value) in self.metric_sums.iter_mut().zip(&f.metrics) {
+            if let Some(v) = value.filter(|v| v.is_finite()) {
+                sum.0 += v;
+                sum.1 += 1;
+            }
+        }
+    }
+
+    /// How many metrics beyond the standard ones it sums.
+    pub fn metrics(&self) -> usize {
+        self.kinds.len()
     }
 
     /// Episodes counted.
@@ -241,6 +276,17 @@ impl Tally {
                 0.0
             },
             moving,
+            metrics: self
+                .kinds
+                .iter()
+                .zip(&self.metric_sums)
+                .map(|(k, &(sum, count))| MetricMean {
+                    name: k.column.name.to_string(),
+                    unit: k.column.unit.to_string(),
+                    mean: if count == 0 { 0.0 } else { sum / count as f64 },
+                    episodes: count,
+                })
+                .collect(),
         }
     }
 }
@@ -310,6 +356,21 @@ impl Summary {
                 ],
             );
         }
+        let at = rows
+            .iter()
+            .position(|(k, _)| *k == "wall time")
+            .unwrap_or(rows.len());
+        rows.splice(
+            at..at,
+            self.metrics.iter().map(|m| {
+                let value = if m.episodes == 0 {
+                    "none".to_string()
+                } else {
+                    format!("{:.3} {} (mean of {} episodes)", m.mean, m.unit, m.episodes)
+                };
+                (m.name.as_str(), value)
+            }),
+        );
         if self.collision_ends > 0 {
             rows.insert(4, ("ended by collision", self.collision_ends.to_string()));
         }

@@ -40,6 +40,9 @@ pub struct RobotRecord {
     pub robot_collisions: u32,
     /// How it went among moving obstacles, when there were some.
     pub dynamic: Option<crate::sim::episode::DynamicMetrics>,
+    /// Its value of each metric the configuration asks for beyond the standard ones, in the
+    /// order of [`crate::eval::metric::kinds`].
+    pub metrics: Vec<Option<f64>>,
     /// Distance driven, px.
     pub path_length_px: f64,
     /// Goals it had (1, or a goal list's length).
@@ -85,6 +88,7 @@ impl RobotRecord {
             trajectory: Vec::new(),
             mover_tracks: Vec::new(),
             dynamic: self.dynamic,
+            metrics: self.metrics.clone(),
             step_log: Vec::new(),
             world: None,
         }
@@ -429,6 +433,10 @@ impl Evaluator {
         let mut rollout = TeamRollout::start(self.config(), worlds, seed, policy)?;
         watch(rollout.team());
         let n = rollout.team().robots().len();
+        let mut gauges = crate::eval::metric::Gauges::start(self.config(), n);
+        if let Some(g) = &mut gauges {
+            g.watch_team(rollout.team());
+        }
         let paths = recording.trajectory;
         let mut tracks: Vec<Vec<Point>> = vec![Vec::new(); if paths { n } else { 0 }];
         let mut step_logs: Vec<Vec<StepLog>> =
@@ -462,6 +470,9 @@ impl Evaluator {
                 }
             }
             note(team, &mut tracks);
+            if let Some(g) = &mut gauges {
+                g.watch_team(team);
+            }
             watch(team);
         }
         let team = rollout.team();
@@ -489,6 +500,12 @@ impl Evaluator {
                 Some(_) => 1.0,
                 None => 0.0,
             };
+            let end = crate::eval::metric::End {
+                outcome,
+                steps: r.steps(),
+                arrived_at: team.arrived_at(k),
+                path_length_px: r.path_length_px(),
+            };
             robots.push(RobotRecord {
                 robot: k,
                 policy: names.get(k).cloned().unwrap_or_default(),
@@ -499,6 +516,7 @@ impl Evaluator {
                 collisions: r.collisions(),
                 robot_collisions: r.robot_collisions(),
                 dynamic: r.dynamic_metrics(),
+                metrics: gauges.as_ref().map_or_else(Vec::new, |g| g.values(k, &end)),
                 goals: team.goals(k).len() as u32,
                 goals_reached: r.goals_reached(),
                 tour,

@@ -8,7 +8,8 @@ use crate::io::atomic::OutputError;
 use crate::io::figures::{self, FIGURES_FILE};
 use crate::io::manifest::RunManifest;
 use crate::io::run_dir::{
-    episode_row, finish, lone_headers, manifest, restore, timing_row, RunInfo, RunWriter, Streams,
+    episode_row, finish, lone_headers, manifest, restore, timing_row, Layout, RunInfo, RunWriter,
+    Streams,
 };
 
 /// The rows one finished episode adds to a lone robot's run files: its `episodes.csv` and
@@ -27,19 +28,19 @@ pub struct EpisodeRows {
 }
 
 impl EpisodeRows {
-    /// The rows of `record`, whose figures are `f`; `dynamic`: the scene has moving obstacles.
-    pub fn with(record: &EpisodeRecord, f: &Figures, dynamic: bool) -> Self {
+    /// The rows of `record`, whose figures are `f`, laid out as `layout` says.
+    pub fn with(record: &EpisodeRecord, f: &Figures, layout: Layout) -> Self {
         Self {
             seed: record.seed,
-            episode: episode_row(record, dynamic),
+            episode: episode_row(record, layout),
             timing: timing_row(record.seed, record.wall_time_s).to_vec(),
             figures: figures::lone_row(record.seed, f),
         }
     }
 
-    /// The rows of `record`.
-    pub fn of(record: &EpisodeRecord, dynamic: bool) -> Self {
-        Self::with(record, &Figures::of(record), dynamic)
+    /// The rows of `record`, laid out as `layout` says.
+    pub fn of(record: &EpisodeRecord, layout: Layout) -> Self {
+        Self::with(record, &Figures::of(record), layout)
     }
 
     /// The rows for each run file, in the order of `RUN_FILES` (see [`crate::io::run_dir`]) (no `robots.csv`).
@@ -80,12 +81,13 @@ impl BlockRun {
         info: &RunInfo,
     ) -> Result<Self, OutputError> {
         let plan = writer.plan(config, options, info);
-        let streams = writer.open(&plan, lone_headers(!config.moving.is_empty()));
-        let mut tally = Tally::default();
+        let layout = Layout::of(config);
+        let streams = writer.open(&plan, lone_headers(layout));
+        let mut tally = Tally::measuring(layout.metrics);
         let done = writer.done();
         if done > 0 {
             restore(&writer.dir, done, &mut |row| {
-                let (_, f) = figures::parse_lone(row)?;
+                let (_, f) = figures::parse_lone(row, layout.metrics.len())?;
                 tally.add(&f);
                 Ok(())
             })?;
@@ -123,10 +125,12 @@ impl BlockRun {
                 });
             }
             let record = csv::StringRecord::from(r.figures.clone());
-            let (_, f) = figures::parse_lone(&record).map_err(|message| OutputError::Format {
-                path: self.writer.dir.join(FIGURES_FILE),
-                message: format!("seed {}: {message}", r.seed),
-            })?;
+            let metrics = self.tally.metrics();
+            let (_, f) =
+                figures::parse_lone(&record, metrics).map_err(|message| OutputError::Format {
+                    path: self.writer.dir.join(FIGURES_FILE),
+                    message: format!("seed {}: {message}", r.seed),
+                })?;
             if let Err(e) = self.streams.add(&self.writer, &r.files()) {
                 self.broken = Some(e.to_string());
                 return Err(e);

@@ -3,6 +3,7 @@
 //! for bit (`episodes.csv` rounds its numbers). Floats are written as the hexadecimal bits of
 //! the `f64`; the file is removed once the run is complete.
 
+use crate::eval::metric::Kind;
 use crate::eval::{Figures, Outcome, RobotFigures, TeamFigures};
 use crate::sim::episode::DynamicMetrics;
 
@@ -45,11 +46,24 @@ const ROBOT_FIELDS: [&str; 9] = [
     "near_steps",
 ];
 
-/// Columns for team episodes of `robots` robots.
-pub fn team_columns(robots: usize) -> Vec<String> {
+/// The exact-figure column of each metric of `kinds`.
+fn metric_columns(kinds: &[Kind]) -> impl Iterator<Item = String> + '_ {
+    kinds.iter().map(|k| format!("{}_bits", k.column.name))
+}
+
+/// Columns for a lone robot's episodes measuring the metrics of `kinds`.
+pub fn lone_columns(kinds: &[Kind]) -> Vec<String> {
+    let mut columns: Vec<String> = LONE_COLUMNS.iter().map(|c| c.to_string()).collect();
+    columns.extend(metric_columns(kinds));
+    columns
+}
+
+/// Columns for team episodes of `robots` robots measuring the metrics of `kinds`.
+pub fn team_columns(robots: usize, kinds: &[Kind]) -> Vec<String> {
     let mut columns: Vec<String> = TEAM_BASE.iter().map(|c| c.to_string()).collect();
     for k in 0..robots {
         columns.extend(ROBOT_FIELDS.iter().map(|f| format!("robot{k}_{f}")));
+        columns.extend(metric_columns(kinds).map(|f| format!("robot{k}_{f}")));
     }
     columns
 }
@@ -77,7 +91,13 @@ pub fn lone_row(seed: u64, f: &Figures) -> Vec<String> {
         ]),
         None => row.extend([String::new(), String::new(), String::new()]),
     }
+    row.extend(metric_bits(&f.metrics));
     row
+}
+
+/// The exact figures of metric `values`, empty for none.
+fn metric_bits(values: &[Option<f64>]) -> impl Iterator<Item = String> + '_ {
+    values.iter().map(|v| v.map_or(String::new(), bits))
 }
 
 /// The row of a team episode of `seed`: the team's figures, then each robot's (`robots[k]`).
@@ -101,6 +121,7 @@ pub fn team_row(seed: u64, team: &TeamFigures, robots: &[Figures]) -> Vec<String
             bits(r.total_reward),
         ]);
         row.extend(dynamic_fields(r.dynamic));
+        row.extend(metric_bits(&r.metrics));
     }
     row
 }
@@ -159,6 +180,14 @@ impl Fields<'_> {
         self.at += n;
     }
 
+    fn optional_bits(&mut self) -> Result<Option<f64>, String> {
+        if self.row.get(self.at).is_some_and(str::is_empty) {
+            self.at += 1;
+            return Ok(None);
+        }
+        self.bits().map(Some)
+    }
+
     fn optional<T: std::str::FromStr>(&mut self) -> Result<Option<T>, String> {
         if self.row.get(self.at).is_some_and(str::is_empty) {
             self.at += 1;
@@ -168,11 +197,9 @@ impl Fields<'_> {
     }
 }
 
-/// A lone robot's figures from `row` (made by [`lone_row`]): its seed and figures.
-pub fn parse_lone(row: &csv::StringRecord) -> Result<(u64, Figures), String> {
-    let mut f = Fields { row, at: 0 };
-    let seed = f.parse()?;
-    let figures = Figures {
+/// A robot's figures from the next fields of `f`, with `metrics` metric values after them.
+fn robot_figures(f: &mut Fields<'_>, metrics: usize) -> Result<Figures, String> {
+    Ok(Figures {
         outcome: f.outcome()?,
         steps: f.parse()?,
         collisions: f.parse()?,
@@ -185,17 +212,31 @@ pub fn parse_lone(row: &csv::StringRecord) -> Result<(u64, Figures), String> {
                 min_clearance_px: f.bits()?,
                 near_steps: f.parse()?,
             }),
-            None => None,
+            None => {
+                f.skip(2);
+                None
+            }
         },
-    };
-    Ok((seed, figures))
+        metrics: (0..metrics)
+            .map(|_| f.optional_bits())
+            .collect::<Result<_, _>>()?,
+    })
 }
 
-/// A team episode's figures from `row` (made by [`team_row`] for `robots` robots): its seed, the
-/// team's figures and each robot's as a lone robot's.
+/// A lone robot's figures from `row` (made by [`lone_row`] with `metrics` metric values): its
+/// seed and figures.
+pub fn parse_lone(row: &csv::StringRecord, metrics: usize) -> Result<(u64, Figures), String> {
+    let mut f = Fields { row, at: 0 };
+    let seed = f.parse()?;
+    Ok((seed, robot_figures(&mut f, metrics)?))
+}
+
+/// A team episode's figures from `row` (made by [`team_row`] for `robots` robots with `metrics`
+/// metric values each): its seed, the team's figures and each robot's as a lone robot's.
 pub fn parse_team(
     row: &csv::StringRecord,
     robots: usize,
+    metrics: usize,
 ) -> Result<(u64, TeamFigures, Vec<Figures>), String> {
     let mut f = Fields { row, at: 0 };
     let seed = f.parse()?;
@@ -210,31 +251,16 @@ pub fn parse_team(
     };
     let mut lone = Vec::with_capacity(robots);
     for _ in 0..robots {
-        let r = Figures {
-            outcome: f.outcome()?,
-            steps: f.parse()?,
-            collisions: f.parse()?,
-            path_length_px: f.bits()?,
-            spl: f.bits()?,
-            total_reward: f.bits()?,
-            dynamic: match f.optional::<u32>()? {
-                Some(collisions) => Some(DynamicMetrics {
-                    collisions,
-                    min_clearance_px: f.bits()?,
-                    near_steps: f.parse()?,
-                }),
-                None => {
-                    f.skip(2);
-                    None
-                }
-            },
-        };
+        let r = robot_figures(&mut f, metrics)?;
         team.robots.push(RobotFigures {
             outcome: r.outcome,
             steps: r.steps,
             spl: r.spl,
         });
         lone.push(r);
+    }
+    if f.at != row.len() {
+        return Err(format!("{} fields, not {}", row.len(), f.at));
     }
     Ok((seed, team, lone))
 }
@@ -257,19 +283,36 @@ mod tests {
                 min_clearance_px: f64::INFINITY,
                 near_steps: 5,
             }),
+            metrics: Vec::new(),
         };
         let row = csv::StringRecord::from(lone_row(9, &lone));
-        let (seed, back) = parse_lone(&row).expect("parses");
+        let (seed, back) = parse_lone(&row, 0).expect("parses");
         assert_eq!(seed, 9);
         assert_eq!(back.spl.to_bits(), (-0.0f64).to_bits());
         assert_eq!(back.path_length_px.to_bits(), (0.1f64 + 0.2).to_bits());
         assert_eq!(back, lone);
         let plain = Figures {
             dynamic: None,
-            ..lone
+            ..lone.clone()
         };
         let row = csv::StringRecord::from(lone_row(1, &plain));
-        assert_eq!(parse_lone(&row).expect("parses").1, plain);
+        assert_eq!(parse_lone(&row, 0).expect("parses").1, plain);
+        // Metric values follow, a missing one as an empty field, after either kind of row.
+        for dynamic in [None, lone.dynamic] {
+            let measured = Figures {
+                dynamic,
+                metrics: vec![Some(0.1 + 0.2), None, Some(-0.0)],
+                ..lone.clone()
+            };
+            let row = csv::StringRecord::from(lone_row(2, &measured));
+            assert_eq!(
+                row.len(),
+                lone_columns(&crate::eval::metric::CROWD[..3]).len()
+            );
+            let back = parse_lone(&row, 3).expect("parses").1;
+            assert_eq!(back, measured);
+            assert_eq!(back.metrics[2].map(f64::to_bits), Some((-0.0f64).to_bits()));
+        }
 
         let team = TeamFigures {
             outcome: Outcome::Deadlock,
@@ -284,18 +327,33 @@ mod tests {
                 spl: -0.0,
             }],
         };
-        let row = csv::StringRecord::from(team_row(4, &team, &[plain]));
-        assert_eq!(row.len(), team_columns(1).len());
-        let (seed, t, robots) = parse_team(&row, 1).expect("parses");
-        assert_eq!((seed, &t, robots.as_slice()), (4, &team, &[plain][..]));
-        assert!(parse_team(&row, 2).is_err());
+        let row = csv::StringRecord::from(team_row(4, &team, std::slice::from_ref(&plain)));
+        assert_eq!(row.len(), team_columns(1, &[]).len());
+        let (seed, t, robots) = parse_team(&row, 1, 0).expect("parses");
+        assert_eq!(
+            (seed, &t, robots.as_slice()),
+            (4, &team, std::slice::from_ref(&plain))
+        );
+        assert!(parse_team(&row, 2, 0).is_err());
+        assert!(parse_team(&row, 1, 1).is_err());
         // A team among moving obstacles keeps each robot's figures there too, after a robot
         // without them.
         let mut two = team.clone();
         two.robots.push(two.robots[0]);
-        let row = csv::StringRecord::from(team_row(5, &two, &[plain, lone]));
-        assert_eq!(row.len(), team_columns(2).len());
-        let (_, _, robots) = parse_team(&row, 2).expect("parses");
-        assert_eq!(robots, vec![plain, lone]);
+        let row = csv::StringRecord::from(team_row(5, &two, &[plain.clone(), lone.clone()]));
+        assert_eq!(row.len(), team_columns(2, &[]).len());
+        let (_, _, robots) = parse_team(&row, 2, 0).expect("parses");
+        assert_eq!(robots, vec![plain.clone(), lone.clone()]);
+        // With a metric each.
+        let with = |f: &Figures, v| Figures {
+            metrics: vec![v],
+            ..f.clone()
+        };
+        let measured = [with(&plain, None), with(&lone, Some(2.5))];
+        let row = csv::StringRecord::from(team_row(6, &two, &measured));
+        let kinds = &crate::eval::metric::CROWD[..1];
+        assert_eq!(row.len(), team_columns(2, kinds).len());
+        let (_, _, robots) = parse_team(&row, 2, 1).expect("parses");
+        assert_eq!(robots, measured);
     }
 }

@@ -9,6 +9,7 @@
 //! times, so `episodes.csv` is byte-identical whatever the thread count.
 
 use crate::config::ValidConfig;
+use crate::eval::metric;
 use crate::eval::{
     EpisodeRecord, EvalOptions, Outcome, Recording, RunResult, Seeds, Summary, TeamRecord,
 };
@@ -107,8 +108,28 @@ pub const DYNAMIC_COLUMNS: [&str; 3] = [
     "near_moving_fraction",
 ];
 
-/// The `episodes.csv` row of `r` (with [`DYNAMIC_COLUMNS`] when `dynamic`).
-pub fn episode_row(r: &EpisodeRecord, dynamic: bool) -> Vec<String> {
+/// What a lone robot's rows hold beyond [`EPISODE_COLUMNS`]: the moving-obstacle columns when
+/// the episodes have moving obstacles, then a column per metric the configuration asks for.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Layout {
+    /// The episodes have moving obstacles ([`DYNAMIC_COLUMNS`]).
+    pub dynamic: bool,
+    /// The metrics asked for, in column order.
+    pub metrics: &'static [metric::Kind],
+}
+
+impl Layout {
+    /// The rows of runs under `config`.
+    pub fn of(config: &ValidConfig) -> Self {
+        Self {
+            dynamic: !config.moving.is_empty(),
+            metrics: metric::kinds(config),
+        }
+    }
+}
+
+/// The `episodes.csv` row of `r`, laid out as `layout` says.
+pub fn episode_row(r: &EpisodeRecord, layout: Layout) -> Vec<String> {
     let mut row = vec![
         r.seed.to_string(),
         r.outcome.name().to_string(),
@@ -125,7 +146,7 @@ pub fn episode_row(r: &EpisodeRecord, dynamic: bool) -> Vec<String> {
         format!("{:.3}", r.goal.y),
         r.reason.clone().unwrap_or_default(),
     ];
-    if dynamic {
+    if layout.dynamic {
         match r.dynamic {
             Some(d) => row.extend([
                 d.collisions.to_string(),
@@ -139,15 +160,29 @@ pub fn episode_row(r: &EpisodeRecord, dynamic: bool) -> Vec<String> {
             None => row.extend([String::new(), String::new(), String::new()]),
         }
     }
+    row.extend(metric_cells(layout.metrics, &r.metrics));
     row
 }
 
-/// The `episodes.csv` header (with [`DYNAMIC_COLUMNS`] when `dynamic`).
-pub fn episode_header(dynamic: bool) -> Vec<&'static str> {
+/// The cells of metric `values` (in the order of `kinds`), as `episodes.csv` and `robots.csv`
+/// write them.
+pub fn metric_cells<'a>(
+    kinds: &'a [metric::Kind],
+    values: &'a [Option<f64>],
+) -> impl Iterator<Item = String> + 'a {
+    kinds
+        .iter()
+        .enumerate()
+        .map(|(i, k)| metric::cell(&k.column, values.get(i).copied().flatten()))
+}
+
+/// The `episodes.csv` header, laid out as `layout` says.
+pub fn episode_header(layout: Layout) -> Vec<&'static str> {
     let mut header = EPISODE_COLUMNS.to_vec();
-    if dynamic {
+    if layout.dynamic {
         header.extend(DYNAMIC_COLUMNS);
     }
+    header.extend(metric::columns(layout.metrics).map(|c| c.name));
     header
 }
 
@@ -155,10 +190,13 @@ pub fn episode_header(dynamic: bool) -> Vec<&'static str> {
 /// episodes had moving obstacles.
 pub fn write_episodes(records: &[EpisodeRecord], out: &mut dyn Write) -> std::io::Result<()> {
     let mut w = csv::Writer::from_writer(out);
-    let dynamic = records.iter().any(|r| r.dynamic.is_some());
-    w.write_record(episode_header(dynamic))?;
+    let layout = Layout {
+        dynamic: records.iter().any(|r| r.dynamic.is_some()),
+        metrics: &[],
+    };
+    w.write_record(episode_header(layout))?;
     for r in records {
-        w.write_record(episode_row(r, dynamic))?;
+        w.write_record(episode_row(r, layout))?;
     }
     w.flush()
 }
@@ -896,13 +934,13 @@ impl RunInfo {
 }
 
 /// The headers of a lone robot's run files, in the order of [`RUN_FILES`].
-pub(crate) fn lone_headers(dynamic: bool) -> [Option<Vec<String>>; 4] {
+pub(crate) fn lone_headers(layout: Layout) -> [Option<Vec<String>>; 4] {
     let strings = |h: &[&str]| Some(h.iter().map(|c| c.to_string()).collect());
     [
-        strings(&episode_header(dynamic)),
+        strings(&episode_header(layout)),
         strings(&TIMING_COLUMNS),
         None,
-        strings(&figures::LONE_COLUMNS),
+        Some(figures::lone_columns(layout.metrics)),
     ]
 }
 
@@ -1038,7 +1076,7 @@ mod tests {
         result
             .records
             .iter()
-            .map(|r| EpisodeRows::of(r, false))
+            .map(|r| EpisodeRows::of(r, Layout::default()))
             .collect()
     }
 

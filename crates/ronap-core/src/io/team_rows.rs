@@ -1,7 +1,9 @@
 //! A team run's rows: `episodes.csv` (a row per team episode) and `robots.csv` (a row per robot
 //! of each), their columns, and the writers of whole files.
 
+use crate::eval::metric::{self, Kind};
 use crate::eval::{Outcome, TeamRecord};
+use crate::io::run_dir::metric_cells;
 use std::io::Write;
 
 /// Columns of a team run's `episodes.csv` (one row per team episode).
@@ -76,12 +78,22 @@ pub const ROBOT_COLUMNS: [&str; 24] = [
     "reason",
 ];
 
-/// The `robots.csv` rows of `r`: one per robot.
-pub fn robot_rows(r: &TeamRecord) -> Vec<Vec<String>> {
+/// The columns of `robots.csv` measuring the metrics of `kinds`: [`ROBOT_COLUMNS`], then one
+/// per metric.
+pub fn robot_columns(kinds: &[Kind]) -> Vec<String> {
+    ROBOT_COLUMNS
+        .iter()
+        .map(|c| c.to_string())
+        .chain(metric::columns(kinds).map(|c| c.name.to_string()))
+        .collect()
+}
+
+/// The `robots.csv` rows of `r`: one per robot, with the metrics of `kinds`.
+pub fn robot_rows(r: &TeamRecord, kinds: &[Kind]) -> Vec<Vec<String>> {
     r.robots
         .iter()
         .map(|x| {
-            vec![
+            let mut row = vec![
                 r.seed.to_string(),
                 x.robot.to_string(),
                 x.policy.clone(),
@@ -110,7 +122,9 @@ pub fn robot_rows(r: &TeamRecord) -> Vec<Vec<String>> {
                 format!("{:.3}", x.goal.x),
                 format!("{:.3}", x.goal.y),
                 x.reason.clone().unwrap_or_default(),
-            ]
+            ];
+            row.extend(metric_cells(kinds, &x.metrics));
+            row
         })
         .collect()
 }
@@ -120,7 +134,7 @@ pub fn write_robots(records: &[TeamRecord], out: &mut dyn Write) -> std::io::Res
     let mut w = csv::Writer::from_writer(out);
     w.write_record(ROBOT_COLUMNS)?;
     for r in records {
-        for row in robot_rows(r) {
+        for row in robot_rows(r, &[]) {
             w.write_record(row)?;
         }
     }

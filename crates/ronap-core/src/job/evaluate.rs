@@ -6,7 +6,7 @@ use crate::eval::{EpisodeRecord, Figures, RunEnd, RunResult, Summary, Tally};
 use crate::io::atomic::OutputError;
 use crate::io::figures;
 use crate::io::manifest::RunManifest;
-use crate::io::run_dir::{finish, lone_headers, manifest, restore, EpisodeRows, RunWriter};
+use crate::io::run_dir::{finish, lone_headers, manifest, restore, EpisodeRows, Layout, RunWriter};
 use crate::job::{animate, RunRequest};
 use crate::policy::{PolicyError, PolicyFactory};
 
@@ -52,16 +52,17 @@ pub fn evaluate_into(
         options.steps_of = w.gif_seeds().to_vec();
     }
     let config = evaluator.config();
-    let mut tally = Tally::default();
+    let layout = Layout::of(config);
+    let mut tally = Tally::measuring(layout.metrics);
     let mut write_error = None;
     let mut streams = None;
     let done = writer.as_ref().map_or(0, RunWriter::done);
     if let Some(w) = &writer {
         let plan = w.plan(config, &options, info);
-        streams = Some(w.open(&plan, lone_headers(!config.moving.is_empty())));
+        streams = Some(w.open(&plan, lone_headers(layout)));
         if done > 0 {
             if let Err(e) = restore(&w.dir, done, &mut |row| {
-                let (_, f) = figures::parse_lone(row)?;
+                let (_, f) = figures::parse_lone(row, layout.metrics.len())?;
                 tally.add(&f);
                 Ok(())
             }) {
@@ -83,7 +84,6 @@ pub fn evaluate_into(
             seeds: options.seeds.after(done),
             ..options.clone()
         };
-        let dynamic = !config.moving.is_empty();
         let on_finish = |r: &EpisodeRecord| {
             if let Some(w) = &writer {
                 w.episode(r);
@@ -101,7 +101,7 @@ pub fn evaluate_into(
         evaluator.stream(factory, &rest, cancel, &on_finish, &mut |r| {
             let f = Figures::of(&r);
             if let (Some(s), Some(w)) = (&mut streams, &writer) {
-                if let Err(e) = s.add(w, &EpisodeRows::with(&r, &f, dynamic).files()) {
+                if let Err(e) = s.add(w, &EpisodeRows::with(&r, &f, layout).files()) {
                     write_error = Some(e);
                     return false;
                 }

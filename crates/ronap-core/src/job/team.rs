@@ -8,7 +8,7 @@ use crate::eval::{
 use crate::io::atomic::OutputError;
 use crate::io::figures;
 use crate::io::run_dir::{finish, manifest, restore, timing_row, RunWriter, TIMING_COLUMNS};
-use crate::io::team_rows::{robot_rows, team_episode_row, ROBOT_COLUMNS, TEAM_COLUMNS};
+use crate::io::team_rows::{robot_columns, robot_rows, team_episode_row, TEAM_COLUMNS};
 use crate::job::{animate, RunRequest};
 use crate::policy::{PolicyError, TeamPolicyFactory};
 
@@ -47,7 +47,8 @@ pub fn evaluate_team_into(
         options.steps_of = w.gif_seeds().to_vec();
     }
     let config = evaluator.config();
-    let (mut team, mut robots) = (TeamTally::default(), Tally::default());
+    let metrics = crate::eval::metric::kinds(config);
+    let (mut team, mut robots) = (TeamTally::default(), Tally::measuring(metrics));
     let mut write_error = None;
     let mut streams = None;
     let done = writer.as_ref().map_or(0, RunWriter::done);
@@ -58,13 +59,13 @@ pub fn evaluate_team_into(
         let headers = [
             strings(&TEAM_COLUMNS),
             strings(&TIMING_COLUMNS),
-            strings(&ROBOT_COLUMNS),
-            Some(figures::team_columns(size)),
+            Some(robot_columns(metrics)),
+            Some(figures::team_columns(size, metrics)),
         ];
         streams = Some(w.open(&plan, headers));
         if done > 0 {
             if let Err(e) = restore(&w.dir, done, &mut |row| {
-                let (_, t, lone) = figures::parse_team(row, size)?;
+                let (_, t, lone) = figures::parse_team(row, size, metrics.len())?;
                 team.add(&t);
                 for f in &lone {
                     robots.add(f);
@@ -117,7 +118,7 @@ pub fn evaluate_team_into(
                 let rows = [
                     vec![team_episode_row(&r)],
                     vec![timing_row(r.seed, r.wall_time_s).to_vec()],
-                    robot_rows(&r),
+                    robot_rows(&r, metrics),
                     vec![figures::team_row(r.seed, &t, &lone)],
                 ];
                 if let Err(e) = s.add(w, &rows) {
