@@ -8,6 +8,7 @@
 //! sensors and the collision check need, written for boxes so they cost a few nanoseconds each.
 
 pub mod index;
+pub mod orca;
 pub mod point_grid;
 pub(crate) mod prefetch;
 pub mod ray_grid;
