@@ -331,7 +331,8 @@ fn a_team_of_one_runs_as_the_lone_robot_column_for_column() {
     for (name, base, policy) in [
         ("maze", String::new(), "apf"),
         ("maze", String::new(), "geodesic"),
-        ("pedestrians", pedestrians, "geodesic-wait"),
+        ("pedestrians", pedestrians.clone(), "geodesic-wait"),
+        ("pedestrians", pedestrians, "orca"),
     ] {
         let lone_file = dir.path().join(format!("{name}-{policy}-lone.toml"));
         let team_file = dir.path().join(format!("{name}-{policy}-team.toml"));

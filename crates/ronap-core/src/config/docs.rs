@@ -60,6 +60,13 @@ const FIELD_DOCS: &[(&str, &str, &str, Option<&str>)] = &[
     ("apf", "influence_px", "APF policy: distance d0 beyond which obstacles do not repel, px.", None),
     ("apf", "lattice_px", "APF policy: spacing of the positions the descent steps between, px.", None),
     ("apf", "repel_moving", "APF policy: also steer away from the moving obstacles within laser range.", None),
+    ("orca", "time_horizon_steps", "orca policy: steps over which velocities are kept clear of other agents.", None),
+    ("orca", "obstacle_time_horizon_steps", "orca policy: steps over which velocities are kept clear of still obstacles.", None),
+    ("orca", "max_neighbours", "orca policy: most agents avoided at once (the nearest).", None),
+    ("orca", "speed_px", "orca policy: preferred (and largest) speed, px per step. Unset: the robot's max_linear_speed_px (continuous actions) or move_speed_px (discrete); below max_linear_speed_px, a turning step can still cover it.", Some("4.0")),
+    ("orca", "sense_range_px", "orca policy: how far the robot senses other agents (their positions and velocities), px. Unset: the laser's range.", Some("100.0")),
+    ("orca", "safety_margin_px", "orca policy: added to the robot's radius in ORCA, px (agents meeting in a crowd at a radius a step can otherwise overlap).", None),
+    ("orca", "actions", "orca policy: \"continuous\" ((v, w) tracking the velocity) or \"discrete\" (the action whose result lies closest).", None),
     ("metrics", "crowd", "Measure the crowd metrics: time_to_goal, intrusion_ratio, min_separation_px, ttc_min, path_irregularity, jerk (columns in episodes.csv or a team's robots.csv, means in summary.json).", None),
     ("metrics", "discomfort_px", "Crowd metrics: a step intrudes when a moving obstacle or another robot is closer than this beyond the two bodies, px.", None),
 ];
@@ -150,6 +157,10 @@ const ROBOTS_DOCS: &[(&str, &str)] = &[
         "order",
         "Visiting order: \"given\", \"nearest\" (greedy, geodesic) or \"optimal\" (shortest tour).",
     ),
+    (
+        "jitter_px",
+        "Moves the fixed start and goal by up to this much in x and y, px (uniform, from the seed's own stream). Unset: 0.",
+    ),
 ];
 
 fn commented(block: &str) -> String {
@@ -173,11 +184,14 @@ impl SimConfig {
         if let (Some(table), Ok(team)) = (value.as_table_mut(), toml::Value::try_from(&self.team)) {
             table.entry("team").or_insert(team);
         }
-        // So are [observation], [metrics] and reward shaping.
+        // So are [observation], [orca], [metrics] and reward shaping.
         if let (Some(table), Ok(metrics)) =
             (value.as_table_mut(), toml::Value::try_from(&self.metrics))
         {
             table.entry("metrics").or_insert(metrics);
+        }
+        if let (Some(table), Ok(orca)) = (value.as_table_mut(), toml::Value::try_from(&self.orca)) {
+            table.entry("orca").or_insert(orca);
         }
         if let (Some(table), Ok(observation)) = (
             value.as_table_mut(),
@@ -352,6 +366,8 @@ mod documented_tests {
         c.reward.shaping = Shaping::Geodesic;
         c.reward.shaping_gamma = 0.9;
         c.metrics.crowd = true;
+        c.orca.sense_range_px = Some(50.0);
+        c.orca.speed_px = Some(4.0);
         let full = toml::Value::try_from(&c).unwrap();
         let mut count = 0;
         for (sec, table) in full.as_table().unwrap() {

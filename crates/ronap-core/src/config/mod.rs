@@ -6,7 +6,7 @@
 //!
 //! One file per section, each with its fields, their defaults and their checks: `scene.rs` (scene,
 //! maze, warehouse, map, static obstacles), `robot.rs` (robot, laser), `episode.rs` (episode,
-//! reward, observation), `moving.rs`, `team.rs` (robots, team), `apf.rs`, `metrics.rs`. This file assembles
+//! reward, observation), `moving.rs`, `team.rs` (robots, team), `apf.rs`, `orca.rs`, `metrics.rs`. This file assembles
 //! them into [`SimConfig`] and [`ValidConfig`]; `docs.rs` writes the commented TOML and `file.rs`
 //! reads files. The sections sit here, below the layers that use them, rather than beside their
 //! code: a scene, a robot and a policy all read the one validated configuration, and a section
@@ -18,6 +18,7 @@ mod episode;
 mod file;
 mod metrics;
 mod moving;
+mod orca;
 mod robot;
 mod scene;
 mod team;
@@ -29,6 +30,7 @@ pub use episode::{
 pub use file::{key_line, ConfigFile};
 pub use metrics::MetricsConfig;
 pub use moving::{MotionKind, MovingConfig, MovingShape, Patrol, MAX_MOVING};
+pub use orca::{OrcaConfig, PlannerActions};
 pub use robot::{LaserConfig, OnCollision, RobotConfig, MAX_BEAMS};
 pub use scene::{
     is_convex_polygon, MapConfig, MazeConfig, ObstacleConfig, SceneConfig, SceneKind,
@@ -105,6 +107,9 @@ pub struct SimConfig {
     /// How the robots of a team talk (docs/model.md "Several robots", communication).
     #[serde(skip_serializing_if = "TeamConfig::is_default")]
     pub team: TeamConfig,
+    /// The `orca` policy (docs/model.md "Local planners among moving things").
+    #[serde(skip_serializing_if = "OrcaConfig::is_default")]
+    pub orca: OrcaConfig,
     /// Metrics beyond the standard ones (docs/model.md "Crowd metrics").
     #[serde(skip_serializing_if = "MetricsConfig::is_default")]
     pub metrics: MetricsConfig,
@@ -306,6 +311,7 @@ impl SimConfig {
         team::validate_robots(&self.robots)?;
         self.team.validate()?;
         self.metrics.validate()?;
+        self.orca.validate()?;
         Ok(ValidConfig(self))
     }
 }

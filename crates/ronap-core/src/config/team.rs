@@ -109,6 +109,15 @@ pub struct TeamRobotConfig {
     /// The order the goals are visited in: `given` (default), `nearest` (greedily by geodesic
     /// distance) or `optimal` (the shortest tour).
     pub order: Order,
+    /// Moves the fixed `start` and `goal` by up to this much in x and in y, px, uniformly, drawn
+    /// from the episode seed's own jitter stream (so each seed poses the task a little apart and
+    /// no other draw changes). Default 0.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub jitter_px: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 impl Default for TeamRobotConfig {
@@ -128,6 +137,7 @@ impl Default for TeamRobotConfig {
             goals: Vec::new(),
             goal_count: 1,
             order: Order::Given,
+            jitter_px: 0.0,
         }
     }
 }
@@ -172,6 +182,7 @@ pub(super) fn validate_robots(robots_config: &[TeamRobotConfig]) -> Result<(), C
             "must be between 1 and 10000",
         )?;
         robots += u64::from(r.count);
+        length(&f("jitter_px"), r.jitter_px, true)?;
         for (name, v) in [("start", r.start.map(|s| [s[0], s[1]])), ("goal", r.goal)] {
             if let Some(p) = v {
                 point(&f(name), p)?;

@@ -104,6 +104,27 @@ impl Follower {
         }
     }
 
+    /// Where `p` projects onto the path, moving on to the next segment once past the end of this
+    /// one (and never back): the path length and the fraction of the segment.
+    fn along(&mut self, p: Point) -> (f64, f64) {
+        let mut along = self.project(self.segment, p);
+        while along.1 >= 1.0 && self.segment + 2 < self.path.len() {
+            self.segment += 1;
+            along = self.project(self.segment, p);
+        }
+        along
+    }
+
+    /// The point the lookahead further along the path than `p` (the end once within the
+    /// lookahead of it), for a policy that steers by velocity; `None` for an empty path.
+    pub fn aim(&mut self, p: Point) -> Option<Point> {
+        if self.path.len() < 2 {
+            return self.path.last().copied();
+        }
+        let along = self.along(p);
+        Some(self.point_at(along.0 + self.lookahead_px))
+    }
+
     /// The next action for `episode`'s robot.
     pub fn next(&mut self, episode: &Episode) -> FollowStep {
         let Some(&last) = self.path.last() else {
@@ -114,12 +135,7 @@ impl Follower {
         if self.path.len() == 1 {
             return FollowStep::Arrived;
         }
-        // Move on to the next segment once past the end of this one (and never back).
-        let mut along = self.project(self.segment, p);
-        while along.1 >= 1.0 && self.segment + 2 < self.path.len() {
-            self.segment += 1;
-            along = self.project(self.segment, p);
-        }
+        let along = self.along(p);
         let total = self.length_to[self.length_to.len() - 1];
         let remaining = total - along.0 + (p - self.point_at(along.0)).norm();
         if remaining < self.best_remaining - PROGRESS_PX {

@@ -93,13 +93,17 @@ fn follow(world: &World, mut path: Vec<Point>, prefix: Option<usize>) -> Followe
     Follower::new(path, world.config().robot.move_speed_px * 2.0)
 }
 
+/// A follower of the smoothed shortest path from `from` to `goal` in `world`; `None` when there
+/// is none.
+pub(crate) fn planned(world: &World, from: Point, goal: Point) -> Option<Follower> {
+    let radius = world.config().robot.radius_px;
+    grid_path(world.scene(), world.grid(), from, goal, radius, CLOSE_COST)
+        .map(|path| follow(world, path, None))
+}
+
 impl Policy for Geodesic {
     fn reset(&mut self, world: &World, episode: &Episode) -> Result<(), PolicyError> {
-        let radius = world.config().robot.radius_px;
-        let (scene, grid) = (world.scene(), world.grid());
-        let from = episode.pose().position();
-        let path = grid_path(scene, grid, from, episode.goal(), radius, CLOSE_COST);
-        self.follower = path.map(|path| follow(world, path, None));
+        self.follower = planned(world, episode.pose().position(), episode.goal());
         Ok(())
     }
 

@@ -9,6 +9,7 @@ pub mod follow;
 pub mod geodesic;
 pub mod mlp;
 pub mod name;
+pub mod orca;
 pub mod random;
 pub mod team;
 
@@ -44,6 +45,17 @@ pub trait Policy: Send {
 
     /// The decision for the episode's current state.
     fn act(&mut self, episode: &Episode) -> Result<Decision, PolicyError>;
+
+    /// The decision for robot `k` of `team` when it is driven by this policy alone among the
+    /// team's ([`team::PerRobot`]): by default [`Policy::act`] on the robot's own episode; a
+    /// policy that avoids the other robots and the team's moving obstacles sees them here.
+    fn act_in_team(
+        &mut self,
+        team: &crate::sim::team::Team,
+        k: usize,
+    ) -> Result<Decision, PolicyError> {
+        self.act(team.robot(k))
+    }
 
     /// The message a robot of a team broadcasts with its last decision (`team.message_size`
     /// floats, zeros already in `out`); the built-in policies send none.

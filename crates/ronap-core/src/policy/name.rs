@@ -1,9 +1,9 @@
 //! Policies by name, as users give them: a built-in (`apf`, `geodesic`, `geodesic-wait`,
-//! `random`) or
+//! `random`, `orca`) or
 //! `mlp:FILE[@RULE]`.
 
 use crate::policy::mlp::{self, DecisionRule, MlpFactory};
-use crate::policy::{apf, geodesic, random, Policy, PolicyError, PolicyFactory};
+use crate::policy::{apf, geodesic, orca, random, Policy, PolicyError, PolicyFactory};
 
 /// The built-in policies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -16,11 +16,13 @@ pub enum Builtin {
     GeodesicWait,
     /// Uniformly random discrete actions: the floor.
     Random,
+    /// Optimal Reciprocal Collision Avoidance along the geodesic path, among what moves.
+    Orca,
 }
 
 impl Builtin {
     /// Every built-in policy with its name and a one-line description.
-    pub const ALL: [(Builtin, &'static str, &'static str); 4] = [
+    pub const ALL: [(Builtin, &'static str, &'static str); 5] = [
         (
             Builtin::Apf,
             "apf",
@@ -40,6 +42,11 @@ impl Builtin {
             Builtin::Random,
             "random",
             "uniformly random LEFT/AHEAD/RIGHT",
+        ),
+        (
+            Builtin::Orca,
+            "orca",
+            "ORCA (optimal reciprocal collision avoidance) along the geodesic path: avoids the moving obstacles and robots it senses ([orca] settings)",
         ),
     ];
 
@@ -67,6 +74,7 @@ impl PolicyFactory for Builtin {
             Builtin::Geodesic => Box::new(geodesic::Geodesic::default()),
             Builtin::GeodesicWait => Box::new(geodesic::GeodesicWait::default()),
             Builtin::Random => Box::new(random::RandomPolicy::default()),
+            Builtin::Orca => Box::new(orca::Orca::default()),
         })
     }
 

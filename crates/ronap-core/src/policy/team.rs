@@ -94,7 +94,7 @@ impl TeamPolicy for PerRobot {
                 continue;
             }
             policy.hear(team.inbox(k));
-            let decision = policy.act(team.robot(k)).map_err(|e| (k, e))?;
+            let decision = policy.act_in_team(team, k).map_err(|e| (k, e))?;
             if size > 0 && matches!(decision, Decision::Act(_)) {
                 let said = &mut self.said[k];
                 said.clear();

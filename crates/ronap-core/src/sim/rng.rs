@@ -28,6 +28,8 @@ pub enum Stream {
     Moving = 6,
     /// The starts and goals of a team's robots after the first.
     Team = 7,
+    /// The jitter of a `[[robots]]` entry's fixed start and goal.
+    Jitter = 8,
 }
 
 /// The generator for `purpose` in the episode with `seed`.

@@ -166,6 +166,32 @@ fn sweeps_touch(a0: Point, a1: Point, b0: Point, b1: Point, reach: f64) -> bool 
     point_segment_distance_squared(Point::origin(), from, to) < reach * reach
 }
 
+/// `config` with its fixed start and goal moved by up to `jitter_px` in x and y (uniform draws
+/// from `rng`: the start's, then the goal's); `None` without jitter.
+fn jittered(
+    config: &ValidConfig,
+    jitter_px: f64,
+    rng: &mut crate::sim::rng::Rng,
+) -> Result<Option<ValidConfig>, EpisodeError> {
+    use rand::Rng as _;
+    if jitter_px <= 0.0 {
+        return Ok(None);
+    }
+    let mut c = config.as_sim_config().clone();
+    let mut draw = || rng.random_range(-jitter_px..=jitter_px);
+    if let Some(s) = &mut c.episode.start {
+        s[0] += draw();
+        s[1] += draw();
+    }
+    if let Some(g) = &mut c.episode.goal {
+        g[0] += draw();
+        g[1] += draw();
+    }
+    c.validate()
+        .map(Some)
+        .map_err(|e| EpisodeError::Moving(e.to_string()))
+}
+
 impl Team {
     /// The team `config.robots` describes for episode `seed`: robot `k` in `worlds[e]`, where
     /// `e` is its `[[robots]]` entry (each world holds the entry's configuration and the shared
@@ -179,15 +205,17 @@ impl Team {
         let mut robots: Vec<Episode> = Vec::with_capacity(n);
         let mut on_arrival = Vec::with_capacity(n);
         let mut others = stream(seed, Stream::Team);
+        let mut jitter = stream(seed, Stream::Jitter);
         let mut taken: Vec<(Point, Point, f64)> = Vec::new();
         let mut goal_lists: Vec<Vec<Point>> = Vec::with_capacity(n);
         let mut k = 0;
         for (e, entry) in config.robots.iter().enumerate() {
             let world = &worlds[e];
-            let cfg = world.config();
             let scene = world.scene();
-            let radius = cfg.robot.radius_px;
+            let radius = world.config().robot.radius_px;
             for _ in 0..entry.count {
+                let jittered = jittered(world.config(), entry.jitter_px, &mut jitter)?;
+                let cfg = jittered.as_ref().unwrap_or(world.config());
                 let both_fixed = cfg.episode.start.is_some() && cfg.episode.goal.is_some();
                 let grid = (!both_fixed && needs_region_grid(cfg, scene)).then(|| world.grid());
                 // A fixed start is not drawn, so nothing else keeps it apart from the others.
