@@ -21,14 +21,11 @@ use crate::sim::moving::Movers;
 use crate::sim::robot::{Action, DiscreteAction};
 use crate::sim::team::Team;
 use crate::sim::world::World;
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::TAU;
 
 /// How sharply a unicycle's speed falls with the angle between its chord and the velocity it
 /// tracks: `cos^ALIGN_POWER`.
 const ALIGN_POWER: i32 = 8;
-
-/// Sides of the polygon round a disc obstacle that ORCA avoids.
-const DISC_SIDES: usize = 12;
 
 /// ORCA towards the geodesic path's lookahead point.
 #[derive(Debug, Default)]
@@ -156,39 +153,9 @@ impl Orca {
             &mut self.near,
         );
         let others: Vec<Agent<f64>> = self.near.iter().map(|&(_, j)| self.agents[j]).collect();
-        // The still scene's boxes within the obstacles' reach, as polygons.
-        self.obstacles.vertices.clear();
         let reach = horizon.obstacles * speed + radius;
-        let scene = me.scene();
-        for &b in scene.boxes_near(p, reach) {
-            let b = scene.boxes()[b as usize];
-            let (lo, hi) = (b.min, b.max);
-            self.obstacles.add(&[
-                V2::new(lo.x, lo.y),
-                V2::new(hi.x, lo.y),
-                V2::new(hi.x, hi.y),
-                V2::new(lo.x, hi.y),
-            ]);
-        }
-        // Added discs (as the 12-gons round them) and polygons.
-        for shape in scene.shapes() {
-            if shape.aabb().distance_squared(p) > reach * reach {
-                continue;
-            }
-            let corners: Vec<V2<f64>> = match shape.as_disc() {
-                Some((c, r)) => {
-                    let out = r / (PI / DISC_SIDES as f64).cos();
-                    (0..DISC_SIDES)
-                        .map(|j| {
-                            let a = TAU * j as f64 / DISC_SIDES as f64;
-                            V2::new(c.x + out * a.cos(), c.y + out * a.sin())
-                        })
-                        .collect()
-                }
-                None => shape.corners().into_iter().map(p2).collect(),
-            };
-            self.obstacles.add(&corners);
-        }
+        me.scene()
+            .orca_obstacles_near(p, reach, &mut self.obstacles);
         obstacle_neighbours(&self.obstacles, p2(p), radius, &horizon, &mut self.edges);
         let edges: Vec<usize> = self.edges.iter().map(|&(_, e)| e).collect();
         let around = Surroundings {

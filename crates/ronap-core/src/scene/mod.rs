@@ -16,6 +16,7 @@ pub mod warehouse;
 
 use crate::config::{MapConfig, MazeConfig};
 use crate::geometry::index::BinIndex;
+use crate::geometry::orca::{Obstacles, V2};
 use crate::geometry::prefetch;
 use crate::geometry::ray_grid::{self, RayGrid};
 use crate::geometry::shape::Shape;
@@ -530,6 +531,61 @@ impl Scene {
     #[inline]
     pub fn boxes_near(&self, p: Point, radius: f64) -> &[u32] {
         self.index.near(p, radius)
+    }
+
+    /// The still obstacles within `reach` of `p` as ORCA avoids them, into `out` (cleared
+    /// first): boxes as rectangles, added discs as the 12-gons round them, polygons as they are,
+    /// each counter-clockwise.
+    pub fn orca_obstacles_near(&self, p: Point, reach: f64, out: &mut Obstacles<f64>) {
+        /// Sides of the polygon round a disc.
+        const DISC_SIDES: usize = 12;
+        out.vertices.clear();
+        let mut add_box = |b: &Aabb| {
+            let (lo, hi) = (b.min, b.max);
+            out.add(&[
+                V2::new(lo.x, lo.y),
+                V2::new(hi.x, lo.y),
+                V2::new(hi.x, hi.y),
+                V2::new(lo.x, hi.y),
+            ]);
+        };
+        if self.piece_px(reach).is_some() {
+            for &b in self.boxes_near(p, reach) {
+                add_box(&self.boxes[b as usize]);
+            }
+        } else {
+            // Beyond the index's reach: every box near enough.
+            for b in self
+                .boxes
+                .iter()
+                .filter(|b| b.distance_squared(p) <= reach * reach)
+            {
+                add_box(b);
+            }
+        }
+        for shape in &self.shapes {
+            if shape.aabb().distance_squared(p) > reach * reach {
+                continue;
+            }
+            let corners: Vec<V2<f64>> = match shape.as_disc() {
+                Some((c, r)) => {
+                    let step = std::f64::consts::TAU / DISC_SIDES as f64;
+                    let out_r = r / (step / 2.0).cos();
+                    (0..DISC_SIDES)
+                        .map(|j| {
+                            let a = step * j as f64;
+                            V2::new(c.x + out_r * a.cos(), c.y + out_r * a.sin())
+                        })
+                        .collect()
+                }
+                None => shape
+                    .corners()
+                    .into_iter()
+                    .map(|c| V2::new(c.x, c.y))
+                    .collect(),
+            };
+            out.add(&corners);
+        }
     }
 
     /// Length of the pieces long queries are cut into, so that each piece (grown by `radius`) is
