@@ -545,3 +545,86 @@ fn config_prints_a_file_that_run_accepts() {
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert_eq!(json(&out.join("summary.json"))["config"]["maze"]["cols"], 5);
 }
+
+#[test]
+fn the_crowd_scenarios_run_and_bad_crowd_entries_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, policy) in [
+        ("circle-crossing", "orca"),
+        ("circle-crossing-visible", "geodesic"),
+        ("square-crossing", "geodesic-wait"),
+        ("circle-robots-20", "orca"),
+    ] {
+        let scenario = crate::util::repo_root().join(format!("scenarios/{name}.toml"));
+        let out = dir.path().join(name);
+        crate::util::ok(&ronap(&[
+            "run",
+            "--scenario",
+            scenario.to_str().unwrap(),
+            "--policy",
+            policy,
+            "--seeds",
+            "4",
+            "--out",
+            out.to_str().unwrap(),
+        ]));
+        let episodes = rows(&out.join("episodes.csv"));
+        assert_eq!(episodes.len(), 5, "{name}");
+        if name != "circle-robots-20" {
+            // The crossings measure the crowd metrics.
+            col(&episodes, "intrusion_ratio");
+        }
+    }
+    let scene = "[maze]\ncols = 2\nrows = 2\n";
+    for (body, names) in [
+        (
+            "[[moving]]\nmotion = \"orca\"\npattern = \"circle\"\n",
+            &["bad.toml:6", "moving[0].pattern", "\"circle\"", "pattern_radius_px"][..],
+        ),
+        (
+            "[[moving]]\nmotion = \"orca\"\nspeed_px = -1.0\n",
+            &["bad.toml:6", "moving[0].speed_px", "-1"][..],
+        ),
+        (
+            "[[moving]]\nmotion = \"random_walk\"\npattern = \"square\"\npattern_radius_px = 10.0\n",
+            &["bad.toml:6", "moving[0].pattern", "\"square\"", "orca"][..],
+        ),
+    ] {
+        let bad = dir.path().join("bad.toml");
+        std::fs::write(&bad, format!("{scene}{body}")).unwrap();
+        assert_rejected(
+            &["run", "--scenario", bad.to_str().unwrap(), "--policy", "orca", "--seeds", "1"],
+            names,
+        );
+    }
+    // A pattern that does not fit the scene: no start and goal for the pedestrians.
+    let bad = dir.path().join("big.toml");
+    std::fs::write(
+        &bad,
+        format!(
+            "{scene}[[moving]]\ncount = 3\nmotion = \"orca\"\npattern = \"circle\"\n\
+             pattern_radius_px = 5000.0\n"
+        ),
+    )
+    .unwrap();
+    let o = ronap(&[
+        "run",
+        "--scenario",
+        bad.to_str().unwrap(),
+        "--policy",
+        "orca",
+        "--seeds",
+        "1",
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", crate::util::stderr(&o));
+    assert!(
+        crate::util::stderr(&o).contains("moving[0]"),
+        "{}",
+        crate::util::stderr(&o)
+    );
+    assert!(
+        !crate::util::stderr(&o).contains("panick"),
+        "{}",
+        crate::util::stderr(&o)
+    );
+}

@@ -86,7 +86,7 @@ const MOVING_DOCS: &[(&str, &str)] = &[
     ),
     (
         "motion",
-        "\"still\", \"linear\", \"waypoints\", \"random_walk\" or \"appear\".",
+        "\"still\", \"linear\", \"waypoints\", \"random_walk\", \"appear\" or \"orca\" (a pedestrian with a goal that avoids the others).",
     ),
     ("speed_px", "Distance moved per step, px."),
     (
@@ -111,6 +111,42 @@ const MOVING_DOCS: &[(&str, &str)] = &[
     (
         "then",
         "appear: how it moves once there: \"still\", \"linear\" or \"random_walk\".",
+    ),
+    (
+        "goal",
+        "orca: fixed goal [x, y], px. Unset: from the pattern, else drawn in free space.",
+    ),
+    (
+        "max_speed_px",
+        "orca: largest speed, px per step (speed_px is the preferred one). Unset: speed_px.",
+    ),
+    (
+        "on_arrival",
+        "orca: at its goal \"stay\", \"new_goal\" (draw another) or \"vanish\".",
+    ),
+    (
+        "sees_robots",
+        "orca: whether it avoids the robots too (false: CrowdNav's invisible robot).",
+    ),
+    (
+        "pattern",
+        "orca: start and goal by a crowd pattern, \"circle\" (opposite points) or \"square\" (opposite sides). Unset: drawn.",
+    ),
+    (
+        "pattern_center",
+        "The pattern's centre [x, y], px. Unset: the scene's centre.",
+    ),
+    (
+        "pattern_radius_px",
+        "The circle's radius, or the square's half side, px.",
+    ),
+    (
+        "jitter_px",
+        "A pattern's start and goal move by up to this in x and y, px.",
+    ),
+    (
+        "orca",
+        "orca: { time_horizon_steps = 20, obstacle_time_horizon_steps = 20, neighbour_dist_px = 200, max_neighbours = 10, safety_margin_px = 1 } (RVO2's agent settings, in steps and px).",
     ),
 ];
 

@@ -29,7 +29,9 @@ pub use episode::{
 };
 pub use file::{key_line, ConfigFile};
 pub use metrics::MetricsConfig;
-pub use moving::{MotionKind, MovingConfig, MovingShape, Patrol, MAX_MOVING};
+pub use moving::{
+    AgentOrca, Arrival, MotionKind, MovingConfig, MovingShape, Patrol, Pattern, MAX_MOVING,
+};
 pub use orca::{OrcaConfig, PlannerActions};
 pub use robot::{LaserConfig, OnCollision, RobotConfig, MAX_BEAMS};
 pub use scene::{

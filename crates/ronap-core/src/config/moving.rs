@@ -31,6 +31,94 @@ pub enum MotionKind {
     RandomWalk,
     /// Absent until a step drawn in `[from_step, to_step]`, then present and moving as `then`.
     Appear,
+    /// A pedestrian with a goal that avoids the others by Optimal Reciprocal Collision
+    /// Avoidance (docs/model.md "Crowds that react").
+    Orca,
+}
+
+/// What a reactive pedestrian does at its goal.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Arrival {
+    /// Stops there (and still gives way).
+    #[default]
+    Stay,
+    /// Walks on to a new goal drawn in free space.
+    NewGoal,
+    /// Leaves the scene.
+    Vanish,
+}
+
+impl Arrival {
+    fn is_stay(&self) -> bool {
+        *self == Arrival::Stay
+    }
+}
+
+/// Where a crowd's pedestrians start and head (CrowdNav's crossings).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Pattern {
+    /// On a circle of `pattern_radius_px` round `pattern_center`, at angles drawn from the seed,
+    /// heading for the opposite point.
+    Circle,
+    /// On one side of a square of half side `pattern_radius_px` round `pattern_center` (left or
+    /// right, drawn), heading for a point drawn on the opposite side.
+    Square,
+}
+
+/// How a reactive (`orca`) pedestrian avoids: RVO2's agent settings, in steps and px.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct AgentOrca {
+    /// Steps over which its velocity keeps clear of other agents. Default 20 (CrowdNav's 5 s at
+    /// 0.25 s a step).
+    pub time_horizon_steps: f64,
+    /// Steps over which its velocity keeps clear of still obstacles. Default 20.
+    pub obstacle_time_horizon_steps: f64,
+    /// How far it looks for other agents, px. Default 200 (CrowdNav's 10 m).
+    pub neighbour_dist_px: f64,
+    /// Most agents it avoids at once (the nearest). Default 10.
+    pub max_neighbours: u32,
+    /// Added to its radius (and to the other agents') in ORCA, px: in a dense crossing ORCA's
+    /// linear program can have no solution and agents would overlap by a fraction of a px.
+    /// Default 1.
+    pub safety_margin_px: f64,
+}
+
+impl Default for AgentOrca {
+    fn default() -> Self {
+        Self {
+            time_horizon_steps: 20.0,
+            obstacle_time_horizon_steps: 20.0,
+            neighbour_dist_px: 200.0,
+            max_neighbours: 10,
+            safety_margin_px: 1.0,
+        }
+    }
+}
+
+impl AgentOrca {
+    fn is_default(&self) -> bool {
+        *self == Self::default()
+    }
+}
+
+/// A pattern as a TOML file writes it.
+fn pattern_name(p: Option<Pattern>) -> String {
+    match p {
+        Some(Pattern::Circle) => "\"circle\"".into(),
+        Some(Pattern::Square) => "\"square\"".into(),
+        None => String::new(),
+    }
+}
+
+fn is_false(v: &bool) -> bool {
+    !*v
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// How a `waypoints` obstacle goes round its points.
@@ -80,6 +168,34 @@ pub struct MovingConfig {
     pub min_robot_distance_px: f64,
     /// `appear`: how it moves once there: `still` (default), `linear` or `random_walk`.
     pub then: MotionKind,
+    /// `orca`: fixed goal `[x, y]`, px. Default: from `pattern`, else drawn in free space.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub goal: Option<[f64; 2]>,
+    /// `orca`: largest speed, px per step (`speed_px` is the preferred one). Default `speed_px`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_speed_px: Option<f64>,
+    /// `orca`: at its goal `stay` (default), `new_goal` or `vanish`.
+    #[serde(skip_serializing_if = "Arrival::is_stay")]
+    pub on_arrival: Arrival,
+    /// `orca`: whether it avoids the robots too. Default false (CrowdNav's invisible robot: it
+    /// walks into a robot that does not give way).
+    #[serde(skip_serializing_if = "is_false")]
+    pub sees_robots: bool,
+    /// `orca`: place start and goal by a crowd pattern, `circle` or `square`. Default: drawn.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pattern: Option<Pattern>,
+    /// The pattern's centre `[x, y]`, px. Default: the scene's centre.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pattern_center: Option<[f64; 2]>,
+    /// The circle's radius, or the square's half side, px.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub pattern_radius_px: f64,
+    /// A pattern's start and goal move by up to this much in x and y, px (uniform). Default 0.
+    #[serde(skip_serializing_if = "is_zero")]
+    pub jitter_px: f64,
+    /// `orca`: how it avoids.
+    #[serde(skip_serializing_if = "AgentOrca::is_default")]
+    pub orca: AgentOrca,
 }
 
 impl Default for MovingConfig {
@@ -100,6 +216,15 @@ impl Default for MovingConfig {
             to_step: 200,
             min_robot_distance_px: 30.0,
             then: MotionKind::Still,
+            goal: None,
+            max_speed_px: None,
+            on_arrival: Arrival::Stay,
+            sees_robots: false,
+            pattern: None,
+            pattern_center: None,
+            pattern_radius_px: 0.0,
+            jitter_px: 0.0,
+            orca: AgentOrca::default(),
         }
     }
 }
@@ -165,6 +290,50 @@ pub(super) fn validate_moving(moving: &[MovingConfig]) -> Result<(), ConfigError
             &f("to_step"),
             m.to_step,
             "must be at least from_step",
+        )?;
+        check(
+            m.then != MotionKind::Orca,
+            &f("then"),
+            "\"orca\"",
+            "an appearing obstacle moves as still, linear or random_walk",
+        )?;
+        if let Some(g) = m.goal {
+            point(&f("goal"), g)?;
+        }
+        if let Some(v) = m.max_speed_px {
+            length(&f("max_speed_px"), v, true)?;
+        }
+        if let Some(c) = m.pattern_center {
+            point(&f("pattern_center"), c)?;
+        }
+        length(&f("pattern_radius_px"), m.pattern_radius_px, true)?;
+        check(
+            m.pattern.is_none() || m.pattern_radius_px > 0.0,
+            &f("pattern"),
+            pattern_name(m.pattern),
+            "a crowd pattern needs a positive pattern_radius_px",
+        )?;
+        check(
+            m.pattern.is_none() || m.motion == MotionKind::Orca,
+            &f("pattern"),
+            pattern_name(m.pattern),
+            "crowd patterns place orca pedestrians (motion = \"orca\")",
+        )?;
+        length(&f("jitter_px"), m.jitter_px, true)?;
+        let o = &m.orca;
+        length(&f("orca.time_horizon_steps"), o.time_horizon_steps, false)?;
+        length(
+            &f("orca.obstacle_time_horizon_steps"),
+            o.obstacle_time_horizon_steps,
+            false,
+        )?;
+        length(&f("orca.neighbour_dist_px"), o.neighbour_dist_px, true)?;
+        length(&f("orca.safety_margin_px"), o.safety_margin_px, true)?;
+        check(
+            o.max_neighbours <= 1000,
+            &f("orca.max_neighbours"),
+            o.max_neighbours,
+            "must be between 0 and 1000",
         )?;
     }
     check(

@@ -16,6 +16,7 @@
 mod behaviour;
 mod body;
 mod heading;
+mod pedestrian;
 mod waypoints;
 
 pub use behaviour::{Agent, Behaviour, Neighbours};
@@ -44,6 +45,8 @@ enum Motion {
     },
     /// Moved by its [`Behaviour`] (kept beside the entries, in [`Movers::behaviours`]).
     Behaves,
+    /// A reactive pedestrian (kept beside the entries, in [`Movers::pedestrians`]).
+    Reactive,
 }
 
 /// An entry's behaviour: a built-in held as itself, so that its step is called directly and
@@ -65,12 +68,14 @@ pub(super) struct Entry {
     appears_at: Option<u32>,
     /// Its fixed start overlaps the robot: absent until the robot is clear of it.
     held: bool,
+    /// A pedestrian that left the scene at its goal (`on_arrival = "vanish"`).
+    gone: bool,
     min_gap: f64,
 }
 
 impl Entry {
     pub(super) fn present(&self) -> bool {
-        self.appears_at.is_none() && !self.held
+        self.appears_at.is_none() && !self.held && !self.gone
     }
 
     /// Whether it moves along its heading this step (present, `linear` or `random_walk`), and
@@ -146,6 +151,10 @@ pub struct Movers {
     entries: Vec<Entry>,
     /// The behaviour of each entry that has one ([`Motion::Behaves`]).
     behaviours: Vec<Option<Behave>>,
+    /// The reactive pedestrian of each entry that is one ([`Motion::Reactive`]).
+    pedestrians: Vec<Option<pedestrian::Pedestrian>>,
+    /// Their planning, when there are some.
+    crowd: Option<pedestrian::Crowd>,
     state: State,
     rng: Rng,
     /// Largest bounding radius plus step, for the quick distance tests.
@@ -215,6 +224,11 @@ impl Movers {
         let mut rng = stream(seed, Stream::Moving);
         let mut entries = Vec::new();
         let mut behaviours = Vec::new();
+        let mut pedestrians = Vec::new();
+        let robot_goals: Vec<(Disc, Point)> =
+            robots.iter().copied().zip(goals.iter().copied()).collect();
+        // Pattern pedestrians placed so far: starts and goals, with their radii.
+        let mut taken: Vec<(Point, f64)> = Vec::new();
         let mut state = State::default();
         let mut reach: f64 = 0.0;
         for (entry, m) in config.moving.iter().enumerate() {
@@ -223,21 +237,55 @@ impl Movers {
                 MovingShape::Disc => Body::Disc(m.radius_px),
                 MovingShape::Box => Body::Box(Vector::new(m.size_px[0], m.size_px[1]) / 2.0),
             };
-            reach = reach.max(body.bounding_radius() + m.speed_px);
+            let speed = m.max_speed_px.unwrap_or(m.speed_px).max(m.speed_px);
+            reach = reach.max(body.bounding_radius() + speed);
             for _ in 0..m.count {
-                let (e, behaviour, position, dir) =
-                    Self::make(m, body, scene, robots, goals, &mut rng).map_err(err)?;
-                let near = m.speed_px + body.bounding_radius() + robot_radius;
-                state.push(&e, position, dir, m.speed_px, near);
+                let (e, behaviour, position, dir) = if m.motion == MotionKind::Orca {
+                    let (start, goal) =
+                        pedestrian::place(m, body, scene, &robot_goals, &taken, &mut rng)
+                            .ok_or_else(|| {
+                                err(format!(
+                                    "found no free start and goal at least {} px from the \
+                                     robots' and clear of the other pedestrians'",
+                                    m.min_robot_distance_px
+                                ))
+                            })?;
+                    taken.extend([
+                        (start, body.bounding_radius()),
+                        (goal, body.bounding_radius()),
+                    ]);
+                    pedestrians.push(Some(pedestrian::Pedestrian::new(m, goal)));
+                    let held = robots.iter().any(|r| body.gap(start, r.at, r.radius) < 0.0);
+                    let e = Entry {
+                        body,
+                        motion: Motion::Reactive,
+                        appears_at: None,
+                        held,
+                        gone: false,
+                        min_gap: m.min_robot_distance_px,
+                    };
+                    (e, None, start, Vector::new(1.0, 0.0))
+                } else {
+                    pedestrians.push(None);
+                    Self::make(m, body, scene, robots, goals, &mut rng).map_err(err)?
+                };
+                let near = speed + body.bounding_radius() + robot_radius;
+                state.push(&e, position, dir, speed, near);
                 entries.push(e);
                 behaviours.push(behaviour);
             }
         }
         state.sort_keys();
         let waiting = entries.iter().filter(|e| !e.present()).count();
+        let crowd = pedestrians
+            .iter()
+            .any(Option::is_some)
+            .then(pedestrian::Crowd::default);
         Ok(Some(Self {
             entries,
             behaviours,
+            pedestrians,
+            crowd,
             state,
             rng,
             reach,
@@ -290,7 +338,8 @@ impl Movers {
         let mut dir = Vector::new(1.0, 0.0);
         let mut behaviour = None;
         let motion = match kind {
-            MotionKind::Still | MotionKind::Appear => Motion::Still,
+            // Orca entries are made by `pedestrian::place`, never here.
+            MotionKind::Still | MotionKind::Appear | MotionKind::Orca => Motion::Still,
             MotionKind::Linear | MotionKind::RandomWalk => {
                 let deg = match m.direction_deg {
                     Some(d) => d,
@@ -317,6 +366,7 @@ impl Movers {
             motion,
             appears_at,
             held,
+            gone: false,
             min_gap: m.min_robot_distance_px,
         };
         Ok((entry, behaviour, position, dir))
@@ -427,6 +477,16 @@ impl Movers {
         if appeared && self.behaviours.iter().any(Option::is_some) {
             state.sort_keys();
         }
+        if let Some(crowd) = &mut self.crowd {
+            crowd.plan(
+                &mut self.entries,
+                state,
+                &mut self.pedestrians,
+                robots,
+                scene,
+                &mut self.rng,
+            );
+        }
         state.wide.clear();
         for i in 0..state.sigma.len() {
             let sigma = state.sigma[i];
@@ -446,6 +506,10 @@ impl Movers {
             let speed = state.speed[i];
             let to = match e.motion {
                 Motion::Still => continue,
+                Motion::Reactive => match &self.pedestrians[i] {
+                    Some(p) if p.next != Vector::zeros() => from + p.next,
+                    _ => continue,
+                },
                 Motion::Heading { .. } => {
                     if state.fits[i] {
                         Point::new(state.ahead_x[i], state.ahead_y[i])

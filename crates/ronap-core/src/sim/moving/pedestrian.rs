@@ -1,0 +1,362 @@
+//! Reactive pedestrians (docs/model.md "Crowds that react"): `orca` obstacles, each walking to
+//! its goal at `speed_px` and avoiding the others (and, with `sees_robots`, the robots) by
+//! Optimal Reciprocal Collision Avoidance ([`crate::geometry::orca`]) and the still scene. All
+//! choose their velocities at once from where everyone stood after the last step, as RVO2 steps
+//! its agents; then each moves under the usual contact rules (a move that would touch a robot is
+//! not made). Their starts and goals come from a crowd pattern (`circle`, `square`), are fixed,
+//! or are drawn in free space, all from the obstacles' own random stream.
+
+use super::{free_spot, Body, Disc, Entry, SPOT_TRIES};
+use crate::config::{AgentOrca, Arrival, MovingConfig, Pattern};
+use crate::geometry::orca::{
+    agent_neighbours, new_velocity, obstacle_neighbours, Agent, Horizon, Line, Obstacles,
+    Surroundings, V2,
+};
+use crate::geometry::{Point, Vector};
+use crate::scene::Scene;
+use crate::sim::moving::heading::State;
+use crate::sim::rng::Rng;
+use rand::Rng as _;
+use std::f64::consts::TAU;
+
+/// One reactive pedestrian's goal, settings and chosen velocity.
+#[derive(Clone, Debug)]
+pub(super) struct Pedestrian {
+    goal: Point,
+    /// Preferred speed, px per step.
+    speed: f64,
+    max_speed: f64,
+    on_arrival: Arrival,
+    sees_robots: bool,
+    orca: AgentOrca,
+    /// The velocity chosen for this step.
+    pub(super) next: Vector,
+}
+
+impl Pedestrian {
+    /// The pedestrian `m` describes, heading for `goal`.
+    pub(super) fn new(m: &MovingConfig, goal: Point) -> Self {
+        Self {
+            goal,
+            speed: m.speed_px,
+            max_speed: m.max_speed_px.unwrap_or(m.speed_px),
+            on_arrival: m.on_arrival,
+            sees_robots: m.sees_robots,
+            orca: m.orca.clone(),
+            next: Vector::zeros(),
+        }
+    }
+}
+
+/// Where a pedestrian of entry `m` (its `body`) starts and heads: by its pattern, fixed, or
+/// drawn in free space; a pattern's start and goal keep clear of the robots' starts and goals by
+/// `min_robot_distance_px` and of the pedestrians placed before (`taken`: centres and radii,
+/// starts and goals). `None` when no such place turned up.
+pub(super) fn place(
+    m: &MovingConfig,
+    body: Body,
+    scene: &Scene,
+    robots: &[(Disc, Point)],
+    taken: &[(Point, f64)],
+    rng: &mut Rng,
+) -> Option<(Point, Point)> {
+    let r = body.bounding_radius();
+    let center = m
+        .pattern_center
+        .map_or(Point::new(scene.width() / 2.0, scene.height() / 2.0), |c| {
+            Point::new(c[0], c[1])
+        });
+    let clear_of_all = |p: Point| {
+        robots.iter().all(|(d, goal)| {
+            body.gap(p, d.at, d.radius) >= m.min_robot_distance_px
+                && body.gap(p, *goal, d.radius) >= m.min_robot_distance_px
+        }) && taken
+            .iter()
+            .all(|&(q, rq)| (p - q).norm() >= r + rq + PLACEMENT_GAP_PX)
+    };
+    let Some(pattern) = m.pattern else {
+        let start = match m.start {
+            Some(s) => Point::new(s[0], s[1]),
+            None => free_spot(body, scene, rng, clear_of_all)?,
+        };
+        let goal = match m.goal {
+            Some(g) => Point::new(g[0], g[1]),
+            None => free_spot(body, scene, rng, |_| true)?,
+        };
+        return Some((start, goal));
+    };
+    let radius = m.pattern_radius_px;
+    let j = m.jitter_px;
+    for _ in 0..SPOT_TRIES {
+        let (start, goal) = match pattern {
+            Pattern::Circle => {
+                let a = rng.random_range(0.0..TAU);
+                let u = Vector::new(a.cos(), a.sin()) * radius;
+                (center + u, center - u)
+            }
+            Pattern::Square => {
+                let side = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+                let from = rng.random_range(-radius..=radius);
+                let to = rng.random_range(-radius..=radius);
+                (
+                    center + Vector::new(side * radius, from),
+                    center + Vector::new(-side * radius, to),
+                )
+            }
+        };
+        let mut jitter = || {
+            if j > 0.0 {
+                Vector::new(rng.random_range(-j..=j), rng.random_range(-j..=j))
+            } else {
+                Vector::zeros()
+            }
+        };
+        let (start, goal) = (start + jitter(), goal + jitter());
+        if clear_of_all(start)
+            && clear_of_all(goal)
+            && body.clear_at(scene, start)
+            && body.clear_at(scene, goal)
+        {
+            return Some((start, goal));
+        }
+    }
+    None
+}
+
+/// Least gap between two pedestrians placed by a pattern, px.
+const PLACEMENT_GAP_PX: f64 = 2.0;
+
+/// What the pedestrians' planning keeps between steps: where everyone was after the last step
+/// (their velocities are the displacements since), and scratch space.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Crowd {
+    last: Vec<Option<Point>>,
+    last_robots: Vec<Point>,
+    agents: Vec<Agent<f64>>,
+    /// The obstacle each agent is (`None`: a robot).
+    owners: Vec<Option<usize>>,
+    near: Vec<(f64, usize)>,
+    edges: Vec<(f64, usize)>,
+    edge_list: Vec<usize>,
+    others: Vec<Agent<f64>>,
+    lines: Vec<Line<f64>>,
+    obstacles: Obstacles<f64>,
+}
+
+fn v2(v: Vector) -> V2<f64> {
+    V2::new(v.x, v.y)
+}
+
+impl Crowd {
+    /// Chooses this step's velocity of every present pedestrian (`pedestrians[i]` of entry `i`)
+    /// from where everyone stands, with the robots `robots` where they stand; a pedestrian at its
+    /// goal stays, vanishes (`entries[i]` gone) or draws a new goal from `rng`.
+    pub(super) fn plan(
+        &mut self,
+        entries: &mut [Entry],
+        state: &State,
+        pedestrians: &mut [Option<Pedestrian>],
+        robots: &[Disc],
+        scene: &Scene,
+        rng: &mut Rng,
+    ) {
+        self.last.resize(entries.len(), None);
+        self.agents.clear();
+        self.owners.clear();
+        // Velocities are the displacements since the last planning (a step ago).
+        for (i, e) in entries.iter().enumerate() {
+            let now = e.present().then(|| state.position(i));
+            let last = std::mem::replace(&mut self.last[i], now);
+            if let Some(at) = now {
+                let velocity = last.map_or(Vector::zeros(), |l| at - l);
+                self.agents.push(Agent {
+                    position: V2::new(at.x, at.y),
+                    velocity: v2(velocity),
+                    radius: e.body.bounding_radius(),
+                });
+                self.owners.push(Some(i));
+            }
+        }
+        let pedestrian_agents = self.agents.len();
+        if pedestrians.iter().flatten().any(|p| p.sees_robots) {
+            // Pedestrians move before the robots within a step and a pedestrian's move is
+            // checked against a robot where it stands: each robot is avoided both where it will
+            // be (an agent moving as it did in its last step) and where it stands (at rest).
+            for (k, r) in robots.iter().enumerate() {
+                let velocity = self
+                    .last_robots
+                    .get(k)
+                    .map_or(Vector::zeros(), |&l| r.at - l);
+                for v in [velocity, Vector::zeros()] {
+                    self.agents.push(Agent {
+                        position: V2::new(r.at.x, r.at.y),
+                        velocity: v2(v),
+                        radius: r.radius,
+                    });
+                    self.owners.push(None);
+                }
+            }
+        }
+        self.last_robots.clear();
+        self.last_robots.extend(robots.iter().map(|r| r.at));
+        for a in 0..pedestrian_agents {
+            let Some(i) = self.owners[a] else { continue };
+            let Some(p) = pedestrians[i].as_mut() else {
+                continue;
+            };
+            let margin = p.orca.safety_margin_px;
+            let mut me = self.agents[a];
+            let at = Point::new(me.position.x, me.position.y);
+            let to_goal = p.goal - at;
+            let preferred = if to_goal.norm() < me.radius {
+                match p.on_arrival {
+                    Arrival::Stay => Vector::zeros(),
+                    Arrival::Vanish => {
+                        entries[i].gone = true;
+                        p.next = Vector::zeros();
+                        continue;
+                    }
+                    Arrival::NewGoal => {
+                        if let Some(g) = free_spot(entries[i].body, scene, rng, |_| true) {
+                            p.goal = g;
+                        }
+                        Vector::zeros()
+                    }
+                }
+            } else {
+                to_goal * (p.speed.min(to_goal.norm()) / to_goal.norm())
+            };
+            let horizon = Horizon {
+                agents: p.orca.time_horizon_steps,
+                obstacles: p.orca.obstacle_time_horizon_steps,
+                max_speed: p.max_speed,
+                time_step: 1.0,
+            };
+            // The robots are agents only to those that see them.
+            let visible = if p.sees_robots {
+                self.agents.len()
+            } else {
+                pedestrian_agents
+            };
+            agent_neighbours(
+                &self.agents[..visible],
+                a,
+                p.orca.neighbour_dist_px,
+                p.orca.max_neighbours as usize,
+                &mut self.near,
+            );
+            self.others.clear();
+            self.others.extend(self.near.iter().map(|&(_, j)| Agent {
+                radius: self.agents[j].radius + margin,
+                ..self.agents[j]
+            }));
+            let reach = horizon.obstacles * horizon.max_speed + me.radius;
+            scene.orca_obstacles_near(at, reach, &mut self.obstacles);
+            obstacle_neighbours(
+                &self.obstacles,
+                me.position,
+                me.radius,
+                &horizon,
+                &mut self.edges,
+            );
+            self.edge_list.clear();
+            self.edge_list.extend(self.edges.iter().map(|&(_, e)| e));
+            me.radius += margin;
+            let around = Surroundings {
+                agents: &self.others,
+                obstacles: &self.obstacles,
+                edges: &self.edge_list,
+            };
+            let v = new_velocity(&me, v2(preferred), &around, &horizon, &mut self.lines);
+            p.next = Vector::new(v.x, v.y);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::config::{MotionKind, MovingConfig, Pattern};
+    use crate::sim::episode::Episode;
+    use crate::sim::robot::DiscreteAction;
+    use crate::sim::world::maze_scene;
+    use std::sync::Arc;
+
+    /// An open 400 px hall with `count` ORCA pedestrians crossing a circle of radius 120, the
+    /// robot turning on the spot in a corner.
+    fn crossing(count: u32, sees_robots: bool) -> crate::SimConfig {
+        let mut c = crate::SimConfig::default();
+        c.maze.cols = 1;
+        c.maze.rows = 1;
+        c.maze.cell_px = 400.0;
+        c.scene.seed = Some(0);
+        c.episode.start = Some([20.0, 20.0, 0.0]);
+        c.episode.goal = Some([380.0, 380.0]);
+        c.moving = vec![MovingConfig {
+            count,
+            radius_px: 6.0,
+            motion: MotionKind::Orca,
+            speed_px: 4.0,
+            pattern: Some(Pattern::Circle),
+            pattern_radius_px: 120.0,
+            jitter_px: 2.0,
+            sees_robots,
+            ..Default::default()
+        }];
+        c
+    }
+
+    fn episode(c: &crate::SimConfig, seed: u64) -> Episode {
+        let c = c.clone().validate().expect("valid");
+        let scene = Arc::new(maze_scene(&c, 0));
+        Episode::new(&c, scene, seed).expect("episode")
+    }
+
+    #[test]
+    fn pedestrians_cross_a_circle_without_overlapping_and_arrive() {
+        let mut least = f64::INFINITY;
+        let mut arrived = 0;
+        for seed in 0..40 {
+            let mut e = episode(&crossing(16, true), seed);
+            let goals: Vec<_> = e
+                .movers()
+                .expect("movers")
+                .items()
+                .map(|m| crate::geometry::Point::new(400.0, 400.0) - m.position().coords)
+                .collect();
+            for _ in 0..150 {
+                e.step(DiscreteAction::Left);
+                let m: Vec<_> = e.movers().expect("movers").items().collect();
+                for i in 0..m.len() {
+                    for j in i + 1..m.len() {
+                        least = least.min((m[i].position() - m[j].position()).norm() - 12.0);
+                    }
+                }
+            }
+            let m: Vec<_> = e.movers().expect("movers").items().collect();
+            arrived += m
+                .iter()
+                .zip(&goals)
+                .filter(|(m, g)| (m.position() - **g).norm() < 10.0)
+                .count();
+        }
+        // Each walks to the opposite point (within its radius, give or take the jitter).
+        eprintln!("{arrived} of 640 arrived; least gap {least}");
+        assert!(arrived >= 608, "{arrived} of 640 arrived");
+        assert!(least >= 0.0, "pedestrians overlapped by {}", -least);
+    }
+
+    #[test]
+    fn a_crowd_never_changes_the_maze_start_or_goal() {
+        let plain = episode(&crate::SimConfig::default(), 3);
+        let mut c = crate::SimConfig {
+            moving: crossing(5, false).moving,
+            ..Default::default()
+        };
+        c.moving[0].pattern_radius_px = 60.0;
+        c.moving[0].min_robot_distance_px = 0.0;
+        let crowd = episode(&c, 3);
+        assert_eq!(plain.start(), crowd.start());
+        assert_eq!(plain.goal(), crowd.goal());
+        assert_eq!(plain.scene().boxes(), crowd.scene().boxes());
+    }
+}
