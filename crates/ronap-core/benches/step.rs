@@ -3,7 +3,8 @@
 //! `cargo bench -p ronap-core --bench step`. Targets: one step under 1 us (1,000,000 steps/s on one
 //! core), with 100 `random_walk` discs too (`step/100_random_walk_discs`), and a scan among them
 //! (`scan/100_discs`) within twice the still-maze scan (`scan/default`); `scan/parry2d` is the
-//! same scan through parry2d's general ray cast, for comparison.
+//! same scan through parry2d's general ray cast, for comparison. Among 100 ORCA pedestrians in an
+//! open hall (`step/100_orca_pedestrians`) the target is 5 us a step (200,000 steps/s).
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use ronap_core::geometry::reference::ParryScene;
@@ -29,12 +30,33 @@ fn crowd_config() -> ronap_core::SimConfig {
     }
 }
 
+/// An open 1000 px hall with 100 ORCA pedestrians (discs of 6 px at 2 px a step) walking to goals
+/// drawn in free space, a new one at each arrival.
+fn orca_config() -> ronap_core::SimConfig {
+    let mut c = ronap_core::SimConfig {
+        moving: vec![ronap_core::config::MovingConfig {
+            count: 100,
+            radius_px: 6.0,
+            motion: ronap_core::config::MotionKind::Orca,
+            on_arrival: ronap_core::config::Arrival::NewGoal,
+            ..Default::default()
+        }],
+        ..Default::default()
+    };
+    c.maze.cols = 1;
+    c.maze.rows = 1;
+    c.maze.cell_px = 1000.0;
+    c.episode.min_goal_distance_px = 400.0;
+    c
+}
+
 fn step(c: &mut Criterion) {
     let mut group = c.benchmark_group("step");
     group.throughput(Throughput::Elements(1));
     for (name, sim) in [
         ("default", ronap_core::SimConfig::default()),
         ("100_random_walk_discs", crowd_config()),
+        ("100_orca_pedestrians", orca_config()),
     ] {
         // Long episodes, so the figure is the step and not the occasional new episode.
         let mut sim = sim;

@@ -167,17 +167,24 @@ pub fn agent_neighbours<T: Real>(
             .map(|(j, a)| ((p - a.position).abs_sq(), j))
             .filter(|&(d, _)| d < range_sq),
     );
+    // The `max` nearest first (the same as sorting them all and keeping the first `max`).
+    if out.len() > max {
+        out.select_nth_unstable_by(max - 1, nearest_first);
+        out.truncate(max);
+    }
     sort_nearest(out);
-    out.truncate(max);
 }
 
-/// Sorts `(distance, index)` pairs nearest first, ties by index (a stable insertion order).
+/// `(distance, index)` pairs nearest first, ties by index (a stable insertion order).
+fn nearest_first<T: Real>(a: &(T, usize), b: &(T, usize)) -> std::cmp::Ordering {
+    a.0.partial_cmp(&b.0)
+        .unwrap_or(std::cmp::Ordering::Equal)
+        .then(a.1.cmp(&b.1))
+}
+
+/// Sorts `(distance, index)` pairs nearest first, ties by index.
 fn sort_nearest<T: Real>(pairs: &mut [(T, usize)]) {
-    pairs.sort_by(|a, b| {
-        a.0.partial_cmp(&b.0)
-            .unwrap_or(std::cmp::Ordering::Equal)
-            .then(a.1.cmp(&b.1))
-    });
+    pairs.sort_unstable_by(nearest_first);
 }
 
 /// What [`new_velocity`] needs besides the agent: its neighbours and the obstacles.
