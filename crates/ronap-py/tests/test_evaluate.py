@@ -234,3 +234,33 @@ def test_ctrl_c_stops_the_run_keeping_its_files_then_raises(tmp_path):
     rows = (out / "episodes.csv").read_text().splitlines()
     assert summary["summary"]["episodes"] == len(rows) - 1 > 0
     assert not list(out.glob("*.partial")) and not (out / ".ronap.lock").exists()
+
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
+
+
+def test_crowd_crossing_with_orca_reports_the_crowd_metrics():
+    scenario = str(ROOT / "scenarios" / "circle-crossing-visible.toml")
+    orca = ronap.evaluate("orca", range(30), scenario=scenario)
+    geodesic = ronap.evaluate("geodesic", range(30), scenario=scenario)
+    means = {m["name"]: m for m in orca["summary"]["metrics"]}
+    assert set(means) == {
+        "time_to_goal",
+        "intrusion_ratio",
+        "min_separation_px",
+        "ttc_min",
+        "path_irregularity",
+        "jerk",
+    }
+    # Every episode's metrics are in its row, and the summary's mean is their mean.
+    ratios = [r["intrusion_ratio"] for r in orca["episodes"]]
+    assert len(ratios) == 30 and all(0.0 <= x <= 1.0 for x in ratios)
+    assert means["intrusion_ratio"]["mean"] == pytest.approx(sum(ratios) / 30)
+    times = [r["time_to_goal"] for r in orca["episodes"] if r["outcome"] == "success"]
+    assert means["time_to_goal"]["episodes"] == len(times) > 0
+    # ORCA keeps further from the pedestrians than driving straight through them.
+    g = {m["name"]: m for m in geodesic["summary"]["metrics"]}
+    assert means["intrusion_ratio"]["mean"] < g["intrusion_ratio"]["mean"]
+    assert orca["summary"]["success_rate"] >= 0.9
+    # Without [metrics] a run has none.
+    assert "metrics" not in ronap.evaluate("geodesic", range(2))["summary"]
