@@ -294,7 +294,16 @@ impl Tally {
 impl Summary {
     /// The summary of `records`, over a run that took `wall_time_s`.
     pub fn new(records: &[EpisodeRecord], wall_time_s: f64) -> Self {
-        let mut tally = Tally::default();
+        // Records carry the values of the metrics their configuration asked for (the crowd
+        // metrics, when any).
+        let measured = records
+            .first()
+            .is_some_and(|r| r.metrics.len() == crate::eval::metric::CROWD.len());
+        let mut tally = if measured {
+            Tally::measuring(&crate::eval::metric::CROWD)
+        } else {
+            Tally::default()
+        };
         for r in records {
             tally.add(&Figures::of(r));
         }

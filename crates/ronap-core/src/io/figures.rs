@@ -228,7 +228,11 @@ fn robot_figures(f: &mut Fields<'_>, metrics: usize) -> Result<Figures, String> 
 pub fn parse_lone(row: &csv::StringRecord, metrics: usize) -> Result<(u64, Figures), String> {
     let mut f = Fields { row, at: 0 };
     let seed = f.parse()?;
-    Ok((seed, robot_figures(&mut f, metrics)?))
+    let figures = robot_figures(&mut f, metrics)?;
+    if f.at != row.len() {
+        return Err(format!("{} fields, not {}", row.len(), f.at));
+    }
+    Ok((seed, figures))
 }
 
 /// A team episode's figures from `row` (made by [`team_row`] for `robots` robots with `metrics`

@@ -156,7 +156,9 @@ impl Orca {
         let reach = horizon.obstacles * speed + radius;
         me.scene()
             .orca_obstacles_near(p, reach, &mut self.obstacles);
-        obstacle_neighbours(&self.obstacles, p2(p), radius, &horizon, &mut self.edges);
+        // The agent as ORCA sees it: grown by the margin.
+        let grown = self.agents[0].radius;
+        obstacle_neighbours(&self.obstacles, p2(p), grown, &horizon, &mut self.edges);
         let edges: Vec<usize> = self.edges.iter().map(|&(_, e)| e).collect();
         let around = Surroundings {
             agents: &others,
@@ -251,8 +253,11 @@ fn discrete(me: &Episode, v: Vector, aim: Vector) -> DiscreteAction {
 impl Policy for Orca {
     fn reset(&mut self, world: &World, episode: &Episode) -> Result<(), PolicyError> {
         self.path = planned(world, episode.pose().position(), episode.goal());
-        self.last.clear();
-        self.last_me = None;
+        // On to the next goal of a list (mid-episode), the others' last positions still hold.
+        if episode.steps() == 0 {
+            self.last.clear();
+            self.last_me = None;
+        }
         Ok(())
     }
 

@@ -167,9 +167,11 @@ fn sweeps_touch(a0: Point, a1: Point, b0: Point, b1: Point, reach: f64) -> bool 
 }
 
 /// `config` with its fixed start and goal moved by up to `jitter_px` in x and y (uniform draws
-/// from `rng`: the start's, then the goal's); `None` without jitter.
+/// from `rng`: the start's, then the goal's, drawn again until the robot's disc is clear of
+/// the still scene at both, up to [`JITTER_TRIES`] times); `None` without jitter.
 fn jittered(
     config: &ValidConfig,
+    scene: &crate::scene::Scene,
     jitter_px: f64,
     rng: &mut crate::sim::rng::Rng,
 ) -> Result<Option<ValidConfig>, EpisodeError> {
@@ -177,20 +179,36 @@ fn jittered(
     if jitter_px <= 0.0 {
         return Ok(None);
     }
-    let mut c = config.as_sim_config().clone();
-    let mut draw = || rng.random_range(-jitter_px..=jitter_px);
-    if let Some(s) = &mut c.episode.start {
-        s[0] += draw();
-        s[1] += draw();
+    let radius = config.robot.radius_px;
+    for _ in 0..JITTER_TRIES {
+        let mut c = config.as_sim_config().clone();
+        let mut draw = || rng.random_range(-jitter_px..=jitter_px);
+        let mut clear = true;
+        if let Some(s) = &mut c.episode.start {
+            s[0] += draw();
+            s[1] += draw();
+            clear &= scene.disc_clear(Point::new(s[0], s[1]), radius);
+        }
+        if let Some(g) = &mut c.episode.goal {
+            g[0] += draw();
+            g[1] += draw();
+            clear &= scene.disc_clear(Point::new(g[0], g[1]), radius);
+        }
+        if clear {
+            return c
+                .validate()
+                .map(Some)
+                .map_err(|e| EpisodeError::Moving(e.to_string()));
+        }
     }
-    if let Some(g) = &mut c.episode.goal {
-        g[0] += draw();
-        g[1] += draw();
-    }
-    c.validate()
-        .map(Some)
-        .map_err(|e| EpisodeError::Moving(e.to_string()))
+    Err(EpisodeError::Moving(format!(
+        "no start and goal within jitter_px = {jitter_px} of the fixed ones is clear of the \
+         scene in {JITTER_TRIES} draws"
+    )))
 }
+
+/// Draws of a jittered start and goal before giving up.
+const JITTER_TRIES: usize = 100;
 
 impl Team {
     /// The team `config.robots` describes for episode `seed`: robot `k` in `worlds[e]`, where
@@ -214,7 +232,7 @@ impl Team {
             let scene = world.scene();
             let radius = world.config().robot.radius_px;
             for _ in 0..entry.count {
-                let jittered = jittered(world.config(), entry.jitter_px, &mut jitter)?;
+                let jittered = jittered(world.config(), scene, entry.jitter_px, &mut jitter)?;
                 let cfg = jittered.as_ref().unwrap_or(world.config());
                 let both_fixed = cfg.episode.start.is_some() && cfg.episode.goal.is_some();
                 let grid = (!both_fixed && needs_region_grid(cfg, scene)).then(|| world.grid());

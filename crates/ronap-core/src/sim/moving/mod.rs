@@ -70,7 +70,7 @@ pub(super) struct Entry {
     held: bool,
     /// A pedestrian that left the scene at its goal (`on_arrival = "vanish"`).
     gone: bool,
-    min_gap: f64,
+    pub(super) min_gap: f64,
 }
 
 impl Entry {
@@ -237,7 +237,12 @@ impl Movers {
                 MovingShape::Disc => Body::Disc(m.radius_px),
                 MovingShape::Box => Body::Box(Vector::new(m.size_px[0], m.size_px[1]) / 2.0),
             };
-            let speed = m.max_speed_px.unwrap_or(m.speed_px).max(m.speed_px);
+            // A pedestrian moves at most its largest speed; every other obstacle at its speed.
+            let speed = if m.motion == MotionKind::Orca {
+                m.max_speed_px.unwrap_or(m.speed_px).max(m.speed_px)
+            } else {
+                m.speed_px
+            };
             reach = reach.max(body.bounding_radius() + speed);
             for _ in 0..m.count {
                 let (e, behaviour, position, dir) = if m.motion == MotionKind::Orca {
@@ -507,7 +512,16 @@ impl Movers {
             let to = match e.motion {
                 Motion::Still => continue,
                 Motion::Reactive => match &self.pedestrians[i] {
-                    Some(p) if p.next != Vector::zeros() => from + p.next,
+                    // ORCA keeps it off the still scene, but not always exactly (its linear
+                    // program can fail on an obstacle's half-plane): a move into a wall is not
+                    // made.
+                    Some(p) if p.next != Vector::zeros() => {
+                        let to = from + p.next;
+                        if !e.body.sweep_clear(scene, from, to) {
+                            continue;
+                        }
+                        to
+                    }
                     _ => continue,
                 },
                 Motion::Heading { .. } => {

@@ -81,7 +81,7 @@ pub(super) fn place(
         };
         let goal = match m.goal {
             Some(g) => Point::new(g[0], g[1]),
-            None => free_spot(body, scene, rng, |_| true)?,
+            None => free_spot(body, scene, rng, clear_of_all)?,
         };
         return Some((start, goal));
     };
@@ -183,10 +183,11 @@ impl Crowd {
             // checked against a robot where it stands: each robot is avoided both where it will
             // be (an agent moving as it did in its last step) and where it stands (at rest).
             for (k, r) in robots.iter().enumerate() {
-                let velocity = self
-                    .last_robots
-                    .get(k)
-                    .map_or(Vector::zeros(), |&l| r.at - l);
+                // A robot that vanished shifts the others down: no velocity for that step.
+                let velocity = match self.last_robots.get(k) {
+                    Some(&l) if self.last_robots.len() == robots.len() => r.at - l,
+                    _ => Vector::zeros(),
+                };
                 for v in [velocity, Vector::zeros()] {
                     self.agents.push(Agent {
                         position: V2::new(r.at.x, r.at.y),
@@ -217,7 +218,11 @@ impl Crowd {
                         continue;
                     }
                     Arrival::NewGoal => {
-                        if let Some(g) = free_spot(entries[i].body, scene, rng, |_| true) {
+                        // Away from the robots, as its first goal was.
+                        let (body, gap) = (entries[i].body, entries[i].min_gap);
+                        let far =
+                            |q: Point| robots.iter().all(|r| body.gap(q, r.at, r.radius) >= gap);
+                        if let Some(g) = free_spot(body, scene, rng, far) {
                             p.goal = g;
                         }
                         Vector::zeros()
@@ -250,12 +255,12 @@ impl Crowd {
                 radius: self.agents[j].radius + margin,
                 ..self.agents[j]
             }));
-            let reach = horizon.obstacles * horizon.max_speed + me.radius;
+            let reach = horizon.obstacles * horizon.max_speed + me.radius + margin;
             scene.orca_obstacles_near(at, reach, &mut self.obstacles);
             obstacle_neighbours(
                 &self.obstacles,
                 me.position,
-                me.radius,
+                me.radius + margin,
                 &horizon,
                 &mut self.edges,
             );
@@ -343,6 +348,24 @@ mod tests {
         eprintln!("{arrived} of 640 arrived; least gap {least}");
         assert!(arrived >= 608, "{arrived} of 640 arrived");
         assert!(least >= 0.0, "pedestrians overlapped by {}", -least);
+    }
+
+    #[test]
+    fn max_speed_px_is_a_pedestrians_only() {
+        let c = crate::SimConfig {
+            moving: vec![MovingConfig {
+                motion: MotionKind::Linear,
+                speed_px: 2.0,
+                max_speed_px: Some(10.0),
+                ..Default::default()
+            }],
+            ..Default::default()
+        };
+        let mut e = episode(&c, 1);
+        let before = e.movers().expect("movers").items().next().expect("one").position();
+        e.step(DiscreteAction::Left);
+        let after = e.movers().expect("movers").items().next().expect("one").position();
+        assert!((after - before).norm() <= 2.0 + 1e-9, "{before} {after}");
     }
 
     #[test]
