@@ -5,7 +5,7 @@
 //! summary a mean per metric, from the [`Kind`] alone: a new metric is its file and its line in
 //! [`CROWD`].
 //!
-//! Metrics are measured by the evaluator ([`Gauges`]), never in the stepping loop of a bench or
+//! Metrics are measured by the evaluator (its `Gauges`), never in the stepping loop of a bench or
 //! a learner, so a run that asks for none pays nothing.
 
 mod gauges;
