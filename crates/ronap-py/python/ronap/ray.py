@@ -44,17 +44,19 @@ def _block(payload: Any, seeds: list[int], config_json: str, maze_seed: int | No
     cpus = ray.get_runtime_context().get_assigned_resources().get("CPU", 1.0)
     kind, value = payload
     config = _ronap.Config(config_json)
+
+    def run(policy: Any) -> Any:
+        return _ronap.evaluate(policy, seeds, config, maze_seed=maze_seed, map_path=map, threads=max(1, int(cpus)), rows=True)
+
+    if kind != "mlp":
+        return run(value)["rows"]
+    # Only a network needs a file (Ray may end a worker before such a directory is removed).
     with tempfile.TemporaryDirectory(prefix="ronap-block-") as tmp:
-        if kind == "mlp":
-            data, rule = value
-            path = os.path.join(tmp, "net.safetensors")
-            with open(path, "wb") as f:
-                f.write(data)
-            policy: Any = f"mlp:{path}" + (f"@{rule}" if rule else "")
-        else:
-            policy = value
-        result = _ronap.evaluate(policy, seeds, config, maze_seed=maze_seed, map_path=map, threads=max(1, int(cpus)), rows=True)
-    return result["rows"]
+        data, rule = value
+        path = os.path.join(tmp, "net.safetensors")
+        with open(path, "wb") as f:
+            f.write(data)
+        return run(f"mlp:{path}" + (f"@{rule}" if rule else ""))["rows"]
 
 
 def _payload(policy: str | Callable[[Any], Any]) -> tuple[str, Any]:

@@ -362,9 +362,21 @@ mod tests {
             ..Default::default()
         };
         let mut e = episode(&c, 1);
-        let before = e.movers().expect("movers").items().next().expect("one").position();
+        let before = e
+            .movers()
+            .expect("movers")
+            .items()
+            .next()
+            .expect("one")
+            .position();
         e.step(DiscreteAction::Left);
-        let after = e.movers().expect("movers").items().next().expect("one").position();
+        let after = e
+            .movers()
+            .expect("movers")
+            .items()
+            .next()
+            .expect("one")
+            .position();
         assert!((after - before).norm() <= 2.0 + 1e-9, "{before} {after}");
     }
 
