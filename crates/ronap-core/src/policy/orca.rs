@@ -143,7 +143,6 @@ impl Orca {
             max_speed: speed,
             time_step: 1.0,
         };
-        let radius = config.robot.radius_px;
         let range = config.orca.sense_range_px.unwrap_or(config.laser.range_px);
         agent_neighbours(
             &self.agents,
@@ -153,11 +152,11 @@ impl Orca {
             &mut self.near,
         );
         let others: Vec<Agent<f64>> = self.near.iter().map(|&(_, j)| self.agents[j]).collect();
-        let reach = horizon.obstacles * speed + radius;
-        me.scene()
-            .orca_obstacles_near(p, reach, &mut self.obstacles);
         // The agent as ORCA sees it: grown by the margin.
         let grown = self.agents[0].radius;
+        let reach = horizon.obstacles * speed + grown;
+        me.scene()
+            .orca_obstacles_near(p, reach, &mut self.obstacles);
         obstacle_neighbours(&self.obstacles, p2(p), grown, &horizon, &mut self.edges);
         let edges: Vec<usize> = self.edges.iter().map(|&(_, e)| e).collect();
         let around = Surroundings {
