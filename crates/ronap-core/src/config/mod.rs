@@ -29,6 +29,8 @@ pub use episode::{
 };
 pub use file::{key_line, ConfigFile};
 pub use metrics::MetricsConfig;
+#[cfg(test)]
+pub(crate) use moving::maze_pedestrians;
 pub use moving::{
     AgentOrca, Arrival, MotionKind, MovingConfig, MovingShape, Patrol, Pattern, MAX_MOVING,
 };
@@ -202,6 +204,16 @@ impl ValidConfig {
         let step = self.robot.move_speed_px.max(self.robot.max_linear_speed_px);
         self.laser.range_px.max(step + self.robot.radius_px)
     }
+}
+
+/// Whether a field that defaults to false is false (left out of written configurations).
+fn is_false(v: &bool) -> bool {
+    !*v
+}
+
+/// Whether a field that defaults to 0 is 0 (left out of written configurations).
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 fn check(

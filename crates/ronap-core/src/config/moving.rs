@@ -113,14 +113,6 @@ fn pattern_name(p: Option<Pattern>) -> String {
     }
 }
 
-fn is_false(v: &bool) -> bool {
-    !*v
-}
-
-fn is_zero(v: &f64) -> bool {
-    *v == 0.0
-}
-
 /// How a `waypoints` obstacle goes round its points.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -179,7 +171,7 @@ pub struct MovingConfig {
     pub on_arrival: Arrival,
     /// `orca`: whether it avoids the robots too. Default false (CrowdNav's invisible robot: it
     /// walks into a robot that does not give way).
-    #[serde(skip_serializing_if = "is_false")]
+    #[serde(skip_serializing_if = "super::is_false")]
     pub sees_robots: bool,
     /// `orca`: place start and goal by a crowd pattern, `circle` or `square`. Default: drawn.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -188,10 +180,10 @@ pub struct MovingConfig {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pattern_center: Option<[f64; 2]>,
     /// The circle's radius, or the square's half side, px.
-    #[serde(skip_serializing_if = "is_zero")]
+    #[serde(skip_serializing_if = "super::is_zero")]
     pub pattern_radius_px: f64,
     /// A pattern's start and goal move by up to this much in x and y, px (uniform). Default 0.
-    #[serde(skip_serializing_if = "is_zero")]
+    #[serde(skip_serializing_if = "super::is_zero")]
     pub jitter_px: f64,
     /// `orca`: how it avoids.
     #[serde(skip_serializing_if = "AgentOrca::is_default")]
@@ -226,6 +218,23 @@ impl Default for MovingConfig {
             jitter_px: 0.0,
             orca: AgentOrca::default(),
         }
+    }
+}
+
+/// The paper's maze with the 20 wandering pedestrians of `scenarios/maze-pedestrians.toml`
+/// (discs of 6 px at 1.5 px a step, turning by N(0, 20 deg^2)), for tests.
+#[cfg(test)]
+pub(crate) fn maze_pedestrians() -> super::SimConfig {
+    super::SimConfig {
+        moving: vec![MovingConfig {
+            count: 20,
+            radius_px: 6.0,
+            motion: MotionKind::RandomWalk,
+            speed_px: 1.5,
+            turn_sigma_deg: 20.0,
+            ..Default::default()
+        }],
+        ..Default::default()
     }
 }
 

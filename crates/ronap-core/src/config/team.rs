@@ -112,12 +112,8 @@ pub struct TeamRobotConfig {
     /// Moves the fixed `start` and `goal` by up to this much in x and in y, px, uniformly, drawn
     /// from the episode seed's own jitter stream (so each seed poses the task a little apart and
     /// no other draw changes). Default 0.
-    #[serde(skip_serializing_if = "is_zero")]
+    #[serde(skip_serializing_if = "super::is_zero")]
     pub jitter_px: f64,
-}
-
-fn is_zero(v: &f64) -> bool {
-    *v == 0.0
 }
 
 impl Default for TeamRobotConfig {

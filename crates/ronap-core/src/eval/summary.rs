@@ -292,18 +292,10 @@ impl Tally {
 }
 
 impl Summary {
-    /// The summary of `records`, over a run that took `wall_time_s`.
-    pub fn new(records: &[EpisodeRecord], wall_time_s: f64) -> Self {
-        // Records carry the values of the metrics their configuration asked for (the crowd
-        // metrics, when any).
-        let measured = records
-            .first()
-            .is_some_and(|r| r.metrics.len() == crate::eval::metric::CROWD.len());
-        let mut tally = if measured {
-            Tally::measuring(&crate::eval::metric::CROWD)
-        } else {
-            Tally::default()
-        };
+    /// The summary of `records`, whose metrics beyond the standard ones are those of `kinds`
+    /// (`metric::kinds` of their configuration), over a run that took `wall_time_s`.
+    pub fn new(records: &[EpisodeRecord], kinds: &'static [Kind], wall_time_s: f64) -> Self {
+        let mut tally = Tally::measuring(kinds);
         for r in records {
             tally.add(&Figures::of(r));
         }

@@ -11,11 +11,9 @@ use super::follow::Follower;
 use super::geodesic::planned;
 use super::{Decision, Policy, PolicyError};
 use crate::config::PlannerActions;
-use crate::geometry::orca::{
-    agent_neighbours, new_velocity, obstacle_neighbours, Agent, Horizon, Line, Obstacles,
-    Surroundings, V2,
-};
+use crate::geometry::orca::{Agent, Horizon, V2};
 use crate::geometry::{wrap_deg, Point, Vector};
+use crate::sim::avoid::{Avoid, Avoider};
 use crate::sim::episode::Episode;
 use crate::sim::moving::Movers;
 use crate::sim::robot::{Action, DiscreteAction};
@@ -40,18 +38,7 @@ pub struct Orca {
     index: usize,
     // Scratch space kept between steps.
     agents: Vec<Agent<f64>>,
-    near: Vec<(f64, usize)>,
-    edges: Vec<(f64, usize)>,
-    lines: Vec<Line<f64>>,
-    obstacles: Obstacles<f64>,
-}
-
-fn v2(v: Vector) -> V2<f64> {
-    V2::new(v.x, v.y)
-}
-
-fn p2(p: Point) -> V2<f64> {
-    V2::new(p.x, p.y)
+    avoider: Avoider,
 }
 
 impl Orca {
@@ -74,21 +61,19 @@ impl Orca {
         self.last_me = Some(p);
         self.agents.clear();
         self.agents.push(Agent {
-            position: p2(p),
-            velocity: v2(velocity),
-            radius: config.robot.radius_px + config.orca.safety_margin_px,
+            position: V2::from(p),
+            velocity: V2::from(velocity),
+            radius: config.robot.radius_px,
         });
         let mover_count = movers.map_or(0, |m| m.items().len());
         self.last.resize(mover_count + team_size, None);
-        // Every agent is grown by the margin too: the gap kept is the margin on each side.
-        let margin = config.orca.safety_margin_px;
         let mut seen = |slot: usize, at: Option<Point>, radius: f64, agents: &mut Vec<_>| {
             let last = std::mem::replace(&mut self.last[slot], at);
             if let Some(at) = at.filter(|a| (a - p).norm() <= range + radius) {
                 agents.push(Agent {
-                    position: p2(at),
-                    velocity: v2(last.map_or(Vector::zeros(), |l| at - l)),
-                    radius: radius + margin,
+                    position: V2::from(at),
+                    velocity: V2::from(last.map_or(Vector::zeros(), |l| at - l)),
+                    radius,
                 });
             }
         };
@@ -143,35 +128,18 @@ impl Orca {
             max_speed: speed,
             time_step: 1.0,
         };
-        let range = config.orca.sense_range_px.unwrap_or(config.laser.range_px);
-        agent_neighbours(
-            &self.agents,
-            0,
-            range,
-            config.orca.max_neighbours as usize,
-            &mut self.near,
+        let v = self.avoider.velocity(
+            me.scene(),
+            &Avoid {
+                agents: &self.agents,
+                me: 0,
+                preferred,
+                horizon,
+                neighbour_dist: config.orca.sense_range_px.unwrap_or(config.laser.range_px),
+                max_neighbours: config.orca.max_neighbours as usize,
+                margin: config.orca.safety_margin_px,
+            },
         );
-        let others: Vec<Agent<f64>> = self.near.iter().map(|&(_, j)| self.agents[j]).collect();
-        // The agent as ORCA sees it: grown by the margin.
-        let grown = self.agents[0].radius;
-        let reach = horizon.obstacles * speed + grown;
-        me.scene()
-            .orca_obstacles_near(p, reach, &mut self.obstacles);
-        obstacle_neighbours(&self.obstacles, p2(p), grown, &horizon, &mut self.edges);
-        let edges: Vec<usize> = self.edges.iter().map(|&(_, e)| e).collect();
-        let around = Surroundings {
-            agents: &others,
-            obstacles: &self.obstacles,
-            edges: &edges,
-        };
-        let v = new_velocity(
-            &self.agents[0],
-            v2(preferred),
-            &around,
-            &horizon,
-            &mut self.lines,
-        );
-        let v = Vector::new(v.x, v.y);
         Decision::Act(match actions {
             PlannerActions::Continuous => continuous(me, v, to_aim),
             PlannerActions::Discrete => discrete(me, v, to_aim).into(),
@@ -281,7 +249,7 @@ impl Policy for Orca {
 
 #[cfg(test)]
 mod tests {
-    use crate::config::{MotionKind, MovingConfig, PlannerActions, TeamRobotConfig};
+    use crate::config::{PlannerActions, TeamRobotConfig};
     use crate::eval::{EvalOptions, Evaluator, Outcome, Summary};
     use crate::policy::{factory, PerRobotFactory};
     use crate::sim::world::Scenes;
@@ -297,27 +265,13 @@ mod tests {
         let run = ev
             .run(f.as_ref(), &options, &AtomicBool::new(false), &|_| {})
             .expect("runs");
-        Summary::new(&run.records, 1.0)
-    }
-
-    fn pedestrians() -> crate::SimConfig {
-        crate::SimConfig {
-            moving: vec![MovingConfig {
-                count: 20,
-                radius_px: 6.0,
-                motion: MotionKind::RandomWalk,
-                speed_px: 1.5,
-                turn_sigma_deg: 20.0,
-                ..Default::default()
-            }],
-            ..Default::default()
-        }
+        Summary::new(&run.records, crate::eval::metric::kinds(ev.config()), 1.0)
     }
 
     #[test]
     fn among_pedestrians_orca_arrives_with_fewer_contacts_than_geodesic() {
-        let orca = lone_run(pedestrians(), "orca", 30);
-        let geodesic = lone_run(pedestrians(), "geodesic", 30);
+        let orca = lone_run(crate::config::maze_pedestrians(), "orca", 30);
+        let geodesic = lone_run(crate::config::maze_pedestrians(), "geodesic", 30);
         let contacts = |s: &Summary| {
             s.moving
                 .as_ref()

@@ -5,6 +5,7 @@
 //! `geometry` and `scene`.
 
 pub mod action;
+pub mod avoid;
 pub mod episode;
 pub mod kinematics;
 pub mod lidar;

@@ -127,24 +127,13 @@ impl Gauges {
 
 #[cfg(test)]
 mod tests {
-    use crate::config::{MotionKind, MovingConfig};
     use crate::eval::{Evaluator, Recording};
     use crate::policy::factory;
     use crate::sim::world::Scenes;
 
     /// Episodes among pedestrians with the crowd metrics on, recording what pictures need.
     fn evaluator() -> Evaluator {
-        let mut c = crate::SimConfig {
-            moving: vec![MovingConfig {
-                count: 20,
-                radius_px: 6.0,
-                motion: MotionKind::RandomWalk,
-                speed_px: 1.5,
-                turn_sigma_deg: 20.0,
-                ..Default::default()
-            }],
-            ..Default::default()
-        };
+        let mut c = crate::config::maze_pedestrians();
         c.metrics.crowd = true;
         c.metrics.discomfort_px = 8.0;
         Evaluator::new(c.validate().expect("valid"), Scenes::MazePerSeed)

@@ -158,6 +158,24 @@ impl<T: Real> Neg for V2<T> {
     }
 }
 
+impl From<crate::geometry::Vector> for V2<f64> {
+    fn from(v: crate::geometry::Vector) -> Self {
+        Self::new(v.x, v.y)
+    }
+}
+
+impl From<crate::geometry::Point> for V2<f64> {
+    fn from(p: crate::geometry::Point) -> Self {
+        Self::new(p.x, p.y)
+    }
+}
+
+impl From<V2<f64>> for crate::geometry::Vector {
+    fn from(v: V2<f64>) -> Self {
+        Self::new(v.x, v.y)
+    }
+}
+
 /// How far `c` lies left of the line from `a` to `b` (RVO2's `leftOf`: positive on the left).
 pub fn left_of<T: Real>(a: V2<T>, b: V2<T>, c: V2<T>) -> T {
     (a - c).det(b - a)

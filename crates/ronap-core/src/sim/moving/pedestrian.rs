@@ -8,12 +8,10 @@
 
 use super::{free_spot, Body, Disc, Entry, SPOT_TRIES};
 use crate::config::{AgentOrca, Arrival, MovingConfig, Pattern};
-use crate::geometry::orca::{
-    agent_neighbours, new_velocity, obstacle_neighbours, Agent, Horizon, Line, Obstacles,
-    Surroundings, V2,
-};
+use crate::geometry::orca::{Agent, Horizon, V2};
 use crate::geometry::{Point, Vector};
 use crate::scene::Scene;
+use crate::sim::avoid::{Avoid, Avoider};
 use crate::sim::moving::heading::State;
 use crate::sim::rng::Rng;
 use rand::Rng as _;
@@ -135,16 +133,7 @@ pub(super) struct Crowd {
     agents: Vec<Agent<f64>>,
     /// The obstacle each agent is (`None`: a robot).
     owners: Vec<Option<usize>>,
-    near: Vec<(f64, usize)>,
-    edges: Vec<(f64, usize)>,
-    edge_list: Vec<usize>,
-    others: Vec<Agent<f64>>,
-    lines: Vec<Line<f64>>,
-    obstacles: Obstacles<f64>,
-}
-
-fn v2(v: Vector) -> V2<f64> {
-    V2::new(v.x, v.y)
+    avoider: Avoider,
 }
 
 impl Crowd {
@@ -170,8 +159,8 @@ impl Crowd {
             if let Some(at) = now {
                 let velocity = last.map_or(Vector::zeros(), |l| at - l);
                 self.agents.push(Agent {
-                    position: V2::new(at.x, at.y),
-                    velocity: v2(velocity),
+                    position: V2::from(at),
+                    velocity: V2::from(velocity),
                     radius: e.body.bounding_radius(),
                 });
                 self.owners.push(Some(i));
@@ -190,8 +179,8 @@ impl Crowd {
                 };
                 for v in [velocity, Vector::zeros()] {
                     self.agents.push(Agent {
-                        position: V2::new(r.at.x, r.at.y),
-                        velocity: v2(v),
+                        position: V2::from(r.at),
+                        velocity: V2::from(v),
                         radius: r.radius,
                     });
                     self.owners.push(None);
@@ -205,8 +194,7 @@ impl Crowd {
             let Some(p) = pedestrians[i].as_mut() else {
                 continue;
             };
-            let margin = p.orca.safety_margin_px;
-            let mut me = self.agents[a];
+            let me = self.agents[a];
             let at = Point::new(me.position.x, me.position.y);
             let to_goal = p.goal - at;
             let preferred = if to_goal.norm() < me.radius {
@@ -243,37 +231,18 @@ impl Crowd {
             } else {
                 pedestrian_agents
             };
-            agent_neighbours(
-                &self.agents[..visible],
-                a,
-                p.orca.neighbour_dist_px,
-                p.orca.max_neighbours as usize,
-                &mut self.near,
+            p.next = self.avoider.velocity(
+                scene,
+                &Avoid {
+                    agents: &self.agents[..visible],
+                    me: a,
+                    preferred,
+                    horizon,
+                    neighbour_dist: p.orca.neighbour_dist_px,
+                    max_neighbours: p.orca.max_neighbours as usize,
+                    margin: p.orca.safety_margin_px,
+                },
             );
-            self.others.clear();
-            self.others.extend(self.near.iter().map(|&(_, j)| Agent {
-                radius: self.agents[j].radius + margin,
-                ..self.agents[j]
-            }));
-            let reach = horizon.obstacles * horizon.max_speed + me.radius + margin;
-            scene.orca_obstacles_near(at, reach, &mut self.obstacles);
-            obstacle_neighbours(
-                &self.obstacles,
-                me.position,
-                me.radius + margin,
-                &horizon,
-                &mut self.edges,
-            );
-            self.edge_list.clear();
-            self.edge_list.extend(self.edges.iter().map(|&(_, e)| e));
-            me.radius += margin;
-            let around = Surroundings {
-                agents: &self.others,
-                obstacles: &self.obstacles,
-                edges: &self.edge_list,
-            };
-            let v = new_velocity(&me, v2(preferred), &around, &horizon, &mut self.lines);
-            p.next = Vector::new(v.x, v.y);
         }
     }
 }
@@ -362,21 +331,17 @@ mod tests {
             ..Default::default()
         };
         let mut e = episode(&c, 1);
-        let before = e
-            .movers()
-            .expect("movers")
-            .items()
-            .next()
-            .expect("one")
-            .position();
+        let position = |e: &Episode| {
+            e.movers()
+                .expect("movers")
+                .items()
+                .next()
+                .expect("one")
+                .position()
+        };
+        let before = position(&e);
         e.step(DiscreteAction::Left);
-        let after = e
-            .movers()
-            .expect("movers")
-            .items()
-            .next()
-            .expect("one")
-            .position();
+        let after = position(&e);
         assert!((after - before).norm() <= 2.0 + 1e-9, "{before} {after}");
     }
 

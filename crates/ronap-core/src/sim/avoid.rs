@@ -1,0 +1,85 @@
+//! One agent's ORCA step among other agents and the still scene, as the `orca` policy and the
+//! ORCA pedestrians both take it: its nearest agents, the scene's obstacles within the reach of
+//! its obstacle horizon, every agent grown by a safety margin, and the velocity ORCA gives.
+
+use crate::geometry::orca::{
+    agent_neighbours, new_velocity, obstacle_neighbours, Agent, Horizon, Line, Obstacles,
+    Surroundings,
+};
+use crate::geometry::Vector;
+use crate::scene::Scene;
+
+/// What one agent avoids with.
+#[derive(Clone, Copy, Debug)]
+pub struct Avoid<'a> {
+    /// The agents, the one avoiding among them (radii as they are, without the margin).
+    pub agents: &'a [Agent<f64>],
+    /// The one avoiding: its index in `agents`.
+    pub me: usize,
+    /// The velocity it wants.
+    pub preferred: Vector,
+    /// Its horizons, speed limit and time step.
+    pub horizon: Horizon<f64>,
+    /// How far it looks for other agents (centre to centre).
+    pub neighbour_dist: f64,
+    /// Most agents it avoids at once (the nearest).
+    pub max_neighbours: usize,
+    /// Added to every agent's radius, its own too.
+    pub margin: f64,
+}
+
+/// The scratch space of ORCA steps, kept between them.
+#[derive(Clone, Debug, Default)]
+pub struct Avoider {
+    near: Vec<(f64, usize)>,
+    others: Vec<Agent<f64>>,
+    edges: Vec<(f64, usize)>,
+    edge_list: Vec<usize>,
+    lines: Vec<Line<f64>>,
+    obstacles: Obstacles<f64>,
+}
+
+impl Avoider {
+    /// The velocity ORCA gives `a.me` in `scene`.
+    pub fn velocity(&mut self, scene: &Scene, a: &Avoid<'_>) -> Vector {
+        agent_neighbours(
+            a.agents,
+            a.me,
+            a.neighbour_dist,
+            a.max_neighbours,
+            &mut self.near,
+        );
+        self.others.clear();
+        self.others.extend(self.near.iter().map(|&(_, j)| Agent {
+            radius: a.agents[j].radius + a.margin,
+            ..a.agents[j]
+        }));
+        let mut me = a.agents[a.me];
+        me.radius += a.margin;
+        let at = crate::geometry::Point::new(me.position.x, me.position.y);
+        let reach = a.horizon.obstacles * a.horizon.max_speed + me.radius;
+        scene.orca_obstacles_near(at, reach, &mut self.obstacles);
+        obstacle_neighbours(
+            &self.obstacles,
+            me.position,
+            me.radius,
+            &a.horizon,
+            &mut self.edges,
+        );
+        self.edge_list.clear();
+        self.edge_list.extend(self.edges.iter().map(|&(_, e)| e));
+        let around = Surroundings {
+            agents: &self.others,
+            obstacles: &self.obstacles,
+            edges: &self.edge_list,
+        };
+        new_velocity(
+            &me,
+            a.preferred.into(),
+            &around,
+            &a.horizon,
+            &mut self.lines,
+        )
+        .into()
+    }
+}
