@@ -554,9 +554,12 @@ fn the_crowd_scenarios_run_and_bad_crowd_entries_are_named() {
         ("circle-crossing-visible", "geodesic"),
         ("square-crossing", "geodesic-wait"),
         ("circle-robots-20", "orca"),
+        ("crowd-hall", "social-force"),
+        ("circle-crossing", "dwa"),
+        ("circle-robots-20", "social-force"),
     ] {
         let scenario = crate::util::repo_root().join(format!("scenarios/{name}.toml"));
-        let out = dir.path().join(name);
+        let out = dir.path().join(format!("{name}-{policy}"));
         crate::util::ok(&ronap(&[
             "run",
             "--scenario",
@@ -588,6 +591,18 @@ fn the_crowd_scenarios_run_and_bad_crowd_entries_are_named() {
         (
             "[[moving]]\nmotion = \"random_walk\"\npattern = \"square\"\npattern_radius_px = 10.0\n",
             &["bad.toml:6", "moving[0].pattern", "\"square\"", "orca"][..],
+        ),
+        (
+            "[[moving]]\nmotion = \"social_force\"\nsocial_force = { lambda = 2.0 }\n",
+            &["bad.toml:6", "moving[0].social_force.lambda", "2.0"][..],
+        ),
+        (
+            "[[moving]]\nmotion = \"social_force\"\nmax_speed_px = -3.0\n",
+            &["bad.toml:6", "moving[0].max_speed_px", "-3"][..],
+        ),
+        (
+            "[dwa]\nhorizon_steps = 0\n",
+            &["bad.toml:5", "dwa.horizon_steps", "0"][..],
         ),
     ] {
         let bad = dir.path().join("bad.toml");

@@ -163,7 +163,15 @@ def test_mazes_as_arrays():
     assert img.shape == (500, 500, 3)
     small = ronap.maze_occupancy(7, scale=0.5)
     assert np.array_equal(small, np.all(img == 0, axis=-1))
-    assert set(ronap.policies()) == {"apf", "geodesic", "geodesic-wait", "orca", "random"}
+    assert set(ronap.policies()) == {
+        "apf",
+        "geodesic",
+        "geodesic-wait",
+        "orca",
+        "social-force",
+        "dwa",
+        "random",
+    }
 
 
 def test_out_of_range_counts_and_seeds_are_config_errors_naming_them():

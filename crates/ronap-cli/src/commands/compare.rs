@@ -27,7 +27,7 @@ pub enum By {
 #[derive(Args, Debug)]
 pub struct CompareArgs {
     /// A policy to compare (repeat for each; at least two in all, counting --run): apf, geodesic,
-    /// geodesic-wait, orca, random, mlp:FILE.safetensors[@RULE] or py:FILE.py:FUNCTION, as for `ronap
+    /// geodesic-wait, orca, social-force, dwa, random, mlp:FILE.safetensors[@RULE] or py:FILE.py:FUNCTION, as for `ronap
     /// run`.
     #[arg(long, value_name = "NAME")]
     policy: Vec<String>,

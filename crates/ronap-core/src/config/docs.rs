@@ -67,6 +67,21 @@ const FIELD_DOCS: &[(&str, &str, &str, Option<&str>)] = &[
     ("orca", "sense_range_px", "orca policy: how far the robot senses other agents (their positions and velocities), px. Unset: the laser's range.", Some("100.0")),
     ("orca", "safety_margin_px", "orca policy: added to the robot's radius in ORCA, px (agents meeting in a crowd at a radius a step can otherwise overlap).", None),
     ("orca", "actions", "orca policy: \"continuous\" ((v, w) tracking the velocity) or \"discrete\" (the action whose result lies closest).", None),
+    ("social_force", "speed_px", "social-force policy: preferred (and largest) speed, px per step. Unset: the robot's max_linear_speed_px (continuous actions) or move_speed_px (discrete).", Some("4.0")),
+    ("social_force", "sense_range_px", "social-force policy: how far the robot senses other agents, px. Unset: the laser's range.", Some("100.0")),
+    ("social_force", "actions", "social-force policy: \"continuous\" ((v, w) tracking the velocity) or \"discrete\" (the action whose result lies closest).", None),
+    ("social_force", "forces", "social-force policy: { relaxation_steps (tau, steps), agent_strength_px (A, px/step^2), agent_range_px (B, px), obstacle_strength_px, obstacle_range_px, lambda (weight of an agent behind, 0-1), neighbour_dist_px } (Helbing-Molnar 1995 at 20 px a metre, 4 steps a second).", None),
+    ("dwa", "horizon_steps", "dwa policy: steps each sampled command is rolled out for.", None),
+    ("dwa", "speed_samples", "dwa policy: linear speeds sampled across the window.", None),
+    ("dwa", "turn_samples", "dwa policy: turn rates sampled across the window.", None),
+    ("dwa", "linear_accel_px", "dwa policy: largest change of the linear speed in a step, px per step^2 (the window round the last command).", None),
+    ("dwa", "angular_accel_deg", "dwa policy: largest change of the turn rate in a step, degrees per step^2.", None),
+    ("dwa", "heading_weight", "dwa policy: weight of facing the path's aim at the rollout's end.", None),
+    ("dwa", "clearance_weight", "dwa policy: weight of the share of the rollout's steps before its first contact.", None),
+    ("dwa", "speed_weight", "dwa policy: weight of the speed (as a fraction of the largest).", None),
+    ("dwa", "safety_margin_px", "dwa policy: a rollout step nearer than this to anything sensed (beyond the bodies) is a contact, px.", None),
+    ("dwa", "sense_range_px", "dwa policy: how far the robot senses moving agents, px. Unset: the laser's range.", Some("100.0")),
+    ("dwa", "actions", "dwa policy: \"continuous\" (sampled (v, w)) or \"discrete\" (LEFT, AHEAD, RIGHT, each taken once then AHEAD).", None),
     ("metrics", "crowd", "Measure the crowd metrics: time_to_goal, intrusion_ratio, min_separation_px, ttc_min, path_irregularity, jerk (columns in episodes.csv or a team's robots.csv, means in summary.json).", None),
     ("metrics", "discomfort_px", "Crowd metrics: a step intrudes when a moving obstacle or another robot is closer than this beyond the two bodies, px.", None),
 ];
@@ -86,7 +101,7 @@ const MOVING_DOCS: &[(&str, &str)] = &[
     ),
     (
         "motion",
-        "\"still\", \"linear\", \"waypoints\", \"random_walk\", \"appear\" or \"orca\" (a pedestrian with a goal that avoids the others).",
+        "\"still\", \"linear\", \"waypoints\", \"random_walk\", \"appear\", \"orca\" or \"social_force\" (pedestrians with a goal that avoid the others by ORCA, or are pushed by the social force model).",
     ),
     ("speed_px", "Distance moved per step, px."),
     (
@@ -114,23 +129,23 @@ const MOVING_DOCS: &[(&str, &str)] = &[
     ),
     (
         "goal",
-        "orca: fixed goal [x, y], px. Unset: from the pattern, else drawn in free space.",
+        "orca, social_force: fixed goal [x, y], px. Unset: from the pattern, else drawn in free space.",
     ),
     (
         "max_speed_px",
-        "orca: largest speed, px per step (speed_px is the preferred one). Unset: speed_px.",
+        "orca, social_force: largest speed, px per step (speed_px is the preferred one). Unset: speed_px.",
     ),
     (
         "on_arrival",
-        "orca: at its goal \"stay\", \"new_goal\" (draw another) or \"vanish\".",
+        "orca, social_force: at its goal \"stay\", \"new_goal\" (draw another) or \"vanish\".",
     ),
     (
         "sees_robots",
-        "orca: whether it avoids the robots too (false: CrowdNav's invisible robot).",
+        "orca, social_force: whether it avoids the robots too (false: CrowdNav's invisible robot).",
     ),
     (
         "pattern",
-        "orca: start and goal by a crowd pattern, \"circle\" (opposite points) or \"square\" (opposite sides). Unset: drawn.",
+        "orca, social_force: start and goal by a crowd pattern, \"circle\" (opposite points), \"square\" (opposite sides) or \"random\" (drawn in free space). Unset: drawn.",
     ),
     (
         "pattern_center",
@@ -147,6 +162,10 @@ const MOVING_DOCS: &[(&str, &str)] = &[
     (
         "orca",
         "orca: { time_horizon_steps = 20, obstacle_time_horizon_steps = 20, neighbour_dist_px = 200, max_neighbours = 10, safety_margin_px = 1 } (RVO2's agent settings, in steps and px).",
+    ),
+    (
+        "social_force",
+        "social_force: { relaxation_steps = 2, agent_strength_px = 8.75, agent_range_px = 6, obstacle_strength_px = 62.5, obstacle_range_px = 4, lambda = 0.5, neighbour_dist_px = 60 } (Helbing-Molnar 1995 at 20 px a metre, 4 steps a second).",
     ),
 ];
 
@@ -220,7 +239,7 @@ impl SimConfig {
         if let (Some(table), Ok(team)) = (value.as_table_mut(), toml::Value::try_from(&self.team)) {
             table.entry("team").or_insert(team);
         }
-        // So are [observation], [orca], [metrics] and reward shaping.
+        // So are [observation], [orca], [social_force], [dwa], [metrics] and reward shaping.
         if let (Some(table), Ok(metrics)) =
             (value.as_table_mut(), toml::Value::try_from(&self.metrics))
         {
@@ -228,6 +247,15 @@ impl SimConfig {
         }
         if let (Some(table), Ok(orca)) = (value.as_table_mut(), toml::Value::try_from(&self.orca)) {
             table.entry("orca").or_insert(orca);
+        }
+        if let (Some(table), Ok(sf)) = (
+            value.as_table_mut(),
+            toml::Value::try_from(&self.social_force),
+        ) {
+            table.entry("social_force").or_insert(sf);
+        }
+        if let (Some(table), Ok(dwa)) = (value.as_table_mut(), toml::Value::try_from(&self.dwa)) {
+            table.entry("dwa").or_insert(dwa);
         }
         if let (Some(table), Ok(observation)) = (
             value.as_table_mut(),

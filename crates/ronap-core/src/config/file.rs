@@ -128,7 +128,8 @@ pub fn key_line(text: &str, field: &str) -> Option<usize> {
         };
         let k = k.trim();
         let here = current == name && (index.is_none() || index == current_index);
-        if here && k == key {
+        // The key itself, or an inline table holding it: `orca = { max_neighbours = 5 }`.
+        if here && (k == key || key.strip_prefix(k).is_some_and(|r| r.starts_with('.'))) {
             return Some(i + 1);
         }
         // A dotted key at the top level: `laser.beams = 9`.

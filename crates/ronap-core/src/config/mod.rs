@@ -6,7 +6,7 @@
 //!
 //! One file per section, each with its fields, their defaults and their checks: `scene.rs` (scene,
 //! maze, warehouse, map, static obstacles), `robot.rs` (robot, laser), `episode.rs` (episode,
-//! reward, observation), `moving.rs`, `team.rs` (robots, team), `apf.rs`, `orca.rs`, `metrics.rs`. This file assembles
+//! reward, observation), `moving.rs`, `team.rs` (robots, team), `apf.rs`, `orca.rs`, `social_force.rs`, `dwa.rs`, `metrics.rs`. This file assembles
 //! them into [`SimConfig`] and [`ValidConfig`]; `docs.rs` writes the commented TOML and `file.rs`
 //! reads files. The sections sit here, below the layers that use them, rather than beside their
 //! code: a scene, a robot and a policy all read the one validated configuration, and a section
@@ -14,6 +14,7 @@
 
 mod apf;
 mod docs;
+mod dwa;
 mod episode;
 mod file;
 mod metrics;
@@ -21,9 +22,11 @@ mod moving;
 mod orca;
 mod robot;
 mod scene;
+mod social_force;
 mod team;
 
 pub use apf::ApfConfig;
+pub use dwa::DwaConfig;
 pub use episode::{
     EpisodeConfig, ObservationConfig, RewardConfig, Shaping, ACTION_MEMORY, MAX_HISTORY,
 };
@@ -40,6 +43,7 @@ pub use scene::{
     is_convex_polygon, MapConfig, MazeConfig, ObstacleConfig, SceneConfig, SceneKind,
     WarehouseConfig,
 };
+pub use social_force::{Forces, SocialForceConfig};
 pub use team::{
     OnArrival, Order, TeamConfig, TeamRobotConfig, MAX_GOALS, MAX_NEIGHBOURS, MAX_ROBOTS,
 };
@@ -114,6 +118,12 @@ pub struct SimConfig {
     /// The `orca` policy (docs/model.md "Local planners among moving things").
     #[serde(skip_serializing_if = "OrcaConfig::is_default")]
     pub orca: OrcaConfig,
+    /// The `social-force` policy (docs/model.md "Local planners among moving things").
+    #[serde(skip_serializing_if = "SocialForceConfig::is_default")]
+    pub social_force: SocialForceConfig,
+    /// The `dwa` policy (docs/model.md "Local planners among moving things").
+    #[serde(skip_serializing_if = "DwaConfig::is_default")]
+    pub dwa: DwaConfig,
     /// Metrics beyond the standard ones (docs/model.md "Crowd metrics").
     #[serde(skip_serializing_if = "MetricsConfig::is_default")]
     pub metrics: MetricsConfig,
@@ -326,6 +336,8 @@ impl SimConfig {
         self.team.validate()?;
         self.metrics.validate()?;
         self.orca.validate()?;
+        self.social_force.validate()?;
+        self.dwa.validate()?;
         Ok(ValidConfig(self))
     }
 }

@@ -1,7 +1,7 @@
 //! Moving and appearing obstacles (docs/model.md "Moving obstacles"): each `[[moving]]` entry's
 //! shape, start and motion, with its defaults and checks.
 
-use crate::config::{check, finite, length, point, ConfigError};
+use crate::config::{check, finite, length, point, ConfigError, Forces};
 use serde::{Deserialize, Serialize};
 
 /// The shape of a moving obstacle.
@@ -34,6 +34,30 @@ pub enum MotionKind {
     /// A pedestrian with a goal that avoids the others by Optimal Reciprocal Collision
     /// Avoidance (docs/model.md "Crowds that react").
     Orca,
+    /// A pedestrian with a goal pushed by the social force model (docs/model.md "Crowds that
+    /// react").
+    SocialForce,
+}
+
+impl MotionKind {
+    /// Whether it is a reactive pedestrian's (`orca`, `social_force`): a goal, a preferred
+    /// speed, seeing the others.
+    pub fn is_reactive(self) -> bool {
+        matches!(self, MotionKind::Orca | MotionKind::SocialForce)
+    }
+
+    /// The name a TOML file gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            MotionKind::Still => "still",
+            MotionKind::Linear => "linear",
+            MotionKind::Waypoints => "waypoints",
+            MotionKind::RandomWalk => "random_walk",
+            MotionKind::Appear => "appear",
+            MotionKind::Orca => "orca",
+            MotionKind::SocialForce => "social_force",
+        }
+    }
 }
 
 /// What a reactive pedestrian does at its goal.
@@ -65,6 +89,8 @@ pub enum Pattern {
     /// On one side of a square of half side `pattern_radius_px` round `pattern_center` (left or
     /// right, drawn), heading for a point drawn on the opposite side.
     Square,
+    /// Start and goal drawn in free space (as with no pattern).
+    Random,
 }
 
 /// How a reactive (`orca`) pedestrian avoids: RVO2's agent settings, in steps and px.
@@ -109,6 +135,7 @@ fn pattern_name(p: Option<Pattern>) -> String {
     match p {
         Some(Pattern::Circle) => "\"circle\"".into(),
         Some(Pattern::Square) => "\"square\"".into(),
+        Some(Pattern::Random) => "\"random\"".into(),
         None => String::new(),
     }
 }
@@ -160,20 +187,20 @@ pub struct MovingConfig {
     pub min_robot_distance_px: f64,
     /// `appear`: how it moves once there: `still` (default), `linear` or `random_walk`.
     pub then: MotionKind,
-    /// `orca`: fixed goal `[x, y]`, px. Default: from `pattern`, else drawn in free space.
+    /// `orca`, `social_force`: fixed goal `[x, y]`, px. Default: from `pattern`, else drawn in free space.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub goal: Option<[f64; 2]>,
-    /// `orca`: largest speed, px per step (`speed_px` is the preferred one). Default `speed_px`.
+    /// `orca`, `social_force`: largest speed, px per step (`speed_px` is the preferred one). Default `speed_px`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_speed_px: Option<f64>,
-    /// `orca`: at its goal `stay` (default), `new_goal` or `vanish`.
+    /// `orca`, `social_force`: at its goal `stay` (default), `new_goal` or `vanish`.
     #[serde(skip_serializing_if = "Arrival::is_stay")]
     pub on_arrival: Arrival,
-    /// `orca`: whether it avoids the robots too. Default false (CrowdNav's invisible robot: it
+    /// `orca`, `social_force`: whether it avoids the robots too. Default false (CrowdNav's invisible robot: it
     /// walks into a robot that does not give way).
     #[serde(skip_serializing_if = "super::is_false")]
     pub sees_robots: bool,
-    /// `orca`: place start and goal by a crowd pattern, `circle` or `square`. Default: drawn.
+    /// `orca`, `social_force`: place start and goal by a crowd pattern, `circle`, `square` or `random`. Default: drawn.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pattern: Option<Pattern>,
     /// The pattern's centre `[x, y]`, px. Default: the scene's centre.
@@ -188,6 +215,9 @@ pub struct MovingConfig {
     /// `orca`: how it avoids.
     #[serde(skip_serializing_if = "AgentOrca::is_default")]
     pub orca: AgentOrca,
+    /// `social_force`: its forces.
+    #[serde(skip_serializing_if = "Forces::is_default")]
+    pub social_force: Forces,
 }
 
 impl Default for MovingConfig {
@@ -217,6 +247,7 @@ impl Default for MovingConfig {
             pattern_radius_px: 0.0,
             jitter_px: 0.0,
             orca: AgentOrca::default(),
+            social_force: Forces::default(),
         }
     }
 }
@@ -301,9 +332,9 @@ pub(super) fn validate_moving(moving: &[MovingConfig]) -> Result<(), ConfigError
             "must be at least from_step",
         )?;
         check(
-            m.then != MotionKind::Orca,
+            !m.then.is_reactive(),
             &f("then"),
-            "\"orca\"",
+            format!("{:?}", m.then.name()),
             "an appearing obstacle moves as still, linear or random_walk",
         )?;
         if let Some(g) = m.goal {
@@ -317,16 +348,16 @@ pub(super) fn validate_moving(moving: &[MovingConfig]) -> Result<(), ConfigError
         }
         length(&f("pattern_radius_px"), m.pattern_radius_px, true)?;
         check(
-            m.pattern.is_none() || m.pattern_radius_px > 0.0,
+            matches!(m.pattern, None | Some(Pattern::Random)) || m.pattern_radius_px > 0.0,
             &f("pattern"),
             pattern_name(m.pattern),
             "a crowd pattern needs a positive pattern_radius_px",
         )?;
         check(
-            m.pattern.is_none() || m.motion == MotionKind::Orca,
+            m.pattern.is_none() || m.motion.is_reactive(),
             &f("pattern"),
             pattern_name(m.pattern),
-            "crowd patterns place orca pedestrians (motion = \"orca\")",
+            "crowd patterns place pedestrians (motion = \"orca\" or \"social_force\")",
         )?;
         length(&f("jitter_px"), m.jitter_px, true)?;
         let o = &m.orca;
@@ -344,6 +375,7 @@ pub(super) fn validate_moving(moving: &[MovingConfig]) -> Result<(), ConfigError
             o.max_neighbours,
             "must be between 0 and 1000",
         )?;
+        m.social_force.validate(&f("social_force"))?;
     }
     check(
         total <= u64::from(MAX_MOVING),

@@ -14,6 +14,7 @@ pub(crate) mod prefetch;
 pub mod ray_grid;
 pub mod reference;
 pub mod shape;
+pub mod social_force;
 
 use nalgebra::{Point2, Vector2};
 
@@ -193,7 +194,17 @@ impl Aabb {
         p.x >= self.min.x && p.x <= self.max.x && p.y >= self.min.y && p.y <= self.max.y
     }
 
-    /// Squared distance from `p` to the box (0 inside).
+    /// The point of the box nearest `p` (`p` itself inside).
+    #[inline]
+    pub fn nearest_point(&self, p: Point) -> Point {
+        Point::new(
+            p.x.clamp(self.min.x, self.max.x),
+            p.y.clamp(self.min.y, self.max.y),
+        )
+    }
+
+    /// Squared distance from `p` to the box, 0 inside.
+    #[inline]
     pub fn distance_squared(&self, p: Point) -> f64 {
         let dx = (self.min.x - p.x).max(0.0).max(p.x - self.max.x);
         let dy = (self.min.y - p.y).max(0.0).max(p.y - self.max.y);

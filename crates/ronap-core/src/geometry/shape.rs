@@ -104,6 +104,25 @@ impl Shape {
         }
     }
 
+    /// The point of the shape nearest `p` (`p` itself inside).
+    pub fn nearest_point(&self, p: Point) -> Point {
+        match &self.kind {
+            Kind::Disc { center, ball } => {
+                let away = p - center;
+                let d = away.norm();
+                if d <= ball.radius {
+                    p
+                } else {
+                    center + away * (ball.radius / d)
+                }
+            }
+            Kind::Polygon(poly) => {
+                let q = poly.project_point(&Isometry::identity(), &pp(p), true);
+                Point::new(q.point.x, q.point.y)
+            }
+        }
+    }
+
     /// Distance between the segment `a`–`b` and the shape, 0 when they meet.
     pub fn segment_distance(&self, a: Point, b: Point) -> f64 {
         match &self.kind {

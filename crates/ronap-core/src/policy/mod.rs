@@ -5,12 +5,15 @@
 pub mod apf;
 pub mod batched;
 pub mod dodge;
+pub mod dwa;
 pub mod follow;
 pub mod geodesic;
+mod local;
 pub mod mlp;
 pub mod name;
 pub mod orca;
 pub mod random;
+pub mod social_force;
 pub mod team;
 
 pub use name::{factory, Builtin, PolicyNameError};

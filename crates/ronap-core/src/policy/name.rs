@@ -1,9 +1,10 @@
 //! Policies by name, as users give them: a built-in (`apf`, `geodesic`, `geodesic-wait`,
-//! `random`, `orca`) or
-//! `mlp:FILE[@RULE]`.
+//! `random`, `orca`, `social-force`, `dwa`) or `mlp:FILE[@RULE]`.
 
 use crate::policy::mlp::{self, DecisionRule, MlpFactory};
-use crate::policy::{apf, geodesic, orca, random, Policy, PolicyError, PolicyFactory};
+use crate::policy::{
+    apf, dwa, geodesic, orca, random, social_force, Policy, PolicyError, PolicyFactory,
+};
 
 /// The built-in policies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -18,11 +19,15 @@ pub enum Builtin {
     Random,
     /// Optimal Reciprocal Collision Avoidance along the geodesic path, among what moves.
     Orca,
+    /// The social force model along the geodesic path, among what moves.
+    SocialForce,
+    /// The dynamic window approach along the geodesic path, among what moves.
+    Dwa,
 }
 
 impl Builtin {
     /// Every built-in policy with its name and a one-line description.
-    pub const ALL: [(Builtin, &'static str, &'static str); 5] = [
+    pub const ALL: [(Builtin, &'static str, &'static str); 7] = [
         (
             Builtin::Apf,
             "apf",
@@ -47,6 +52,16 @@ impl Builtin {
             Builtin::Orca,
             "orca",
             "ORCA (optimal reciprocal collision avoidance) along the geodesic path: avoids the moving obstacles and robots it senses ([orca] settings)",
+        ),
+        (
+            Builtin::SocialForce,
+            "social-force",
+            "the social force model (Helbing-Molnar) along the geodesic path: pushed away from what it senses and from walls ([social_force] settings)",
+        ),
+        (
+            Builtin::Dwa,
+            "dwa",
+            "the dynamic window approach along the geodesic path: samples (v, w), rolls each out against the laser's points and what moves ([dwa] settings)",
         ),
     ];
 
@@ -75,6 +90,8 @@ impl PolicyFactory for Builtin {
             Builtin::GeodesicWait => Box::new(geodesic::GeodesicWait::default()),
             Builtin::Random => Box::new(random::RandomPolicy::default()),
             Builtin::Orca => Box::new(orca::Orca::default()),
+            Builtin::SocialForce => Box::new(social_force::SocialForce::default()),
+            Builtin::Dwa => Box::new(dwa::Dwa::default()),
         })
     }
 

@@ -9,119 +9,38 @@
 
 use super::follow::Follower;
 use super::geodesic::planned;
+use super::local::{self, Senses};
 use super::{Decision, Policy, PolicyError};
-use crate::config::PlannerActions;
-use crate::geometry::orca::{Agent, Horizon, V2};
-use crate::geometry::{wrap_deg, Point, Vector};
+use crate::geometry::orca::Horizon;
 use crate::sim::avoid::{Avoid, Avoider};
 use crate::sim::episode::Episode;
-use crate::sim::moving::Movers;
-use crate::sim::robot::{Action, DiscreteAction};
 use crate::sim::team::Team;
 use crate::sim::world::World;
-use std::f64::consts::TAU;
-
-/// How sharply a unicycle's speed falls with the angle between its chord and the velocity it
-/// tracks: `cos^ALIGN_POWER`.
-const ALIGN_POWER: i32 = 8;
 
 /// ORCA towards the geodesic path's lookahead point.
 #[derive(Debug, Default)]
 pub struct Orca {
     path: Option<Follower>,
-    /// Where each sensed agent was at the last decision (moving obstacles by index, then the
-    /// team's robots by index): its velocity is its displacement since.
-    last: Vec<Option<Point>>,
-    /// Where this robot was at the last decision.
-    last_me: Option<Point>,
-    /// Its index in its team (0 alone).
-    index: usize,
-    // Scratch space kept between steps.
-    agents: Vec<Agent<f64>>,
+    senses: Senses,
     avoider: Avoider,
 }
 
 impl Orca {
-    /// The agents round `me` (the moving obstacles `movers`, then `robots`: a team's present
-    /// robots by index, `me` among them as `index`; none for a lone robot) within the sensing
-    /// range, with their velocities, into `self.agents` (`me` first); remembers where each is for
-    /// the next step. `team_size`: robots in the team (0 alone).
-    fn sense(
-        &mut self,
-        me: &Episode,
-        movers: Option<&Movers>,
-        robots: &[(usize, &Episode)],
-        index: Option<usize>,
-        team_size: usize,
-    ) {
+    /// How far the robot senses.
+    fn range(me: &Episode) -> f64 {
         let config = me.config();
-        let range = config.orca.sense_range_px.unwrap_or(config.laser.range_px);
-        let p = me.pose().position();
-        let velocity = self.last_me.map_or(Vector::zeros(), |l| p - l);
-        self.last_me = Some(p);
-        self.agents.clear();
-        self.agents.push(Agent {
-            position: V2::from(p),
-            velocity: V2::from(velocity),
-            radius: config.robot.radius_px,
-        });
-        let mover_count = movers.map_or(0, |m| m.items().len());
-        self.last.resize(mover_count + team_size, None);
-        let mut seen = |slot: usize, at: Option<Point>, radius: f64, agents: &mut Vec<_>| {
-            let last = std::mem::replace(&mut self.last[slot], at);
-            if let Some(at) = at.filter(|a| (a - p).norm() <= range + radius) {
-                agents.push(Agent {
-                    position: V2::from(at),
-                    velocity: V2::from(last.map_or(Vector::zeros(), |l| at - l)),
-                    radius,
-                });
-            }
-        };
-        if let Some(m) = movers {
-            for (i, o) in m.items().enumerate() {
-                let at = o.present().then(|| o.position());
-                seen(i, at, o.body().bounding_radius(), &mut self.agents);
-            }
-        }
-        for &(k, r) in robots {
-            if Some(k) != index {
-                let radius = r.config().robot.radius_px;
-                seen(
-                    mover_count + k,
-                    Some(r.pose().position()),
-                    radius,
-                    &mut self.agents,
-                );
-            }
-        }
+        config.orca.sense_range_px.unwrap_or(config.laser.range_px)
     }
 
-    /// The decision for `me` (whose agents [`Orca::sense`] has gathered) in its still scene.
+    /// The decision for `me` (whose agents are sensed) in its still scene.
     fn decide(&mut self, me: &Episode) -> Decision {
         let Some(path) = &mut self.path else {
             return Decision::GiveUp("no path to the goal".into());
         };
         let config = me.config();
-        let pose = me.pose();
-        let p = pose.position();
         let actions = config.orca.actions;
-        let speed = config.orca.speed_px.unwrap_or(match actions {
-            PlannerActions::Continuous => config.robot.max_linear_speed_px,
-            PlannerActions::Discrete => config.robot.move_speed_px,
-        });
-        // Full speed towards the lookahead point, slowing to land on the goal.
-        let aim = path.aim(p).unwrap_or(me.goal());
-        let to_aim = aim - p;
-        let to_goal = (me.goal() - p).norm();
-        let preferred = match to_aim.try_normalize(1e-12) {
-            Some(u) => u * speed.min(to_goal),
-            None => Vector::zeros(),
-        };
-        // A thousandth of a px off, in a direction turning with the step and the robot, as
-        // RVO2's examples do: perfect symmetry (robots swapping across a circle) can otherwise
-        // hold ORCA agents still for ever.
-        let turn = f64::from(me.steps()) * 2.399_963 + self.index as f64 * 0.618_034 * TAU;
-        let preferred = preferred + crate::geometry::unit(turn.to_degrees()) * 1e-3;
+        let speed = local::planner_speed(me, config.orca.speed_px, actions);
+        let (preferred, to_aim) = local::preferred(path, me, speed, self.senses.index);
         let horizon = Horizon {
             agents: config.orca.time_horizon_steps,
             obstacles: config.orca.obstacle_time_horizon_steps,
@@ -131,118 +50,34 @@ impl Orca {
         let v = self.avoider.velocity(
             me.scene(),
             &Avoid {
-                agents: &self.agents,
+                agents: &self.senses.agents,
                 me: 0,
                 preferred,
                 horizon,
-                neighbour_dist: config.orca.sense_range_px.unwrap_or(config.laser.range_px),
+                neighbour_dist: Self::range(me),
                 max_neighbours: config.orca.max_neighbours as usize,
                 margin: config.orca.safety_margin_px,
             },
         );
-        Decision::Act(match actions {
-            PlannerActions::Continuous => continuous(me, v, to_aim),
-            PlannerActions::Discrete => discrete(me, v, to_aim).into(),
-        })
-    }
-}
-
-/// The signed turn from the robot's heading to `direction`, degrees in [-180, 180).
-fn turn_to(me: &Episode, direction: Vector) -> f64 {
-    let bearing = direction.y.atan2(direction.x).to_degrees();
-    wrap_deg(bearing - me.pose().z_deg + 180.0) - 180.0
-}
-
-/// The unicycle command whose step moves the robot by `v`: an arc of constant speed and turn
-/// rate ends along its chord, at half the turn from the heading (from the reversed heading when
-/// driving backwards), so a turn of twice the velocity's bearing `e` from the heading (or from
-/// the reversed heading, for a velocity behind the robot) and a speed of `|v| e / sin e` land
-/// exactly on `v` when the turn is within `max_angular_speed_deg`. Beyond it the robot turns as
-/// far as it may, at the speed that keeps its chord's advance along `v`. Standing (`v` zero), it
-/// turns towards `aim`.
-fn continuous(me: &Episode, v: Vector, aim: Vector) -> Action {
-    let speed = v.norm();
-    if speed <= 1e-9 {
-        if aim.norm_squared() == 0.0 {
-            return Action::Continuous { v: 0.0, w_deg: 0.0 };
-        }
-        let w_max = me.config().robot.max_angular_speed_deg;
-        return Action::Continuous {
-            v: 0.0,
-            w_deg: turn_to(me, aim).clamp(-w_max, w_max),
-        };
-    }
-    let error = turn_to(me, v);
-    // A velocity behind the robot is driven backwards.
-    let (error, sign) = if error.abs() > 90.0 {
-        (wrap_deg(error) - 180.0, -1.0)
-    } else {
-        (error, 1.0)
-    };
-    let w_max = me.config().robot.max_angular_speed_deg;
-    let w_deg = (2.0 * error).clamp(-w_max, w_max);
-    let half = (w_deg / 2.0).to_radians();
-    // The chord of an arc of length `v` turning by `w` is `v sin(w/2) / (w/2)` long.
-    let chord_per_speed = if half.abs() < 1e-9 {
-        1.0
-    } else {
-        half.sin() / half
-    };
-    // Off the velocity's line by `error - w/2`: slower the further off, so a robot that cannot
-    // turn in time does not sweep across what ORCA kept it clear of.
-    let along = (error.to_radians() - half).cos().max(0.0).powi(ALIGN_POWER);
-    Action::Continuous {
-        v: sign * speed * along / chord_per_speed,
-        w_deg,
-    }
-}
-
-/// The discrete action that follows velocity `v`: AHEAD when the heading lies within half a
-/// turn of it and it is at least half a step long (the AHEAD step then lies closer to where `v`
-/// leads than standing), else a turn towards it (towards `aim` when it is shorter).
-fn discrete(me: &Episode, v: Vector, aim: Vector) -> DiscreteAction {
-    let robot = &me.config().robot;
-    let toward = if v.norm() >= robot.move_speed_px / 2.0 {
-        v
-    } else {
-        aim
-    };
-    let error = turn_to(me, toward);
-    if error.abs() <= robot.turn_speed_deg / 2.0 && toward == v {
-        DiscreteAction::Ahead
-    } else if error >= 0.0 {
-        DiscreteAction::Left
-    } else {
-        DiscreteAction::Right
+        Decision::Act(local::action(me, v, to_aim, actions))
     }
 }
 
 impl Policy for Orca {
     fn reset(&mut self, world: &World, episode: &Episode) -> Result<(), PolicyError> {
         self.path = planned(world, episode.pose().position(), episode.goal());
-        // On to the next goal of a list (mid-episode), the others' last positions still hold.
-        if episode.steps() == 0 {
-            self.last.clear();
-            self.last_me = None;
-        }
+        self.senses.reset(episode);
         Ok(())
     }
 
     fn act(&mut self, episode: &Episode) -> Result<Decision, PolicyError> {
-        self.sense(episode, episode.movers(), &[], None, 0);
+        self.senses.lone(episode, Self::range(episode));
         Ok(self.decide(episode))
     }
 
     fn act_in_team(&mut self, team: &Team, k: usize) -> Result<Decision, PolicyError> {
         let me = team.robot(k);
-        let robots: Vec<(usize, &Episode)> = team
-            .robots()
-            .iter()
-            .enumerate()
-            .filter(|&(j, _)| team.present(j))
-            .collect();
-        self.index = k;
-        self.sense(me, team.movers(), &robots, Some(k), team.robots().len());
+        self.senses.in_team(team, k, Self::range(me));
         Ok(self.decide(me))
     }
 }

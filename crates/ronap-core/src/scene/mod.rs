@@ -588,6 +588,32 @@ impl Scene {
         }
     }
 
+    /// Calls `f` with the nearest point of every still obstacle (box, disc or polygon) that
+    /// lies within `reach` of `p`, in no particular order.
+    pub fn nearest_points(&self, p: Point, reach: f64, mut f: impl FnMut(Point)) {
+        let reach2 = reach * reach;
+        let mut boxes = |b: &Aabb| {
+            if b.distance_squared(p) <= reach2 {
+                f(b.nearest_point(p));
+            }
+        };
+        if self.piece_px(reach).is_some() {
+            for &b in self.boxes_near(p, reach) {
+                boxes(&self.boxes[b as usize]);
+            }
+        } else {
+            self.boxes.iter().for_each(boxes);
+        }
+        for shape in &self.shapes {
+            if shape.aabb().distance_squared(p) <= reach2 {
+                let q = shape.nearest_point(p);
+                if (q - p).norm_squared() <= reach2 {
+                    f(q);
+                }
+            }
+        }
+    }
+
     /// Length of the pieces long queries are cut into, so that each piece (grown by `radius`) is
     /// answered by one bin of the index; `None` when the index cannot serve `radius` at all.
     fn piece_px(&self, radius: f64) -> Option<f64> {

@@ -238,14 +238,14 @@ impl Movers {
                 MovingShape::Box => Body::Box(Vector::new(m.size_px[0], m.size_px[1]) / 2.0),
             };
             // A pedestrian moves at most its largest speed; every other obstacle at its speed.
-            let speed = if m.motion == MotionKind::Orca {
+            let speed = if m.motion.is_reactive() {
                 m.max_speed_px.unwrap_or(m.speed_px).max(m.speed_px)
             } else {
                 m.speed_px
             };
             reach = reach.max(body.bounding_radius() + speed);
             for _ in 0..m.count {
-                let (e, behaviour, position, dir) = if m.motion == MotionKind::Orca {
+                let (e, behaviour, position, dir) = if m.motion.is_reactive() {
                     let (start, goal) =
                         pedestrian::place(m, body, scene, &robot_goals, &taken, &mut rng)
                             .ok_or_else(|| {
@@ -343,8 +343,10 @@ impl Movers {
         let mut dir = Vector::new(1.0, 0.0);
         let mut behaviour = None;
         let motion = match kind {
-            // Orca entries are made by `pedestrian::place`, never here.
-            MotionKind::Still | MotionKind::Appear | MotionKind::Orca => Motion::Still,
+            // Pedestrians are made by `pedestrian::place`, never here.
+            MotionKind::Still | MotionKind::Appear | MotionKind::Orca | MotionKind::SocialForce => {
+                Motion::Still
+            }
             MotionKind::Linear | MotionKind::RandomWalk => {
                 let deg = match m.direction_deg {
                     Some(d) => d,

@@ -1,14 +1,17 @@
-//! Reactive pedestrians (docs/model.md "Crowds that react"): `orca` obstacles, each walking to
-//! its goal at `speed_px` and avoiding the others (and, with `sees_robots`, the robots) by
-//! Optimal Reciprocal Collision Avoidance ([`crate::geometry::orca`]) and the still scene. All
-//! choose their velocities at once from where everyone stood after the last step, as RVO2 steps
-//! its agents; then each moves under the usual contact rules (a move that would touch a robot is
-//! not made). Their starts and goals come from a crowd pattern (`circle`, `square`), are fixed,
-//! or are drawn in free space, all from the obstacles' own random stream.
+//! Reactive pedestrians (docs/model.md "Crowds that react"): `orca` and `social_force`
+//! obstacles, each walking to its goal at `speed_px` among the others (and, with `sees_robots`,
+//! the robots) and the still scene, avoiding them by Optimal Reciprocal Collision Avoidance
+//! ([`crate::geometry::orca`]) or pushed away from them by the social force model
+//! ([`crate::geometry::social_force`]). All choose their velocities at once from where everyone
+//! stood after the last step, as RVO2 steps its agents; then each moves under the usual contact
+//! rules (a move that would touch a robot, or a wall, is not made). Their starts and goals come
+//! from a crowd pattern (`circle`, `square`, `random`), are fixed, or are drawn in free space,
+//! all from the obstacles' own random stream.
 
 use super::{free_spot, Body, Disc, Entry, SPOT_TRIES};
-use crate::config::{AgentOrca, Arrival, MovingConfig, Pattern};
+use crate::config::{AgentOrca, Arrival, Forces, MotionKind, MovingConfig, Pattern};
 use crate::geometry::orca::{Agent, Horizon, V2};
+use crate::geometry::social_force::{self, Walker};
 use crate::geometry::{Point, Vector};
 use crate::scene::Scene;
 use crate::sim::avoid::{Avoid, Avoider};
@@ -17,6 +20,13 @@ use crate::sim::rng::Rng;
 use rand::Rng as _;
 use std::f64::consts::TAU;
 
+/// How a pedestrian chooses its velocity.
+#[derive(Clone, Debug)]
+enum Model {
+    Orca(AgentOrca),
+    SocialForce(Forces),
+}
+
 /// One reactive pedestrian's goal, settings and chosen velocity.
 #[derive(Clone, Debug)]
 pub(super) struct Pedestrian {
@@ -24,9 +34,11 @@ pub(super) struct Pedestrian {
     /// Preferred speed, px per step.
     speed: f64,
     max_speed: f64,
+    /// How far a drawn goal keeps from the still scene beyond its body, px.
+    goal_keep: f64,
     on_arrival: Arrival,
     sees_robots: bool,
-    orca: AgentOrca,
+    model: Model,
     /// The velocity chosen for this step.
     pub(super) next: Vector,
 }
@@ -38,9 +50,14 @@ impl Pedestrian {
             goal,
             speed: m.speed_px,
             max_speed: m.max_speed_px.unwrap_or(m.speed_px),
+            goal_keep: goal_keep(m),
             on_arrival: m.on_arrival,
             sees_robots: m.sees_robots,
-            orca: m.orca.clone(),
+            model: if m.motion == MotionKind::SocialForce {
+                Model::SocialForce(m.social_force.clone())
+            } else {
+                Model::Orca(m.orca.clone())
+            },
             next: Vector::zeros(),
         }
     }
@@ -72,35 +89,39 @@ pub(super) fn place(
             .iter()
             .all(|&(q, rq)| (p - q).norm() >= r + rq + PLACEMENT_GAP_PX)
     };
-    let Some(pattern) = m.pattern else {
-        let start = match m.start {
-            Some(s) => Point::new(s[0], s[1]),
-            None => free_spot(body, scene, rng, clear_of_all)?,
-        };
-        let goal = match m.goal {
-            Some(g) => Point::new(g[0], g[1]),
-            None => free_spot(body, scene, rng, clear_of_all)?,
-        };
-        return Some((start, goal));
+    let circle = match m.pattern {
+        Some(Pattern::Circle) => true,
+        Some(Pattern::Square) => false,
+        None | Some(Pattern::Random) => {
+            let start = match m.start {
+                Some(s) => Point::new(s[0], s[1]),
+                None => free_spot(body, scene, rng, clear_of_all)?,
+            };
+            let keep = goal_keep(m);
+            let goal = match m.goal {
+                Some(g) => Point::new(g[0], g[1]),
+                None => free_spot(body, scene, rng, |p| {
+                    clear_of_all(p) && keeps_off(scene, p, r, keep)
+                })?,
+            };
+            return Some((start, goal));
+        }
     };
     let radius = m.pattern_radius_px;
     let j = m.jitter_px;
     for _ in 0..SPOT_TRIES {
-        let (start, goal) = match pattern {
-            Pattern::Circle => {
-                let a = rng.random_range(0.0..TAU);
-                let u = Vector::new(a.cos(), a.sin()) * radius;
-                (center + u, center - u)
-            }
-            Pattern::Square => {
-                let side = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
-                let from = rng.random_range(-radius..=radius);
-                let to = rng.random_range(-radius..=radius);
-                (
-                    center + Vector::new(side * radius, from),
-                    center + Vector::new(-side * radius, to),
-                )
-            }
+        let (start, goal) = if circle {
+            let a = rng.random_range(0.0..TAU);
+            let u = Vector::new(a.cos(), a.sin()) * radius;
+            (center + u, center - u)
+        } else {
+            let side = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+            let from = rng.random_range(-radius..=radius);
+            let to = rng.random_range(-radius..=radius);
+            (
+                center + Vector::new(side * radius, from),
+                center + Vector::new(-side * radius, to),
+            )
         };
         let mut jitter = || {
             if j > 0.0 {
@@ -119,6 +140,22 @@ pub(super) fn place(
         }
     }
     None
+}
+
+/// How far a drawn goal keeps from the still scene beyond the pedestrian's body, px: a social
+/// force walker is held off walls by their push (about four decay lengths against its drive),
+/// so a goal nearer than that could never be reached; an ORCA walker needs no gap.
+fn goal_keep(m: &MovingConfig) -> f64 {
+    if m.motion == MotionKind::SocialForce {
+        4.0 * m.social_force.obstacle_range_px
+    } else {
+        0.0
+    }
+}
+
+/// Whether a body of bounding radius `r` at `p` keeps `keep` px from the still scene.
+fn keeps_off(scene: &Scene, p: Point, r: f64, keep: f64) -> bool {
+    keep <= 0.0 || scene.clearance(p, r + keep).is_none()
 }
 
 /// Least gap between two pedestrians placed by a pattern, px.
@@ -208,8 +245,11 @@ impl Crowd {
                     Arrival::NewGoal => {
                         // Away from the robots, as its first goal was.
                         let (body, gap) = (entries[i].body, entries[i].min_gap);
-                        let far =
-                            |q: Point| robots.iter().all(|r| body.gap(q, r.at, r.radius) >= gap);
+                        let keep = p.goal_keep;
+                        let far = |q: Point| {
+                            robots.iter().all(|r| body.gap(q, r.at, r.radius) >= gap)
+                                && keeps_off(scene, q, body.bounding_radius(), keep)
+                        };
                         if let Some(g) = free_spot(body, scene, rng, far) {
                             p.goal = g;
                         }
@@ -219,37 +259,89 @@ impl Crowd {
             } else {
                 to_goal * (p.speed.min(to_goal.norm()) / to_goal.norm())
             };
-            let horizon = Horizon {
-                agents: p.orca.time_horizon_steps,
-                obstacles: p.orca.obstacle_time_horizon_steps,
-                max_speed: p.max_speed,
-                time_step: 1.0,
+            p.next = match &p.model {
+                Model::Orca(orca) => {
+                    let horizon = Horizon {
+                        agents: orca.time_horizon_steps,
+                        obstacles: orca.obstacle_time_horizon_steps,
+                        max_speed: p.max_speed,
+                        time_step: 1.0,
+                    };
+                    // The robots are agents only to those that see them.
+                    let visible = if p.sees_robots {
+                        self.agents.len()
+                    } else {
+                        pedestrian_agents
+                    };
+                    self.avoider.velocity(
+                        scene,
+                        &Avoid {
+                            agents: &self.agents[..visible],
+                            me: a,
+                            preferred,
+                            horizon,
+                            neighbour_dist: orca.neighbour_dist_px,
+                            max_neighbours: orca.max_neighbours as usize,
+                            margin: orca.safety_margin_px,
+                        },
+                    )
+                }
+                Model::SocialForce(forces) => {
+                    let others = self.agents[..pedestrian_agents]
+                        .iter()
+                        .enumerate()
+                        .filter(|&(b, _)| b != a)
+                        .map(|(_, o)| (Point::new(o.position.x, o.position.y), o.radius));
+                    let robots = robots
+                        .iter()
+                        .filter(|_| p.sees_robots)
+                        .map(|r| (r.at, r.radius));
+                    pushed(
+                        forces,
+                        &me,
+                        preferred,
+                        p.max_speed,
+                        others.chain(robots),
+                        scene,
+                    )
+                }
             };
-            // The robots are agents only to those that see them.
-            let visible = if p.sees_robots {
-                self.agents.len()
-            } else {
-                pedestrian_agents
-            };
-            p.next = self.avoider.velocity(
-                scene,
-                &Avoid {
-                    agents: &self.agents[..visible],
-                    me: a,
-                    preferred,
-                    horizon,
-                    neighbour_dist: p.orca.neighbour_dist_px,
-                    max_neighbours: p.orca.max_neighbours as usize,
-                    margin: p.orca.safety_margin_px,
-                },
-            );
         }
     }
+}
+
+/// The velocity the social force model gives the agent `me` wanting `preferred`, among `others`
+/// (centres and radii) and the still scene, cut to `max_speed`.
+fn pushed(
+    forces: &Forces,
+    me: &Agent<f64>,
+    preferred: Vector,
+    max_speed: f64,
+    others: impl Iterator<Item = (Point, f64)>,
+    scene: &Scene,
+) -> Vector {
+    let walker = Walker {
+        position: Point::new(me.position.x, me.position.y),
+        velocity: Vector::new(me.velocity.x, me.velocity.y),
+        radius: me.radius,
+    };
+    let desired = social_force::desired_direction(preferred, walker.velocity);
+    let mut push = Vector::zeros();
+    for (at, radius) in others {
+        push += social_force::agent_force(forces, &walker, desired, at, radius);
+    }
+    // Beyond ten decay lengths a wall pushes by less than 1/20000 of its strength.
+    let reach = walker.radius + 10.0 * forces.obstacle_range_px;
+    scene.nearest_points(walker.position, reach, |q| {
+        push += social_force::obstacle_force(forces, &walker, q);
+    });
+    social_force::next_velocity(forces, &walker, preferred, push, max_speed)
 }
 
 #[cfg(test)]
 mod tests {
     use crate::config::{MotionKind, MovingConfig, Pattern};
+
     use crate::sim::episode::Episode;
     use crate::sim::robot::DiscreteAction;
     use crate::sim::world::maze_scene;
@@ -317,6 +409,87 @@ mod tests {
         eprintln!("{arrived} of 640 arrived; least gap {least}");
         assert!(arrived >= 608, "{arrived} of 640 arrived");
         assert!(least >= 0.0, "pedestrians overlapped by {}", -least);
+    }
+
+    #[test]
+    fn social_force_walkers_cross_a_circle_and_arrive() {
+        let mut c = crossing(8, true);
+        c.moving[0].motion = MotionKind::SocialForce;
+        let mut arrived = 0;
+        let mut least = f64::INFINITY;
+        for seed in 0..20 {
+            let mut e = episode(&c, seed);
+            let goals: Vec<_> = e
+                .movers()
+                .expect("movers")
+                .items()
+                .map(|m| crate::geometry::Point::new(400.0, 400.0) - m.position().coords)
+                .collect();
+            for _ in 0..200 {
+                e.step(DiscreteAction::Left);
+                let m: Vec<_> = e.movers().expect("movers").items().collect();
+                for i in 0..m.len() {
+                    for j in i + 1..m.len() {
+                        least = least.min((m[i].position() - m[j].position()).norm() - 12.0);
+                    }
+                }
+            }
+            let m: Vec<_> = e.movers().expect("movers").items().collect();
+            arrived += m
+                .iter()
+                .zip(&goals)
+                .filter(|(m, g)| (m.position() - **g).norm() < 10.0)
+                .count();
+        }
+        eprintln!("{arrived} of 160 arrived; least gap {least}");
+        assert!(arrived >= 150, "{arrived} of 160 arrived");
+        // The push keeps them apart, if not as strictly as ORCA.
+        assert!(least >= -2.0, "walkers overlapped by {}", -least);
+    }
+
+    #[test]
+    fn drawn_social_force_goals_keep_off_the_walls_and_walkers_keep_walking() {
+        let c = crate::SimConfig {
+            moving: vec![MovingConfig {
+                count: 40,
+                radius_px: 6.0,
+                motion: MotionKind::SocialForce,
+                speed_px: 3.0,
+                on_arrival: crate::config::Arrival::NewGoal,
+                pattern: Some(Pattern::Random),
+                ..Default::default()
+            }],
+            ..crossing(1, false)
+        };
+        let mut e = episode(&c, 5);
+        let start: Vec<_> = e
+            .movers()
+            .expect("movers")
+            .items()
+            .map(|m| m.position())
+            .collect();
+        let mut moved = vec![0.0; start.len()];
+        for _ in 0..600 {
+            let before: Vec<_> = e
+                .movers()
+                .expect("movers")
+                .items()
+                .map(|m| m.position())
+                .collect();
+            e.step(DiscreteAction::Left);
+            for (k, m) in e.movers().expect("movers").items().enumerate() {
+                moved[k] += (m.position() - before[k]).norm();
+                assert!(
+                    e.scene().disc_clear(m.position(), 6.0),
+                    "walker {k} in a wall"
+                );
+            }
+        }
+        // Walking on from goal to goal, none is held for long against a wall: each covers at
+        // least half of what 600 steps at 3 px would.
+        for (k, d) in moved.iter().enumerate() {
+            assert!(*d >= 900.0, "walker {k} walked only {d} px");
+        }
     }
 
     #[test]

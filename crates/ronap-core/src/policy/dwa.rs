@@ -1,0 +1,306 @@
+//! The `dwa` policy (docs/model.md "Local planners among moving things"): the dynamic window
+//! approach of Fox, Burgard and Thrun (1997). Each step it samples unicycle commands `(v, w)`
+//! within `dwa.linear_accel_px` and `dwa.angular_accel_deg` of the last one (and the robot's
+//! limits; `v` from 0 up), rolls each out for `dwa.horizon_steps` steps, and scores it:
+//!
+//! `heading_weight * heading + clearance_weight * clearance + speed_weight * speed`,
+//!
+//! where `heading` is 1 when the rollout ends facing the lookahead point of the geodesic path
+//! (moved on along its direction beyond the reach of any rollout) and 0 facing away, `clearance` the share of the rollout's steps before it first comes within
+//! `dwa.safety_margin_px` of the laser's points or of the moving obstacles and other robots it
+//! senses (each moving on at its last velocity): Fox et al.'s distance to the nearest obstacle
+//! on the trajectory, in steps; and `speed` the speed as a fraction of the largest. A command is
+//! admissible when its first step keeps clear of the still scene and the robot could stop
+//! (at `dwa.linear_accel_px` a step; a discrete robot at once) before that first contact; when none is, the one whose
+//! contact comes latest is taken. With discrete actions the candidates are LEFT, AHEAD and
+//! RIGHT, each taken once and followed by AHEAD steps.
+
+use super::follow::Follower;
+use super::geodesic::planned;
+use super::local::Senses;
+use super::{Decision, Policy, PolicyError};
+use crate::config::PlannerActions;
+use crate::geometry::{unit, wrap_deg, Point};
+use crate::sim::episode::Episode;
+use crate::sim::robot::{Action, DiscreteAction, Pose, Robot};
+use crate::sim::team::Team;
+use crate::sim::world::World;
+
+/// The dynamic window approach towards the geodesic path's lookahead point.
+#[derive(Debug, Default)]
+pub struct Dwa {
+    path: Option<Follower>,
+    senses: Senses,
+    /// The command taken at the last step: the window lies round it.
+    last: (f64, f64),
+    /// The laser's hit points, px (scratch).
+    points: Vec<Point>,
+}
+
+/// How one rollout did.
+#[derive(Clone, Copy, Debug)]
+struct Rollout {
+    /// The steps before it first comes within the margin of anything sensed (the horizon when
+    /// it never does).
+    free_steps: u32,
+    /// Where it ends.
+    end: Pose,
+    /// Whether its first step is clear of the still scene.
+    first_clear: bool,
+}
+
+impl Dwa {
+    /// How far the robot senses moving agents.
+    fn range(me: &Episode) -> f64 {
+        let config = me.config();
+        config.dwa.sense_range_px.unwrap_or(config.laser.range_px)
+    }
+
+    /// The least gap between `me` and what it senses now, px.
+    fn gap_now(&self, me: &Episode) -> f64 {
+        let p = me.pose().position();
+        let r = me.config().robot.radius_px;
+        let points = self.points.iter().map(|q| (p - q).norm() - r);
+        let agents = self.senses.agents[1..]
+            .iter()
+            .map(|o| (p - Point::new(o.position.x, o.position.y)).norm() - r - o.radius);
+        points.chain(agents).fold(f64::INFINITY, f64::min)
+    }
+
+    /// The laser's hit points round `me`, into `self.points`.
+    fn laser_points(&mut self, me: &Episode) {
+        self.points.clear();
+        let laser = me.laser();
+        let pose = me.pose();
+        for (i, &d) in me.readings().iter().enumerate() {
+            if d < laser.range_px() {
+                let a = laser.beam_angle_deg(i, pose.z_deg);
+                self.points.push(pose.position() + unit(a) * d);
+            }
+        }
+    }
+
+    /// Rolls `actions` out from `me`'s pose: the first for one step, `then` for the rest.
+    /// The rollout stops where it reaches the goal. A contact is a gap below `margin` (or below the gap the robot already keeps, less a
+    /// hundredth of a px, when that is smaller: a robot already near a wall may stay as near).
+    fn roll(
+        &self,
+        me: &Episode,
+        robot: &Robot,
+        margin: f64,
+        first: Action,
+        then: Action,
+    ) -> Rollout {
+        let config = me.config();
+        let r = config.robot.radius_px;
+        let mut pose = me.pose();
+        let horizon = config.dwa.horizon_steps;
+        let mut free_steps = horizon;
+        let mut first_clear = true;
+        for k in 0..horizon {
+            let action = if k == 0 { first } else { then };
+            let motion = robot.motion(pose, action);
+            if k == 0 {
+                first_clear = robot.motion_clear(me.scene(), pose, &motion);
+            }
+            pose = motion.end;
+            let p = pose.position();
+            // Reaching the goal ends the episode: nothing after it counts.
+            if (p - me.goal()).norm() < config.episode.goal_tolerance_px {
+                break;
+            }
+            if free_steps < horizon {
+                continue;
+            }
+            let ahead = f64::from(k + 1);
+            let touches = self.points.iter().any(|q| (p - q).norm() - r < margin)
+                || self.senses.agents[1..].iter().any(|o| {
+                    let at = Point::new(
+                        o.position.x + o.velocity.x * ahead,
+                        o.position.y + o.velocity.y * ahead,
+                    );
+                    (p - at).norm() - r - o.radius < margin
+                });
+            if touches {
+                free_steps = k;
+            }
+        }
+        Rollout {
+            free_steps,
+            end: pose,
+            first_clear,
+        }
+    }
+
+    /// The decision for `me` (whose agents are sensed) in its still scene.
+    fn decide(&mut self, me: &Episode) -> Decision {
+        let Some(path) = &mut self.path else {
+            return Decision::GiveUp("no path to the goal".into());
+        };
+        let p = me.pose().position();
+        let aim = path.aim(p).unwrap_or(me.goal());
+        self.laser_points(me);
+        let config = me.config();
+        let dwa = &config.dwa;
+        let robot = &config.robot;
+        let top_speed = match dwa.actions {
+            PlannerActions::Continuous => robot.max_linear_speed_px,
+            PlannerActions::Discrete => robot.move_speed_px,
+        };
+        // Headings are judged towards the aim put beyond the furthest rollout's end, so that a
+        // fast rollout is not faulted for passing it.
+        let beyond = 2.0 * f64::from(dwa.horizon_steps) * top_speed;
+        let aim = match (aim - p).try_normalize(1e-9) {
+            Some(u) if (aim - p).norm() < beyond => p + u * beyond,
+            _ => aim,
+        };
+        // Each candidate: its first action, the one repeated after it, and its speed in px.
+        let candidates: Vec<(Action, Action, f64)> = match dwa.actions {
+            PlannerActions::Discrete => {
+                let ahead = Action::from(DiscreteAction::Ahead);
+                [
+                    DiscreteAction::Left,
+                    DiscreteAction::Ahead,
+                    DiscreteAction::Right,
+                ]
+                .into_iter()
+                .map(|a| {
+                    // The rollout's mean speed: a turn stands for its first step.
+                    let h = f64::from(dwa.horizon_steps);
+                    let speed = if a == DiscreteAction::Ahead {
+                        robot.move_speed_px
+                    } else {
+                        robot.move_speed_px * (h - 1.0) / h
+                    };
+                    (Action::from(a), ahead, speed)
+                })
+                .collect()
+            }
+            PlannerActions::Continuous => {
+                let (v0, w0) = self.last;
+                let v_max = robot.max_linear_speed_px;
+                let w_max = robot.max_angular_speed_deg;
+                let (v_lo, v_hi) = (
+                    (v0 - dwa.linear_accel_px).max(0.0),
+                    (v0 + dwa.linear_accel_px).min(v_max),
+                );
+                let (w_lo, w_hi) = (
+                    (w0 - dwa.angular_accel_deg).max(-w_max),
+                    (w0 + dwa.angular_accel_deg).min(w_max),
+                );
+                let across = |lo: f64, hi: f64, n: u32, i: u32| {
+                    lo + (hi - lo) * f64::from(i) / f64::from(n - 1)
+                };
+                let mut out = Vec::new();
+                for i in 0..dwa.speed_samples {
+                    let v = across(v_lo, v_hi, dwa.speed_samples, i);
+                    for j in 0..dwa.turn_samples {
+                        let w_deg = across(w_lo, w_hi, dwa.turn_samples, j);
+                        let a = Action::Continuous { v, w_deg };
+                        out.push((a, a, v));
+                    }
+                }
+                out
+            }
+        };
+        let body = Robot::new(robot);
+        let margin = dwa.safety_margin_px.min(self.gap_now(me) - 0.01);
+        let mut best: Option<(bool, f64, Action)> = None;
+        for (first, then, speed) in candidates {
+            let roll = self.roll(me, &body, margin, first, then);
+            // Steps it takes to stop from `speed` (a discrete robot stops at once).
+            let stopping = match dwa.actions {
+                PlannerActions::Continuous => (speed / dwa.linear_accel_px).ceil().max(1.0),
+                PlannerActions::Discrete => 1.0,
+            };
+            let admissible = roll.first_clear && f64::from(roll.free_steps) >= stopping;
+            let score = if admissible {
+                let to_aim = aim - roll.end.position();
+                let heading = if to_aim.norm() < 1e-9 {
+                    1.0
+                } else {
+                    let bearing = to_aim.y.atan2(to_aim.x).to_degrees();
+                    let off = (wrap_deg(bearing - roll.end.z_deg + 180.0) - 180.0).abs();
+                    1.0 - off / 180.0
+                };
+                let clearance = f64::from(roll.free_steps) / f64::from(dwa.horizon_steps);
+                dwa.heading_weight * heading
+                    + dwa.clearance_weight * clearance
+                    + dwa.speed_weight * speed / top_speed
+            } else if roll.first_clear {
+                // None admissible: the latest contact, slower first.
+                f64::from(roll.free_steps) - speed / (top_speed + 1.0)
+            } else {
+                f64::NEG_INFINITY
+            };
+            if best.is_none_or(|(a, s, _)| (admissible, score) > (a, s)) {
+                best = Some((admissible, score, first));
+            }
+        }
+        let action = best.map_or(Action::Continuous { v: 0.0, w_deg: 0.0 }, |b| b.2);
+        self.last = match action {
+            Action::Continuous { v, w_deg } => (v, w_deg),
+            Action::Discrete(_) => (0.0, 0.0),
+        };
+        Decision::Act(action)
+    }
+}
+
+impl Policy for Dwa {
+    fn reset(&mut self, world: &World, episode: &Episode) -> Result<(), PolicyError> {
+        self.path = planned(world, episode.pose().position(), episode.goal());
+        self.senses.reset(episode);
+        if episode.steps() == 0 {
+            self.last = (0.0, 0.0);
+        }
+        Ok(())
+    }
+
+    fn act(&mut self, episode: &Episode) -> Result<Decision, PolicyError> {
+        self.senses.lone(episode, Self::range(episode));
+        Ok(self.decide(episode))
+    }
+
+    fn act_in_team(&mut self, team: &Team, k: usize) -> Result<Decision, PolicyError> {
+        let me = team.robot(k);
+        self.senses.in_team(team, k, Self::range(me));
+        Ok(self.decide(me))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::config::PlannerActions;
+    use crate::eval::{EvalOptions, Evaluator, Summary};
+    use crate::policy::factory;
+    use crate::sim::world::Scenes;
+    use std::sync::atomic::AtomicBool;
+
+    fn lone_run(config: crate::SimConfig, seeds: u64) -> Summary {
+        let ev = Evaluator::new(config.validate().expect("valid"), Scenes::MazePerSeed);
+        let f = factory("dwa", ev.config().observation_size()).expect("policy");
+        let options = EvalOptions {
+            seeds: (0..seeds).collect::<Vec<_>>().into(),
+            ..Default::default()
+        };
+        let run = ev
+            .run(f.as_ref(), &options, &AtomicBool::new(false), &|_| {})
+            .expect("runs");
+        Summary::new(&run.records, crate::eval::metric::kinds(ev.config()), 1.0)
+    }
+
+    #[test]
+    fn dwa_reaches_maze_goals_without_touching_a_wall() {
+        let s = lone_run(crate::SimConfig::default(), 20);
+        assert!(s.success_rate >= 0.9, "{s:?}");
+        assert!(s.collisions_per_episode <= 0.05, "{s:?}");
+    }
+
+    #[test]
+    fn with_discrete_actions_dwa_reaches_maze_goals() {
+        let mut c = crate::SimConfig::default();
+        c.dwa.actions = PlannerActions::Discrete;
+        let s = lone_run(c, 20);
+        assert!(s.success_rate >= 0.8, "{s:?}");
+    }
+}
