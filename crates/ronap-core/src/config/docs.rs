@@ -432,6 +432,9 @@ mod documented_tests {
         c.metrics.crowd = true;
         c.orca.sense_range_px = Some(50.0);
         c.orca.speed_px = Some(4.0);
+        c.social_force.sense_range_px = Some(50.0);
+        c.social_force.speed_px = Some(4.0);
+        c.dwa.sense_range_px = Some(50.0);
         let full = toml::Value::try_from(&c).unwrap();
         let mut count = 0;
         for (sec, table) in full.as_table().unwrap() {

@@ -57,6 +57,7 @@ impl Orca {
                 neighbour_dist: Self::range(me),
                 max_neighbours: config.orca.max_neighbours as usize,
                 margin: config.orca.safety_margin_px,
+                candidates: None,
             },
         );
         Decision::Act(local::action(me, v, to_aim, actions))

@@ -3,7 +3,7 @@
 //! its obstacle horizon, every agent grown by a safety margin, and the velocity ORCA gives.
 
 use crate::geometry::orca::{
-    agent_neighbours, new_velocity, obstacle_neighbours, Agent, Horizon, Line, Obstacles,
+    agent_neighbours_among, new_velocity, obstacle_neighbours, Agent, Horizon, Line, Obstacles,
     Surroundings,
 };
 use crate::geometry::Vector;
@@ -26,6 +26,9 @@ pub struct Avoid<'a> {
     pub max_neighbours: usize,
     /// Added to every agent's radius, its own too.
     pub margin: f64,
+    /// The agents that may lie within `neighbour_dist` (indices into `agents`, each once, in
+    /// any order), when a spatial grid has narrowed them down; `None`: every agent.
+    pub candidates: Option<&'a [u32]>,
 }
 
 /// The scratch space of ORCA steps, kept between them.
@@ -42,13 +45,24 @@ pub struct Avoider {
 impl Avoider {
     /// The velocity ORCA gives `a.me` in `scene`.
     pub fn velocity(&mut self, scene: &Scene, a: &Avoid<'_>) -> Vector {
-        agent_neighbours(
-            a.agents,
-            a.me,
-            a.neighbour_dist,
-            a.max_neighbours,
-            &mut self.near,
-        );
+        match a.candidates {
+            Some(c) => agent_neighbours_among(
+                a.agents,
+                a.me,
+                c.iter().map(|&j| j as usize),
+                a.neighbour_dist,
+                a.max_neighbours,
+                &mut self.near,
+            ),
+            None => agent_neighbours_among(
+                a.agents,
+                a.me,
+                0..a.agents.len(),
+                a.neighbour_dist,
+                a.max_neighbours,
+                &mut self.near,
+            ),
+        }
         self.others.clear();
         self.others.extend(self.near.iter().map(|&(_, j)| Agent {
             radius: a.agents[j].radius + a.margin,

@@ -153,6 +153,19 @@ pub fn agent_neighbours<T: Real>(
     max: usize,
     out: &mut Vec<(T, usize)>,
 ) {
+    agent_neighbours_among(agents, me, 0..agents.len(), range, max, out);
+}
+
+/// [`agent_neighbours`] among the agents `candidates` (indices into `agents`, each at most once,
+/// in any order; a superset of those within `range`, as a spatial grid gives): the same answer.
+pub fn agent_neighbours_among<T: Real>(
+    agents: &[Agent<T>],
+    me: usize,
+    candidates: impl Iterator<Item = usize>,
+    range: T,
+    max: usize,
+    out: &mut Vec<(T, usize)>,
+) {
     out.clear();
     if max == 0 {
         return;
@@ -160,11 +173,9 @@ pub fn agent_neighbours<T: Real>(
     let p = agents[me].position;
     let range_sq = range * range;
     out.extend(
-        agents
-            .iter()
-            .enumerate()
-            .filter(|&(j, _)| j != me)
-            .map(|(j, a)| ((p - a.position).abs_sq(), j))
+        candidates
+            .filter(|&j| j != me)
+            .map(|j| ((p - agents[j].position).abs_sq(), j))
             .filter(|&(d, _)| d < range_sq),
     );
     // The `max` nearest first (the same as sorting them all and keeping the first `max`).

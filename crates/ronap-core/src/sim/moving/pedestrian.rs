@@ -11,6 +11,7 @@
 use super::{free_spot, Body, Disc, Entry, SPOT_TRIES};
 use crate::config::{AgentOrca, Arrival, Forces, MotionKind, MovingConfig, Pattern};
 use crate::geometry::orca::{Agent, Horizon, V2};
+use crate::geometry::point_grid::PointGrid;
 use crate::geometry::social_force::{self, Walker};
 use crate::geometry::{Point, Vector};
 use crate::scene::Scene;
@@ -26,6 +27,9 @@ enum Model {
     Orca(AgentOrca),
     SocialForce(Forces),
 }
+
+/// The least side of the neighbour grid's cells, px.
+const MIN_CELL_PX: f64 = 16.0;
 
 /// One reactive pedestrian's goal, settings and chosen velocity.
 #[derive(Clone, Debug)]
@@ -44,6 +48,14 @@ pub(super) struct Pedestrian {
 }
 
 impl Pedestrian {
+    /// How far it looks for other agents, px.
+    fn reach(&self) -> f64 {
+        match &self.model {
+            Model::Orca(o) => o.neighbour_dist_px,
+            Model::SocialForce(f) => f.neighbour_dist_px,
+        }
+    }
+
     /// The pedestrian `m` describes, heading for `goal`.
     pub(super) fn new(m: &MovingConfig, goal: Point) -> Self {
         Self {
@@ -171,6 +183,10 @@ pub(super) struct Crowd {
     /// The obstacle each agent is (`None`: a robot).
     owners: Vec<Option<usize>>,
     avoider: Avoider,
+    /// The pedestrian agents binned by position, for their neighbours.
+    grid: Option<PointGrid>,
+    /// The agents near the one planning (scratch).
+    near: Vec<u32>,
 }
 
 impl Crowd {
@@ -204,6 +220,22 @@ impl Crowd {
             }
         }
         let pedestrian_agents = self.agents.len();
+        // Each pedestrian's neighbours come from the cells of a grid as wide as the furthest
+        // any looks: a superset of those in reach, so every answer is as from all of them.
+        let reach = pedestrians
+            .iter()
+            .flatten()
+            .map(Pedestrian::reach)
+            .fold(0.0, f64::max);
+        let grid = self.grid.get_or_insert_with(|| {
+            PointGrid::new(scene.width(), scene.height(), reach.max(MIN_CELL_PX))
+        });
+        grid.fill(
+            self.agents
+                .iter()
+                .enumerate()
+                .map(|(a, g)| (a, Point::new(g.position.x, g.position.y))),
+        );
         if pedestrians.iter().flatten().any(|p| p.sees_robots) {
             // Pedestrians move before the robots within a step and a pedestrian's move is
             // checked against a robot where it stands: each robot is avoided both where it will
@@ -259,6 +291,7 @@ impl Crowd {
             } else {
                 to_goal * (p.speed.min(to_goal.norm()) / to_goal.norm())
             };
+            grid.near_any_order(at, p.reach(), &mut self.near);
             p.next = match &p.model {
                 Model::Orca(orca) => {
                     let horizon = Horizon {
@@ -269,6 +302,7 @@ impl Crowd {
                     };
                     // The robots are agents only to those that see them.
                     let visible = if p.sees_robots {
+                        self.near.extend(pedestrian_agents as u32..self.agents.len() as u32);
                         self.agents.len()
                     } else {
                         pedestrian_agents
@@ -283,15 +317,21 @@ impl Crowd {
                             neighbour_dist: orca.neighbour_dist_px,
                             max_neighbours: orca.max_neighbours as usize,
                             margin: orca.safety_margin_px,
+                            candidates: Some(&self.near),
                         },
                     )
                 }
                 Model::SocialForce(forces) => {
-                    let others = self.agents[..pedestrian_agents]
+                    let agents = &self.agents;
+                    let others = self
+                        .near
                         .iter()
-                        .enumerate()
-                        .filter(|&(b, _)| b != a)
-                        .map(|(_, o)| (Point::new(o.position.x, o.position.y), o.radius));
+                        .map(|&b| b as usize)
+                        .filter(|&b| b != a)
+                        .map(|b| {
+                            let o = &agents[b];
+                            (Point::new(o.position.x, o.position.y), o.radius)
+                        });
                     let robots = robots
                         .iter()
                         .filter(|_| p.sees_robots)
