@@ -302,7 +302,8 @@ impl Crowd {
                     };
                     // The robots are agents only to those that see them.
                     let visible = if p.sees_robots {
-                        self.near.extend(pedestrian_agents as u32..self.agents.len() as u32);
+                        self.near
+                            .extend(pedestrian_agents as u32..self.agents.len() as u32);
                         self.agents.len()
                     } else {
                         pedestrian_agents
