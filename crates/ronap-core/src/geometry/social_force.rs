@@ -39,7 +39,7 @@ pub fn agent_force(f: &Forces, me: &Walker, desired: Vector, at: Point, radius: 
     } else {
         f.lambda + (1.0 - f.lambda) * (1.0 + cos_phi) / 2.0
     };
-    n * (f.agent_strength_px * weight * ((me.radius + radius - d) / f.agent_range_px).exp())
+    n * (f.agent_strength_px * weight * push_factor((me.radius + radius - d) / f.agent_range_px))
 }
 
 /// The push of a still obstacle whose nearest point to `me` is `nearest`; none from inside it.
@@ -49,7 +49,13 @@ pub fn obstacle_force(f: &Forces, me: &Walker, nearest: Point) -> Vector {
     if d == 0.0 {
         return Vector::zeros();
     }
-    away / d * (f.obstacle_strength_px * ((me.radius - d) / f.obstacle_range_px).exp())
+    away / d * (f.obstacle_strength_px * push_factor((me.radius - d) / f.obstacle_range_px))
+}
+
+/// `exp(x)` with `x` held at most 50 (`e^50`, 5e21): deep overlaps with a short decay length
+/// would otherwise overflow to infinity and give NaN velocities.
+fn push_factor(x: f64) -> f64 {
+    x.min(50.0).exp()
 }
 
 /// The velocity after one step of the model: `me` relaxing towards `preferred` under the pushes

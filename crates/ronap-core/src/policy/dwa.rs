@@ -10,10 +10,11 @@
 //! `dwa.safety_margin_px` of the laser's points or of the moving obstacles and other robots it
 //! senses (each moving on at its last velocity): Fox et al.'s distance to the nearest obstacle
 //! on the trajectory, in steps; and `speed` the speed as a fraction of the largest. A command is
-//! admissible when its first step keeps clear of the still scene and the robot could stop
-//! (at `dwa.linear_accel_px` a step; a discrete robot at once) before that first contact; when none is, the one whose
-//! contact comes latest is taken. With discrete actions the candidates are LEFT, AHEAD and
-//! RIGHT, each taken once and followed by AHEAD steps.
+//! admissible when its first step keeps clear of the still scene and its rollout makes no contact
+//! or the robot could stop (at `dwa.linear_accel_px` a step; a discrete robot at once) before the
+//! first; when none is, the one whose contact comes latest is taken, and when no first step is
+//! clear the robot stands and turns towards the aim. With discrete actions the candidates are
+//! LEFT, AHEAD and RIGHT, each taken once and followed by AHEAD steps.
 
 use super::follow::Follower;
 use super::geodesic::planned;
@@ -56,17 +57,6 @@ impl Dwa {
         config.dwa.sense_range_px.unwrap_or(config.laser.range_px)
     }
 
-    /// The least gap between `me` and what it senses now, px.
-    fn gap_now(&self, me: &Episode) -> f64 {
-        let p = me.pose().position();
-        let r = me.config().robot.radius_px;
-        let points = self.points.iter().map(|q| (p - q).norm() - r);
-        let agents = self.senses.agents[1..]
-            .iter()
-            .map(|o| (p - Point::new(o.position.x, o.position.y)).norm() - r - o.radius);
-        points.chain(agents).fold(f64::INFINITY, f64::min)
-    }
-
     /// The laser's hit points round `me`, into `self.points`.
     fn laser_points(&mut self, me: &Episode) {
         self.points.clear();
@@ -81,8 +71,9 @@ impl Dwa {
     }
 
     /// Rolls `actions` out from `me`'s pose: the first for one step, `then` for the rest.
-    /// The rollout stops where it reaches the goal. A contact is a gap below `margin` (or below the gap the robot already keeps, less a
-    /// hundredth of a px, when that is smaller: a robot already near a wall may stay as near).
+    /// The rollout stops where it reaches the goal. A contact is a gap to a thing below `margin`
+    /// (or below the gap the robot already keeps to that thing, less a hundredth of a px, when
+    /// that is smaller: a robot already near a wall may stay as near).
     fn roll(
         &self,
         me: &Episode,
@@ -94,6 +85,9 @@ impl Dwa {
         let config = me.config();
         let r = config.robot.radius_px;
         let mut pose = me.pose();
+        let p0 = pose.position();
+        // Each thing's threshold: the margin, or the gap already kept when that is smaller.
+        let limit = |gap0: f64| margin.min(gap0 - 0.01);
         let horizon = config.dwa.horizon_steps;
         let mut free_steps = horizon;
         let mut first_clear = true;
@@ -113,13 +107,17 @@ impl Dwa {
                 continue;
             }
             let ahead = f64::from(k + 1);
-            let touches = self.points.iter().any(|q| (p - q).norm() - r < margin)
+            let touches = self
+                .points
+                .iter()
+                .any(|q| (p - q).norm() - r < limit((p0 - q).norm() - r))
                 || self.senses.agents[1..].iter().any(|o| {
+                    let now = Point::new(o.position.x, o.position.y);
                     let at = Point::new(
                         o.position.x + o.velocity.x * ahead,
                         o.position.y + o.velocity.y * ahead,
                     );
-                    (p - at).norm() - r - o.radius < margin
+                    (p - at).norm() - r - o.radius < limit((p0 - now).norm() - r - o.radius)
                 });
             if touches {
                 free_steps = k;
@@ -204,7 +202,7 @@ impl Dwa {
             }
         };
         let body = Robot::new(robot);
-        let margin = dwa.safety_margin_px.min(self.gap_now(me) - 0.01);
+        let margin = dwa.safety_margin_px;
         let mut best: Option<(bool, f64, Action)> = None;
         for (first, then, speed) in candidates {
             let roll = self.roll(me, &body, margin, first, then);
@@ -213,7 +211,8 @@ impl Dwa {
                 PlannerActions::Continuous => (speed / dwa.linear_accel_px).ceil().max(1.0),
                 PlannerActions::Discrete => 1.0,
             };
-            let admissible = roll.first_clear && f64::from(roll.free_steps) >= stopping;
+            let admissible = roll.first_clear
+                && (roll.free_steps == dwa.horizon_steps || f64::from(roll.free_steps) >= stopping);
             let score = if admissible {
                 let to_aim = aim - roll.end.position();
                 let heading = if to_aim.norm() < 1e-9 {
@@ -226,7 +225,12 @@ impl Dwa {
                 let clearance = f64::from(roll.free_steps) / f64::from(dwa.horizon_steps);
                 dwa.heading_weight * heading
                     + dwa.clearance_weight * clearance
-                    + dwa.speed_weight * speed / top_speed
+                    + dwa.speed_weight
+                        * if top_speed > 0.0 {
+                            speed / top_speed
+                        } else {
+                            0.0
+                        }
             } else if roll.first_clear {
                 // None admissible: the latest contact, slower first.
                 f64::from(roll.free_steps) - speed / (top_speed + 1.0)
@@ -237,7 +241,23 @@ impl Dwa {
                 best = Some((admissible, score, first));
             }
         }
-        let action = best.map_or(Action::Continuous { v: 0.0, w_deg: 0.0 }, |b| b.2);
+        let action = match best {
+            Some((_, score, a)) if score > f64::NEG_INFINITY => a,
+            // No first step is clear: stand and turn towards the aim.
+            _ => {
+                let to_aim = aim - p;
+                let off = wrap_deg(to_aim.y.atan2(to_aim.x).to_degrees() - me.pose().z_deg + 180.0)
+                    - 180.0;
+                match dwa.actions {
+                    PlannerActions::Continuous => Action::Continuous {
+                        v: 0.0,
+                        w_deg: off.clamp(-robot.max_angular_speed_deg, robot.max_angular_speed_deg),
+                    },
+                    PlannerActions::Discrete if off >= 0.0 => DiscreteAction::Left.into(),
+                    PlannerActions::Discrete => DiscreteAction::Right.into(),
+                }
+            }
+        };
         self.last = match action {
             Action::Continuous { v, w_deg } => (v, w_deg),
             Action::Discrete(_) => (0.0, 0.0),

@@ -1,8 +1,8 @@
 //! The `social-force` policy (docs/model.md "Local planners among moving things"): the social
 //! force model ([`crate::geometry::social_force`]) applied to the robot. Each step the robot's
 //! velocity relaxes towards full speed along its geodesic path, pushed away from the moving
-//! obstacles and other robots it senses (ground truth within `social_force.sense_range_px`) and
-//! from the still scene; the velocity becomes the unicycle command that tracks it, or the
+//! obstacles and other robots it senses (ground truth within `social_force.sense_range_px`; those
+//! beyond `forces.neighbour_dist_px` do not push) and from the still scene; the velocity becomes the unicycle command that tracks it, or the
 //! discrete action whose result lies closest.
 
 use super::follow::Follower;

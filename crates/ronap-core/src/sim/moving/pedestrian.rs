@@ -489,7 +489,7 @@ mod tests {
     }
 
     #[test]
-    fn drawn_social_force_goals_keep_off_the_walls_and_walkers_keep_walking() {
+    fn social_force_walkers_with_drawn_goals_keep_walking() {
         let c = crate::SimConfig {
             moving: vec![MovingConfig {
                 count: 40,
