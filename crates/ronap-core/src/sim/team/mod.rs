@@ -14,6 +14,11 @@
 //! The first robot's start and goal are drawn as a lone robot's are (the same stream), the
 //! others' from a stream of their own, each clear of the robots placed before it.
 
+mod comm;
+mod step;
+
+pub use comm::{Broadcast, Inbox, InboxIter};
+
 use crate::config::{OnArrival, TeamConfig, ValidConfig};
 use crate::geometry::point_grid::PointGrid;
 use crate::geometry::{point_segment_distance_squared, Point};
@@ -21,7 +26,6 @@ use crate::sim::episode::{Episode, Status};
 use crate::sim::moving::{Disc, Movers};
 use crate::sim::placement::{needs_region_grid, sample_placement_with, EpisodeError};
 use crate::sim::rng::{robot_stream, stream, Stream};
-use crate::sim::robot::{Action, Motion, Pose};
 use crate::sim::world::World;
 use std::sync::Arc;
 
@@ -30,91 +34,6 @@ pub const PLACEMENT_GAP_PX: f64 = 2.0;
 
 /// Side of the cells of the grids that find the robots near a robot, px.
 const NEAR_CELL_PX: f64 = 64.0;
-
-/// What a robot broadcast at a step: received the step after by the robots within
-/// `team.comm_range_px`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Broadcast {
-    /// The sender.
-    pub from: usize,
-    /// Its pose when it sent.
-    pub pose: Pose,
-    /// Its (current) goal.
-    pub goal: Point,
-    /// Its policy's message (`team.message_size` floats).
-    pub message: Vec<f32>,
-}
-
-/// What a robot received at the last step ([`Team::inbox`]): the broadcasts of the robots that
-/// were within range when they sent, nearest first.
-#[derive(Clone, Copy, Debug)]
-pub struct Inbox<'a> {
-    sent: &'a [Broadcast],
-    places: &'a [u32],
-}
-
-impl<'a> Inbox<'a> {
-    /// Number of broadcasts received.
-    pub fn len(&self) -> usize {
-        self.places.len()
-    }
-
-    /// Whether nothing was received.
-    pub fn is_empty(&self) -> bool {
-        self.places.is_empty()
-    }
-
-    /// The `i`-th nearest broadcast.
-    pub fn get(&self, i: usize) -> Option<&'a Broadcast> {
-        self.places.get(i).map(|&m| &self.sent[m as usize])
-    }
-
-    /// The broadcasts, nearest first.
-    pub fn iter(&self) -> InboxIter<'a> {
-        InboxIter {
-            sent: self.sent,
-            places: self.places.iter(),
-        }
-    }
-}
-
-impl<'a> IntoIterator for Inbox<'a> {
-    type Item = &'a Broadcast;
-    type IntoIter = InboxIter<'a>;
-
-    fn into_iter(self) -> InboxIter<'a> {
-        self.iter()
-    }
-}
-
-/// The broadcasts of an [`Inbox`], nearest first.
-#[derive(Clone, Debug)]
-pub struct InboxIter<'a> {
-    sent: &'a [Broadcast],
-    places: std::slice::Iter<'a, u32>,
-}
-
-impl<'a> Iterator for InboxIter<'a> {
-    type Item = &'a Broadcast;
-
-    fn next(&mut self) -> Option<&'a Broadcast> {
-        self.places.next().map(|&m| &self.sent[m as usize])
-    }
-
-    fn size_hint(&self) -> (usize, Option<usize>) {
-        self.places.size_hint()
-    }
-}
-
-impl ExactSizeIterator for InboxIter<'_> {}
-
-impl std::ops::Index<usize> for Inbox<'_> {
-    type Output = Broadcast;
-
-    fn index(&self, i: usize) -> &Broadcast {
-        &self.sent[self.places[i] as usize]
-    }
-}
 
 /// Several robots in one scene.
 #[derive(Clone, Debug)]
@@ -414,30 +333,6 @@ impl Team {
         self.robots.iter().any(|r| r.status() == Status::Deadlock)
     }
 
-    /// Floats in a robot's message (`team.message_size`).
-    pub fn message_size(&self) -> usize {
-        self.comm.message_size as usize
-    }
-
-    /// Sets robot `k`'s message for the next broadcast (the first `team.message_size` floats of
-    /// `message`; the rest zeros).
-    pub fn set_message(&mut self, k: usize, message: &[f32]) {
-        let out = &mut self.outbox[k];
-        out.fill(0.0);
-        for (o, m) in out.iter_mut().zip(message) {
-            *o = *m;
-        }
-    }
-
-    /// What robot `k` received at the last step: the broadcasts of the robots that were within
-    /// `team.comm_range_px` of it when they sent, nearest first.
-    pub fn inbox(&self, k: usize) -> Inbox<'_> {
-        Inbox {
-            sent: &self.sent,
-            places: &self.inbox[self.inbox_starts[k] as usize..self.inbox_starts[k + 1] as usize],
-        }
-    }
-
     /// Robot `k`'s goals as drawn or listed (one, or a goal list).
     pub fn goals(&self, k: usize) -> &[Point] {
         &self.goal_lists[k]
@@ -470,254 +365,6 @@ impl Team {
     pub fn running(&self, k: usize) -> bool {
         !self.retired[k] && self.robots[k].status() == Status::Running
     }
-
-    /// One step: `actions[k]` for each robot (`None`: it does nothing, as a robot whose episode
-    /// is over). Moving obstacles move first, then every running robot at once.
-    pub fn step(&mut self, actions: &[Option<Action>]) {
-        if self.is_done() {
-            return;
-        }
-        self.steps += 1;
-        let n = self.robots.len();
-        let present: Vec<usize> = (0..n).filter(|&k| self.present(k)).collect();
-        // What every robot in the scene broadcasts now, received after the step.
-        let sent: Vec<Broadcast> = present
-            .iter()
-            .map(|&k| Broadcast {
-                from: k,
-                pose: self.robots[k].pose(),
-                goal: self.robots[k].goal(),
-                message: std::mem::replace(
-                    &mut self.outbox[k],
-                    vec![0.0; self.comm.message_size as usize],
-                ),
-            })
-            .collect();
-        let discs: Vec<Disc> = present.iter().map(|&k| disc(&self.robots[k])).collect();
-        let mut touched = vec![false; n];
-        if let Some(movers) = &mut self.movers {
-            let scene = self.robots[0].scene().clone();
-            movers.advance_among(self.steps, &scene, &discs, &mut self.touched);
-            for &i in &self.touched {
-                touched[present[i]] = true;
-            }
-        }
-        // Each running robot's motion and what the still scene and the obstacles say of it.
-        let running: Vec<bool> = (0..n).map(|k| self.running(k)).collect();
-        let mut motions: Vec<Option<Motion>> = vec![None; n];
-        let mut wall = vec![false; n];
-        let mut moving = vec![false; n];
-        for k in 0..n {
-            let Some(action) = actions.get(k).copied().flatten().filter(|_| running[k]) else {
-                continue;
-            };
-            let r = &self.robots[k];
-            let m = r.motion(action);
-            wall[k] = !r.robot().motion_clear(r.scene(), r.pose(), &m);
-            moving[k] = match &self.movers {
-                Some(movers) => !r
-                    .robot()
-                    .motion_clear_by(r.pose(), &m, |a, b, rad| movers.sweep_clear(a, b, rad)),
-                None => false,
-            };
-            motions[k] = Some(m);
-        }
-        // Robots against robots, until no remaining motion touches another robot.
-        let ends: Vec<Point> = (0..n)
-            .map(|k| match &motions[k] {
-                Some(m) if !wall[k] && !moving[k] => m.end.position(),
-                _ => self.robots[k].pose().position(),
-            })
-            .collect();
-        let starts: Vec<Point> = self.robots.iter().map(|r| r.pose().position()).collect();
-        let radii: Vec<f64> = self
-            .robots
-            .iter()
-            .map(|r| r.config().robot.radius_px)
-            .collect();
-        let mut blocked = vec![false; n];
-        let moves = |k: usize, blocked: &[bool]| !blocked[k] && ends[k] != starts[k];
-        // Each moving robot's candidates: the robots within its reach of its start, in index
-        // order (the exact test below decides).
-        self.grid_before
-            .fill(present.iter().map(|&k| (k, starts[k])));
-        let max_move = present
-            .iter()
-            .map(|&k| (ends[k] - starts[k]).norm())
-            .fold(0.0, f64::max);
-        let mut near_start = vec![0usize; n + 1];
-        let mut near: Vec<u32> = Vec::new();
-        let mut found = Vec::new();
-        for k in 0..n {
-            near_start[k] = near.len();
-            if present.binary_search(&k).is_ok() && moves(k, &blocked) {
-                let reach = (ends[k] - starts[k]).norm() + max_move + radii[k] + self.max_radius;
-                self.grid_before.near(starts[k], reach, &mut found);
-                near.extend(found.iter().filter(|&&j| j as usize != k));
-            }
-        }
-        near_start[n] = near.len();
-        loop {
-            let mut changed = false;
-            for &i in &present {
-                if !moves(i, &blocked) {
-                    continue;
-                }
-                for &j in &near[near_start[i]..near_start[i + 1]] {
-                    let j = j as usize;
-                    let reach = radii[i] + radii[j];
-                    let (j0, j1) = if moves(j, &blocked) {
-                        (starts[j], ends[j])
-                    } else {
-                        (starts[j], starts[j])
-                    };
-                    // Far apart: neither sweep can reach the other.
-                    let span = (ends[i] - starts[i]).norm() + (j1 - j0).norm() + reach;
-                    if (starts[i] - starts[j]).norm() > span {
-                        continue;
-                    }
-                    if sweeps_touch(starts[i], ends[i], j0, j1, reach) {
-                        blocked[i] = true;
-                        if moves(j, &blocked) {
-                            blocked[j] = true;
-                        }
-                        changed = true;
-                        break;
-                    }
-                }
-            }
-            if !changed {
-                break;
-            }
-        }
-        // Make the motions, then read every sensor among everyone's new poses.
-        let mut collided = std::mem::take(&mut self.collided);
-        collided.clear();
-        collided.resize(n, false);
-        let before: Vec<f64> = self.robots.iter().map(|r| r.distance_px()).collect();
-        let mut moved_any = false;
-        for k in 0..n {
-            if let Some(m) = &motions[k] {
-                collided[k] = self.robots[k].apply(m, wall[k], moving[k], touched[k], blocked[k]);
-                moved_any |= self.robots[k].pose().position() != starts[k];
-            }
-        }
-        self.sense_all();
-        self.deliver(sent);
-        for k in 0..n {
-            self.rewards[k] = 0.0;
-            if let Some(m) = &motions[k] {
-                self.rewards[k] = self.robots[k].score(before[k], m, collided[k]);
-                if self.robots[k].status() == Status::Success {
-                    self.arrived_at[k].get_or_insert(self.steps);
-                }
-            }
-        }
-        self.collided = collided;
-        self.still_for = if moved_any { 0 } else { self.still_for + 1 };
-        // A deadlock is a team's: a team of one that stands still is a lone robot that does,
-        // and runs on as one would (to its time-out, or until its policy gives up). In a team of
-        // two or more, the robots still running deadlock even when the others are done.
-        if n > 1 && self.still_for >= self.deadlock_steps {
-            for k in 0..n {
-                if self.running(k) {
-                    self.robots[k].end(Status::Deadlock);
-                }
-            }
-        }
-    }
-
-    /// Hands each robot in the scene the broadcasts `sent` from within range of where it was,
-    /// nearest first, and writes the nearest `team.neighbours` into its observation; `sent` is
-    /// kept until the next step.
-    fn deliver(&mut self, sent: Vec<Broadcast>) {
-        let range = self.comm.comm_range_px;
-        let scale = range.max(1.0);
-        let slot = self.comm.slot_size();
-        let k_near = self.comm.neighbours as usize;
-        self.sent = sent;
-        let sent = &self.sent;
-        // `sent` is in robot order, and the grid holds where the senders were.
-        let of = places_of(sent.iter().map(|b| b.from), self.robots.len());
-        let mut found = Vec::new();
-        let mut near: Vec<(f64, u32)> = Vec::new();
-        self.inbox.clear();
-        for i in 0..self.robots.len() {
-            self.inbox_starts[i] = self.inbox.len() as u32;
-            let Some(me) = of[i].map(|m| &sent[m as usize]) else {
-                continue;
-            };
-            let at = me.pose.position();
-            // Any order: what is kept is sorted by distance, then sender.
-            self.grid_before.near_any_order(at, range, &mut found);
-            near.clear();
-            near.extend(
-                found
-                    .iter()
-                    .filter(|&&j| j as usize != i)
-                    .filter_map(|&j| of[j as usize])
-                    .map(|m| ((sent[m as usize].pose.position() - at).norm(), m))
-                    .filter(|(d, _)| *d <= range),
-            );
-            // Places in `sent` are in sender order.
-            near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            self.inbox.extend(near.iter().map(|&(_, m)| m));
-            if k_near == 0 {
-                continue;
-            }
-            let pose = self.robots[i].pose();
-            let (sin, cos) = pose.z_deg.to_radians().sin_cos();
-            let slots = self.robots[i].neighbour_slots_mut();
-            slots.fill(0.0);
-            for (&(_, m), out) in near.iter().zip(slots.chunks_mut(slot)).take(k_near) {
-                let b = &sent[m as usize];
-                let d = b.pose.position() - pose.position();
-                out[0] = ((d.x * cos + d.y * sin) / scale) as f32;
-                out[1] = ((-d.x * sin + d.y * cos) / scale) as f32;
-                out[2] = (crate::geometry::wrap_deg(b.pose.z_deg - pose.z_deg) / 360.0) as f32;
-                out[3] = 1.0;
-                for (o, m) in out[4..].iter_mut().zip(&b.message) {
-                    *o = *m;
-                }
-            }
-        }
-        self.inbox_starts[self.robots.len()] = self.inbox.len() as u32;
-    }
-
-    /// Every running robot reads its sensors among the others (discs) and the obstacles.
-    fn sense_all(&mut self) {
-        let n = self.robots.len();
-        let discs: Vec<(usize, Disc)> = (0..n)
-            .filter(|&k| self.present(k))
-            .map(|k| (k, disc(&self.robots[k])))
-            .collect();
-        let of = places_of(discs.iter().map(|(k, _)| *k), n);
-        let movers = self.movers.take();
-        self.grid_after.fill(discs.iter().map(|(k, d)| (*k, d.at)));
-        let mut others = Vec::with_capacity(discs.len());
-        let mut found = Vec::new();
-        for k in 0..n {
-            if !self.running(k) && self.steps > 0 {
-                continue;
-            }
-            // The robots the laser can reach, in any order (sense_among keeps its exact test,
-            // and a reading is the least of the distances its beam meets, whatever their
-            // order: robots never overlap, so no two robots give a beam the same distance 0).
-            let r = &self.robots[k];
-            let reach = r.laser().range_px() + r.config().robot.radius_px + self.max_radius;
-            self.grid_after
-                .near_any_order(r.pose().position(), reach, &mut found);
-            others.clear();
-            others.extend(
-                found
-                    .iter()
-                    .filter(|&&j| j as usize != k)
-                    .filter_map(|&j| of[j as usize].map(|m| discs[m as usize].1)),
-            );
-            self.robots[k].sense_among(movers.as_deref(), &others);
-        }
-        self.movers = movers;
-    }
 }
 
 /// For each of `n` robots, its place in the list `robots` (of robot indices), if listed: a
@@ -740,7 +387,7 @@ mod tests {
     use super::*;
     use crate::config::{TeamConfig, TeamRobotConfig};
     use crate::geometry::Vector;
-    use crate::sim::robot::DiscreteAction;
+    use crate::sim::robot::{Action, DiscreteAction};
 
     /// The unit vector `v` scaled to `len`.
     fn along(v: Vector, len: f64) -> Vector {

@@ -1,0 +1,96 @@
+//! The per-episode files of a run directory: trajectory pictures (`png/`) and step logs
+//! (`steps/`), and the removal of those an earlier run left.
+
+use crate::eval::{EpisodeRecord, TeamRecord};
+use crate::io::atomic::{save_image, write_atomic, OutputError};
+use crate::io::fault::{self, Op};
+use crate::io::steplog::{write_step_log, write_steps};
+use crate::render::trajectory::trajectory_image;
+use std::path::Path;
+
+/// Writes the per-episode files a record asks for: its trajectory picture (`png/`) and its step
+/// log (`steps/`), each when `picture` / `steps` say so and the record holds what they need.
+pub(super) fn write_episode_files(
+    dir: &Path,
+    record: &EpisodeRecord,
+    picture: bool,
+    steps: bool,
+) -> Result<(), OutputError> {
+    if picture {
+        if let Some(img) = trajectory_image(record, 1.0) {
+            let path = dir.join("png").join(format!(
+                "seed-{:06}-{}.png",
+                record.seed,
+                record.outcome.name()
+            ));
+            save_image(&path, &img)?;
+        }
+    }
+    if steps {
+        let path = dir
+            .join("steps")
+            .join(format!("seed-{:06}.csv", record.seed));
+        write_atomic(&path, |out| write_steps(record, out))?;
+    }
+    Ok(())
+}
+
+/// Writes team episode `record`'s picture (when `picture`) and its robots' step logs (those it
+/// recorded).
+pub(super) fn write_team_files(
+    dir: &Path,
+    record: &TeamRecord,
+    picture: bool,
+    steps: Option<&[usize]>,
+) -> Result<(), OutputError> {
+    if picture {
+        if let Some(img) = crate::render::team::team_image(record, 1.0) {
+            let path = dir.join("png").join(format!(
+                "seed-{:06}-{}.png",
+                record.seed,
+                record.outcome.name()
+            ));
+            save_image(&path, &img)?;
+        }
+    }
+    let Some(beams) = steps else {
+        return Ok(());
+    };
+    for (k, steps) in record.step_logs.iter().enumerate() {
+        let path = dir
+            .join("steps")
+            .join(format!("seed-{:06}-robot-{k}.csv", record.seed));
+        let beams = beams.get(k).copied().unwrap_or_default();
+        write_atomic(&path, |out| write_step_log(record.seed, beams, steps, out))?;
+    }
+    Ok(())
+}
+
+/// Removes the per-episode files an earlier run left in `dir` (`png/seed-*.png`,
+/// `steps/seed-*.csv`, the GIFs `ronap replay` drew beside them, `steps/seed-*.gif`, and
+/// `gif/seed-*.gif`), so a reused output directory shows only this run. Nothing else is touched.
+pub(super) fn remove_stale_files(dir: &Path) -> Result<(), OutputError> {
+    for (sub, ext) in [
+        ("png", ".png"),
+        ("steps", ".csv"),
+        ("steps", ".gif"),
+        ("gif", ".gif"),
+    ] {
+        let Ok(entries) = std::fs::read_dir(dir.join(sub)) else {
+            continue;
+        };
+        for entry in entries.flatten() {
+            let name = entry.file_name();
+            let name = name.to_string_lossy();
+            if name.starts_with("seed-") && name.ends_with(ext) {
+                let removed =
+                    fault::check(Op::Remove).and_then(|()| std::fs::remove_file(entry.path()));
+                removed.map_err(|source| OutputError::Io {
+                    path: entry.path(),
+                    source,
+                })?;
+            }
+        }
+    }
+    Ok(())
+}
