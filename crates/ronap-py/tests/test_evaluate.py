@@ -264,3 +264,48 @@ def test_crowd_crossing_with_orca_reports_the_crowd_metrics():
     assert orca["summary"]["success_rate"] >= 0.9
     # Without [metrics] a run has none.
     assert "metrics" not in ronap.evaluate("geodesic", range(2))["summary"]
+
+
+CROWD_SCENARIOS = [
+    "circle-crossing",
+    "circle-crossing-visible",
+    "square-crossing",
+    "crowd-hall",
+]
+
+
+@pytest.mark.parametrize("name", CROWD_SCENARIOS)
+@pytest.mark.parametrize("policy", ["orca", "social-force", "dwa"])
+def test_every_crowd_scenario_runs_with_every_local_planner(name, policy):
+    scenario = str(ROOT / "scenarios" / f"{name}.toml")
+    result = ronap.evaluate(policy, range(3), scenario=scenario)
+    assert result["summary"]["episodes"] == 3
+    assert len(result["episodes"]) == 3
+    # The crowd scenarios measure the crowd metrics, each a number in range.
+    for row in result["episodes"]:
+        assert 0.0 <= row["intrusion_ratio"] <= 1.0
+    # The same seeds give the same episodes.
+    again = ronap.evaluate(policy, range(3), scenario=scenario)
+    assert [r["outcome"] for r in again["episodes"]] == [
+        r["outcome"] for r in result["episodes"]
+    ]
+
+
+@pytest.mark.parametrize(
+    ("body", "field"),
+    [
+        (
+            'motion = "social_force"\nsocial_force = { lambda = 2.0 }\n',
+            "moving[0].social_force.lambda",
+        ),
+        ('motion = "orca"\nspeed_px = -1.0\n', "moving[0].speed_px"),
+        ('motion = "orca"\npattern = "circle"\n', "moving[0].pattern"),
+    ],
+)
+def test_a_bad_crowd_entry_is_one_error_naming_file_line_and_field(tmp_path, body, field):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(f"[maze]\ncols = 2\nrows = 2\n[[moving]]\n{body}")
+    with pytest.raises(Exception) as caught:
+        ronap.evaluate("orca", range(1), scenario=str(bad))
+    message = str(caught.value)
+    assert "bad.toml:6" in message and field in message, message

@@ -533,6 +533,80 @@ mod tests {
         }
     }
 
+    /// Property: in open space, ORCA pedestrians that see the robot never overlap each other or
+    /// the robot, over 1000 random crowds (2-20 walkers of radius 3-8 px at 1-5 px a step with
+    /// goals drawn anew at each arrival, 60 steps each, the robot turning on the spot).
+    #[test]
+    fn orca_pedestrians_that_see_everyone_never_overlap() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(45);
+        let mut least = f64::INFINITY;
+        for config in 0..1000u64 {
+            let radius = rng.random_range(3.0..8.0);
+            let mut c = crossing(1, true);
+            c.moving[0] = MovingConfig {
+                count: rng.random_range(2..=20),
+                radius_px: radius,
+                motion: MotionKind::Orca,
+                speed_px: rng.random_range(1.0..5.0),
+                on_arrival: crate::config::Arrival::NewGoal,
+                sees_robots: true,
+                min_robot_distance_px: 10.0,
+                ..Default::default()
+            };
+            let mut e = episode(&c, config);
+            let robot = e.pose().position();
+            for _ in 0..60 {
+                e.step(DiscreteAction::Left);
+                let m: Vec<_> = e.movers().expect("movers").items().collect();
+                for i in 0..m.len() {
+                    let p = m[i].position();
+                    least = least.min((p - robot).norm() - radius - 5.0);
+                    for q in &m[i + 1..] {
+                        least = least.min((p - q.position()).norm() - 2.0 * radius);
+                    }
+                }
+            }
+        }
+        eprintln!("least gap over 1000 crowds: {least}");
+        assert!(least >= 0.0, "agents overlapped by {}", -least);
+    }
+
+    /// The same crowd episodes, bit for bit, on one thread and on several.
+    #[test]
+    fn crowds_give_the_same_records_on_any_thread_count() {
+        use crate::eval::{EvalOptions, Evaluator};
+        use crate::policy::factory;
+        use crate::sim::world::Scenes;
+        use std::sync::atomic::AtomicBool;
+        let mut c = crossing(12, true);
+        c.moving[0].motion = MotionKind::SocialForce;
+        c.moving.push(MovingConfig {
+            on_arrival: crate::config::Arrival::NewGoal,
+            pattern: Some(Pattern::Random),
+            ..crossing(8, false).moving[0].clone()
+        });
+        c.metrics.crowd = true;
+        let ev = Evaluator::new(c.validate().expect("valid"), Scenes::MazePerSeed);
+        let records = |threads: usize| {
+            let f = factory("orca", ev.config().observation_size()).expect("policy");
+            let options = EvalOptions {
+                seeds: (0..12).collect::<Vec<_>>().into(),
+                threads,
+                ..Default::default()
+            };
+            let run = ev
+                .run(f.as_ref(), &options, &AtomicBool::new(false), &|_| {})
+                .expect("runs");
+            run.records
+                .iter()
+                .map(|r| format!("{r:?}").replace(&format!("{:?}", r.wall_time_s), ""))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(records(1), records(2));
+        assert_eq!(records(1), records(4));
+    }
+
     #[test]
     fn max_speed_px_is_a_pedestrians_only() {
         let c = crate::SimConfig {
