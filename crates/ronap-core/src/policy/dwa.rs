@@ -70,7 +70,7 @@ impl Dwa {
         }
     }
 
-    /// Rolls `actions` out from `me`'s pose: the first for one step, `then` for the rest.
+    /// Rolls out from `me`'s pose: `first` for one step, `then` for the rest.
     /// The rollout stops where it reaches the goal. A contact is a gap to a thing below `margin`
     /// (or below the gap the robot already keeps to that thing, less a hundredth of a px, when
     /// that is smaller: a robot already near a wall may stay as near).
