@@ -2,6 +2,7 @@
 
 import json
 import pathlib
+import signal
 import threading
 import time
 
@@ -222,6 +223,9 @@ def test_ctrl_c_stops_the_run_keeping_its_files_then_raises(tmp_path):
         return 1
 
     out = tmp_path / "run"
+    # A shell that starts the tests in the background leaves SIGINT ignored, and Python then
+    # never installs its handler: interrupt_main would do nothing and the run go on for ever.
+    handler = signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(1.0, _thread.interrupt_main)
     timer.start()
     try:
@@ -229,6 +233,7 @@ def test_ctrl_c_stops_the_run_keeping_its_files_then_raises(tmp_path):
             ronap.evaluate(slow, range(1_000_000), out=str(out), threads=1)
     finally:
         timer.cancel()
+        signal.signal(signal.SIGINT, handler)
     summary = json.loads((out / "summary.json").read_text())
     assert summary["interrupted"] is True
     rows = (out / "episodes.csv").read_text().splitlines()
