@@ -9,8 +9,8 @@ use super::follow::Follower;
 use super::geodesic::planned;
 use super::local::{self, Senses};
 use super::{Decision, Policy, PolicyError};
-use crate::geometry::social_force::{self, Walker};
-use crate::geometry::{Point, Vector};
+use crate::geometry::Point;
+use crate::sim::avoid::social_force_velocity;
 use crate::sim::episode::Episode;
 use crate::sim::team::Team;
 use crate::sim::world::World;
@@ -41,23 +41,11 @@ impl SocialForce {
         let forces = &config.forces;
         let speed = local::planner_speed(me, config.speed_px, config.actions);
         let (preferred, to_aim) = local::preferred(path, me, speed, self.senses.index);
-        let mine = self.senses.agents[0];
-        let walker = Walker {
-            position: Point::new(mine.position.x, mine.position.y),
-            velocity: Vector::new(mine.velocity.x, mine.velocity.y),
-            radius: mine.radius,
-        };
-        let desired = social_force::desired_direction(preferred, walker.velocity);
-        let mut push = Vector::zeros();
-        for other in &self.senses.agents[1..] {
-            let at = Point::new(other.position.x, other.position.y);
-            push += social_force::agent_force(forces, &walker, desired, at, other.radius);
-        }
-        let reach = walker.radius + 10.0 * forces.obstacle_range_px;
-        me.scene().nearest_points(walker.position, reach, |q| {
-            push += social_force::obstacle_force(forces, &walker, q);
-        });
-        let v = social_force::next_velocity(forces, &walker, preferred, push, speed);
+        let (mine, others) = self.senses.agents.split_at(1);
+        let others = others
+            .iter()
+            .map(|o| (Point::new(o.position.x, o.position.y), o.radius));
+        let v = social_force_velocity(forces, &mine[0], preferred, speed, others, me.scene());
         Decision::Act(local::action(me, v, to_aim, config.actions))
     }
 }

@@ -1,12 +1,15 @@
-//! One agent's ORCA step among other agents and the still scene, as the `orca` policy and the
-//! ORCA pedestrians both take it: its nearest agents, the scene's obstacles within the reach of
-//! its obstacle horizon, every agent grown by a safety margin, and the velocity ORCA gives.
+//! One agent's step among other agents and the still scene, as the local planners and the
+//! reactive pedestrians both take it: by ORCA (its nearest agents, the scene's obstacles within
+//! the reach of its obstacle horizon, every agent grown by a safety margin, and the velocity ORCA
+//! gives), or by the social force model (the pushes of the agents and of the still scene).
 
+use crate::config::Forces;
 use crate::geometry::orca::{
     agent_neighbours_among, new_velocity, obstacle_neighbours, Agent, Horizon, Line, Obstacles,
     Surroundings,
 };
-use crate::geometry::Vector;
+use crate::geometry::social_force::{self, Walker};
+use crate::geometry::{Point, Vector};
 use crate::scene::Scene;
 
 /// What one agent avoids with.
@@ -96,4 +99,32 @@ impl Avoider {
         )
         .into()
     }
+}
+
+/// The velocity one step of the social force model gives the agent `me` wanting `preferred`, among `others`
+/// (centres and radii) and the still scene, cut to `max_speed`.
+pub fn social_force_velocity(
+    forces: &Forces,
+    me: &Agent<f64>,
+    preferred: Vector,
+    max_speed: f64,
+    others: impl Iterator<Item = (Point, f64)>,
+    scene: &Scene,
+) -> Vector {
+    let walker = Walker {
+        position: Point::new(me.position.x, me.position.y),
+        velocity: Vector::new(me.velocity.x, me.velocity.y),
+        radius: me.radius,
+    };
+    let desired = social_force::desired_direction(preferred, walker.velocity);
+    let mut push = Vector::zeros();
+    for (at, radius) in others {
+        push += social_force::agent_force(forces, &walker, desired, at, radius);
+    }
+    // Beyond ten decay lengths a wall pushes by less than 1/20000 of its strength.
+    let reach = walker.radius + 10.0 * forces.obstacle_range_px;
+    scene.nearest_points(walker.position, reach, |q| {
+        push += social_force::obstacle_force(forces, &walker, q);
+    });
+    social_force::next_velocity(forces, &walker, preferred, push, max_speed)
 }

@@ -12,10 +12,9 @@ use super::{free_spot, Body, Disc, Entry, SPOT_TRIES};
 use crate::config::{AgentOrca, Arrival, Forces, MotionKind, MovingConfig, Pattern};
 use crate::geometry::orca::{Agent, Horizon, V2};
 use crate::geometry::point_grid::PointGrid;
-use crate::geometry::social_force::{self, Walker};
 use crate::geometry::{Point, Vector};
 use crate::scene::Scene;
-use crate::sim::avoid::{Avoid, Avoider};
+use crate::sim::avoid::{social_force_velocity, Avoid, Avoider};
 use crate::sim::moving::heading::State;
 use crate::sim::rng::Rng;
 use rand::Rng as _;
@@ -337,7 +336,7 @@ impl Crowd {
                         .iter()
                         .filter(|_| p.sees_robots)
                         .map(|r| (r.at, r.radius));
-                    pushed(
+                    social_force_velocity(
                         forces,
                         &me,
                         preferred,
@@ -351,38 +350,9 @@ impl Crowd {
     }
 }
 
-/// The velocity the social force model gives the agent `me` wanting `preferred`, among `others`
-/// (centres and radii) and the still scene, cut to `max_speed`.
-fn pushed(
-    forces: &Forces,
-    me: &Agent<f64>,
-    preferred: Vector,
-    max_speed: f64,
-    others: impl Iterator<Item = (Point, f64)>,
-    scene: &Scene,
-) -> Vector {
-    let walker = Walker {
-        position: Point::new(me.position.x, me.position.y),
-        velocity: Vector::new(me.velocity.x, me.velocity.y),
-        radius: me.radius,
-    };
-    let desired = social_force::desired_direction(preferred, walker.velocity);
-    let mut push = Vector::zeros();
-    for (at, radius) in others {
-        push += social_force::agent_force(forces, &walker, desired, at, radius);
-    }
-    // Beyond ten decay lengths a wall pushes by less than 1/20000 of its strength.
-    let reach = walker.radius + 10.0 * forces.obstacle_range_px;
-    scene.nearest_points(walker.position, reach, |q| {
-        push += social_force::obstacle_force(forces, &walker, q);
-    });
-    social_force::next_velocity(forces, &walker, preferred, push, max_speed)
-}
-
 #[cfg(test)]
 mod tests {
     use crate::config::{MotionKind, MovingConfig, Pattern};
-
     use crate::sim::episode::Episode;
     use crate::sim::robot::DiscreteAction;
     use crate::sim::world::maze_scene;
