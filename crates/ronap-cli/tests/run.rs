@@ -604,6 +604,22 @@ fn the_crowd_scenarios_run_and_bad_crowd_entries_are_named() {
             "[dwa]\nhorizon_steps = 0\n",
             &["bad.toml:5", "dwa.horizon_steps", "0"][..],
         ),
+        (
+            "[[crowd]]\ncount = 4\nspeed_px = -2.0\n",
+            &["bad.toml:6", "crowd[0].speed_px", "-2"][..],
+        ),
+        (
+            "[[crowd]]\npattern = \"square\"\n",
+            &["bad.toml:5", "crowd[0].pattern", "\"square\"", "pattern_radius_px"][..],
+        ),
+        (
+            "[[crowd]]\nmotion = \"linear\"\n",
+            &["bad.toml:5", "crowd[0].motion", "\"linear\"", "orca"][..],
+        ),
+        (
+            "[episode]\nstart = [20.0, 20.0, 0.0]\n[[crowd]]\nrobot_follows = true\n",
+            &["bad.toml:7", "crowd[0].robot_follows", "episode.start"][..],
+        ),
     ] {
         let bad = dir.path().join("bad.toml");
         std::fs::write(&bad, format!("{scene}{body}")).unwrap();
@@ -613,33 +629,33 @@ fn the_crowd_scenarios_run_and_bad_crowd_entries_are_named() {
         );
     }
     // A pattern that does not fit the scene: no start and goal for the pedestrians.
-    let bad = dir.path().join("big.toml");
-    std::fs::write(
-        &bad,
-        format!(
-            "{scene}[[moving]]\ncount = 3\nmotion = \"orca\"\npattern = \"circle\"\n\
-             pattern_radius_px = 5000.0\n"
-        ),
-    )
-    .unwrap();
-    let o = ronap(&[
-        "run",
-        "--scenario",
-        bad.to_str().unwrap(),
-        "--policy",
-        "orca",
-        "--seeds",
-        "1",
-    ]);
-    assert_eq!(o.status.code(), Some(2), "{}", crate::util::stderr(&o));
-    assert!(
-        crate::util::stderr(&o).contains("moving[0]"),
-        "{}",
-        crate::util::stderr(&o)
-    );
-    assert!(
-        !crate::util::stderr(&o).contains("panick"),
-        "{}",
-        crate::util::stderr(&o)
-    );
+    for (table, entry) in [("moving", "moving[0]"), ("crowd", "crowd[0]")] {
+        let bad = dir.path().join("big.toml");
+        std::fs::write(
+            &bad,
+            format!(
+                "{scene}[[moving]]\ncount = 1\n[[{table}]]\ncount = 3\nmotion = \"orca\"\n\
+                 pattern = \"circle\"\npattern_radius_px = 5000.0\n"
+            ),
+        )
+        .unwrap();
+        let o = ronap(&[
+            "run",
+            "--scenario",
+            bad.to_str().unwrap(),
+            "--policy",
+            "orca",
+            "--seeds",
+            "1",
+        ]);
+        let err = crate::util::stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        let entry = if table == "moving" {
+            "moving[1]"
+        } else {
+            entry
+        };
+        assert!(err.contains(entry), "{err}");
+        assert!(!err.contains("panick"), "{err}");
+    }
 }

@@ -297,19 +297,24 @@ def test_every_crowd_scenario_runs_with_every_local_planner(name, policy):
 
 
 @pytest.mark.parametrize(
-    ("body", "field"),
+    ("table", "body", "field"),
     [
         (
+            "moving",
             'motion = "social_force"\nsocial_force = { lambda = 2.0 }\n',
             "moving[0].social_force.lambda",
         ),
-        ('motion = "orca"\nspeed_px = -1.0\n', "moving[0].speed_px"),
-        ('motion = "orca"\npattern = "circle"\n', "moving[0].pattern"),
+        ("moving", 'motion = "orca"\nspeed_px = -1.0\n', "moving[0].speed_px"),
+        ("moving", 'motion = "orca"\npattern = "circle"\n', "moving[0].pattern"),
+        ("crowd", 'count = 3\nspeed_px = -1.0\n', "crowd[0].speed_px"),
+        ("crowd", 'count = 3\npattern = "circle"\n', "crowd[0].pattern"),
     ],
 )
-def test_a_bad_crowd_entry_is_one_error_naming_file_line_and_field(tmp_path, body, field):
+def test_a_bad_crowd_entry_is_one_error_naming_file_line_and_field(
+    tmp_path, table, body, field
+):
     bad = tmp_path / "bad.toml"
-    bad.write_text(f"[maze]\ncols = 2\nrows = 2\n[[moving]]\n{body}")
+    bad.write_text(f"[maze]\ncols = 2\nrows = 2\n[[{table}]]\n{body}")
     with pytest.raises(Exception) as caught:
         ronap.evaluate("orca", range(1), scenario=str(bad))
     message = str(caught.value)

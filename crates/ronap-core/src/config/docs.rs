@@ -44,6 +44,7 @@ const FIELD_DOCS: &[(&str, &str, &str, Option<&str>)] = &[
     ("episode", "goal", "Fixed goal [x px, y px]. Unset: drawn from the seed.", Some("[850.0, 850.0]")),
     ("episode", "grid_px", "Cell side of the free-space grid for connected regions and planners, px.", None),
     ("episode", "safety_radius_px", "A step is near a moving obstacle when the gap to one is below this, px. Unset: two robot radii.", Some("10.0")),
+    ("episode", "collision_ends", "Any contact (a wall, a moving obstacle, another robot) ends the episode as a collision, as crowd-navigation papers count it (robot.on_collision = \"terminate\" for every robot).", None),
     ("episode", "deadlock_steps", "Several robots: the episode ends as a deadlock when no robot of a team of two or more has moved for this many steps.", None),
     ("team", "comm_range_px", "Several robots: range of each robot's broadcast (pose, goal, message), px.", None),
     ("team", "message_size", "Several robots: floats in the message a policy broadcasts each step (0: pose and goal only).", None),
@@ -169,6 +170,61 @@ const MOVING_DOCS: &[(&str, &str)] = &[
     ),
 ];
 
+/// Every field of a `[[crowd]]` entry and what it means.
+const CROWD_DOCS: &[(&str, &str)] = &[
+    ("count", "How many pedestrians this entry makes."),
+    (
+        "pattern",
+        "\"circle\" (start on a circle, goal at the opposite point), \"square\" (start on one side of a square, goal on the opposite side) or \"random\" (start and goal drawn in free space).",
+    ),
+    (
+        "motion",
+        "\"orca\" (avoid the others by ORCA) or \"social_force\" (pushed by the social force model).",
+    ),
+    ("radius_px", "Disc radius, px."),
+    ("speed_px", "Preferred speed, px per step."),
+    (
+        "max_speed_px",
+        "Largest speed, px per step. Unset: speed_px.",
+    ),
+    (
+        "pattern_center",
+        "The pattern's centre [x, y], px. Unset: the scene's centre.",
+    ),
+    (
+        "pattern_radius_px",
+        "The circle's radius, or the square's half side, px (circle and square need it).",
+    ),
+    (
+        "jitter_px",
+        "Starts and goals move by up to this in x and y, px.",
+    ),
+    (
+        "on_arrival",
+        "At its goal \"stay\", \"new_goal\" (draw another) or \"vanish\".",
+    ),
+    (
+        "sees_robots",
+        "Whether they avoid the robots too (false: CrowdNav's invisible robot).",
+    ),
+    (
+        "min_robot_distance_px",
+        "Least gap between a pedestrian's start or goal and the robot's start and goal, px.",
+    ),
+    (
+        "robot_follows",
+        "circle, square: the robot starts at the pattern's bottom point (cx, cy - R) heading up and heads for its top point (cx, cy + R), as CrowdNav puts it (leave episode.start and episode.goal unset).",
+    ),
+    (
+        "orca",
+        "orca: { time_horizon_steps = 20, obstacle_time_horizon_steps = 20, neighbour_dist_px = 200, max_neighbours = 10, safety_margin_px = 1 }.",
+    ),
+    (
+        "social_force",
+        "social_force: { relaxation_steps = 2, agent_strength_px = 8.75, agent_range_px = 6, obstacle_strength_px = 62.5, obstacle_range_px = 4, lambda = 0.5, neighbour_dist_px = 60 }.",
+    ),
+];
+
 /// Every field of a `[[robots]]` entry and what it means.
 const ROBOTS_DOCS: &[(&str, &str)] = &[
     ("count", "How many robots this entry makes."),
@@ -263,6 +319,11 @@ impl SimConfig {
         ) {
             table.entry("observation").or_insert(observation);
         }
+        if let Some(episode) = value.get_mut("episode").and_then(|r| r.as_table_mut()) {
+            episode
+                .entry("collision_ends")
+                .or_insert(toml::Value::Boolean(self.episode.collision_ends));
+        }
         if let Some(reward) = value.get_mut("reward").and_then(|r| r.as_table_mut()) {
             if let Ok(kind) = toml::Value::try_from(self.reward.shaping) {
                 reward.entry("shaping").or_insert(kind);
@@ -319,6 +380,28 @@ impl SimConfig {
             }
             None => out.push_str(&commented(
                 "[[moving]]\ncount = 5\nshape = \"disc\"\nradius_px = 8.0\nmotion = \"random_walk\"\nspeed_px = 2.0\n",
+            )),
+        }
+        out.push_str(
+            "\n# Crowds of reactive pedestrians, any number of entries; each makes `count` pedestrians\n\
+             # placed by a pattern (after the [[moving]] entries' obstacles, from their random stream).\n",
+        );
+        let crowds = value.get("crowd").and_then(|v| v.as_array());
+        match crowds.filter(|a| !a.is_empty()) {
+            Some(list) => {
+                for c in list {
+                    out.push_str("[[crowd]]\n");
+                    for &(field, doc) in CROWD_DOCS {
+                        out.push_str(&format!("# {doc}\n"));
+                        match c.get(field) {
+                            Some(v) => out.push_str(&format!("{field} = {v}\n")),
+                            None => out.push_str(&format!("# {field} = ...\n")),
+                        }
+                    }
+                }
+            }
+            None => out.push_str(&commented(
+                "[[crowd]]\ncount = 5\npattern = \"circle\"\npattern_radius_px = 80.0\nmotion = \"orca\"\nspeed_px = 2.0\n",
             )),
         }
         out.push_str(
@@ -423,6 +506,7 @@ mod documented_tests {
         c.episode.reward_min = Some(-1.0);
         c.episode.start = Some([0.0; 3]);
         c.episode.safety_radius_px = Some(3.0);
+        c.episode.collision_ends = true;
         c.scene.seed = Some(1);
         c.scene.file = Some("m.png".into());
         c.team.neighbours = 1;
@@ -450,5 +534,40 @@ mod documented_tests {
             }
         }
         assert_eq!(count, FIELD_DOCS.len());
+    }
+
+    #[test]
+    fn every_crowd_field_is_documented_and_reads_back() {
+        let crowd = crate::config::CrowdConfig {
+            max_speed_px: Some(3.0),
+            pattern_center: Some([1.0, 2.0]),
+            pattern_radius_px: 5.0,
+            jitter_px: 1.0,
+            robot_follows: true,
+            orca: crate::config::AgentOrca {
+                max_neighbours: 3,
+                ..Default::default()
+            },
+            social_force: crate::config::Forces {
+                lambda: 0.2,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        let full = toml::Value::try_from(&crowd).unwrap();
+        let keys: Vec<_> = full.as_table().unwrap().keys().cloned().collect();
+        let documented: Vec<_> = CROWD_DOCS.iter().map(|(f, _)| f.to_string()).collect();
+        let mut sorted = documented.clone();
+        sorted.sort();
+        assert_eq!(keys, sorted);
+        let c = SimConfig {
+            crowd: vec![crowd],
+            ..SimConfig::default()
+        };
+        let text = c.to_documented_toml();
+        assert_eq!(SimConfig::from_toml_str(&text).unwrap(), c);
+        assert!(SimConfig::default()
+            .to_documented_toml()
+            .contains("# [[crowd]]\n"));
     }
 }

@@ -30,6 +30,11 @@ pub struct EpisodeConfig {
     /// Several robots: the episode ends as a deadlock when no robot of a team of two or more has
     /// moved for this many steps. Default 100.
     pub deadlock_steps: u32,
+    /// Any contact (a wall, a moving obstacle, another robot) ends the episode as a collision,
+    /// the rule crowd-navigation papers use: `robot.on_collision = "terminate"` for every
+    /// robot. Default false.
+    #[serde(skip_serializing_if = "super::is_false")]
+    pub collision_ends: bool,
 }
 
 impl Default for EpisodeConfig {
@@ -44,6 +49,7 @@ impl Default for EpisodeConfig {
             grid_px: 5.0,
             safety_radius_px: None,
             deadlock_steps: 100,
+            collision_ends: false,
         }
     }
 }

@@ -13,6 +13,7 @@
 //! kept in `sim` or `policy` would make this layer import from above it.
 
 mod apf;
+mod crowd;
 mod docs;
 mod dwa;
 mod episode;
@@ -26,6 +27,7 @@ mod social_force;
 mod team;
 
 pub use apf::ApfConfig;
+pub use crowd::{CrowdConfig, RobotPattern};
 pub use dwa::DwaConfig;
 pub use episode::{
     EpisodeConfig, ObservationConfig, RewardConfig, Shaping, ACTION_MEMORY, MAX_HISTORY,
@@ -109,6 +111,10 @@ pub struct SimConfig {
     pub obstacles: Vec<ObstacleConfig>,
     /// Moving obstacles.
     pub moving: Vec<MovingConfig>,
+    /// Crowds of reactive pedestrians placed by a pattern (docs/model.md "Crowds that react"):
+    /// each stands for a `[[moving]]` entry, after the file's own.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub crowd: Vec<CrowdConfig>,
     /// Several robots (docs/model.md "Several robots"); none: the one robot of `[robot]`.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub robots: Vec<TeamRobotConfig>,
@@ -129,22 +135,71 @@ pub struct SimConfig {
     pub metrics: MetricsConfig,
 }
 
-/// A [`SimConfig`] whose every field has been checked. Dereferences to the `SimConfig`.
-/// The default is the (valid) default configuration.
+/// A [`SimConfig`] whose every field has been checked. Dereferences to the configuration in
+/// effect: the one written with its shorthands spelt out (each `[[crowd]]` as the `[[moving]]`
+/// entry it stands for, after the file's own; `episode.collision_ends` as
+/// `robot.on_collision = "terminate"`). The default is the (valid) default configuration.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct ValidConfig(SimConfig);
+pub struct ValidConfig {
+    /// In effect.
+    effective: SimConfig,
+    /// As written, when it differs from `effective`.
+    written: Option<Box<SimConfig>>,
+    /// Where a crowd's pattern puts the robot.
+    robot_pattern: Option<RobotPattern>,
+}
 
 impl Deref for ValidConfig {
     type Target = SimConfig;
     fn deref(&self) -> &SimConfig {
-        &self.0
+        &self.effective
     }
 }
 
 impl ValidConfig {
+    /// A checked configuration, in effect as written.
+    fn plain(config: SimConfig) -> Self {
+        Self {
+            effective: config,
+            written: None,
+            robot_pattern: None,
+        }
+    }
+
     /// The configuration as written, for saving next to results.
     pub fn as_sim_config(&self) -> &SimConfig {
-        &self.0
+        self.written.as_deref().unwrap_or(&self.effective)
+    }
+
+    /// Where a `[[crowd]]` entry with `robot_follows` puts the robot's start and goal.
+    pub fn robot_pattern(&self) -> Option<&RobotPattern> {
+        self.robot_pattern.as_ref()
+    }
+
+    /// The robot's fixed start `[x, y, heading deg]` and goal `[x, y]` in a scene of `width` x
+    /// `height` px: from `[episode]`, or from a crowd's pattern the robot follows.
+    pub fn fixed_start_goal(
+        &self,
+        width: f64,
+        height: f64,
+    ) -> (Option<[f64; 3]>, Option<[f64; 2]>) {
+        match self
+            .robot_pattern
+            .as_ref()
+            .and_then(|p| p.start_goal(width, height))
+        {
+            Some((start, goal)) => (Some(start), Some(goal)),
+            None => (self.episode.start, self.episode.goal),
+        }
+    }
+
+    /// Whether the robot's start and goal are both fixed (by `[episode]` or a crowd's pattern).
+    pub fn start_and_goal_fixed(&self) -> bool {
+        let pattern = self
+            .robot_pattern
+            .as_ref()
+            .is_some_and(|p| p.pattern != Pattern::Random);
+        pattern || (self.episode.start.is_some() && self.episode.goal.is_some())
     }
 
     /// Length of the observation a policy sees: one value per laser beam, then the goal
@@ -181,7 +236,7 @@ impl ValidConfig {
     /// The configuration of team robot `k` as a one-robot configuration: `[robot]`, `[laser]`
     /// and `[episode]` with its entry's fields put in (validated with the whole team).
     pub fn team_robot(&self, k: usize) -> ValidConfig {
-        let mut c = self.0.clone();
+        let mut c = self.effective.clone();
         c.robots = Vec::new();
         if let Some(e) = self.team_entry(k) {
             if let Some(v) = e.radius_px {
@@ -205,7 +260,7 @@ impl ValidConfig {
             c.episode.start = e.start;
             c.episode.goal = e.goal.or(e.goals.first().copied());
         }
-        ValidConfig(c)
+        ValidConfig::plain(c)
     }
 
     /// The query distance scenes are indexed for: the laser range or a step plus the robot
@@ -332,13 +387,31 @@ impl SimConfig {
         self.warehouse.validate()?;
         scene::validate_obstacles(&self.obstacles)?;
         moving::validate_moving(&self.moving)?;
+        let fixed = self.episode.start.is_some() || self.episode.goal.is_some();
+        let robot_pattern = crowd::validate_crowds(&self.crowd, fixed, !self.robots.is_empty())?;
         team::validate_robots(&self.robots)?;
         self.team.validate()?;
         self.metrics.validate()?;
         self.orca.validate()?;
         self.social_force.validate()?;
         self.dwa.validate()?;
-        Ok(ValidConfig(self))
+        if self.crowd.is_empty() && !self.episode.collision_ends {
+            moving::validate_total(&self.moving)?;
+            return Ok(ValidConfig::plain(self));
+        }
+        let mut effective = self.clone();
+        effective
+            .moving
+            .extend(effective.crowd.drain(..).map(|c| c.to_moving()));
+        moving::validate_total(&effective.moving)?;
+        if effective.episode.collision_ends {
+            effective.robot.on_collision = OnCollision::Terminate;
+        }
+        Ok(ValidConfig {
+            effective,
+            written: Some(Box::new(self)),
+            robot_pattern,
+        })
     }
 }
 

@@ -125,7 +125,7 @@ impl Default for AgentOrca {
 }
 
 impl AgentOrca {
-    fn is_default(&self) -> bool {
+    pub(super) fn is_default(&self) -> bool {
         *self == Self::default()
     }
 }
@@ -275,113 +275,124 @@ pub const MAX_MOVING: u32 = 10_000;
 /// Checks every `[[moving]]` entry (`moving[i]`) and their total, naming the first field out of
 /// range.
 pub(super) fn validate_moving(moving: &[MovingConfig]) -> Result<(), ConfigError> {
-    let mut total = 0u64;
     for (i, m) in moving.iter().enumerate() {
-        let f = |name: &str| format!("moving[{i}].{name}");
-        check(
-            (1..=MAX_MOVING).contains(&m.count),
-            &f("count"),
-            m.count,
-            "must be between 1 and 10000",
-        )?;
-        total += u64::from(m.count);
-        length(&f("radius_px"), m.radius_px, false)?;
-        length(&f("size_px"), m.size_px[0], false)?;
-        length(&f("size_px"), m.size_px[1], false)?;
-        if let Some(p) = m.start {
-            point(&f("start"), p)?;
-        }
-        length(&f("speed_px"), m.speed_px, true)?;
-        if let Some(d) = m.direction_deg {
-            finite(&f("direction_deg"), d)?;
-        }
-        check(
-            m.turn_sigma_deg.is_finite() && (0.0..=360.0).contains(&m.turn_sigma_deg),
-            &f("turn_sigma_deg"),
-            format!("{:?}", m.turn_sigma_deg),
-            "must be between 0 and 360",
-        )?;
-        length(&f("min_robot_distance_px"), m.min_robot_distance_px, true)?;
-        for p in &m.points {
-            point(&f("points"), *p)?;
-        }
-        let patrols = m.motion == MotionKind::Waypoints
-            || (m.motion == MotionKind::Appear && m.then == MotionKind::Waypoints);
-        check(
-            !patrols || m.points.len() >= 2,
-            &f("points"),
-            format!("{:?}", m.points),
-            "a waypoints obstacle needs at least two points",
-        )?;
-        check(
-            !(m.motion == MotionKind::Appear && m.then == MotionKind::Waypoints),
-            &f("then"),
-            "\"waypoints\"",
-            "an appearing obstacle moves as still, linear or random_walk",
-        )?;
-        check(
-            m.then != MotionKind::Appear,
-            &f("then"),
-            "\"appear\"",
-            "an appearing obstacle moves as still, linear or random_walk",
-        )?;
-        check(
-            m.from_step <= m.to_step,
-            &f("to_step"),
-            m.to_step,
-            "must be at least from_step",
-        )?;
-        check(
-            !m.then.is_reactive(),
-            &f("then"),
-            format!("{:?}", m.then.name()),
-            "an appearing obstacle moves as still, linear or random_walk",
-        )?;
-        if let Some(g) = m.goal {
-            point(&f("goal"), g)?;
-        }
-        if let Some(v) = m.max_speed_px {
-            length(&f("max_speed_px"), v, true)?;
-        }
-        if let Some(c) = m.pattern_center {
-            point(&f("pattern_center"), c)?;
-        }
-        length(&f("pattern_radius_px"), m.pattern_radius_px, true)?;
-        check(
-            matches!(m.pattern, None | Some(Pattern::Random)) || m.pattern_radius_px > 0.0,
-            &f("pattern"),
-            pattern_name(m.pattern),
-            "a crowd pattern needs a positive pattern_radius_px",
-        )?;
-        check(
-            m.pattern.is_none() || m.motion.is_reactive(),
-            &f("pattern"),
-            pattern_name(m.pattern),
-            "crowd patterns place pedestrians (motion = \"orca\" or \"social_force\")",
-        )?;
-        length(&f("jitter_px"), m.jitter_px, true)?;
-        let o = &m.orca;
-        length(&f("orca.time_horizon_steps"), o.time_horizon_steps, false)?;
-        length(
-            &f("orca.obstacle_time_horizon_steps"),
-            o.obstacle_time_horizon_steps,
-            false,
-        )?;
-        length(&f("orca.neighbour_dist_px"), o.neighbour_dist_px, true)?;
-        length(&f("orca.safety_margin_px"), o.safety_margin_px, true)?;
-        check(
-            o.max_neighbours <= 1000,
-            &f("orca.max_neighbours"),
-            o.max_neighbours,
-            "must be between 0 and 1000",
-        )?;
-        m.social_force.validate(&f("social_force"))?;
+        validate_entry(m, &|name: &str| format!("moving[{i}].{name}"))?;
     }
+    Ok(())
+}
+
+/// Checks that `moving` (every entry, crowds included) makes at most [`MAX_MOVING`] obstacles.
+pub(super) fn validate_total(moving: &[MovingConfig]) -> Result<(), ConfigError> {
+    let total: u64 = moving.iter().map(|m| u64::from(m.count)).sum();
     check(
         total <= u64::from(MAX_MOVING),
         "moving",
         total,
         "at most 10000 moving obstacles in all",
+    )
+}
+
+/// Checks one entry, naming its fields by `f` (`moving[2].speed_px`, `crowd[0].speed_px`).
+pub(super) fn validate_entry(
+    m: &MovingConfig,
+    f: &dyn Fn(&str) -> String,
+) -> Result<(), ConfigError> {
+    check(
+        (1..=MAX_MOVING).contains(&m.count),
+        &f("count"),
+        m.count,
+        "must be between 1 and 10000",
     )?;
+    length(&f("radius_px"), m.radius_px, false)?;
+    length(&f("size_px"), m.size_px[0], false)?;
+    length(&f("size_px"), m.size_px[1], false)?;
+    if let Some(p) = m.start {
+        point(&f("start"), p)?;
+    }
+    length(&f("speed_px"), m.speed_px, true)?;
+    if let Some(d) = m.direction_deg {
+        finite(&f("direction_deg"), d)?;
+    }
+    check(
+        m.turn_sigma_deg.is_finite() && (0.0..=360.0).contains(&m.turn_sigma_deg),
+        &f("turn_sigma_deg"),
+        format!("{:?}", m.turn_sigma_deg),
+        "must be between 0 and 360",
+    )?;
+    length(&f("min_robot_distance_px"), m.min_robot_distance_px, true)?;
+    for p in &m.points {
+        point(&f("points"), *p)?;
+    }
+    let patrols = m.motion == MotionKind::Waypoints
+        || (m.motion == MotionKind::Appear && m.then == MotionKind::Waypoints);
+    check(
+        !patrols || m.points.len() >= 2,
+        &f("points"),
+        format!("{:?}", m.points),
+        "a waypoints obstacle needs at least two points",
+    )?;
+    check(
+        !(m.motion == MotionKind::Appear && m.then == MotionKind::Waypoints),
+        &f("then"),
+        "\"waypoints\"",
+        "an appearing obstacle moves as still, linear or random_walk",
+    )?;
+    check(
+        m.then != MotionKind::Appear,
+        &f("then"),
+        "\"appear\"",
+        "an appearing obstacle moves as still, linear or random_walk",
+    )?;
+    check(
+        m.from_step <= m.to_step,
+        &f("to_step"),
+        m.to_step,
+        "must be at least from_step",
+    )?;
+    check(
+        !m.then.is_reactive(),
+        &f("then"),
+        format!("{:?}", m.then.name()),
+        "an appearing obstacle moves as still, linear or random_walk",
+    )?;
+    if let Some(g) = m.goal {
+        point(&f("goal"), g)?;
+    }
+    if let Some(v) = m.max_speed_px {
+        length(&f("max_speed_px"), v, true)?;
+    }
+    if let Some(c) = m.pattern_center {
+        point(&f("pattern_center"), c)?;
+    }
+    length(&f("pattern_radius_px"), m.pattern_radius_px, true)?;
+    check(
+        matches!(m.pattern, None | Some(Pattern::Random)) || m.pattern_radius_px > 0.0,
+        &f("pattern"),
+        pattern_name(m.pattern),
+        "a crowd pattern needs a positive pattern_radius_px",
+    )?;
+    check(
+        m.pattern.is_none() || m.motion.is_reactive(),
+        &f("pattern"),
+        pattern_name(m.pattern),
+        "crowd patterns place pedestrians (motion = \"orca\" or \"social_force\")",
+    )?;
+    length(&f("jitter_px"), m.jitter_px, true)?;
+    let o = &m.orca;
+    length(&f("orca.time_horizon_steps"), o.time_horizon_steps, false)?;
+    length(
+        &f("orca.obstacle_time_horizon_steps"),
+        o.obstacle_time_horizon_steps,
+        false,
+    )?;
+    length(&f("orca.neighbour_dist_px"), o.neighbour_dist_px, true)?;
+    length(&f("orca.safety_margin_px"), o.safety_margin_px, true)?;
+    check(
+        o.max_neighbours <= 1000,
+        &f("orca.max_neighbours"),
+        o.max_neighbours,
+        "must be between 0 and 1000",
+    )?;
+    m.social_force.validate(&f("social_force"))?;
     Ok(())
 }

@@ -154,8 +154,9 @@ pub fn sample_placement_with(
 ) -> Result<Placement, EpisodeError> {
     let radius = config.robot.radius_px;
     let e = &config.episode;
-    let fixed_start = e.start.map(|s| Pose::new(s[0], s[1], s[2]));
-    let fixed_goal = e.goal.map(|g| Point::new(g[0], g[1]));
+    let (start, goal) = config.fixed_start_goal(scene.width(), scene.height());
+    let fixed_start = start.map(|s| Pose::new(s[0], s[1], s[2]));
+    let fixed_goal = goal.map(|g| Point::new(g[0], g[1]));
     if let (Some(start), Some(goal)) = (fixed_start, fixed_goal) {
         return Ok(Placement { start, goal });
     }

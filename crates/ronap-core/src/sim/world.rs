@@ -113,7 +113,7 @@ impl World {
                 robots: self.config.team_size(),
             });
         }
-        let both_fixed = self.config.episode.start.is_some() && self.config.episode.goal.is_some();
+        let both_fixed = self.config.start_and_goal_fixed();
         let grid =
             (!both_fixed && needs_region_grid(&self.config, &self.scene)).then(|| self.grid());
         let placement = sample_placement(&self.config, &self.scene, grid, seed)?;

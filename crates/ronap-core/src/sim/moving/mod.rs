@@ -137,9 +137,11 @@ impl Track {
 
 /// Where a moving obstacle could not be placed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("moving[{entry}]: {message}")]
+#[error("{table}[{entry}]: {message}")]
 pub struct MovingError {
-    /// The `[[moving]]` entry, from 0.
+    /// `moving` or `crowd`: the kind of entry.
+    pub table: &'static str,
+    /// The `[[moving]]` (or `[[crowd]]`) entry, from 0.
     pub entry: usize,
     /// What went wrong.
     pub message: String,
@@ -232,7 +234,20 @@ impl Movers {
         let mut state = State::default();
         let mut reach: f64 = 0.0;
         for (entry, m) in config.moving.iter().enumerate() {
-            let err = |message: String| MovingError { entry, message };
+            // Entries past the file's own `[[moving]]` ones are its crowds.
+            let own = config.as_sim_config().moving.len();
+            let err = |message: String| match entry.checked_sub(own) {
+                Some(k) => MovingError {
+                    table: "crowd",
+                    entry: k,
+                    message,
+                },
+                None => MovingError {
+                    table: "moving",
+                    entry,
+                    message,
+                },
+            };
             let body = match m.shape {
                 MovingShape::Disc => Body::Disc(m.radius_px),
                 MovingShape::Box => Body::Box(Vector::new(m.size_px[0], m.size_px[1]) / 2.0),

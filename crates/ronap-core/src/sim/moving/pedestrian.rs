@@ -617,4 +617,51 @@ mod tests {
         assert_eq!(plain.goal(), crowd.goal());
         assert_eq!(plain.scene().boxes(), crowd.scene().boxes());
     }
+
+    #[test]
+    fn a_crowd_entry_with_the_robot_on_its_pattern_is_the_same_episode_spelt_out() {
+        // CrowdNav's circle crossing, written with [episode] start and goal and a [[moving]]
+        // entry, and as a [[crowd]] the robot follows: the same start, goal and pedestrians.
+        let spelt = crossing(6, false);
+        let mut short = spelt.clone();
+        let m = short.moving.remove(0);
+        short.episode.start = None;
+        short.episode.goal = None;
+        short.crowd = vec![crate::config::CrowdConfig {
+            count: m.count,
+            pattern: Pattern::Circle,
+            radius_px: m.radius_px,
+            speed_px: m.speed_px,
+            pattern_radius_px: 180.0,
+            jitter_px: m.jitter_px,
+            robot_follows: true,
+            ..Default::default()
+        }];
+        let mut spelt = spelt;
+        spelt.moving[0].pattern_radius_px = 180.0;
+        spelt.episode.start = Some([200.0, 20.0, 90.0]);
+        spelt.episode.goal = Some([200.0, 380.0]);
+        for seed in 0..5 {
+            let (mut a, mut b) = (episode(&spelt, seed), episode(&short, seed));
+            assert_eq!((a.start(), a.goal()), (b.start(), b.goal()));
+            for _ in 0..60 {
+                a.step(DiscreteAction::Ahead);
+                b.step(DiscreteAction::Ahead);
+                let pa: Vec<_> = a
+                    .movers()
+                    .expect("movers")
+                    .items()
+                    .map(|m| m.position())
+                    .collect();
+                let pb: Vec<_> = b
+                    .movers()
+                    .expect("movers")
+                    .items()
+                    .map(|m| m.position())
+                    .collect();
+                assert_eq!(pa, pb);
+                assert_eq!(a.pose(), b.pose());
+            }
+        }
+    }
 }
