@@ -8,8 +8,8 @@
 #![allow(clippy::unwrap_used)]
 
 use ronap_core::geometry::orca::{
-    agent_neighbours, new_velocity, obstacle_neighbours, Agent, Horizon, Obstacles, Real,
-    Surroundings, V2,
+    agent_neighbours, crowd_step, new_velocity, Agent, CrowdAgent, CrowdSettings, Horizon,
+    Obstacles, Real, Surroundings, V2,
 };
 use serde_json::Value;
 
@@ -21,68 +21,46 @@ fn num<T: Real>(v: &Value) -> T {
     T::of(v.as_f64().unwrap())
 }
 
+/// One neighbour list, one obstacle-edge list and one new velocity an agent.
+type Choice = (Vec<usize>, Vec<usize>, [f64; 2]);
+
 /// One case computed in `T`: each agent's neighbours (agents, obstacle edges) and new velocity.
-#[allow(clippy::type_complexity)]
-fn step<T: Real>(case: &Value) -> Vec<(Vec<usize>, Vec<usize>, [f64; 2])> {
+fn step<T: Real>(case: &Value) -> Vec<Choice> {
     let p = &case["params"];
-    let list = case["agents"].as_array().unwrap();
-    let agents: Vec<Agent<T>> = list
+    let agents: Vec<CrowdAgent<T>> = case["agents"]
+        .as_array()
+        .unwrap()
         .iter()
-        .map(|a| Agent {
-            position: v2(&a["position"]),
-            velocity: v2(&a["velocity"]),
-            radius: num(&a["radius"]),
+        .map(|a| CrowdAgent {
+            agent: Agent {
+                position: v2(&a["position"]),
+                velocity: v2(&a["velocity"]),
+                radius: num(&a["radius"]),
+            },
+            max_speed: num(&a["max_speed"]),
+            preferred: v2(&a["preferred"]),
         })
         .collect();
-    let mut obstacles = Obstacles::default();
-    for b in case["boxes"].as_array().unwrap() {
-        let points: Vec<V2<T>> = b.as_array().unwrap().iter().map(v2).collect();
-        obstacles.add(&points);
-    }
-    let (mut near, mut edges, mut lines) = (Vec::new(), Vec::new(), Vec::new());
-    let mut out = Vec::new();
-    for (i, a) in list.iter().enumerate() {
-        let horizon = Horizon {
-            agents: num(&p["time_horizon"]),
-            obstacles: num(&p["time_horizon_obst"]),
-            max_speed: num(&a["max_speed"]),
-            time_step: num(&p["time_step"]),
-        };
-        agent_neighbours(
-            &agents,
-            i,
-            num(&p["neighbor_dist"]),
-            p["max_neighbors"].as_u64().unwrap() as usize,
-            &mut near,
-        );
-        obstacle_neighbours(
-            &obstacles,
-            agents[i].position,
-            agents[i].radius,
-            &horizon,
-            &mut edges,
-        );
-        let others: Vec<Agent<T>> = near.iter().map(|&(_, j)| agents[j]).collect();
-        let edge_list: Vec<usize> = edges.iter().map(|&(_, e)| e).collect();
-        let around = Surroundings {
-            agents: &others,
-            obstacles: &obstacles,
-            edges: &edge_list,
-        };
-        let v = new_velocity(
-            &agents[i],
-            v2(&a["preferred"]),
-            &around,
-            &horizon,
-            &mut lines,
-        );
-        out.push((
-            near.iter().map(|&(_, j)| j).collect(),
-            edge_list,
-            [v.x.to_f64(), v.y.to_f64()],
-        ));
-    }
-    out
+    let boxes: Vec<Vec<V2<T>>> = case["boxes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| b.as_array().unwrap().iter().map(v2).collect())
+        .collect();
+    let settings = CrowdSettings {
+        neighbour_dist: num(&p["neighbor_dist"]),
+        max_neighbours: p["max_neighbors"].as_u64().unwrap() as usize,
+        time_horizon: num(&p["time_horizon"]),
+        time_horizon_obstacles: num(&p["time_horizon_obst"]),
+        time_step: num(&p["time_step"]),
+    };
+    crowd_step(&agents, &boxes, &settings)
+        .into_iter()
+        .map(|c| {
+            let v = [c.velocity.x.to_f64(), c.velocity.y.to_f64()];
+            (c.agent_neighbours, c.obstacle_neighbours, v)
+        })
+        .collect()
 }
 
 fn cases() -> Vec<Value> {

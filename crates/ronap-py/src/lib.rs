@@ -12,6 +12,7 @@ mod evaluate;
 mod kwargs;
 mod mlp;
 mod multi_env;
+mod orca;
 mod vec_env;
 
 use conv::{Config, Scenario};
@@ -96,6 +97,7 @@ fn _ronap(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(evaluate::check_policy, m)?)?;
     m.add_function(wrap_pyfunction!(mlp::write_mlp, m)?)?;
     m.add_function(wrap_pyfunction!(mlp::mlp_outputs, m)?)?;
+    m.add_function(wrap_pyfunction!(orca::orca_step, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

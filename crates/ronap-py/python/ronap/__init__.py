@@ -13,6 +13,7 @@
   Rust speed as ``mlp:PATH``; ``mlp_outputs(path, obs)`` runs one on a batch.
 - ``ronap.sb3.VecEnv(n)``: a Stable-Baselines3 ``VecEnv`` stepped in Rust (``pip install ronap[sb3]``).
 - ``maze_occupancy`` / ``maze_image``: scenes as numpy arrays; ``default_config()``, ``policies()``.
+- ``orca_step(agents, obstacles, ...)``: one ORCA step of a crowd (RVO2's, held to ``pyrvo``).
 
 ``NavEnv``, ``VecNavEnv``, ``evaluate`` and ``make_config`` take ``scenario=``: a TOML scenario
 file, as ``ronap run --scenario`` reads, or a dict nested like one (scene, static and moving
@@ -38,6 +39,7 @@ from .env import NavEnv, VecNavEnv
 from .evaluate import evaluate
 from .export import export_policy, import_torch, mlp_outputs
 from .multi import MultiNavEnv, VecMultiNavEnv
+from .orca import orca_step
 from .scenes import maze_image, maze_occupancy, policies
 
 __all__ = [
@@ -61,6 +63,7 @@ __all__ = [
     "maze_image",
     "maze_occupancy",
     "mlp_outputs",
+    "orca_step",
     "policies",
 ]
 

@@ -11,8 +11,10 @@
 
 mod program;
 mod real;
+mod step;
 
 pub use real::{left_of, Real, V2};
+pub use step::{crowd_step, CrowdAgent, CrowdChoice, CrowdSettings};
 
 use program::{linear_program2, linear_program3};
 
