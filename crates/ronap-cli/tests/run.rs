@@ -547,6 +547,40 @@ fn config_prints_a_file_that_run_accepts() {
 }
 
 #[test]
+fn twenty_orca_robots_swap_across_a_circle_all_home_without_contact() {
+    // The bar of CrowdNav's and RVO2's circle: on every one of 50 jittered seeds, every robot
+    // arrives and no two ever touch.
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = crate::util::repo_root().join("scenarios/circle-robots-20.toml");
+    crate::util::ok(&ronap(&[
+        "run",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--policy",
+        "orca",
+        "--seeds",
+        "50",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]));
+    let episodes = rows(&dir.path().join("episodes.csv"));
+    assert_eq!(episodes.len(), 51);
+    let (outcome, arrived, contacts) = (
+        col(&episodes, "outcome"),
+        col(&episodes, "arrived"),
+        col(&episodes, "robot_collisions"),
+    );
+    for row in &episodes[1..] {
+        assert_eq!(
+            (&row[outcome][..], &row[arrived][..], &row[contacts][..]),
+            ("success", "20", "0"),
+            "seed {}",
+            row[0]
+        );
+    }
+}
+
+#[test]
 fn the_crowd_scenarios_run_and_bad_crowd_entries_are_named() {
     let dir = tempfile::tempdir().unwrap();
     for (name, policy) in [
