@@ -174,18 +174,36 @@ pub fn agent_neighbours_among<T: Real>(
     }
     let p = agents[me].position;
     let range_sq = range * range;
-    out.extend(
-        candidates
-            .filter(|&j| j != me)
-            .map(|j| ((p - agents[j].position).abs_sq(), j))
-            .filter(|&(d, _)| d < range_sq),
-    );
-    // The `max` nearest first (the same as sorting them all and keeping the first `max`).
-    if out.len() > max {
-        out.select_nth_unstable_by(max - 1, nearest_first);
-        out.truncate(max);
+    // RVO2's insertion into a list kept sorted and at most `max` long (its `insertAgentNeighbor`),
+    // ordered by (distance, index) so that the candidates' order does not matter: the same as
+    // sorting every agent in range and keeping the first `max`.
+    for j in candidates {
+        if j == me {
+            continue;
+        }
+        let d = (p - agents[j].position).abs_sq();
+        if d < range_sq {
+            insert_nearest(out, (d, j), max);
+        }
     }
-    sort_nearest(out);
+}
+
+/// Puts `new` into `list` (sorted nearest first, at most `max` long, `max` > 0) where it belongs,
+/// dropping the farthest when full; nothing when it is farther than all of a full list.
+fn insert_nearest<T: Real>(list: &mut Vec<(T, usize)>, new: (T, usize), max: usize) {
+    if list.len() == max {
+        match list.last() {
+            Some(last) if nearest_first(&new, last).is_lt() => {
+                list.pop();
+            }
+            _ => return,
+        }
+    }
+    let mut at = list.len();
+    while at > 0 && nearest_first(&new, &list[at - 1]).is_lt() {
+        at -= 1;
+    }
+    list.insert(at, new);
 }
 
 /// `(distance, index)` pairs nearest first, ties by index (a stable insertion order).
