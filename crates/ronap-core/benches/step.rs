@@ -4,7 +4,8 @@
 //! core), with 100 `random_walk` discs too (`step/100_random_walk_discs`), and a scan among them
 //! (`scan/100_discs`) within twice the still-maze scan (`scan/default`); `scan/parry2d` is the
 //! same scan through parry2d's general ray cast, for comparison. Among 100 ORCA pedestrians in an
-//! open hall (`step/100_orca_pedestrians`) the target is 5 us a step (200,000 steps/s).
+//! open hall (`step/100_orca_pedestrians`) the target is 5 us a step (200,000 steps/s). A 360-beam
+//! scan among 500 discs (`scan/360_beams_200px_500_discs`) within 4x of one among 100.
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use ronap_core::geometry::reference::ParryScene;
@@ -119,6 +120,27 @@ fn scan(c: &mut Criterion) {
             )
         })
     });
+    // A 360-beam, 200 px laser among 100 and among 500 discs (the target: within 4x, a cost per
+    // beam that meets a disc rather than per beam and disc).
+    for discs in [100, 500] {
+        let mut sim = crowd_config();
+        sim.moving[0].count = discs;
+        sim.laser.beams = 360;
+        sim.laser.fov_deg = 360.0;
+        sim.laser.range_px = 200.0;
+        let c = sim.validate().expect("valid");
+        let wide = Laser::new(&c.laser);
+        let crowded = Episode::new(&c, Arc::new(maze_scene(&c, 0)), 0).expect("places");
+        let movers = crowded.movers().expect("a crowd").clone();
+        let mut out = vec![0.0; wide.beams()];
+        group.bench_function(format!("360_beams_200px_{discs}_discs"), |b| {
+            b.iter(|| {
+                let heading = unit(black_box(pose.z_deg));
+                wide.scan_toward(&scene, black_box(pose.position()), heading, &mut out);
+                movers.sense_toward(&wide, black_box(pose.position()), radius, heading, &mut out)
+            })
+        });
+    }
     let parry = ParryScene::new(scene.boxes()).expect("walls");
     group.bench_function("parry2d", |b| {
         b.iter(|| {

@@ -737,12 +737,19 @@ impl Movers {
         if count == 0 {
             return least_gap;
         }
-        // More obstacles in range than the list holds (rare): read every present one.
+        // More obstacles in range than the list holds (a long or crowded laser): every present
+        // one in range, gathered again.
         let all: Vec<u32>;
         let list = if overflow {
-            all = (0..self.entries.len() as u32)
-                .filter(|&i| self.entries[i as usize].present())
-                .collect();
+            let mut within = Vec::new();
+            st.near(position, slab, |i| {
+                let (px, py) = (st.x[i] - position.x, st.y[i] - position.y);
+                let d = (px * px + py * py).sqrt();
+                if self.entries[i].present() && d - st.bound[i] <= range {
+                    within.push(i as u32);
+                }
+            });
+            all = within;
             &all[..]
         } else {
             &near[..count]
@@ -768,16 +775,15 @@ impl Movers {
                 return least_gap;
             }
         }
-        laser.refine_toward(position, heading, out, |origin, dir, best| {
-            let mut nearest: Option<f64> = None;
-            for &i in list {
-                let e = &self.entries[i as usize];
-                let p = self.state.position(i as usize);
-                if let Some(t) = e.body.ray(p, origin, dir, nearest.unwrap_or(best)) {
-                    nearest = Some(t);
-                }
-            }
-            nearest
+        // Many, or boxes: each obstacle asked only by the beams whose direction passes within
+        // its bounding circle (the same least hit per beam as asking every beam of every one).
+        let targets: Vec<(Point, f64)> = list
+            .iter()
+            .map(|&i| (st.position(i as usize), st.bound[i as usize]))
+            .collect();
+        laser.refine_round_toward(position, heading, out, &targets, |j, origin, dir, best| {
+            let i = list[j] as usize;
+            self.entries[i].body.ray(targets[j].0, origin, dir, best)
         });
         least_gap
     }
