@@ -17,21 +17,19 @@
 //! LEFT, AHEAD and RIGHT, each taken once and followed by AHEAD steps.
 
 use super::follow::Follower;
-use super::geodesic::planned;
-use super::local::Senses;
-use super::{Decision, Policy, PolicyError};
+use super::local::{Local, Planner, Senses};
+use super::Decision;
 use crate::config::PlannerActions;
 use crate::geometry::{unit, wrap_deg, Point};
 use crate::sim::episode::Episode;
 use crate::sim::robot::{Action, DiscreteAction, Pose, Robot};
-use crate::sim::team::Team;
-use crate::sim::world::World;
 
-/// The dynamic window approach towards the geodesic path's lookahead point.
+/// The `dwa` policy: the dynamic window approach towards the geodesic path's lookahead point.
+pub type Dwa = Local<DwaPlanner>;
+
+/// The dynamic window's search, with the last command it took.
 #[derive(Debug, Default)]
-pub struct Dwa {
-    path: Option<Follower>,
-    senses: Senses,
+pub struct DwaPlanner {
     /// The command taken at the last step: the window lies round it.
     last: (f64, f64),
     /// The laser's hit points, px (scratch).
@@ -50,13 +48,7 @@ struct Rollout {
     first_clear: bool,
 }
 
-impl Dwa {
-    /// How far the robot senses moving agents.
-    fn range(me: &Episode) -> f64 {
-        let config = me.config();
-        config.dwa.sense_range_px.unwrap_or(config.laser.range_px)
-    }
-
+impl DwaPlanner {
     /// The laser's hit points round `me`, into `self.points`.
     fn laser_points(&mut self, me: &Episode) {
         self.points.clear();
@@ -77,6 +69,7 @@ impl Dwa {
     fn roll(
         &self,
         me: &Episode,
+        senses: &Senses,
         robot: &Robot,
         margin: f64,
         first: Action,
@@ -111,7 +104,7 @@ impl Dwa {
                 .points
                 .iter()
                 .any(|q| (p - q).norm() - r < limit((p0 - q).norm() - r))
-                || self.senses.agents[1..].iter().any(|o| {
+                || senses.agents[1..].iter().any(|o| {
                     let now = Point::new(o.position.x, o.position.y);
                     let at = Point::new(
                         o.position.x + o.velocity.x * ahead,
@@ -130,11 +123,8 @@ impl Dwa {
         }
     }
 
-    /// The decision for `me` (whose agents are sensed) in its still scene.
-    fn decide(&mut self, me: &Episode) -> Decision {
-        let Some(path) = &mut self.path else {
-            return Decision::GiveUp("no path to the goal".into());
-        };
+    /// The decision for `me`, following `path`, among the agents `senses` holds.
+    fn choose(&mut self, me: &Episode, path: &mut Follower, senses: &Senses) -> Decision {
         let p = me.pose().position();
         let aim = path.aim(p).unwrap_or(me.goal());
         self.laser_points(me);
@@ -205,7 +195,7 @@ impl Dwa {
         let margin = dwa.safety_margin_px;
         let mut best: Option<(bool, f64, Action)> = None;
         for (first, then, speed) in candidates {
-            let roll = self.roll(me, &body, margin, first, then);
+            let roll = self.roll(me, senses, &body, margin, first, then);
             // Steps it takes to stop from `speed` (a discrete robot stops at once).
             let stopping = match dwa.actions {
                 PlannerActions::Continuous => (speed / dwa.linear_accel_px).ceil().max(1.0),
@@ -266,52 +256,31 @@ impl Dwa {
     }
 }
 
-impl Policy for Dwa {
-    fn reset(&mut self, world: &World, episode: &Episode) -> Result<(), PolicyError> {
-        self.path = planned(world, episode.pose().position(), episode.goal());
-        self.senses.reset(episode);
+impl Planner for DwaPlanner {
+    fn range(me: &Episode) -> f64 {
+        let config = me.config();
+        config.dwa.sense_range_px.unwrap_or(config.laser.range_px)
+    }
+
+    fn decide(&mut self, me: &Episode, path: &mut Follower, senses: &Senses) -> Decision {
+        self.choose(me, path, senses)
+    }
+
+    fn reset(&mut self, episode: &Episode) {
         if episode.steps() == 0 {
             self.last = (0.0, 0.0);
         }
-        Ok(())
-    }
-
-    fn act(&mut self, episode: &Episode) -> Result<Decision, PolicyError> {
-        self.senses.lone(episode, Self::range(episode));
-        Ok(self.decide(episode))
-    }
-
-    fn act_in_team(&mut self, team: &Team, k: usize) -> Result<Decision, PolicyError> {
-        let me = team.robot(k);
-        self.senses.in_team(team, k, Self::range(me));
-        Ok(self.decide(me))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use crate::config::PlannerActions;
-    use crate::eval::{EvalOptions, Evaluator, Summary};
-    use crate::policy::factory;
-    use crate::sim::world::Scenes;
-    use std::sync::atomic::AtomicBool;
-
-    fn lone_run(config: crate::SimConfig, seeds: u64) -> Summary {
-        let ev = Evaluator::new(config.validate().expect("valid"), Scenes::MazePerSeed);
-        let f = factory("dwa", ev.config().observation_size()).expect("policy");
-        let options = EvalOptions {
-            seeds: (0..seeds).collect::<Vec<_>>().into(),
-            ..Default::default()
-        };
-        let run = ev
-            .run(f.as_ref(), &options, &AtomicBool::new(false), &|_| {})
-            .expect("runs");
-        Summary::new(&run.records, crate::eval::metric::kinds(ev.config()), 1.0)
-    }
+    use crate::policy::local::lone_run;
 
     #[test]
     fn dwa_reaches_maze_goals_without_touching_a_wall() {
-        let s = lone_run(crate::SimConfig::default(), 20);
+        let s = lone_run(crate::SimConfig::default(), "dwa", 20);
         assert!(s.success_rate >= 0.9, "{s:?}");
         assert!(s.collisions_per_episode <= 0.05, "{s:?}");
     }
@@ -320,7 +289,7 @@ mod tests {
     fn with_discrete_actions_dwa_reaches_maze_goals() {
         let mut c = crate::SimConfig::default();
         c.dwa.actions = PlannerActions::Discrete;
-        let s = lone_run(c, 20);
+        let s = lone_run(c, "dwa", 20);
         assert!(s.success_rate >= 0.8, "{s:?}");
     }
 }

@@ -5,6 +5,8 @@
 //! robot's action.
 
 use super::follow::Follower;
+use super::geodesic::planned;
+use super::{Decision, Policy, PolicyError};
 use crate::config::PlannerActions;
 use crate::geometry::orca::{Agent, V2};
 use crate::geometry::{wrap_deg, Point, Vector};
@@ -12,15 +14,69 @@ use crate::sim::episode::Episode;
 use crate::sim::moving::Movers;
 use crate::sim::robot::{Action, DiscreteAction};
 use crate::sim::team::Team;
+use crate::sim::world::World;
 use std::f64::consts::TAU;
 
 /// How sharply a unicycle's speed falls with the angle between its chord and the velocity it
 /// tracks: `cos^ALIGN_POWER`.
 const ALIGN_POWER: i32 = 8;
 
+/// A local planner (`orca`, `social-force`, `dwa`): how far it senses, and what it decides from
+/// the agents it sensed, following the geodesic path. [`Local`] makes it a [`Policy`] for a lone
+/// robot and for every robot of a team.
+pub trait Planner: Default + Send {
+    /// How far robot `me` senses other agents, px.
+    fn range(me: &Episode) -> f64;
+
+    /// The decision for `me`, following `path`, among the agents `senses` holds (`me` first).
+    fn decide(&mut self, me: &Episode, path: &mut Follower, senses: &Senses) -> Decision;
+
+    /// An episode (or, mid-episode, the leg to the next goal of a list) begins.
+    fn reset(&mut self, _episode: &Episode) {}
+}
+
+/// A local planner as a policy: its geodesic path to the goal, the agents round the robot as
+/// last sensed, and the planner.
+#[derive(Debug, Default)]
+pub struct Local<P> {
+    path: Option<Follower>,
+    senses: Senses,
+    planner: P,
+}
+
+impl<P: Planner> Local<P> {
+    /// The planner's decision for `me`, whose agents are sensed.
+    fn decide(&mut self, me: &Episode) -> Decision {
+        match &mut self.path {
+            Some(path) => self.planner.decide(me, path, &self.senses),
+            None => Decision::GiveUp("no path to the goal".into()),
+        }
+    }
+}
+
+impl<P: Planner> Policy for Local<P> {
+    fn reset(&mut self, world: &World, episode: &Episode) -> Result<(), PolicyError> {
+        self.path = planned(world, episode.pose().position(), episode.goal());
+        self.senses.reset(episode);
+        self.planner.reset(episode);
+        Ok(())
+    }
+
+    fn act(&mut self, episode: &Episode) -> Result<Decision, PolicyError> {
+        self.senses.lone(episode, P::range(episode));
+        Ok(self.decide(episode))
+    }
+
+    fn act_in_team(&mut self, team: &Team, k: usize) -> Result<Decision, PolicyError> {
+        let me = team.robot(k);
+        self.senses.in_team(team, k, P::range(me));
+        Ok(self.decide(me))
+    }
+}
+
 /// The agents round the robot, as last sensed.
 #[derive(Debug, Default)]
-pub(super) struct Senses {
+pub struct Senses {
     /// Where each sensed agent was at the last decision (moving obstacles by index, then the
     /// team's robots by index): its velocity is its displacement since.
     last: Vec<Option<Point>>,
@@ -232,4 +288,24 @@ fn discrete(me: &Episode, v: Vector, aim: Vector) -> DiscreteAction {
     } else {
         DiscreteAction::Right
     }
+}
+
+/// A run of `policy` alone on seeds `0..seeds` of `config`, summed up (for the planners' tests).
+#[cfg(test)]
+pub(super) fn lone_run(config: crate::SimConfig, policy: &str, seeds: u64) -> crate::eval::Summary {
+    use crate::eval::{EvalOptions, Evaluator, Summary};
+    let ev = Evaluator::new(
+        config.validate().expect("valid"),
+        crate::sim::world::Scenes::MazePerSeed,
+    );
+    let f = super::factory(policy, ev.config().observation_size()).expect("policy");
+    let options = EvalOptions {
+        seeds: (0..seeds).collect::<Vec<_>>().into(),
+        ..Default::default()
+    };
+    let cancel = std::sync::atomic::AtomicBool::new(false);
+    let run = ev
+        .run(f.as_ref(), &options, &cancel, &|_| {})
+        .expect("runs");
+    Summary::new(&run.records, crate::eval::metric::kinds(ev.config()), 1.0)
 }

@@ -8,39 +8,32 @@
 //! closest. Robots of a team that all run `orca` each take half the avoidance.
 
 use super::follow::Follower;
-use super::geodesic::planned;
-use super::local::{self, Senses};
-use super::{Decision, Policy, PolicyError};
+use super::local::{self, Local, Planner, Senses};
+use super::Decision;
 use crate::geometry::orca::Horizon;
 use crate::sim::avoid::{Avoid, Avoider};
 use crate::sim::episode::Episode;
-use crate::sim::team::Team;
-use crate::sim::world::World;
 
-/// ORCA towards the geodesic path's lookahead point.
+/// The `orca` policy: ORCA towards the geodesic path's lookahead point.
+pub type Orca = Local<OrcaPlanner>;
+
+/// ORCA's choice of velocity, with its scratch space.
 #[derive(Debug, Default)]
-pub struct Orca {
-    path: Option<Follower>,
-    senses: Senses,
+pub struct OrcaPlanner {
     avoider: Avoider,
 }
 
-impl Orca {
-    /// How far the robot senses.
+impl Planner for OrcaPlanner {
     fn range(me: &Episode) -> f64 {
         let config = me.config();
         config.orca.sense_range_px.unwrap_or(config.laser.range_px)
     }
 
-    /// The decision for `me` (whose agents are sensed) in its still scene.
-    fn decide(&mut self, me: &Episode) -> Decision {
-        let Some(path) = &mut self.path else {
-            return Decision::GiveUp("no path to the goal".into());
-        };
+    fn decide(&mut self, me: &Episode, path: &mut Follower, senses: &Senses) -> Decision {
         let config = me.config();
         let actions = config.orca.actions;
         let speed = local::planner_speed(me, config.orca.speed_px, actions);
-        let (preferred, to_aim) = local::preferred(path, me, speed, self.senses.index);
+        let (preferred, to_aim) = local::preferred(path, me, speed, senses.index);
         let horizon = Horizon {
             agents: config.orca.time_horizon_steps,
             obstacles: config.orca.obstacle_time_horizon_steps,
@@ -50,7 +43,7 @@ impl Orca {
         let v = self.avoider.velocity(
             me.scene(),
             &Avoid {
-                agents: &self.senses.agents,
+                agents: &senses.agents,
                 me: 0,
                 preferred,
                 horizon,
@@ -64,45 +57,14 @@ impl Orca {
     }
 }
 
-impl Policy for Orca {
-    fn reset(&mut self, world: &World, episode: &Episode) -> Result<(), PolicyError> {
-        self.path = planned(world, episode.pose().position(), episode.goal());
-        self.senses.reset(episode);
-        Ok(())
-    }
-
-    fn act(&mut self, episode: &Episode) -> Result<Decision, PolicyError> {
-        self.senses.lone(episode, Self::range(episode));
-        Ok(self.decide(episode))
-    }
-
-    fn act_in_team(&mut self, team: &Team, k: usize) -> Result<Decision, PolicyError> {
-        let me = team.robot(k);
-        self.senses.in_team(team, k, Self::range(me));
-        Ok(self.decide(me))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use crate::config::{PlannerActions, TeamRobotConfig};
     use crate::eval::{EvalOptions, Evaluator, Outcome, Summary};
+    use crate::policy::local::lone_run;
     use crate::policy::{factory, PerRobotFactory};
     use crate::sim::world::Scenes;
     use std::sync::atomic::AtomicBool;
-
-    fn lone_run(config: crate::SimConfig, policy: &str, seeds: u64) -> Summary {
-        let ev = Evaluator::new(config.validate().expect("valid"), Scenes::MazePerSeed);
-        let f = factory(policy, ev.config().observation_size()).expect("policy");
-        let options = EvalOptions {
-            seeds: (0..seeds).collect::<Vec<_>>().into(),
-            ..Default::default()
-        };
-        let run = ev
-            .run(f.as_ref(), &options, &AtomicBool::new(false), &|_| {})
-            .expect("runs");
-        Summary::new(&run.records, crate::eval::metric::kinds(ev.config()), 1.0)
-    }
 
     #[test]
     fn among_pedestrians_orca_arrives_with_fewer_contacts_than_geodesic() {
