@@ -1,14 +1,16 @@
 //! A lone robot's evaluation into a run directory: the sequence `ronap run`, `ronap compare` and
 //! Python's `ronap.evaluate` share.
 
-use crate::eval::EvalOptions;
-use crate::eval::{EpisodeRecord, Figures, RunEnd, RunResult, Summary, Tally};
+use super::into::{run_into, Episodes, Ran, Tallies};
+use crate::eval::Tally;
+use crate::eval::{EpisodeRecord, EvalOptions, Evaluator, Figures, RunEnd, RunResult, Summary};
 use crate::io::atomic::OutputError;
 use crate::io::figures;
 use crate::io::manifest::RunManifest;
-use crate::io::run_dir::{finish, lone_headers, manifest, restore, EpisodeRows, Layout, RunWriter};
+use crate::io::run_dir::{finish, lone_headers, manifest, EpisodeRows, Layout, RunWriter};
 use crate::job::{animate, RunRequest};
 use crate::policy::{PolicyError, PolicyFactory};
+use std::sync::atomic::AtomicBool;
 
 /// A finished evaluation: the records kept, the summary of every episode of the run and the
 /// manifest that went to `summary.json` (or would have, for a run without a directory).
@@ -39,89 +41,30 @@ pub fn evaluate_into(
     on_record: &(dyn Fn(&EpisodeRecord) + Sync),
     keep: &dyn Fn(&EpisodeRecord) -> bool,
 ) -> Result<Evaluation, PolicyError> {
-    let RunRequest {
-        evaluator,
-        options,
-        info,
-        writer,
-        cancel,
-    } = request;
-    let mut options = options.clone();
-    if let Some(w) = &writer {
-        options.recording = w.recording();
-        options.steps_of = w.gif_seeds().to_vec();
-    }
-    let config = evaluator.config();
+    let config = request.evaluator.config();
     let layout = Layout::of(config);
-    let mut tally = Tally::measuring(layout.metrics);
-    let mut write_error = None;
-    let mut streams = None;
-    let done = writer.as_ref().map_or(0, RunWriter::done);
-    if let Some(w) = &writer {
-        let plan = w.plan(config, &options, info);
-        streams = Some(w.open(&plan, lone_headers(layout)));
-        if done > 0 {
-            if let Err(e) = restore(&w.dir, done, &mut |row| {
-                let (_, f) = figures::parse_lone(row, layout.metrics.len())?;
-                tally.add(&f);
-                Ok(())
-            }) {
-                write_error = Some(e);
-            }
-        }
-    }
-    let steps_before = tally.steps();
-    let mut kept = Vec::new();
-    let end = if write_error.is_some() {
-        RunEnd {
-            episodes: 0,
-            cancelled: false,
-            error: None,
-            wall_time_s: 0.0,
-        }
-    } else {
-        let rest = EvalOptions {
-            seeds: options.seeds.after(done),
-            ..options.clone()
-        };
-        let on_finish = |r: &EpisodeRecord| {
-            if let Some(w) = &writer {
-                w.episode(r);
-                if w.gif_seeds().contains(&r.seed) {
-                    let gif = animate::lone(evaluator, r);
-                    w.animation(
-                        r.seed,
-                        r.outcome,
-                        gif.as_ref().map(|a| &a.bytes[..]).map_err(Clone::clone),
-                    );
-                }
-            }
-            on_record(r);
-        };
-        evaluator.stream(factory, &rest, cancel, &on_finish, &mut |r| {
-            let f = Figures::of(&r);
-            if let (Some(s), Some(w)) = (&mut streams, &writer) {
-                if let Err(e) = s.add(w, &EpisodeRows::with(&r, &f, layout).files()) {
-                    write_error = Some(e);
-                    return false;
-                }
-            }
-            tally.add(&f);
-            if keep(&r) {
-                kept.push(r);
-            }
-            true
-        })?
+    let mut lone = Lone {
+        layout,
+        tally: Tally::measuring(layout.metrics),
+        steps_before: 0,
+        keep,
+        kept: Vec::new(),
     };
-    let result = RunResult {
-        records: kept,
-        cancelled: end.cancelled && write_error.is_none(),
-        error: end.error,
-        wall_time_s: end.wall_time_s,
+    let episodes = LoneEpisodes {
+        evaluator: request.evaluator,
+        factory,
     };
-    let summary = tally.summary(result.wall_time_s, tally.steps() - steps_before);
-    let manifest = manifest(config, &options, info, &result, &summary);
-    if let (Some(w), None) = (&writer, &write_error) {
+    let Ran {
+        mut result,
+        options,
+        streams,
+        mut write_error,
+    } = run_into(&request, &episodes, &mut lone, on_record)?;
+    result.records = lone.kept;
+    let tally = &lone.tally;
+    let summary = tally.summary(result.wall_time_s, tally.steps() - lone.steps_before);
+    let manifest = manifest(config, &options, request.info, &result, &summary);
+    if let (Some(w), None) = (&request.writer, &write_error) {
         write_error = finish(w, streams, &manifest, &result).err();
     }
     Ok(Evaluation {
@@ -130,6 +73,78 @@ pub fn evaluate_into(
         manifest,
         write_error,
     })
+}
+
+/// A lone robot's episodes, by policies from a factory.
+struct LoneEpisodes<'a> {
+    evaluator: &'a Evaluator,
+    factory: &'a dyn PolicyFactory,
+}
+
+impl Episodes<EpisodeRecord> for LoneEpisodes<'_> {
+    fn stream(
+        &self,
+        options: &EvalOptions,
+        cancel: &AtomicBool,
+        on_finish: &(dyn Fn(&EpisodeRecord) + Sync),
+        sink: &mut dyn FnMut(EpisodeRecord) -> bool,
+    ) -> Result<RunEnd, PolicyError> {
+        self.evaluator
+            .stream(self.factory, options, cancel, on_finish, sink)
+    }
+
+    fn files(&self, writer: &RunWriter, r: &EpisodeRecord) {
+        writer.episode(r);
+        if writer.gif_seeds().contains(&r.seed) {
+            let gif = animate::lone(self.evaluator, r);
+            writer.animation(
+                r.seed,
+                r.outcome,
+                gif.as_ref().map(|a| &a.bytes[..]).map_err(Clone::clone),
+            );
+        }
+    }
+}
+
+/// A lone robot's rows and figures, and the records kept.
+struct Lone<'a> {
+    layout: Layout,
+    tally: Tally,
+    steps_before: u64,
+    keep: &'a dyn Fn(&EpisodeRecord) -> bool,
+    kept: Vec<EpisodeRecord>,
+}
+
+impl Tallies<EpisodeRecord> for Lone<'_> {
+    fn headers(&self) -> [Option<Vec<String>>; 4] {
+        lone_headers(self.layout)
+    }
+
+    fn restore(&mut self, row: &csv::StringRecord) -> Result<(), String> {
+        let (_, f) = figures::parse_lone(row, self.layout.metrics.len())?;
+        self.tally.add(&f);
+        Ok(())
+    }
+
+    fn start(&mut self) {
+        self.steps_before = self.tally.steps();
+    }
+
+    fn add(
+        &mut self,
+        r: EpisodeRecord,
+        write: &mut dyn FnMut(&[Vec<Vec<String>>]) -> bool,
+    ) -> bool {
+        let f = Figures::of(&r);
+        if !write(&EpisodeRows::with(&r, &f, self.layout).files()) {
+            return false;
+        }
+        self.tally.add(&f);
+        if (self.keep)(&r) {
+            self.kept.push(r);
+        }
+        true
+    }
 }
 
 #[cfg(test)]

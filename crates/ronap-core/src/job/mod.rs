@@ -8,6 +8,7 @@
 
 mod animate;
 mod evaluate;
+mod into;
 mod replay;
 mod team;
 
