@@ -1,7 +1,7 @@
 //! A lone robot's evaluation into a run directory: the sequence `ronap run`, `ronap compare` and
 //! Python's `ronap.evaluate` share.
 
-use super::into::{run_into, Episodes, Ran, Tallies};
+use super::into::{run_into, Episodes, FileRows, Ran, Tallies};
 use crate::eval::Tally;
 use crate::eval::{EpisodeRecord, EvalOptions, Evaluator, Figures, RunEnd, RunResult, Summary};
 use crate::io::atomic::OutputError;
@@ -130,11 +130,7 @@ impl Tallies<EpisodeRecord> for Lone<'_> {
         self.steps_before = self.tally.steps();
     }
 
-    fn add(
-        &mut self,
-        r: EpisodeRecord,
-        write: &mut dyn FnMut(&[Vec<Vec<String>>]) -> bool,
-    ) -> bool {
+    fn add(&mut self, r: EpisodeRecord, write: &mut dyn FnMut(&[FileRows]) -> bool) -> bool {
         let f = Figures::of(&r);
         if !write(&EpisodeRows::with(&r, &f, self.layout).files()) {
             return false;

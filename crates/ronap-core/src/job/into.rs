@@ -12,6 +12,9 @@ use crate::job::RunRequest;
 use crate::policy::PolicyError;
 use std::sync::atomic::AtomicBool;
 
+/// One episode's rows of one run file.
+pub(super) type FileRows = Vec<Vec<String>>;
+
 /// How a kind of run's episodes run, and the files an episode has of its own.
 pub(super) trait Episodes<R>: Sync {
     /// Runs `options`' seeds: each record to `on_finish` as it ends (any order), then to `sink`
@@ -42,7 +45,7 @@ pub(super) trait Tallies<R> {
 
     /// Hands `record`'s rows of the run files to `write`, then, if it took them, adds the
     /// record to the figures; whether it did.
-    fn add(&mut self, record: R, write: &mut dyn FnMut(&[Vec<Vec<String>>]) -> bool) -> bool;
+    fn add(&mut self, record: R, write: &mut dyn FnMut(&[FileRows]) -> bool) -> bool;
 }
 
 /// How the run went, with its files still under their partial names.

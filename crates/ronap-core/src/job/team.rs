@@ -1,7 +1,7 @@
 //! A team's evaluation into a run directory: team rows in `episodes.csv`, a row per robot in
 //! `robots.csv`, the team and per-robot figures in `summary.json`.
 
-use super::into::{run_into, Episodes, Ran, Tallies};
+use super::into::{run_into, Episodes, FileRows, Ran, Tallies};
 use crate::eval::{
     EvalOptions, Evaluator, Figures, RunEnd, Summary, Tally, TeamFigures, TeamRecord,
     TeamRunResult, TeamSummary, TeamTally,
@@ -153,7 +153,7 @@ impl Tallies<TeamRecord> for Teams {
             (self.team.robot_steps(), self.robots.steps());
     }
 
-    fn add(&mut self, r: TeamRecord, write: &mut dyn FnMut(&[Vec<Vec<String>>]) -> bool) -> bool {
+    fn add(&mut self, r: TeamRecord, write: &mut dyn FnMut(&[FileRows]) -> bool) -> bool {
         let t = TeamFigures::of(&r);
         let lone: Vec<Figures> = r
             .robots
