@@ -131,17 +131,40 @@ impl EvalOptions {
     }
 }
 
-/// What an evaluation produced: every finished record in seed order, and how it stopped.
+/// What an evaluation produced: every finished record (a lone robot's [`EpisodeRecord`], a
+/// team's [`TeamRecord`]) in seed order, and how it stopped.
 #[derive(Debug)]
-pub struct RunResult {
+pub struct Runs<R> {
     /// Finished episodes, in seed order.
-    pub records: Vec<EpisodeRecord>,
+    pub records: Vec<R>,
     /// Whether the cancel flag stopped the run before every seed ran.
     pub cancelled: bool,
     /// The first error (in seed order), if an episode failed; the run stopped at it.
     pub error: Option<RunError>,
     /// Wall time of the whole run, seconds.
     pub wall_time_s: f64,
+}
+
+/// A lone robot's evaluation.
+pub type RunResult = Runs<EpisodeRecord>;
+
+impl<R> Runs<R> {
+    /// Every record `stream` hands its sink, kept, and how the stream ended.
+    fn collect(
+        stream: impl FnOnce(&mut dyn FnMut(R) -> bool) -> Result<RunEnd, PolicyError>,
+    ) -> Result<Self, PolicyError> {
+        let mut records = Vec::new();
+        let end = stream(&mut |r| {
+            records.push(r);
+            true
+        })?;
+        Ok(Self {
+            records,
+            cancelled: end.cancelled,
+            error: end.error,
+            wall_time_s: end.wall_time_s,
+        })
+    }
 }
 
 /// A batch evaluation's setting: the configuration and where episodes take place.
@@ -268,17 +291,7 @@ impl Evaluator {
         cancel: &AtomicBool,
         on_record: &(dyn Fn(&EpisodeRecord) + Sync),
     ) -> Result<RunResult, PolicyError> {
-        let mut records = Vec::new();
-        let end = self.stream(factory, options, cancel, on_record, &mut |r| {
-            records.push(r);
-            true
-        })?;
-        Ok(RunResult {
-            records,
-            cancelled: end.cancelled,
-            error: end.error,
-            wall_time_s: end.wall_time_s,
-        })
+        Runs::collect(|sink| self.stream(factory, options, cancel, on_record, sink))
     }
 
     /// Runs `options.seeds` with policies from `factory`. Each record goes to `on_finish` as

@@ -6,7 +6,7 @@ use crate::eval::ordered::{run_in_order, Window};
 use crate::eval::record::Before;
 use crate::eval::summary::wilson95;
 use crate::eval::{
-    worker_pool, EvalOptions, Evaluator, Failure, Outcome, Recording, RunEnd, StepLog,
+    worker_pool, EvalOptions, Evaluator, Failure, Outcome, Recording, RunEnd, Runs, StepLog,
 };
 use crate::geometry::Point;
 use crate::plan::shortest_path_px;
@@ -391,18 +391,8 @@ impl TeamSummary {
     }
 }
 
-/// What a team evaluation produced.
-#[derive(Debug)]
-pub struct TeamRunResult {
-    /// Finished team episodes, in seed order.
-    pub records: Vec<TeamRecord>,
-    /// Whether the cancel flag stopped the run before every seed ran.
-    pub cancelled: bool,
-    /// The first error (in seed order), if an episode failed.
-    pub error: Option<RunError>,
-    /// Wall time, seconds.
-    pub wall_time_s: f64,
-}
+/// A team's evaluation.
+pub type TeamRunResult = Runs<TeamRecord>;
 
 impl Evaluator {
     /// Runs the team episode of `seed` with `policy`, robot `k`'s policy named `names[k]`.
@@ -577,17 +567,7 @@ impl Evaluator {
         cancel: &AtomicBool,
         on_record: &(dyn Fn(&TeamRecord) + Sync),
     ) -> Result<TeamRunResult, PolicyError> {
-        let mut records = Vec::new();
-        let end = self.stream_team(factory, options, cancel, on_record, &mut |r| {
-            records.push(r);
-            true
-        })?;
-        Ok(TeamRunResult {
-            records,
-            cancelled: end.cancelled,
-            error: end.error,
-            wall_time_s: end.wall_time_s,
-        })
+        Runs::collect(|sink| self.stream_team(factory, options, cancel, on_record, sink))
     }
 
     /// Runs `options.seeds` as team episodes as [`Evaluator::stream`] runs lone ones: each record
