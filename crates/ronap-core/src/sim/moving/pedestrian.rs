@@ -388,19 +388,20 @@ mod tests {
         Episode::new(&c, scene, seed).expect("episode")
     }
 
-    #[test]
-    fn pedestrians_cross_a_circle_without_overlapping_and_arrive() {
-        let mut least = f64::INFINITY;
-        let mut arrived = 0;
-        for seed in 0..40 {
-            let mut e = episode(&crossing(16, true), seed);
+    /// Crowds of `c` (pedestrians crossing a circle round (200, 200)) on `seeds`, each run for
+    /// `steps` steps: how many reached the opposite point (within 10 px), and the least gap
+    /// between two of them at any step.
+    fn crossings(c: &crate::SimConfig, seeds: u64, steps: usize) -> (usize, f64) {
+        let (mut arrived, mut least) = (0, f64::INFINITY);
+        for seed in 0..seeds {
+            let mut e = episode(c, seed);
             let goals: Vec<_> = e
                 .movers()
                 .expect("movers")
                 .items()
                 .map(|m| crate::geometry::Point::new(400.0, 400.0) - m.position().coords)
                 .collect();
-            for _ in 0..150 {
+            for _ in 0..steps {
                 e.step(DiscreteAction::Left);
                 let m: Vec<_> = e.movers().expect("movers").items().collect();
                 for i in 0..m.len() {
@@ -416,6 +417,12 @@ mod tests {
                 .filter(|(m, g)| (m.position() - **g).norm() < 10.0)
                 .count();
         }
+        (arrived, least)
+    }
+
+    #[test]
+    fn pedestrians_cross_a_circle_without_overlapping_and_arrive() {
+        let (arrived, least) = crossings(&crossing(16, true), 40, 150);
         // Each walks to the opposite point (within its radius, give or take the jitter).
         eprintln!("{arrived} of 640 arrived; least gap {least}");
         assert!(arrived >= 608, "{arrived} of 640 arrived");
@@ -426,32 +433,7 @@ mod tests {
     fn social_force_walkers_cross_a_circle_and_arrive() {
         let mut c = crossing(8, true);
         c.moving[0].motion = MotionKind::SocialForce;
-        let mut arrived = 0;
-        let mut least = f64::INFINITY;
-        for seed in 0..20 {
-            let mut e = episode(&c, seed);
-            let goals: Vec<_> = e
-                .movers()
-                .expect("movers")
-                .items()
-                .map(|m| crate::geometry::Point::new(400.0, 400.0) - m.position().coords)
-                .collect();
-            for _ in 0..200 {
-                e.step(DiscreteAction::Left);
-                let m: Vec<_> = e.movers().expect("movers").items().collect();
-                for i in 0..m.len() {
-                    for j in i + 1..m.len() {
-                        least = least.min((m[i].position() - m[j].position()).norm() - 12.0);
-                    }
-                }
-            }
-            let m: Vec<_> = e.movers().expect("movers").items().collect();
-            arrived += m
-                .iter()
-                .zip(&goals)
-                .filter(|(m, g)| (m.position() - **g).norm() < 10.0)
-                .count();
-        }
+        let (arrived, least) = crossings(&c, 20, 200);
         eprintln!("{arrived} of 160 arrived; least gap {least}");
         assert!(arrived >= 150, "{arrived} of 160 arrived");
         // The push keeps them apart, if not as strictly as ORCA.
