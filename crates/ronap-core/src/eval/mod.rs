@@ -316,8 +316,6 @@ impl Evaluator {
         if lanes > 1 {
             return self.stream_side_by_side(factory, options, lanes, cancel, on_finish, sink);
         }
-        let clock = Instant::now();
-        let pool = worker_pool(options.threads)?;
         // Policies are made at most once per worker and handed from episode to episode, so a
         // costly policy (a Python process, a loaded network) is set up `threads` times, not once
         // per seed.
@@ -335,16 +333,25 @@ impl Evaluator {
             record.strip();
             Ok(record)
         };
-        let ended = run_in_order(
-            &pool,
-            options.seeds.len(),
-            Window::for_threads(pool.current_num_threads()),
-            cancel,
-            &work,
-            sink,
-        );
-        RunEnd::of(ended, options.seeds.len(), clock)
+        stream_seeds(options, cancel, &work, sink)
     }
+}
+
+/// Runs job `i` for each seed `i` of `options` (`work(state, i)`, `state` the worker's own) on
+/// `options.threads` workers, at most a [`Window`] ahead of `sink`, which takes the results in
+/// seed order; how the run ended.
+pub(crate) fn stream_seeds<S, R: Send>(
+    options: &EvalOptions,
+    cancel: &AtomicBool,
+    work: &ordered::Job<'_, S, R, Failure>,
+    sink: &mut dyn FnMut(R) -> bool,
+) -> Result<RunEnd, PolicyError> {
+    let clock = Instant::now();
+    let pool = worker_pool(options.threads)?;
+    let count = options.seeds.len();
+    let window = Window::for_threads(pool.current_num_threads());
+    let ended = run_in_order(&pool, count, window, cancel, work, sink);
+    RunEnd::of(ended, count, clock)
 }
 
 /// What an evaluation keeps of an episode as it runs: its clock, the trajectory, obstacle

@@ -2,11 +2,10 @@
 //! (team success: every robot arrived; makespan; summed path length; robot collisions;
 //! deadlocks), and their summary.
 
-use crate::eval::ordered::{run_in_order, Window};
 use crate::eval::record::Before;
 use crate::eval::summary::wilson95;
 use crate::eval::{
-    worker_pool, EvalOptions, Evaluator, Failure, Outcome, Recording, RunEnd, Runs, StepLog,
+    stream_seeds, EvalOptions, Evaluator, Failure, Outcome, Recording, RunEnd, Runs, StepLog,
 };
 use crate::geometry::Point;
 use crate::plan::shortest_path_px;
@@ -581,8 +580,6 @@ impl Evaluator {
         on_finish: &(dyn Fn(&TeamRecord) + Sync),
         sink: &mut dyn FnMut(TeamRecord) -> bool,
     ) -> Result<RunEnd, PolicyError> {
-        let clock = Instant::now();
-        let pool = worker_pool(options.threads)?;
         let names = factory.names();
         // A team's policy is made afresh for every episode.
         let work = |_: &mut Option<()>, i: usize| {
@@ -597,15 +594,7 @@ impl Evaluator {
             r.scene = None;
             Ok(r)
         };
-        let ended = run_in_order(
-            &pool,
-            options.seeds.len(),
-            Window::for_threads(pool.current_num_threads()),
-            cancel,
-            &work,
-            sink,
-        );
-        RunEnd::of(ended, options.seeds.len(), clock)
+        stream_seeds(options, cancel, &work, sink)
     }
 }
 
