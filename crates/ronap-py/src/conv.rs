@@ -309,6 +309,27 @@ pub fn info<'py>(
     Ok(d)
 }
 
+/// `episode` drawn as `view` asks: "top" (the whole scene and `path`, `scale` pixels per px) or
+/// "first_person" (the paper's rotating view, `scale` pixels a side).
+pub fn render<'py>(
+    py: Python<'py>,
+    episode: &ronap_core::Episode,
+    path: &[ronap_core::geometry::Point],
+    view: &str,
+    scale: f64,
+) -> PyResult<Bound<'py, PyArray3<u8>>> {
+    let img = match view {
+        "top" => ronap_core::render::top_down(episode, path, scale),
+        "first_person" => ronap_core::render::first_person(episode, scale as u32),
+        other => {
+            return Err(crate::errors::ConfigError::new_err(format!(
+                "render view {other:?}: expected \"top\" or \"first_person\""
+            )))
+        }
+    };
+    image(py, img)
+}
+
 /// An RGB image as an (height, width, 3) uint8 array.
 pub fn image(py: Python<'_>, img: image::RgbImage) -> PyResult<Bound<'_, PyArray3<u8>>> {
     let (w, h) = img.dimensions();

@@ -106,16 +106,7 @@ impl Env {
             .episode
             .as_ref()
             .ok_or_else(|| errors::RonapError::new_err("render() before reset()"))?;
-        let img = match view {
-            "top" => ronap_core::render::top_down(episode, &self.path, scale),
-            "first_person" => ronap_core::render::first_person(episode, scale as u32),
-            other => {
-                return Err(errors::ConfigError::new_err(format!(
-                    "render view {other:?}: expected \"top\" or \"first_person\""
-                )))
-            }
-        };
-        conv::image(py, img)
+        conv::render(py, episode, &self.path, view, scale)
     }
 
     /// Length of the observation: beams + 1.

@@ -350,19 +350,8 @@ impl VecEnv {
             .batch
             .episode(i)
             .ok_or_else(|| errors::RonapError::new_err("render() before reset()"))?;
-        let img = match view {
-            "top" => {
-                let path = self.paths.as_ref().map_or(&[][..], |p| &p[i][..]);
-                ronap_core::render::top_down(episode, path, scale)
-            }
-            "first_person" => ronap_core::render::first_person(episode, scale as u32),
-            other => {
-                return Err(errors::ConfigError::new_err(format!(
-                    "render view {other:?}: expected \"top\" or \"first_person\""
-                )))
-            }
-        };
-        conv::image(py, img)
+        let path = self.paths.as_ref().map_or(&[][..], |p| &p[i][..]);
+        conv::render(py, episode, path, view, scale)
     }
 
     /// Number of environments.

@@ -3,7 +3,7 @@
 
 use crate::eval::metric::{self, Kind};
 use crate::eval::{Outcome, TeamRecord};
-use crate::io::run_dir::metric_cells;
+use crate::io::run_dir::{metric_cells, start_goal_cells};
 use std::io::Write;
 
 /// Columns of a team run's `episodes.csv` (one row per team episode).
@@ -116,13 +116,8 @@ pub fn robot_rows(r: &TeamRecord, kinds: &[Kind]) -> Vec<Vec<String>> {
                 format!("{:.3}", x.path_length_px),
                 x.shortest_px.map_or(String::new(), |l| format!("{l:.3}")),
                 format!("{:.4}", x.spl),
-                format!("{:.3}", x.start.x),
-                format!("{:.3}", x.start.y),
-                format!("{:.3}", x.start.z_deg),
-                format!("{:.3}", x.goal.x),
-                format!("{:.3}", x.goal.y),
-                x.reason.clone().unwrap_or_default(),
             ];
+            row.extend(start_goal_cells(x.start, x.goal, x.reason.as_deref()));
             row.extend(metric_cells(kinds, &x.metrics));
             row
         })

@@ -21,6 +21,7 @@ use crate::io::manifest::{ManifestError, RunManifest, RunPlan, SCHEMA_VERSION};
 use crate::io::partial::partial_path;
 use crate::scene::map::MapSource;
 use crate::sim::world::SceneSpec;
+pub(crate) use rows::start_goal_cells;
 pub use rows::{
     episode_header, episode_row, metric_cells, timing_row, write_episodes, write_timing, Layout,
     DYNAMIC_COLUMNS, EPISODE_COLUMNS, TIMING_COLUMNS,

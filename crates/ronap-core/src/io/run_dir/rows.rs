@@ -4,6 +4,8 @@
 use crate::config::ValidConfig;
 use crate::eval::metric;
 use crate::eval::EpisodeRecord;
+use crate::geometry::Point;
+use crate::sim::robot::Pose;
 use std::io::Write;
 
 /// Columns of `episodes.csv`.
@@ -51,6 +53,19 @@ impl Layout {
     }
 }
 
+/// A row's start pose, goal and reason cells (`start_x` .. `reason`), as `episodes.csv` and
+/// `robots.csv` write them.
+pub(crate) fn start_goal_cells(start: Pose, goal: Point, reason: Option<&str>) -> [String; 6] {
+    [
+        format!("{:.3}", start.x),
+        format!("{:.3}", start.y),
+        format!("{:.3}", start.z_deg),
+        format!("{:.3}", goal.x),
+        format!("{:.3}", goal.y),
+        reason.unwrap_or_default().to_string(),
+    ]
+}
+
 /// The `episodes.csv` row of `r`, laid out as `layout` says.
 pub fn episode_row(r: &EpisodeRecord, layout: Layout) -> Vec<String> {
     let mut row = vec![
@@ -62,13 +77,8 @@ pub fn episode_row(r: &EpisodeRecord, layout: Layout) -> Vec<String> {
         r.shortest_px.map_or(String::new(), |l| format!("{l:.3}")),
         format!("{:.4}", r.spl),
         format!("{:.4}", r.total_reward),
-        format!("{:.3}", r.start.x),
-        format!("{:.3}", r.start.y),
-        format!("{:.3}", r.start.z_deg),
-        format!("{:.3}", r.goal.x),
-        format!("{:.3}", r.goal.y),
-        r.reason.clone().unwrap_or_default(),
     ];
+    row.extend(start_goal_cells(r.start, r.goal, r.reason.as_deref()));
     if layout.dynamic {
         match r.dynamic {
             Some(d) => row.extend([
