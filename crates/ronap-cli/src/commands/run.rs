@@ -17,6 +17,8 @@ use ronap_core::{Scenes, ValidConfig};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
 
 /// Arguments of `ronap run`.
 #[derive(Args, Debug)]
@@ -162,6 +164,92 @@ impl Job {
         serde_json::json!({ "gif": self.gif, "min_success": self.min_success, "batch": self.batch })
     }
 
+    /// What every run sets up once its episodes can start: its writer (`writer` taken up again,
+    /// or a new one animating the `--gif` seeds' steps as they finish), Ctrl-C, and a progress
+    /// bar counting the episodes left (`what`, after `prefix`).
+    fn begin(
+        &self,
+        writer: Option<RunWriter>,
+        what: &str,
+        prefix: String,
+    ) -> Result<(RunWriter, Arc<AtomicBool>, indicatif::ProgressBar)> {
+        let (first, last) = self.span();
+        if let Some(s) = self.gif.iter().find(|&&s| s < first || s > last) {
+            bail!("--gif {s}: not one of this run's seeds ({first}..={last})");
+        }
+        let writer = match writer {
+            Some(w) => w,
+            None => self.writer(RunFiles {
+                pictures: self.png,
+                steps: self.log_steps,
+                gifs: false,
+            })?,
+        };
+        let writer = writer.animating(self.gif.clone())?;
+        let done = writer.done() as u64;
+        let cancel = cancel_on_ctrl_c("finishing running episodes and writing what is done");
+        let bar = crate::output::progress_bar(
+            self.seeds.len() as u64 - done,
+            &format!("{{prefix}} {{wide_bar}} {{pos}}/{{len}} {what}, {{per_sec}}, eta {{eta}}"),
+            prefix,
+        );
+        Ok((writer, cancel, bar))
+    }
+
+    /// The options and manifest information of this run on `threads` workers.
+    fn options(&self, threads: usize) -> (EvalOptions, RunInfo) {
+        let options = EvalOptions {
+            seeds: self.seeds.clone(),
+            threads,
+            recording: Recording::default(),
+            steps_of: Vec::new(),
+        };
+        let info = RunInfo {
+            policy: self.policy.clone(),
+            scenes: self.info_scenes.clone(),
+            map: self.map.clone(),
+        };
+        (options, info)
+    }
+
+    /// How the run ended, as the exit says it: a write error or a failed episode (an error
+    /// saying what is kept), an interruption (130, with the way to finish), a success rate
+    /// (`rate`, of `what`) below `--min-success` (1), else success.
+    fn end(
+        &self,
+        write_error: Option<OutputError>,
+        error: Option<&ronap_core::run::RunError>,
+        cancelled: bool,
+        (episodes, what, rate): (usize, &str, f64),
+    ) -> Result<ExitCode> {
+        if let Some(e) = write_error {
+            return Err(stopped_writing(e, &self.out_dir));
+        }
+        if let Some(e) = error {
+            bail!("run stopped: {e} (the {episodes} finished episodes are saved)");
+        }
+        if cancelled {
+            println!(
+                "interrupted: {episodes} of {} episodes finished and saved (ronap run --resume {} \
+                 finishes the run)",
+                self.seeds.len(),
+                self.out_dir.display()
+            );
+            return Ok(ExitCode::from(130));
+        }
+        if let Some(min) = self.min_success {
+            if rate < min {
+                eprintln!(
+                    "ronap run: {what} {:.1}% is below --min-success {:.1}%",
+                    100.0 * rate,
+                    100.0 * min
+                );
+                return Ok(ExitCode::from(1));
+            }
+        }
+        Ok(ExitCode::SUCCESS)
+    }
+
     /// The writer of a new run into `out_dir`.
     fn writer(&self, files: RunFiles) -> Result<RunWriter> {
         let dir = &self.out_dir;
@@ -290,44 +378,14 @@ fn run_lone(
     };
     let evaluator = Evaluator::new(config.clone(), scenes);
     let (first, last) = job.span();
-    if let Some(s) = job.gif.iter().find(|&&s| s < first || s > last) {
-        bail!("--gif {s}: not one of this run's seeds ({first}..={last})");
-    }
     // A scene with no room for a start and goal fails the same way for every seed: say so now.
     evaluator
         .worlds()
         .check_start(first)
         .with_context(|| format!("cannot start episodes in this scene (seed {first})"))?;
-    let files = RunFiles {
-        pictures: job.png,
-        steps: job.log_steps,
-        gifs: false,
-    };
-    let writer = match writer {
-        Some(w) => w,
-        None => job.writer(files)?,
-    };
-    // The --gif seeds' steps are recorded as they run and animated as they finish.
-    let writer = writer.animating(job.gif.clone())?;
-    let done = writer.done() as u64;
-
-    let cancel = cancel_on_ctrl_c("finishing running episodes and writing what is done");
-    let bar = crate::output::progress_bar(
-        job.seeds.len() as u64 - done,
-        "{prefix} {wide_bar} {pos}/{len} episodes, {per_sec}, eta {eta}",
-        format!("ronap run {}", job.policy),
-    );
-    let options = EvalOptions {
-        seeds: job.seeds.clone(),
-        threads,
-        recording: Recording::default(),
-        steps_of: Vec::new(),
-    };
-    let info = RunInfo {
-        policy: job.policy.clone(),
-        scenes: job.info_scenes.clone(),
-        map: job.map.clone(),
-    };
+    let (writer, cancel, bar) =
+        job.begin(writer, "episodes", format!("ronap run {}", job.policy))?;
+    let (options, info) = job.options(threads);
     let request = RunRequest {
         evaluator: &evaluator,
         options: &options,
@@ -352,37 +410,13 @@ fn run_lone(
     )?;
     write!(stdout, "{}", summary.table())?;
     writeln!(stdout, "outputs in {}", job.out_dir.display())?;
-    if let Some(e) = evaluation.write_error {
-        return Err(stopped_writing(e, &job.out_dir));
-    }
-    if let Some(e) = &result.error {
-        bail!(
-            "run stopped: {e} (the {} finished episodes are saved)",
-            summary.episodes
-        );
-    }
-    if result.cancelled {
-        writeln!(
-            stdout,
-            "interrupted: {} of {} episodes finished and saved (ronap run --resume {} finishes \
-             the run)",
-            summary.episodes,
-            job.seeds.len(),
-            job.out_dir.display()
-        )?;
-        return Ok(ExitCode::from(130));
-    }
-    if let Some(min) = job.min_success {
-        if summary.success_rate < min {
-            eprintln!(
-                "ronap run: success rate {:.1}% is below --min-success {:.1}%",
-                100.0 * summary.success_rate,
-                100.0 * min
-            );
-            return Ok(ExitCode::from(1));
-        }
-    }
-    Ok(ExitCode::SUCCESS)
+    drop(stdout);
+    job.end(
+        evaluation.write_error,
+        result.error.as_ref(),
+        result.cancelled,
+        (summary.episodes, "success rate", summary.success_rate),
+    )
 }
 
 /// `ronap run` of a scenario with `[[robots]]`: team episodes, each robot driven by its entry's
@@ -404,41 +438,16 @@ fn run_team(
     };
     let names = policies.names.clone();
     let (first, last) = job.span();
-    if let Some(s) = job.gif.iter().find(|&&s| s < first || s > last) {
-        bail!("--gif {s}: not one of this run's seeds ({first}..={last})");
-    }
     let evaluator = Evaluator::new(config.clone(), scenes);
     // A team that cannot be placed fails the same way for every seed: say so before writing.
     ronap_core::sim::team::Team::new(&config, &evaluator.worlds().team(first), first)
         .with_context(|| format!("cannot start team episodes in this scene (seed {first})"))?;
-    let files = RunFiles {
-        pictures: job.png,
-        steps: job.log_steps,
-        gifs: false,
-    };
-    let writer = match writer {
-        Some(w) => w,
-        None => job.writer(files)?,
-    };
-    let writer = writer.animating(job.gif.clone())?;
-    let done = writer.done() as u64;
-    let cancel = cancel_on_ctrl_c("finishing running episodes and writing what is done");
-    let bar = crate::output::progress_bar(
-        job.seeds.len() as u64 - done,
-        "{prefix} {wide_bar} {pos}/{len} team episodes, {per_sec}, eta {eta}",
+    let (writer, cancel, bar) = job.begin(
+        writer,
+        "team episodes",
         format!("ronap run {} robots", names.len()),
-    );
-    let options = EvalOptions {
-        seeds: job.seeds.clone(),
-        threads,
-        recording: Recording::default(),
-        steps_of: Vec::new(),
-    };
-    let info = RunInfo {
-        policy: job.policy.clone(),
-        scenes: job.info_scenes.clone(),
-        map: job.map.clone(),
-    };
+    )?;
+    let (options, info) = job.options(threads);
     let request = RunRequest {
         evaluator: &evaluator,
         options: &options,
@@ -464,29 +473,14 @@ fn run_team(
     writeln!(stdout, "per robot:")?;
     write!(stdout, "{}", evaluation.summary.table())?;
     writeln!(stdout, "outputs in {}", job.out_dir.display())?;
-    if let Some(e) = evaluation.write_error {
-        return Err(stopped_writing(e, &job.out_dir));
-    }
-    if let Some(e) = &evaluation.result.error {
-        bail!(
-            "run stopped: {e} (the {} finished episodes are saved)",
-            evaluation.team.episodes
-        );
-    }
-    if evaluation.result.cancelled {
-        return Ok(ExitCode::from(130));
-    }
-    if let Some(min) = job.min_success {
-        if evaluation.team.team_success_rate < min {
-            eprintln!(
-                "ronap run: team success rate {:.1}% is below --min-success {:.1}%",
-                100.0 * evaluation.team.team_success_rate,
-                100.0 * min
-            );
-            return Ok(ExitCode::from(1));
-        }
-    }
-    Ok(ExitCode::SUCCESS)
+    drop(stdout);
+    let team = &evaluation.team;
+    job.end(
+        evaluation.write_error,
+        evaluation.result.error.as_ref(),
+        evaluation.result.cancelled,
+        (team.episodes, "team success rate", team.team_success_rate),
+    )
 }
 
 /// The error of a run whose files could not be written (a full disk, a read-only directory):
