@@ -689,7 +689,10 @@ fn the_crowd_scenarios_run_and_bad_crowd_entries_are_named() {
         } else {
             entry
         };
-        assert!(err.contains(entry), "{err}");
+        // The file, the line, the key and the value to blame.
+        let key = format!("{entry}.pattern_radius_px = 5000.0");
+        assert!(err.contains("big.toml:10") && err.contains(&key), "{err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
         assert!(!err.contains("panick"), "{err}");
     }
 }

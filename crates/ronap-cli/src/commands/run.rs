@@ -123,11 +123,13 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
             job.policy
         );
     }
-    if config.team_size() > 0 {
+    let scenario = args.episodes.sim.scenario.as_deref();
+    let run = if config.team_size() > 0 {
         run_team(job, config, scenes, None)
     } else {
         run_lone(job, config, scenes, None)
-    }
+    };
+    run.map_err(|e| crate::args::sim::locate_in_scenario(e, scenario))
 }
 
 /// A run as asked for, by flags or by a resumed run's plan.

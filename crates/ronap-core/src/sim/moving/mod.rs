@@ -137,12 +137,14 @@ impl Track {
 
 /// Where a moving obstacle could not be placed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("{table}[{entry}]: {message}")]
+#[error("{table}[{entry}]{}: {message}", field.as_ref().map_or(String::new(), |(f, v)| format!(".{f} = {v}")))]
 pub struct MovingError {
     /// `moving` or `crowd`: the kind of entry.
     pub table: &'static str,
     /// The `[[moving]]` (or `[[crowd]]`) entry, from 0.
     pub entry: usize,
+    /// The field to blame and its value, when one is.
+    pub field: Option<(&'static str, String)>,
     /// What went wrong.
     pub message: String,
 }
@@ -236,17 +238,15 @@ impl Movers {
         for (entry, m) in config.moving.iter().enumerate() {
             // Entries past the file's own `[[moving]]` ones are its crowds.
             let own = config.as_sim_config().moving.len();
-            let err = |message: String| match entry.checked_sub(own) {
-                Some(k) => MovingError {
-                    table: "crowd",
-                    entry: k,
-                    message,
-                },
-                None => MovingError {
-                    table: "moving",
-                    entry,
-                    message,
-                },
+            let (table, index) = match entry.checked_sub(own) {
+                Some(k) => ("crowd", k),
+                None => ("moving", entry),
+            };
+            let err = |message: String| MovingError {
+                table,
+                entry: index,
+                field: None,
+                message,
             };
             let body = match m.shape {
                 MovingShape::Disc => Body::Disc(m.radius_px),
@@ -263,12 +263,11 @@ impl Movers {
                 let (e, behaviour, position, dir) = if m.motion.is_reactive() {
                     let (start, goal) =
                         pedestrian::place(m, body, scene, &robot_goals, &taken, &mut rng)
-                            .ok_or_else(|| {
-                                err(format!(
-                                    "found no free start and goal at least {} px from the \
-                                     robots' and clear of the other pedestrians'",
-                                    m.min_robot_distance_px
-                                ))
+                            .ok_or_else(|| MovingError {
+                                table,
+                                entry: index,
+                                field: pedestrian::pattern_field(m),
+                                message: pedestrian::unplaced(m, scene),
                             })?;
                     taken.extend([
                         (start, body.bounding_radius()),

@@ -169,6 +169,38 @@ fn keeps_off(scene: &Scene, p: Point, r: f64, keep: f64) -> bool {
     keep <= 0.0 || scene.clearance(p, r + keep).is_none()
 }
 
+/// The field to blame when no pedestrian of entry `m` could be placed: its pattern's size.
+pub(super) fn pattern_field(m: &MovingConfig) -> Option<(&'static str, String)> {
+    matches!(m.pattern, Some(Pattern::Circle | Pattern::Square))
+        .then(|| ("pattern_radius_px", format!("{:?}", m.pattern_radius_px)))
+}
+
+/// Why no pedestrian of entry `m` could be placed in `scene`.
+pub(super) fn unplaced(m: &MovingConfig, scene: &Scene) -> String {
+    let clear = format!(
+        "at least {} px from the robots' starts and goals and clear of the other pedestrians'",
+        m.min_robot_distance_px
+    );
+    let [cx, cy] = m
+        .pattern_center
+        .unwrap_or([scene.width() / 2.0, scene.height() / 2.0]);
+    let (w, h) = (scene.width(), scene.height());
+    match m.pattern {
+        Some(p @ (Pattern::Circle | Pattern::Square)) => {
+            let shape = if p == Pattern::Circle {
+                "a circle of that radius"
+            } else {
+                "a square of that half side"
+            };
+            format!(
+                "{shape} round ({cx}, {cy}) gives no free start and goal in the {w} x {h} px \
+                 scene {clear}"
+            )
+        }
+        _ => format!("found no free start and goal in the {w} x {h} px scene {clear}"),
+    }
+}
+
 /// Least gap between two pedestrians placed by a pattern, px.
 const PLACEMENT_GAP_PX: f64 = 2.0;
 
