@@ -1,6 +1,6 @@
 """The soak test, test-sized: scripts/soak steps every built-in policy and both shipped networks
 through episodes on moving seeds and checks flat memory, no hung episode and parsable outputs.
-The long soak (a million episodes per policy) is `scripts/soak` with its defaults (README)."""
+The long soak (a million episodes per policy) is `scripts/soak` with its defaults (docs/contributing.md)."""
 
 import subprocess
 import sys

@@ -16,14 +16,26 @@ use std::process::ExitCode;
 /// Exit code for bad input: arguments, config files, maps, output paths.
 const EXIT_BAD_INPUT: u8 = 2;
 
+/// What `ronap --version` prints after the name: the package version and the version of the
+/// simulation model ([`ronap_core::MODEL_VERSION`]), which says whether recorded runs replay.
+static VERSION: std::sync::LazyLock<String> = std::sync::LazyLock::new(|| {
+    format!(
+        "{} (model version {})",
+        env!("CARGO_PKG_VERSION"),
+        ronap_core::MODEL_VERSION
+    )
+});
+
 /// Fast robot-navigation analysis on the RoNAP model: seeded mazes, a 17-beam laser, discrete
 /// actions, random start and goal.
 #[derive(Parser, Debug)]
 #[doc(hidden)]
 #[command(
     name = "ronap",
-    version,
+    version = VERSION.as_str(),
     about,
+    after_help = "Guides and reference: docs/README.md (getting started, a guide per task, every \
+                  command, configuration field and output column).",
     propagate_version = true,
     allow_negative_numbers = true
 )]

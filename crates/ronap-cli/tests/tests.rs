@@ -10,6 +10,7 @@ mod compare;
 mod keep;
 mod learn;
 mod limits;
+mod reference;
 mod replay;
 mod run;
 mod stream;

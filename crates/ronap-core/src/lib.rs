@@ -40,6 +40,11 @@ pub mod run;
 pub mod scene;
 pub mod sim;
 
+/// The version of the simulation model: the scenes, sensors, kinematics, random streams and
+/// metrics that make an episode out of a seed. Runs recorded under another model version do not
+/// replay the same (`ronap --version` prints it).
+pub const MODEL_VERSION: u32 = 1;
+
 pub use config::{ConfigError, SimConfig, ValidConfig};
 pub use geometry::{Aabb, Point, Vector};
 pub use scene::maze::Maze;
