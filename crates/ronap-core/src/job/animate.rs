@@ -3,9 +3,28 @@
 //! stepped again in the model, no policy is asked again, so a GIF always shows the episode its
 //! row in `episodes.csv` describes.
 
-use crate::eval::{EpisodeRecord, Evaluator, TeamRecord};
+use crate::eval::{EpisodeRecord, Evaluator, Outcome, TeamRecord};
+use crate::io::run_dir::RunWriter;
 use crate::job::{replay_team, RobotLog};
 use crate::render::gif::{animate, Animation, GifOptions};
+
+/// Writes the animation `draw` makes of episode `seed` into `writer`'s run, if the run asks for
+/// one of that seed (`--gif`).
+pub(crate) fn write_if_asked(
+    writer: &RunWriter,
+    seed: u64,
+    outcome: Outcome,
+    draw: impl FnOnce() -> Result<Animation, String>,
+) {
+    if writer.gif_seeds().contains(&seed) {
+        let gif = draw();
+        writer.animation(
+            seed,
+            outcome,
+            gif.as_ref().map(|a| &a.bytes[..]).map_err(Clone::clone),
+        );
+    }
+}
 
 /// The top-view animation of lone episode `record`, whose steps were recorded.
 pub(crate) fn lone(evaluator: &Evaluator, record: &EpisodeRecord) -> Result<Animation, String> {

@@ -95,14 +95,9 @@ impl Episodes<EpisodeRecord> for LoneEpisodes<'_> {
 
     fn files(&self, writer: &RunWriter, r: &EpisodeRecord) {
         writer.episode(r);
-        if writer.gif_seeds().contains(&r.seed) {
-            let gif = animate::lone(self.evaluator, r);
-            writer.animation(
-                r.seed,
-                r.outcome,
-                gif.as_ref().map(|a| &a.bytes[..]).map_err(Clone::clone),
-            );
-        }
+        animate::write_if_asked(writer, r.seed, r.outcome, || {
+            animate::lone(self.evaluator, r)
+        });
     }
 }
 

@@ -106,14 +106,9 @@ impl Episodes<TeamRecord> for TeamEpisodes<'_> {
     }
 
     fn files(&self, writer: &RunWriter, r: &TeamRecord) {
-        if writer.gif_seeds().contains(&r.seed) {
-            let gif = animate::team(self.evaluator, r);
-            writer.animation(
-                r.seed,
-                r.outcome,
-                gif.as_ref().map(|a| &a.bytes[..]).map_err(Clone::clone),
-            );
-        }
+        animate::write_if_asked(writer, r.seed, r.outcome, || {
+            animate::team(self.evaluator, r)
+        });
         writer.team_episode(r, &self.beams);
     }
 }

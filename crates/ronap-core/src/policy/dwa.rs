@@ -122,9 +122,15 @@ impl DwaPlanner {
             first_clear,
         }
     }
+}
 
-    /// The decision for `me`, following `path`, among the agents `senses` holds.
-    fn choose(&mut self, me: &Episode, path: &mut Follower, senses: &Senses) -> Decision {
+impl Planner for DwaPlanner {
+    fn range(me: &Episode) -> f64 {
+        let config = me.config();
+        config.dwa.sense_range_px.unwrap_or(config.laser.range_px)
+    }
+
+    fn decide(&mut self, me: &Episode, path: &mut Follower, senses: &Senses) -> Decision {
         let p = me.pose().position();
         let aim = path.aim(p).unwrap_or(me.goal());
         self.laser_points(me);
@@ -253,17 +259,6 @@ impl DwaPlanner {
             Action::Discrete(_) => (0.0, 0.0),
         };
         Decision::Act(action)
-    }
-}
-
-impl Planner for DwaPlanner {
-    fn range(me: &Episode) -> f64 {
-        let config = me.config();
-        config.dwa.sense_range_px.unwrap_or(config.laser.range_px)
-    }
-
-    fn decide(&mut self, me: &Episode, path: &mut Follower, senses: &Senses) -> Decision {
-        self.choose(me, path, senses)
     }
 
     fn reset(&mut self, episode: &Episode) {

@@ -87,11 +87,7 @@ pub(super) fn place(
     rng: &mut Rng,
 ) -> Option<(Point, Point)> {
     let r = body.bounding_radius();
-    let center = m
-        .pattern_center
-        .map_or(Point::new(scene.width() / 2.0, scene.height() / 2.0), |c| {
-            Point::new(c[0], c[1])
-        });
+    let center = pattern_center(m, scene);
     let clear_of_all = |p: Point| {
         robots.iter().all(|(d, goal)| {
             body.gap(p, d.at, d.radius) >= m.min_robot_distance_px
@@ -175,15 +171,22 @@ pub(super) fn pattern_field(m: &MovingConfig) -> Option<(&'static str, String)> 
         .then(|| ("pattern_radius_px", format!("{:?}", m.pattern_radius_px)))
 }
 
+/// The centre of entry `m`'s crowd pattern: `pattern_center`, else the centre of `scene`.
+fn pattern_center(m: &MovingConfig, scene: &Scene) -> Point {
+    m.pattern_center
+        .map_or(Point::new(scene.width() / 2.0, scene.height() / 2.0), |c| {
+            Point::new(c[0], c[1])
+        })
+}
+
 /// Why no pedestrian of entry `m` could be placed in `scene`.
 pub(super) fn unplaced(m: &MovingConfig, scene: &Scene) -> String {
     let clear = format!(
         "at least {} px from the robots' starts and goals and clear of the other pedestrians'",
         m.min_robot_distance_px
     );
-    let [cx, cy] = m
-        .pattern_center
-        .unwrap_or([scene.width() / 2.0, scene.height() / 2.0]);
+    let c = pattern_center(m, scene);
+    let (cx, cy) = (c.x, c.y);
     let (w, h) = (scene.width(), scene.height());
     match m.pattern {
         Some(p @ (Pattern::Circle | Pattern::Square)) => {
