@@ -2,7 +2,7 @@
 
 use anyhow::Result;
 use ronap_core::policy::{
-    Builtin, PerRobot, PolicyError, PolicyFactory, PolicyNameError, TeamPolicy, TeamPolicyFactory,
+    coordinated, Builtin, PerRobot, PolicyError, PolicyFactory, PolicyNameError, TeamPolicy, TeamPolicyFactory,
 };
 use ronap_core::ValidConfig;
 
@@ -19,6 +19,12 @@ pub fn named_policy(
     config: &ValidConfig,
 ) -> Result<Box<dyn PolicyFactory>> {
     let flag = label;
+    if name == coordinated::NAME {
+        anyhow::bail!(
+            "{flag} coordinated: a team planner, for scenarios with [[robots]]; one robot alone \
+             has no one to coordinate with (orca is what it would run)"
+        );
+    }
     if let Some(spec) = name.strip_prefix("py:") {
         return Ok(Box::new(
             crate::py_policy::PyPolicyFactory::new(spec).map_err(anyhow::Error::msg)?,
@@ -56,6 +62,8 @@ pub struct TeamPolicies {
         crate::py_policy::ProcessPool,
     )>,
     batched: Vec<bool>,
+    /// Every robot driven by the `coordinated` team planner.
+    coordinated: bool,
 }
 
 impl TeamPolicies {
@@ -67,7 +75,32 @@ impl TeamPolicies {
             of_robot: Vec::new(),
             batch: None,
             batched: Vec::new(),
+            coordinated: false,
         };
+        // The team planner drives every robot or none.
+        let named = |e: &ronap_core::config::TeamRobotConfig| {
+            e.policy.clone().unwrap_or_else(|| default.to_string())
+        };
+        if config.robots.iter().any(|e| named(e) == coordinated::NAME) {
+            if let Some((k, other)) = config
+                .robots
+                .iter()
+                .scan(0usize, |first, e| {
+                    let k = *first;
+                    *first += e.count as usize;
+                    Some((k, named(e)))
+                })
+                .find(|(_, n)| n != coordinated::NAME)
+            {
+                anyhow::bail!(
+                    "[[robots]] entry with robot {k}: policy {other} beside coordinated, which plans \
+                     the whole team: give every robot coordinated (or none)"
+                );
+            }
+            team.names = vec![coordinated::NAME.to_string(); config.team_size()];
+            team.coordinated = true;
+            return Ok(team);
+        }
         for entry in &config.robots {
             let k = team.names.len();
             let name = entry.policy.clone().unwrap_or_else(|| default.to_string());
@@ -87,6 +120,9 @@ impl TeamPolicies {
     /// together: one call of the function a step for every such robot of a team episode
     /// (`ronap run --batch` on a team scenario).
     pub fn batched(mut self, default: &str) -> Result<Self> {
+        if self.coordinated {
+            anyhow::bail!("--batch: batches are for py:FILE:FUNCTION policies; coordinated runs in Rust already");
+        }
         let Some(spec) = default.strip_prefix("py:") else {
             anyhow::bail!("--batch: batches are for py:FILE:FUNCTION policies; {default} runs in Rust already");
         };
@@ -103,6 +139,9 @@ impl TeamPolicies {
     /// A new team policy, each robot's policy fresh from its factory; an error names the
     /// policy that could not start.
     pub fn start(&self) -> Result<Box<dyn TeamPolicy>> {
+        if self.coordinated {
+            return Ok(Box::<coordinated::Coordinated>::default());
+        }
         let policies = self
             .of_robot
             .iter()
@@ -120,6 +159,9 @@ impl TeamPolicies {
 /// Each robot driven by a policy of its own ([`PerRobot`]).
 impl TeamPolicyFactory for TeamPolicies {
     fn make(&self) -> Result<Box<dyn TeamPolicy>, PolicyError> {
+        if self.coordinated {
+            return Ok(Box::<coordinated::Coordinated>::default());
+        }
         if let Some((py, pool)) = &self.batch {
             let others = self
                 .of_robot

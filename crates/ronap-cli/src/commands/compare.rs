@@ -10,7 +10,7 @@ use ronap_core::compare::{
 };
 use ronap_core::eval::Evaluator;
 use ronap_core::io::atomic::OutputError;
-use ronap_core::policy::TeamPolicyFactory;
+use ronap_core::policy::{coordinated, TeamPolicyFactory};
 use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -27,8 +27,8 @@ pub enum By {
 #[derive(Args, Debug)]
 pub struct CompareArgs {
     /// A policy to compare (repeat for each; at least two in all, counting --run): apf, geodesic,
-    /// geodesic-wait, orca, social-force, dwa, random, mlp:FILE.safetensors[@RULE] or py:FILE.py:FUNCTION, as for `ronap
-    /// run`.
+    /// geodesic-wait, orca, social-force, dwa, random, coordinated (teams),
+    /// mlp:FILE.safetensors[@RULE] or py:FILE.py:FUNCTION, as for `ronap run`.
     #[arg(long, value_name = "NAME")]
     policy: Vec<String>,
     /// A finished `ronap run` (or a compare's runs/<policy>) directory to reuse instead of running
@@ -82,8 +82,13 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
         } else {
             None
         };
+        let factory = if team.is_some() && name == coordinated::NAME {
+            Box::new(coordinated::CoordinatedFactory::new(config.team_size()))
+        } else {
+            policy_factory(&name, &config.team_robot(0))?
+        };
         contenders.push(Contender {
-            factory: policy_factory(&name, &config.team_robot(0))?,
+            factory,
             team,
             name,
             reuse,

@@ -25,7 +25,9 @@ use std::sync::Arc;
 pub struct RunArgs {
     /// Policy to evaluate: apf (the paper's potential field, Algorithm 3), geodesic (shortest-path
     /// follower, no local minima), geodesic-wait (geodesic that waits for moving obstacles ahead),
-    /// orca (ORCA along the geodesic path: avoids what moves; [orca] settings), random,
+    /// orca (ORCA along the geodesic path: avoids what moves; [orca] settings), social-force,
+    /// dwa, random, coordinated (a scenario's [[robots]] planned together: no deadlocks,
+    /// infeasible tasks named),
     /// mlp:FILE.safetensors (a trained network, e.g.
     /// mlp:policies/bc.safetensors; append @argmax or @sample:T to override its decision rule), or
     /// py:FILE.py:FUNCTION (a Python function: observation in, action 0/1/2 out; run with

@@ -22,7 +22,8 @@ use std::process::ExitCode;
 pub struct ViewArgs {
     /// Policy to watch, as for `ronap run`: apf (the paper's potential field, Algorithm 3),
     /// geodesic (shortest-path follower), geodesic-wait (geodesic that waits for moving
-    /// obstacles ahead), orca (ORCA: avoids what moves), random,
+    /// obstacles ahead), orca (ORCA: avoids what moves), social-force, dwa, random,
+    /// coordinated (a team planned together),
     /// mlp:FILE.safetensors[@argmax|@sample:T] (a
     /// trained network, optionally with another decision rule), or
     /// py:FILE.py:FUNCTION (a Python function: observation in, action 0/1/2 out).

@@ -25,17 +25,20 @@ pub enum Outcome {
     RewardMin,
     /// A team's robots stood still for `episode.deadlock_steps` steps.
     Deadlock,
+    /// The team's policy found before the first step that no plan can do the task.
+    Infeasible,
 }
 
 impl Outcome {
     /// Every outcome, success first.
-    pub const ALL: [Outcome; 6] = [
+    pub const ALL: [Outcome; 7] = [
         Outcome::Success,
         Outcome::Timeout,
         Outcome::Stuck,
         Outcome::Collision,
         Outcome::RewardMin,
         Outcome::Deadlock,
+        Outcome::Infeasible,
     ];
 
     /// The outcome named `name` (as [`Outcome::name`] writes it).
@@ -64,6 +67,7 @@ impl Outcome {
             Outcome::Collision => "collision",
             Outcome::RewardMin => "reward_min",
             Outcome::Deadlock => "deadlock",
+            Outcome::Infeasible => "infeasible",
         }
     }
 }

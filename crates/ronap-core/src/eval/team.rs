@@ -467,7 +467,9 @@ impl Evaluator {
         let team = rollout.team();
         let mut robots = Vec::new();
         for (k, r) in team.robots().iter().enumerate() {
-            let outcome = if team.retired(k) {
+            let outcome = if rollout.infeasible().is_some() {
+                Outcome::Infeasible
+            } else if team.retired(k) {
                 Outcome::Stuck
             } else {
                 Outcome::of(r.status())
@@ -499,7 +501,10 @@ impl Evaluator {
                 robot: k,
                 policy: names.get(k).cloned().unwrap_or_default(),
                 outcome,
-                reason: rollout.gave_up(k).map(str::to_string),
+                reason: rollout
+                    .infeasible()
+                    .or(rollout.gave_up(k))
+                    .map(str::to_string),
                 steps: r.steps(),
                 arrived_at: team.arrived_at(k),
                 collisions: r.collisions(),
@@ -521,6 +526,7 @@ impl Evaluator {
         let all_arrived = robots.iter().all(|r| r.outcome == Outcome::Success);
         let deadlock = team.deadlocked();
         let worst = [
+            Outcome::Infeasible,
             Outcome::Deadlock,
             Outcome::Timeout,
             Outcome::Collision,

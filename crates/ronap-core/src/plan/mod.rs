@@ -4,6 +4,7 @@
 
 pub mod field;
 pub mod path;
+pub mod team;
 pub mod tour;
 
 pub use field::{grid_path, DistanceField, LazyField};

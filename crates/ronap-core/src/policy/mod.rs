@@ -3,6 +3,7 @@
 //! Uses `config`, `geometry`, `scene`, `sim` and `plan`.
 
 pub mod apf;
+pub mod coordinated;
 pub mod batched;
 pub mod dodge;
 pub mod dwa;

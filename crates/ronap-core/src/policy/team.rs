@@ -23,6 +23,13 @@ pub trait TeamPolicy: Send {
     /// robot). On an error, the failing robot; the decisions set before it stand.
     fn act(&mut self, team: &Team, decisions: &mut [Option<Decision>]) -> Result<(), RobotError>;
 
+    /// Why the team's task cannot be done, when the policy found out at [`TeamPolicy::reset`]
+    /// (no plan can bring every robot to its goals): the episode then ends before its first
+    /// step, every robot's outcome `infeasible`. The default finds nothing.
+    fn infeasible(&self) -> Option<&str> {
+        None
+    }
+
     /// The message robot `k` broadcasts with its last decision (`team.message_size` floats,
     /// zeros already in `out`); asked after [`TeamPolicy::act`] for each robot that acted. The
     /// default sends none.

@@ -26,6 +26,8 @@ pub struct TeamRollout {
     message_size: usize,
     /// The actions of the last step, robot by robot (`None`: the robot did not act).
     actions: Vec<Option<Action>>,
+    /// Why no plan can do the task, when the team policy found so before the first step.
+    infeasible: Option<String>,
 }
 
 /// A goal list's tour lengths under each order (geodesic, px; infinite where a leg cannot be
@@ -121,10 +123,17 @@ impl TeamRollout {
         seed: u64,
         policy: &mut dyn TeamPolicy,
     ) -> Result<Self, RunError> {
-        let rollout = Self::placed(config, worlds, seed)?;
+        let mut rollout = Self::placed(config, worlds, seed)?;
         policy
             .reset(&rollout.team, &rollout.worlds)
             .map_err(|(_, e)| RunError::reset(seed, e))?;
+        // An infeasible task ends before its first step: every robot out of the running.
+        if let Some(why) = policy.infeasible() {
+            rollout.infeasible = Some(why.to_string());
+            for k in 0..rollout.team.robots().len() {
+                rollout.team.retire(k);
+            }
+        }
         Ok(rollout)
     }
 
@@ -162,6 +171,7 @@ impl TeamRollout {
             worlds: per_robot,
             tours,
             message_size: config.team.message_size as usize,
+            infeasible: None,
         })
     }
 
@@ -178,6 +188,11 @@ impl TeamRollout {
     /// Robot `k`'s tour lengths, when it has a goal list.
     pub fn tour(&self, k: usize) -> Option<TourLengths> {
         self.tours[k]
+    }
+
+    /// Why no plan can do the task, when the team policy found so before the first step.
+    pub fn infeasible(&self) -> Option<&str> {
+        self.infeasible.as_deref()
     }
 
     /// Why robot `k`'s policy gave up, if it did.

@@ -80,7 +80,7 @@ pub fn policy_colour(index: usize) -> Rgb<u8> {
 }
 
 /// The colour of an outcome in the outcome strip: success green, timeout amber, stuck grey,
-/// collision red, reward floor purple, deadlock brown.
+/// collision red, reward floor purple, deadlock brown, infeasible near black.
 pub fn outcome_colour(outcome: Outcome) -> Rgb<u8> {
     match outcome {
         Outcome::Success => Rgb([46, 160, 67]),
@@ -89,6 +89,7 @@ pub fn outcome_colour(outcome: Outcome) -> Rgb<u8> {
         Outcome::Collision => Rgb([215, 48, 39]),
         Outcome::RewardMin => Rgb([128, 64, 176]),
         Outcome::Deadlock => Rgb([140, 86, 75]),
+        Outcome::Infeasible => Rgb([40, 40, 40]),
     }
 }
 

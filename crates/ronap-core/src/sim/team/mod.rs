@@ -318,6 +318,11 @@ impl Team {
         self.arrived_at[k]
     }
 
+    /// What robot `k` does on arriving at its last goal.
+    pub fn on_arrival(&self, k: usize) -> OnArrival {
+        self.on_arrival[k]
+    }
+
     /// Whether robot `k` is in the scene (a robot that vanished on arrival is not).
     pub fn present(&self, k: usize) -> bool {
         !(self.on_arrival[k] == OnArrival::Vanish && self.robots[k].status() == Status::Success)

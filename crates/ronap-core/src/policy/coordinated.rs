@@ -1,0 +1,488 @@
+//! The `coordinated` team planner (docs/model.md "Teams that finish"): every robot of a team
+//! planned together, then driven along the plan.
+//!
+//! - **Plan.** The scene is cut into square cells wide enough that robots holding different
+//!   cells stay clear of each other, even on the move between neighbouring centres
+//!   ([`PlanGrid`]: `sqrt 2` times a robot diameter and a margin). Each robot's start and goals
+//!   are mapped to cells, and the robots are planned one after the other in space and time,
+//!   each around the cells the robots before it hold ([`plan_team`]); the order is re-drawn from
+//!   the episode's seed when a robot finds no way.
+//! - **Infeasible tasks.** When no order works, each pair of the robot that failed and another
+//!   is searched alone, completely: two robots that cannot reach their goals even without the
+//!   rest (two robots swapping ends of a corridor too narrow to pass) make the task infeasible,
+//!   reported before the first step with the robots and the passage.
+//! - **Execution.** Each robot drives from cell centre to cell centre, moving on to its next
+//!   cell only once the robot planned there before it has left ([`Schedule`]), so delays
+//!   (turning, giving way to what moves) never bring two robots into one cell nor into a
+//!   deadlock. The velocity towards the next centre goes through ORCA (`[orca]` settings, a
+//!   short horizon and a small margin: the plan already keeps the robots apart) among the other
+//!   robots and the moving obstacles, and becomes the robot's action as for the `orca` policy.
+//! - **Fallback.** When no plan is found and none is proved impossible (or a robot's start or
+//!   goal has no cell), every robot runs the `orca` policy instead.
+
+use super::local::{action, planner_speed};
+use super::orca::Orca;
+use super::team::{PerRobot, RobotError, TeamPolicy, TeamPolicyFactory};
+use super::{Decision, Policy, PolicyError};
+use crate::config::{OnArrival, PlannerActions};
+use crate::geometry::orca::{Agent, Horizon, V2};
+use crate::geometry::{Point, Vector};
+use crate::plan::team::{pair_feasible, plan_team, Limits, Pair, PlanGrid, Schedule, Stop, Task};
+use crate::sim::avoid::{Avoid, Avoider};
+use crate::sim::episode::Episode;
+use crate::sim::rng::{stream, Stream};
+use crate::sim::team::Team;
+use crate::sim::world::World;
+use std::sync::Arc;
+
+/// The policy's name.
+pub const NAME: &str = "coordinated";
+
+/// ORCA's horizon among the robots, steps: short, since the plan keeps them apart.
+const TIME_HORIZON_STEPS: f64 = 10.0;
+/// Added to each robot's radius for ORCA, px.
+const ORCA_MARGIN_PX: f64 = 0.5;
+
+/// How close a robot must come to a cell centre to count as there, px: continuous actions land
+/// on it; a discrete step of `move_speed_px` can miss it by up to half a step.
+fn reach_px(me: &Episode, actions: PlannerActions) -> f64 {
+    match actions {
+        PlannerActions::Continuous => 0.5,
+        PlannerActions::Discrete => me.config().robot.move_speed_px / 2.0 + 0.5,
+    }
+}
+
+/// The plan being followed.
+#[derive(Debug)]
+struct Following {
+    schedule: Schedule,
+    /// Each robot's stops: the point to drive to at each.
+    points: Vec<Vec<Point>>,
+    /// Whether each stop reaches a goal (driven onto, never through).
+    goals: Vec<Vec<bool>>,
+    /// The stop each robot heads to (`u32::MAX` once it left the scene).
+    heading: Vec<u32>,
+}
+
+/// The `coordinated` team planner.
+#[derive(Default)]
+pub struct Coordinated {
+    following: Option<Following>,
+    /// When the plan failed without proof of infeasibility: every robot on `orca`.
+    fallback: Option<PerRobot>,
+    infeasible: Option<String>,
+    /// Every robot's centre at the last decision (its velocity is its displacement since), then
+    /// every moving obstacle's.
+    last: Vec<Option<Point>>,
+    agents: Vec<Agent<f64>>,
+    /// The place of each robot in `agents`.
+    slot: Vec<Option<usize>>,
+    avoider: Avoider,
+}
+
+impl std::fmt::Debug for Coordinated {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Coordinated")
+            .field("following", &self.following)
+            .field("infeasible", &self.infeasible)
+            .finish_non_exhaustive()
+    }
+}
+
+/// The cell side of a team's plan: robots on different cells, each within `reach` of its
+/// centre or of the line between two centres, stay clear: `sqrt 2 (2 r + 2 reach + 1)`.
+pub fn cell_px(max_radius: f64, reach: f64) -> f64 {
+    std::f64::consts::SQRT_2 * (2.0 * max_radius + 2.0 * reach + 1.0)
+}
+
+/// Where a robot drives to at a stop on `cell`'s centre `c` that reaches goal `goal`: just far
+/// enough towards the goal to come within `tolerance - 1` px of it.
+fn stop_point(c: Point, goal: Option<Point>, tolerance: f64) -> Point {
+    let Some(g) = goal else {
+        return c;
+    };
+    let off = g - c;
+    let d = off.norm();
+    let within = (tolerance - 1.0).max(0.0);
+    if d <= within {
+        c
+    } else {
+        c + off * ((d - within) / d)
+    }
+}
+
+/// The robots' tasks on `grid`: starts on distinct cells, last goals of robots that stay on
+/// distinct cells; `None` when a start or goal has no free cell near it.
+fn tasks(grid: &PlanGrid, team: &Team) -> Option<Vec<Task>> {
+    let reach = grid.cell_px() * 1.5;
+    let mut starts_taken = std::collections::HashSet::new();
+    let mut parks_taken = std::collections::HashSet::new();
+    let mut out = Vec::new();
+    for (k, r) in team.robots().iter().enumerate() {
+        let start = grid
+            .nearest_free(r.pose().position(), reach)
+            .into_iter()
+            .find(|c| starts_taken.insert(*c))?;
+        let vanish = team.on_arrival(k) == OnArrival::Vanish;
+        let points = goal_points(team, k);
+        let mut goals = Vec::new();
+        for (g, p) in points.iter().enumerate() {
+            let last = g + 1 == points.len();
+            let cells = grid.nearest_free(*p, reach);
+            let cell = if last && !vanish {
+                cells.into_iter().find(|c| parks_taken.insert(*c))?
+            } else {
+                *cells.first()?
+            };
+            goals.push(cell);
+        }
+        out.push(Task {
+            start,
+            goals,
+            vanish,
+        });
+    }
+    Some(out)
+}
+
+/// Robot `k`'s goals still to visit, in visiting order (all of them before the first step).
+fn goal_points(team: &Team, k: usize) -> Vec<Point> {
+    let r = team.robot(k);
+    std::iter::once(r.goal())
+        .chain(r.later_goals().iter().copied())
+        .collect()
+}
+
+/// The cells robot `task` passes through on a shortest way to its last goal, alone.
+fn way_cells(grid: &PlanGrid, task: &Task) -> Vec<usize> {
+    let Some(&goal) = task.goals.last() else {
+        return Vec::new();
+    };
+    let d = grid.moves_to(goal);
+    let mut at = task.start;
+    let mut out = vec![at];
+    while d[at] != 0 && d[at] != u32::MAX {
+        let Some((_, next)) = grid.neighbours(at).find(|&(_, j)| d[j] + 1 == d[at]) else {
+            break;
+        };
+        at = next;
+        out.push(at);
+    }
+    out
+}
+
+/// Why the robots `a` and `b` cannot both arrive: the stretch of `a`'s way that `b`'s shares.
+fn passage(grid: &PlanGrid, tasks: &[Task], a: usize, b: usize) -> String {
+    let wa = way_cells(grid, &tasks[a]);
+    let wb: std::collections::HashSet<usize> = way_cells(grid, &tasks[b]).into_iter().collect();
+    let shared: Vec<Point> = wa
+        .iter()
+        .filter(|c| wb.contains(c))
+        .map(|&c| grid.center(c))
+        .collect();
+    let (lo, hi) = shared.iter().fold(
+        (Point::new(f64::INFINITY, f64::INFINITY), Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY)),
+        |(lo, hi), p| (Point::new(lo.x.min(p.x), lo.y.min(p.y)), Point::new(hi.x.max(p.x), hi.y.max(p.y))),
+    );
+    let place = if shared.is_empty() {
+        String::new()
+    } else {
+        format!(
+            " in the passage from ({:.0}, {:.0}) to ({:.0}, {:.0})",
+            lo.x, lo.y, hi.x, hi.y
+        )
+    };
+    format!(
+        "robots {a} and {b} cannot both reach their goals{place}: no way for the two alone to pass \
+         each other (a complete search on {:.1} px cells)",
+        grid.cell_px()
+    )
+}
+
+impl Coordinated {
+    /// Plans `team`; sets `following`, or `infeasible`, or `fallback`.
+    fn plan(&mut self, team: &Team, worlds: &[Arc<World>]) -> Result<(), RobotError> {
+        self.following = None;
+        self.fallback = None;
+        self.infeasible = None;
+        let actions = worlds[0].config().orca.actions;
+        let max_radius = team
+            .robots()
+            .iter()
+            .map(|r| r.config().robot.radius_px)
+            .fold(0.0, f64::max);
+        let reach = team
+            .robots()
+            .iter()
+            .map(|r| reach_px(r, actions))
+            .fold(0.0, f64::max);
+        let cell = cell_px(max_radius, reach);
+        let anchors: Vec<Point> = team.robots().iter().map(|r| r.pose().position()).collect();
+        let scene = worlds[0].scene();
+        let grid = PlanGrid::best(scene, max_radius + 0.5, cell, &anchors);
+        let mut rng = stream(team.robot(0).seed(), Stream::Policy);
+        let planned = tasks(&grid, team).map(|tasks| {
+            let plan = plan_team(&grid, &tasks, &Limits::default(), &mut rng);
+            (tasks, plan)
+        });
+        if std::env::var_os("RONAP_DEBUG_PLAN").is_some() {
+            let (c, r) = grid.size();
+            eprintln!("grid {c}x{r} cell {cell:.1} free {}: {}", (0..grid.len()).filter(|&i| grid.is_free(i)).count(),
+                match &planned { None => "no tasks".to_string(), Some((_, Ok(p))) => format!("planned, stops {:?}", p.iter().map(Vec::len).collect::<Vec<_>>()), Some((_, Err(e))) => format!("failed {e:?}") });
+        }
+        match planned {
+            Some((_, Ok(plans))) => {
+                self.following = Some(Following {
+                    schedule: Schedule::new(&plans),
+                    points: plans
+                        .iter()
+                        .enumerate()
+                        .map(|(k, stops)| self::points(&grid, team, k, stops))
+                        .collect(),
+                    goals: plans
+                        .iter()
+                        .map(|stops| stops.iter().map(|s| s.goal.is_some()).collect())
+                        .collect(),
+                    heading: vec![0; plans.len()],
+                });
+                Ok(())
+            }
+            Some((tasks, Err(failure))) => {
+                let f = failure.robot;
+                let single = |k: usize| tasks[k].goals.len() == 1;
+                if single(f) {
+                    for j in (0..tasks.len()).filter(|&j| j != f && single(j)) {
+                        if pair_feasible(&grid, &tasks[f], &tasks[j]) == Pair::Infeasible {
+                            let (a, b) = (f.min(j), f.max(j));
+                            self.infeasible = Some(passage(&grid, &tasks, a, b));
+                            return Ok(());
+                        }
+                    }
+                }
+                self.fall_back(team, worlds)
+            }
+            None => self.fall_back(team, worlds),
+        }
+    }
+
+    fn fall_back(&mut self, team: &Team, worlds: &[Arc<World>]) -> Result<(), RobotError> {
+        let policies: Vec<Box<dyn Policy>> = (0..team.robots().len())
+            .map(|_| Box::new(Orca::default()) as Box<dyn Policy>)
+            .collect();
+        let mut p = PerRobot::new(policies);
+        p.reset(team, worlds)?;
+        self.fallback = Some(p);
+        Ok(())
+    }
+
+    /// Every present robot and moving obstacle as an ORCA agent, with its velocity since the
+    /// last decision.
+    fn sense(&mut self, team: &Team) {
+        let n = team.robots().len();
+        let movers = team.movers().map_or(0, |m| m.items().len());
+        self.last.resize(n + movers, None);
+        self.agents.clear();
+        self.slot.clear();
+        let mut seen = |slot: usize, at: Option<Point>, radius: f64, agents: &mut Vec<_>| {
+            let last = std::mem::replace(&mut self.last[slot], at);
+            at.map(|at| {
+                agents.push(Agent {
+                    position: V2::from(at),
+                    velocity: V2::from(last.map_or(Vector::zeros(), |l| at - l)),
+                    radius,
+                });
+                agents.len() - 1
+            })
+        };
+        for (k, r) in team.robots().iter().enumerate() {
+            let at = team.present(k).then(|| r.pose().position());
+            let s = seen(k, at, r.config().robot.radius_px, &mut self.agents);
+            self.slot.push(s);
+        }
+        if let Some(m) = team.movers() {
+            for (i, o) in m.items().enumerate() {
+                let at = o.present().then(|| o.position());
+                seen(n + i, at, o.body().bounding_radius(), &mut self.agents);
+            }
+        }
+    }
+}
+
+/// The points robot `k` drives to along `stops`.
+fn points(grid: &PlanGrid, team: &Team, k: usize, stops: &[Stop]) -> Vec<Point> {
+    let goals = goal_points(team, k);
+    let tolerance = team.robot(k).config().episode.goal_tolerance_px;
+    stops
+        .iter()
+        .map(|s| stop_point(grid.center(s.cell), s.goal.and_then(|g| goals.get(g).copied()), tolerance))
+        .collect()
+}
+
+impl TeamPolicy for Coordinated {
+    fn reset(&mut self, team: &Team, worlds: &[Arc<World>]) -> Result<(), RobotError> {
+        self.last.clear();
+        self.plan(team, worlds)
+    }
+
+    fn infeasible(&self) -> Option<&str> {
+        self.infeasible.as_deref()
+    }
+
+    fn act(&mut self, team: &Team, decisions: &mut [Option<Decision>]) -> Result<(), RobotError> {
+        if let Some(p) = &mut self.fallback {
+            return p.act(team, decisions);
+        }
+        self.sense(team);
+        let Some(f) = &mut self.following else {
+            for (k, d) in decisions.iter_mut().enumerate() {
+                if team.running(k) {
+                    *d = Some(Decision::GiveUp("the team was not planned".into()));
+                }
+            }
+            return Ok(());
+        };
+        // Who has reached the stop it was heading to: within reach of it, or within a step of
+        // it when the stop after it is open too (the robot drives on without slowing).
+        for (k, r) in team.robots().iter().enumerate() {
+            if !team.present(k) {
+                f.heading[k] = u32::MAX;
+                continue;
+            }
+            // A robot that came within the goal's tolerance short of its last stop stays
+            // where it is: it holds its last stop's cell from now on.
+            if !team.running(k) {
+                f.heading[k] = f.heading[k].max(f.points[k].len() as u32);
+                continue;
+            }
+            let h = f.heading[k] as usize;
+            if let Some(&p) = f.points[k].get(h) {
+                let config = r.config();
+                let actions = config.orca.actions;
+                let through = h + 1 < f.points[k].len()
+                    && !f.goals[k][h]
+                    && f.schedule.may_go(k, h + 1, &f.heading);
+                let reach = if through {
+                    planner_speed(r, config.orca.speed_px, actions).max(reach_px(r, actions))
+                } else {
+                    reach_px(r, actions)
+                };
+                if (p - r.pose().position()).norm() <= reach {
+                    f.heading[k] += 1;
+                }
+            }
+        }
+        if std::env::var("RONAP_DEBUG_STEP").ok().and_then(|s| s.parse::<u32>().ok()) == Some(team.steps()) {
+            for (k, r) in team.robots().iter().enumerate() {
+                let h = f.heading[k] as usize;
+                eprintln!("robot {k} running {} heading {h}/{} at {:?} next {:?} waits {:?} goal {:?} reached {}", team.running(k), f.points[k].len(), r.pose().position(), f.points[k].get(h), f.schedule.waits(k, h), r.goal(), r.goals_reached());
+            }
+        }
+        for (k, d) in decisions.iter_mut().enumerate() {
+            if !team.running(k) {
+                continue;
+            }
+            let me = team.robot(k);
+            let config = me.config();
+            let actions = config.orca.actions;
+            let speed = planner_speed(me, config.orca.speed_px, actions);
+            let h = f.heading[k] as usize;
+            let points = &f.points[k];
+            // Where it drives: its next stop once that is open, else where it is; at full speed
+            // through a stop whose next is open too.
+            let open = |p: usize| p == 0 || f.schedule.may_go(k, p, &f.heading);
+            let (target, through) = if h >= points.len() {
+                (me.goal(), false)
+            } else if open(h) {
+                (points[h], h + 1 < points.len() && !f.goals[k][h] && open(h + 1))
+            } else {
+                (points[h - 1], false)
+            };
+            let p = me.pose().position();
+            let to = target - p;
+            let dist = to.norm();
+            let preferred = if dist <= 1e-9 || team.collided(k) {
+                // Blocked last step (an arc into a wall): turn towards the target first.
+                Vector::zeros()
+            } else if through {
+                to * (speed / dist)
+            } else {
+                to * (speed.min(dist) / dist)
+            };
+            let v = match self.slot[k] {
+                Some(slot) => self.avoider.velocity(
+                    me.scene(),
+                    &Avoid {
+                        agents: &self.agents,
+                        me: slot,
+                        preferred,
+                        horizon: Horizon {
+                            agents: TIME_HORIZON_STEPS,
+                            obstacles: config.orca.obstacle_time_horizon_steps,
+                            max_speed: speed,
+                            time_step: 1.0,
+                        },
+                        neighbour_dist: config
+                            .orca
+                            .sense_range_px
+                            .unwrap_or(config.laser.range_px),
+                        max_neighbours: config.orca.max_neighbours as usize,
+                        margin: ORCA_MARGIN_PX,
+                        candidates: None,
+                    },
+                ),
+                None => preferred,
+            };
+            *d = Some(Decision::Act(action(me, v, to, actions)));
+        }
+        Ok(())
+    }
+
+    fn next_goal(
+        &mut self,
+        robot: usize,
+        world: &World,
+        episode: &Episode,
+    ) -> Result<(), PolicyError> {
+        // The plan covers every leg; only the fallback's robots plan each leg afresh.
+        match &mut self.fallback {
+            Some(p) => p.next_goal(robot, world, episode),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Makes [`Coordinated`] team planners, naming every robot's policy `coordinated`.
+#[derive(Clone, Debug)]
+pub struct CoordinatedFactory {
+    robots: usize,
+}
+
+impl CoordinatedFactory {
+    /// The planner of a team of `robots`.
+    pub fn new(robots: usize) -> Self {
+        Self { robots }
+    }
+}
+
+/// As a single robot's policy it cannot start: it plans teams.
+impl super::PolicyFactory for CoordinatedFactory {
+    fn make(&self) -> Result<Box<dyn Policy>, PolicyError> {
+        Err(PolicyError::Failed(
+            "coordinated plans a team of [[robots]]; it has no single-robot form".into(),
+        ))
+    }
+
+    fn name(&self) -> String {
+        NAME.to_string()
+    }
+}
+
+impl TeamPolicyFactory for CoordinatedFactory {
+    fn make(&self) -> Result<Box<dyn TeamPolicy>, PolicyError> {
+        Ok(Box::new(Coordinated::default()))
+    }
+
+    fn names(&self) -> Vec<String> {
+        vec![NAME.to_string(); self.robots]
+    }
+}
