@@ -27,19 +27,24 @@ use super::{Decision, Policy, PolicyError};
 use crate::config::{OnArrival, PlannerActions};
 use crate::geometry::orca::{Agent, Horizon, V2};
 use crate::geometry::{Point, Vector};
-use crate::plan::team::{pair_feasible, plan_team, Limits, Pair, PlanGrid, Schedule, Stop, Task};
+use crate::plan::team::{
+    pair_feasible, plan_team, Limits, Pair, PlanFailure, PlanGrid, Schedule, Stop, Task,
+};
 use crate::sim::avoid::{Avoid, Avoider};
 use crate::sim::episode::Episode;
 use crate::sim::rng::{stream, Stream};
 use crate::sim::team::Team;
 use crate::sim::world::World;
+use std::collections::HashSet;
 use std::sync::Arc;
 
 /// The policy's name.
 pub const NAME: &str = "coordinated";
 
 /// ORCA's horizon among the robots, steps: short, since the plan keeps them apart.
-const TIME_HORIZON_STEPS: f64 = 10.0;
+const TIME_HORIZON_STEPS: f64 = 2.0;
+/// Most plans an episode makes after its first, before its robots fall back to `orca`.
+const MAX_REPLANS: u32 = 50;
 /// Added to each robot's radius for ORCA, px.
 const ORCA_MARGIN_PX: f64 = 0.5;
 
@@ -60,8 +65,127 @@ struct Following {
     points: Vec<Vec<Point>>,
     /// Whether each stop reaches a goal (driven onto, never through).
     goals: Vec<Vec<bool>>,
-    /// The stop each robot heads to (`u32::MAX` once it left the scene).
+    /// The stop each robot heads to (`u32::MAX` once it left the scene, or for a robot not
+    /// planned).
     heading: Vec<u32>,
+    /// Whether a robot stopped for good short of its plan's end (within its goal's tolerance
+    /// on the way to its last stop): the others are planned again around it.
+    stopped_short: bool,
+}
+
+impl Following {
+    /// Whether robot `k` may move to its stop `p`.
+    fn open(&self, k: usize, p: usize) -> bool {
+        p == 0 || self.schedule.may_go(k, p, &self.heading)
+    }
+
+    /// The last stop robot `k` may drive on to without halting: from the one it heads to,
+    /// through open stops, up to the first goal (driven onto, never through).
+    fn open_end(&self, k: usize) -> usize {
+        let h = self.heading[k] as usize;
+        let n = self.points[k].len();
+        let mut e = h;
+        while e + 1 < n && !self.goals[k][e] && self.open(k, e + 1) {
+            e += 1;
+        }
+        e
+    }
+
+    /// Moves each robot's heading on past the stops it has reached: within reach of a stop, or,
+    /// driving through it, past it (beyond the start of the segment that leaves it).
+    fn advance(&mut self, team: &Team) {
+        for (k, r) in team.robots().iter().enumerate() {
+            if !team.present(k) {
+                self.heading[k] = u32::MAX;
+                continue;
+            }
+            // A robot that came within the goal's tolerance short of its last stop stays
+            // where it is: it holds its last stop's cell from now on.
+            if !team.running(k) {
+                let end = self.points[k].len() as u32;
+                if self.heading[k] < end {
+                    self.stopped_short = true;
+                }
+                self.heading[k] = self.heading[k].max(end);
+                continue;
+            }
+            let p = r.pose().position();
+            let config = r.config();
+            let reach = reach_px(r, config.orca.actions);
+            // Past a stop it drives through, it is within its lookahead of it.
+            let through = planner_speed(r, config.orca.speed_px, config.orca.actions);
+            loop {
+                let h = self.heading[k] as usize;
+                let Some(&stop) = self.points[k].get(h) else {
+                    break;
+                };
+                let passed = h < self.open_end(k) && (stop - p).norm() <= through && {
+                    let next = self.points[k][h + 1];
+                    (p - stop).dot(&(next - stop)) > 0.0
+                };
+                if (stop - p).norm() <= reach || (passed && self.open(k, h)) {
+                    self.heading[k] += 1;
+                } else {
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Where robot `me` (`k`) drives this step: `lookahead` px along its plan's open stops
+    /// past where it is (pure pursuit), ending on the last open one; where it is while its
+    /// next stop is closed; its goal once past its last stop.
+    fn aim(&self, k: usize, me: &Episode, lookahead: f64) -> Point {
+        let h = self.heading[k] as usize;
+        let points = &self.points[k];
+        let p = me.pose().position();
+        if h >= points.len() {
+            return me.goal();
+        }
+        if !self.open(k, h) {
+            return points[h - 1];
+        }
+        if h == 0 {
+            return points[0];
+        }
+        let e = self.open_end(k);
+        // Along the segment into stop h from where the robot projects onto it.
+        let (a, b) = (points[h - 1], points[h]);
+        let ab = b - a;
+        let len = ab.norm();
+        let along = if len > 0.0 {
+            ((p - a).dot(&ab) / len).clamp(0.0, len)
+        } else {
+            0.0
+        };
+        let mut left = lookahead + along;
+        let mut from = a;
+        for q in h..=e {
+            let to = points[q];
+            let seg = (to - from).norm();
+            if left <= seg && seg > 0.0 {
+                return from + (to - from) * (left / seg);
+            }
+            left -= seg;
+            from = to;
+        }
+        points[e]
+    }
+}
+
+/// A planning of the running robots: which robots, their tasks, and their plans or the
+/// planner's failure.
+struct Planned {
+    robots: Vec<usize>,
+    tasks: Vec<Task>,
+    plans: Result<Vec<Vec<Stop>>, PlanFailure>,
+}
+
+impl Planned {
+    /// The robots planned and their plans, when the planner found them.
+    fn found(self) -> Option<(Vec<usize>, Vec<Vec<Stop>>)> {
+        Some((self.robots, self.plans.ok()?))
+    }
 }
 
 /// The `coordinated` team planner.
@@ -71,6 +195,14 @@ pub struct Coordinated {
     /// When the plan failed without proof of infeasibility: every robot on `orca`.
     fallback: Option<PerRobot>,
     infeasible: Option<String>,
+    /// The grid the team is planned on.
+    grid: Option<PlanGrid>,
+    /// The robots' worlds (for the fallback).
+    worlds: Vec<Arc<World>>,
+    /// The episode's generator of priority orders.
+    rng: Option<crate::sim::rng::Rng>,
+    /// Plans made since the first.
+    replans: u32,
     /// Every robot's centre at the last decision (its velocity is its displacement since), then
     /// every moving obstacle's.
     last: Vec<Option<Point>>,
@@ -111,14 +243,23 @@ fn stop_point(c: Point, goal: Option<Point>, tolerance: f64) -> Point {
     }
 }
 
-/// The robots' tasks on `grid`: starts on distinct cells, last goals of robots that stay on
-/// distinct cells; `None` when a start or goal has no free cell near it.
-fn tasks(grid: &PlanGrid, team: &Team) -> Option<Vec<Task>> {
+/// The tasks of the running robots of `team` on `grid` (and which robot each is for): starts
+/// on distinct cells, last goals of robots that stay on distinct cells, none on a `blocked`
+/// cell; `None` when a start or goal has no such cell near it.
+fn tasks(
+    grid: &PlanGrid,
+    team: &Team,
+    blocked: &HashSet<usize>,
+) -> Option<(Vec<usize>, Vec<Task>)> {
     let reach = grid.cell_px() * 1.5;
-    let mut starts_taken = std::collections::HashSet::new();
-    let mut parks_taken = std::collections::HashSet::new();
+    let mut starts_taken = blocked.clone();
+    let mut parks_taken = blocked.clone();
+    let mut robots = Vec::new();
     let mut out = Vec::new();
     for (k, r) in team.robots().iter().enumerate() {
+        if !team.running(k) {
+            continue;
+        }
         let start = grid
             .nearest_free(r.pose().position(), reach)
             .into_iter()
@@ -128,21 +269,31 @@ fn tasks(grid: &PlanGrid, team: &Team) -> Option<Vec<Task>> {
         let mut goals = Vec::new();
         for (g, p) in points.iter().enumerate() {
             let last = g + 1 == points.len();
-            let cells = grid.nearest_free(*p, reach);
+            let mut cells = grid
+                .nearest_free(*p, reach)
+                .into_iter()
+                .filter(|c| !blocked.contains(c));
             let cell = if last && !vanish {
-                cells.into_iter().find(|c| parks_taken.insert(*c))?
+                cells.find(|c| parks_taken.insert(*c))?
             } else {
-                *cells.first()?
+                cells.next()?
             };
             goals.push(cell);
         }
+        robots.push(k);
         out.push(Task {
             start,
             goals,
             vanish,
         });
     }
-    Some(out)
+    Some((robots, out))
+}
+
+/// The cells a robot standing at `p` for good blocks: those whose centres lie within a cell of
+/// it (a robot on its way between two cells beyond passes it at least the grid's clearance).
+fn blocked_by(grid: &PlanGrid, p: Point) -> impl Iterator<Item = usize> + '_ {
+    grid.nearest_free(p, grid.cell_px()).into_iter()
 }
 
 /// Robot `k`'s goals still to visit, in visiting order (all of them before the first step).
@@ -200,11 +351,13 @@ fn passage(grid: &PlanGrid, tasks: &[Task], a: usize, b: usize) -> String {
 }
 
 impl Coordinated {
-    /// Plans `team`; sets `following`, or `infeasible`, or `fallback`.
+    /// Plans `team` before its first step: sets `following`, or `infeasible`, or `fallback`.
     fn plan(&mut self, team: &Team, worlds: &[Arc<World>]) -> Result<(), RobotError> {
         self.following = None;
         self.fallback = None;
         self.infeasible = None;
+        self.replans = 0;
+        self.worlds = worlds.to_vec();
         let actions = worlds[0].config().orca.actions;
         let max_radius = team
             .robots()
@@ -216,56 +369,118 @@ impl Coordinated {
             .iter()
             .map(|r| reach_px(r, actions))
             .fold(0.0, f64::max);
-        let cell = cell_px(max_radius, reach);
         let anchors: Vec<Point> = team.robots().iter().map(|r| r.pose().position()).collect();
-        let scene = worlds[0].scene();
-        let grid = PlanGrid::best(scene, max_radius + 0.5, cell, &anchors);
-        let mut rng = stream(team.robot(0).seed(), Stream::Policy);
-        let planned = tasks(&grid, team).map(|tasks| {
-            let plan = plan_team(&grid, &tasks, &Limits::default(), &mut rng);
-            (tasks, plan)
-        });
-        if std::env::var_os("RONAP_DEBUG_PLAN").is_some() {
-            let (c, r) = grid.size();
-            eprintln!("grid {c}x{r} cell {cell:.1} free {}: {}", (0..grid.len()).filter(|&i| grid.is_free(i)).count(),
-                match &planned { None => "no tasks".to_string(), Some((_, Ok(p))) => format!("planned, stops {:?}", p.iter().map(Vec::len).collect::<Vec<_>>()), Some((_, Err(e))) => format!("failed {e:?}") });
-        }
-        match planned {
-            Some((_, Ok(plans))) => {
-                self.following = Some(Following {
-                    schedule: Schedule::new(&plans),
-                    points: plans
-                        .iter()
-                        .enumerate()
-                        .map(|(k, stops)| self::points(&grid, team, k, stops))
-                        .collect(),
-                    goals: plans
-                        .iter()
-                        .map(|stops| stops.iter().map(|s| s.goal.is_some()).collect())
-                        .collect(),
-                    heading: vec![0; plans.len()],
-                });
-                Ok(())
-            }
-            Some((tasks, Err(failure))) => {
-                let f = failure.robot;
-                let single = |k: usize| tasks[k].goals.len() == 1;
-                if single(f) {
-                    for j in (0..tasks.len()).filter(|&j| j != f && single(j)) {
-                        if pair_feasible(&grid, &tasks[f], &tasks[j]) == Pair::Infeasible {
-                            let (a, b) = (f.min(j), f.max(j));
-                            self.infeasible = Some(passage(&grid, &tasks, a, b));
-                            return Ok(());
-                        }
+        let grid = PlanGrid::best(
+            worlds[0].scene(),
+            max_radius + 0.5,
+            cell_px(max_radius, reach),
+            &anchors,
+        );
+        self.rng = Some(stream(team.robot(0).seed(), Stream::Policy));
+        let planned = self.plan_from_here(&grid, team);
+        if let Some(Planned {
+            tasks,
+            plans: Err(failure),
+            ..
+        }) = &planned
+        {
+            let f = failure.robot;
+            let single = |k: usize| tasks[k].goals.len() == 1;
+            if single(f) {
+                for j in (0..tasks.len()).filter(|&j| j != f && single(j)) {
+                    if pair_feasible(&grid, &tasks[f], &tasks[j]) == Pair::Infeasible {
+                        let (a, b) = (f.min(j), f.max(j));
+                        self.infeasible = Some(passage(&grid, tasks, a, b));
+                        return Ok(());
                     }
                 }
-                self.fall_back(team, worlds)
             }
-            None => self.fall_back(team, worlds),
         }
+        self.follow(&grid, team, planned.and_then(Planned::found))?;
+        self.grid = Some(grid);
+        Ok(())
+    }
+
+    /// Plans the running robots of `team` from where they stand, around the robots that stopped
+    /// for good: the robots planned, their tasks and their plans (`None`: a start or goal has no
+    /// cell).
+    fn plan_from_here(&mut self, grid: &PlanGrid, team: &Team) -> Option<Planned> {
+        let mut blocked = HashSet::new();
+        for (k, r) in team.robots().iter().enumerate() {
+            if team.present(k) && !team.running(k) {
+                blocked.extend(blocked_by(grid, r.pose().position()));
+            }
+        }
+        let (robots, tasks) = tasks(grid, team, &blocked)?;
+        let blocked: Vec<usize> = blocked.into_iter().collect();
+        let rng = self
+            .rng
+            .get_or_insert_with(|| stream(team.robot(0).seed(), Stream::Policy));
+        let plans = plan_team(grid, &tasks, &blocked, &Limits::default(), rng);
+        Some(Planned {
+            robots,
+            tasks,
+            plans,
+        })
+    }
+
+    /// Follows `planned` (the robots planned and their plans), or falls back to `orca`.
+    fn follow(
+        &mut self,
+        grid: &PlanGrid,
+        team: &Team,
+        planned: Option<(Vec<usize>, Vec<Vec<Stop>>)>,
+    ) -> Result<(), RobotError> {
+        let Some((robots, plans)) = planned else {
+            self.following = None;
+            let worlds = self.worlds.clone();
+            return self.fall_back(team, &worlds);
+        };
+        let n = team.robots().len();
+        let mut by_robot: Vec<Vec<Stop>> = vec![Vec::new(); n];
+        for (k, stops) in robots.into_iter().zip(plans) {
+            by_robot[k] = stops;
+        }
+        self.following = Some(Following {
+            schedule: Schedule::new(&by_robot),
+            points: by_robot
+                .iter()
+                .enumerate()
+                .map(|(k, stops)| self::points(grid, team, k, stops))
+                .collect(),
+            goals: by_robot
+                .iter()
+                .map(|stops| stops.iter().map(|s| s.goal.is_some()).collect())
+                .collect(),
+            heading: (0..n)
+                .map(|k| if team.running(k) { 0 } else { u32::MAX })
+                .collect(),
+            stopped_short: false,
+        });
+        Ok(())
+    }
+
+    /// Plans the running robots again from where they stand (a robot stopped for good short of
+    /// its plan's end), or falls back to `orca`.
+    fn replan(&mut self, team: &Team) -> Result<(), RobotError> {
+        self.replans += 1;
+        let Some(grid) = self.grid.take() else {
+            return Ok(());
+        };
+        let planned = if self.replans > MAX_REPLANS {
+            None
+        } else {
+            self.plan_from_here(&grid, team).and_then(Planned::found)
+        };
+        self.follow(&grid, team, planned)?;
+        self.grid = Some(grid);
+        Ok(())
     }
 
     fn fall_back(&mut self, team: &Team, worlds: &[Arc<World>]) -> Result<(), RobotError> {
+        if worlds.is_empty() {
+            return Ok(());
+        }
         let policies: Vec<Box<dyn Policy>> = (0..team.robots().len())
             .map(|_| Box::new(Orca::default()) as Box<dyn Policy>)
             .collect();
@@ -341,40 +556,25 @@ impl TeamPolicy for Coordinated {
             }
             return Ok(());
         };
-        // Who has reached the stop it was heading to: within reach of it, or within a step of
-        // it when the stop after it is open too (the robot drives on without slowing).
-        for (k, r) in team.robots().iter().enumerate() {
-            if !team.present(k) {
-                f.heading[k] = u32::MAX;
-                continue;
+        f.advance(team);
+        if f.stopped_short {
+            self.replan(team)?;
+            if let Some(p) = &mut self.fallback {
+                return p.act(team, decisions);
             }
-            // A robot that came within the goal's tolerance short of its last stop stays
-            // where it is: it holds its last stop's cell from now on.
-            if !team.running(k) {
-                f.heading[k] = f.heading[k].max(f.points[k].len() as u32);
-                continue;
-            }
-            let h = f.heading[k] as usize;
-            if let Some(&p) = f.points[k].get(h) {
-                let config = r.config();
-                let actions = config.orca.actions;
-                let through = h + 1 < f.points[k].len()
-                    && !f.goals[k][h]
-                    && f.schedule.may_go(k, h + 1, &f.heading);
-                let reach = if through {
-                    planner_speed(r, config.orca.speed_px, actions).max(reach_px(r, actions))
-                } else {
-                    reach_px(r, actions)
-                };
-                if (p - r.pose().position()).norm() <= reach {
-                    f.heading[k] += 1;
-                }
-            }
+            let Some(f2) = &mut self.following else {
+                return Ok(());
+            };
+            f2.advance(team);
         }
+        let Some(f) = &mut self.following else {
+            return Ok(());
+        };
         if std::env::var("RONAP_DEBUG_STEP").ok().and_then(|s| s.parse::<u32>().ok()) == Some(team.steps()) {
             for (k, r) in team.robots().iter().enumerate() {
+                if !team.running(k) { continue; }
                 let h = f.heading[k] as usize;
-                eprintln!("robot {k} running {} heading {h}/{} at {:?} next {:?} waits {:?} goal {:?} reached {}", team.running(k), f.points[k].len(), r.pose().position(), f.points[k].get(h), f.schedule.waits(k, h), r.goal(), r.goals_reached());
+                eprintln!("robot {k} heading {h}/{} at {:?} next {:?} prev {:?} waits {:?} goal {:?}", f.points[k].len(), r.pose().position(), f.points[k].get(h), h.checked_sub(1).and_then(|i| f.points[k].get(i)), f.schedule.waits(k, h), r.goal());
             }
         }
         for (k, d) in decisions.iter_mut().enumerate() {
@@ -385,26 +585,13 @@ impl TeamPolicy for Coordinated {
             let config = me.config();
             let actions = config.orca.actions;
             let speed = planner_speed(me, config.orca.speed_px, actions);
-            let h = f.heading[k] as usize;
-            let points = &f.points[k];
-            // Where it drives: its next stop once that is open, else where it is; at full speed
-            // through a stop whose next is open too.
-            let open = |p: usize| p == 0 || f.schedule.may_go(k, p, &f.heading);
-            let (target, through) = if h >= points.len() {
-                (me.goal(), false)
-            } else if open(h) {
-                (points[h], h + 1 < points.len() && !f.goals[k][h] && open(h + 1))
-            } else {
-                (points[h - 1], false)
-            };
             let p = me.pose().position();
-            let to = target - p;
+            let aim = f.aim(k, me, speed);
+            let to = aim - p;
             let dist = to.norm();
             let preferred = if dist <= 1e-9 || team.collided(k) {
-                // Blocked last step (an arc into a wall): turn towards the target first.
+                // Blocked last step (an arc into a wall): turn towards the aim first.
                 Vector::zeros()
-            } else if through {
-                to * (speed / dist)
             } else {
                 to * (speed.min(dist) / dist)
             };

@@ -305,11 +305,12 @@ fn stops(grid: &PlanGrid, task: &Task, ticks: &[(usize, u8)]) -> Vec<Stop> {
 
 /// Plans every robot of `tasks` on `grid`: robots in an order of priority (the longest way
 /// first; then the robot that failed moved to the front; then orders drawn from `rng`), each
-/// around those before it. The stops of each robot's plan, or the robot that found no way in
+/// around those before it and clear of the `blocked` cells. The stops of each robot's plan, or the robot that found no way in
 /// the last order tried.
 pub fn plan_team(
     grid: &PlanGrid,
     tasks: &[Task],
+    blocked: &[usize],
     limits: &Limits,
     rng: &mut impl rand::Rng,
 ) -> Result<Vec<Vec<Stop>>, PlanFailure> {
@@ -343,6 +344,9 @@ pub fn plan_team(
             order.shuffle(rng);
         }
         let mut res = Reservations::new(grid.len());
+        for &c in blocked {
+            res.parked[c] = (0, u32::MAX);
+        }
         for (k, t) in tasks.iter().enumerate() {
             res.hold(t.start, 0, k as u32);
         }
