@@ -20,13 +20,14 @@
 //! - **Fallback.** When no plan is found and none is proved impossible (or a robot's start or
 //!   goal has no cell), every robot runs the `orca` policy instead.
 
-use super::local::{action, planner_speed};
+use super::local::{action, planner_speed, turn_to};
 use super::orca::Orca;
 use super::team::{PerRobot, RobotError, TeamPolicy, TeamPolicyFactory};
 use super::{Decision, Policy, PolicyError};
 use crate::config::{OnArrival, PlannerActions};
 use crate::geometry::orca::{Agent, Horizon, V2};
 use crate::geometry::{Point, Vector};
+use crate::sim::robot::Action;
 use crate::plan::team::{
     pair_feasible, plan_team, Limits, Pair, PlanFailure, PlanGrid, Schedule, Stop, Task,
 };
@@ -45,16 +46,43 @@ pub const NAME: &str = "coordinated";
 const TIME_HORIZON_STEPS: f64 = 2.0;
 /// Most plans an episode makes after its first, before its robots fall back to `orca`.
 const MAX_REPLANS: u32 = 50;
-/// Added to each robot's radius for ORCA, px.
-const ORCA_MARGIN_PX: f64 = 0.5;
 
 /// How close a robot must come to a cell centre to count as there, px: continuous actions land
 /// on it; a discrete step of `move_speed_px` can miss it by up to half a step.
 fn reach_px(me: &Episode, actions: PlannerActions) -> f64 {
     match actions {
-        PlannerActions::Continuous => 0.5,
+        PlannerActions::Continuous => 1.0,
         PlannerActions::Discrete => me.config().robot.move_speed_px / 2.0 + 0.5,
     }
+}
+
+/// Largest angle between a unicycle's axis (forwards or backwards) and the way it is to go
+/// that it drives along an arc; beyond it, it turns on the spot first, so that it neither
+/// swings wide of a turn in its plan nor sweeps sideways into a wall. Degrees.
+const ARC_MAX_DEG: f64 = 30.0;
+
+/// The action that follows velocity `v` (towards `aim` when standing): for continuous actions,
+/// a turn on the spot while the robot's axis is more than [`ARC_MAX_DEG`] off the way to go,
+/// else the `orca` policy's tracking command.
+fn drive(me: &Episode, v: Vector, aim: Vector, actions: PlannerActions) -> Action {
+    let way = if v.norm() > 1e-9 { v } else { aim };
+    if actions == PlannerActions::Continuous && way.norm() > 1e-9 {
+        let error = turn_to(me, way);
+        // Off the axis, forwards or backwards.
+        let off = if error.abs() > 90.0 {
+            error - 180.0 * error.signum()
+        } else {
+            error
+        };
+        if off.abs() > ARC_MAX_DEG {
+            let w_max = me.config().robot.max_angular_speed_deg;
+            return Action::Continuous {
+                v: 0.0,
+                w_deg: off.clamp(-w_max, w_max),
+            };
+        }
+    }
+    action(me, v, aim, actions)
 }
 
 /// The plan being followed.
@@ -613,13 +641,13 @@ impl TeamPolicy for Coordinated {
                             .sense_range_px
                             .unwrap_or(config.laser.range_px),
                         max_neighbours: config.orca.max_neighbours as usize,
-                        margin: ORCA_MARGIN_PX,
+                        margin: 0.0,
                         candidates: None,
                     },
                 ),
                 None => preferred,
             };
-            *d = Some(Decision::Act(action(me, v, to, actions)));
+            *d = Some(Decision::Act(drive(me, v, to, actions)));
         }
         Ok(())
     }
