@@ -245,7 +245,9 @@ fn view_of_a_team_shows_every_robot_follows_another_on_tab_and_quits() {
     });
     assert!(screen.contains("at goal    0 / 8"), "{screen}");
     assert!(screen.contains("robot 0 · geodesic"), "{screen}");
-    assert!(screen.contains("robots ● 0 ● 1"), "{screen}");
+    // At 80x24 the colour legend gives way to the keys.
+    assert!(!screen.contains("robots ● 0 ● 1"), "{screen}");
+    assert!(screen.contains("tab     follow the next robot"), "{screen}");
     tmux.keys(&["Tab"]);
     tmux.wait("robot 1 followed", 10, |s| s.contains("robot 1"));
     tmux.keys(&["M"]);
@@ -259,10 +261,10 @@ fn view_of_a_team_shows_every_robot_follows_another_on_tab_and_quits() {
 /// Runs the team view of `scenario` (geodesic, seed 0) to its end in a `width` x `height` pane
 /// and checks that every key is explained and the whole end-of-episode status line is on screen,
 /// its collisions with walls and with robots those robots.csv records for the same episode, and
-/// the followed robot's those of its own row. Returns the status line's rows.
-fn team_view_ends_fitted(name: &str, scenario: &str, width: u16, height: u16) -> Vec<String> {
+/// the followed robot's those of its own row. Returns the screen at the end (empty without tmux).
+fn team_view_ends_fitted(name: &str, scenario: &str, width: u16, height: u16) -> String {
     let Some(tmux) = Tmux::start_sized(name, width, height) else {
-        return Vec::new();
+        return String::new();
     };
     let dir = tempfile::tempdir().unwrap();
     let scenario = repo_root().join("scenarios").join(scenario);
@@ -303,13 +305,13 @@ fn team_view_ends_fitted(name: &str, scenario: &str, width: u16, height: u16) ->
     for line in &lines {
         assert!(line.chars().count() <= usize::from(width), "{screen}");
     }
-    // The status rows: from the one that starts with the mark to the bottom, below the panels.
-    let first = lines
-        .iter()
-        .position(|l| l.starts_with(" ■ ended"))
-        .unwrap();
-    assert!(lines[first - 1].starts_with('└'), "{screen}");
-    let status: Vec<String> = lines[first..].iter().map(|l| l.to_string()).collect();
+    // The status rows at the bottom, below the panels.
+    let status = status_rows(&screen);
+    assert!(!status.is_empty(), "{screen}");
+    assert!(
+        lines[lines.len() - status.len() - 1].starts_with('└'),
+        "{screen}"
+    );
     let joined = status.join(" ");
     assert!(joined.contains(&team), "{team} not in:\n{screen}");
     assert!(joined.contains("step "), "{screen}");
@@ -340,12 +342,25 @@ fn team_view_ends_fitted(name: &str, scenario: &str, width: u16, height: u16) ->
     assert!(screen.contains(&format!("collisions {}", &team["collisions: ".len()..])));
     tmux.keys(&["q"]);
     tmux.wait("the shell", 15, |s| s.contains("after-view rc=0"));
-    status
+    screen
+}
+
+/// The rows of an ended view's status line: from the one that starts with the mark to the
+/// bottom.
+fn status_rows(screen: &str) -> Vec<String> {
+    let lines: Vec<&str> = screen.lines().collect();
+    lines
+        .iter()
+        .position(|l| l.starts_with(" ■ ended"))
+        .map_or_else(Vec::new, |first| {
+            lines[first..].iter().map(|l| l.to_string()).collect()
+        })
 }
 
 #[test]
 fn team_view_at_80_by_24_shows_every_key_and_the_whole_end_of_episode_status() {
-    let status = team_view_ends_fitted("view-team-80", "corridor-swap.toml", 80, 24);
+    let screen = team_view_ends_fitted("view-team-80", "corridor-swap.toml", 80, 24);
+    let status = status_rows(&screen);
     if let Some(first) = status.first() {
         // Too long for one row of 80: the message goes on the next row, whole.
         assert_eq!(status.len(), 2, "{status:?}");
@@ -356,8 +371,11 @@ fn team_view_at_80_by_24_shows_every_key_and_the_whole_end_of_episode_status() {
 
 #[test]
 fn team_view_at_120_by_40_shows_every_key_and_the_whole_end_of_episode_status() {
-    let status = team_view_ends_fitted("view-team-120", "hall-robots.toml", 120, 40);
-    if !status.is_empty() {
+    let screen = team_view_ends_fitted("view-team-120", "hall-robots.toml", 120, 40);
+    if !screen.is_empty() {
+        let status = status_rows(&screen);
+        // Room for the colour legend too.
+        assert!(screen.contains("robots ● 0 ● 1"), "{screen}");
         assert!(status.len() <= 2, "{status:?}");
         assert!(
             status

@@ -42,7 +42,8 @@ pub struct Summary {
     /// Figures among moving obstacles, when the episodes had some.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub moving: Option<MovingSummary>,
-    /// Figures among the other robots of a team, when the episodes were a team's robots'.
+    /// Figures among the other robots of a team, when the episodes were robots' of a team of two
+    /// or more.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub among_robots: Option<AmongRobots>,
     /// The mean of each metric the configuration asked for beyond these (docs/model.md "Crowd

@@ -64,8 +64,10 @@ pub fn evaluate_team_into(
     let team = teams
         .team
         .summary(wall, teams.team.robot_steps() - teams.robot_steps_before);
+    // A team of one is the lone robot: no robot to collide with or deadlock against, and the
+    // same figures.
     let summary = Summary {
-        among_robots: Some(teams.team.among_robots()),
+        among_robots: (teams.size > 1).then(|| teams.team.among_robots()),
         ..teams
             .robots
             .summary(wall, teams.robots.steps() - teams.steps_before)
