@@ -51,6 +51,98 @@ fn the_corridor_swap_deadlocks_and_is_reported_as_one() {
     assert_eq!(summary["team"]["deadlocks"], 3);
 }
 
+/// The value of row `name` of a printed two-column table.
+fn row<'a>(table: &'a str, name: &str) -> &'a str {
+    table
+        .lines()
+        .find_map(|l| l.strip_prefix(&format!("{name}  ")))
+        .unwrap_or_else(|| panic!("no row {name:?} in:\n{table}"))
+        .trim()
+}
+
+#[test]
+fn the_corridor_swap_s_robots_table_counts_their_deadlocks_and_robot_collisions() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("swap");
+    let printed = run_team(
+        &repo_root().join("scenarios/corridor-swap.toml"),
+        &out,
+        &["--seeds", "2"],
+    );
+    let (team, robots_table) = printed.split_once("per robot:\n").unwrap();
+    assert_eq!(row(team, "deadlocks"), "2");
+
+    // Every robot row of robots.csv, as the per-robot table sums them up.
+    let robots = rows(&out.join("robots.csv"));
+    assert_eq!(robots.len(), 1 + 2 * 2);
+    let [outcome, walls, others] =
+        ["outcome", "collisions", "robot_collisions"].map(|c| col(&robots, c));
+    let deadlocked = robots[1..]
+        .iter()
+        .filter(|r| r[outcome] == "deadlock")
+        .count();
+    let mean = |c: usize| {
+        robots[1..]
+            .iter()
+            .map(|r| r[c].parse::<f64>().unwrap())
+            .sum::<f64>()
+            / 4.0
+    };
+    assert_eq!(deadlocked, 4, "{robots:?}");
+    assert!(mean(others) > 0.0);
+    assert_eq!(row(robots_table, "episodes"), "4");
+    assert_eq!(row(robots_table, "deadlocks"), "4");
+    assert!(row(robots_table, "success rate").starts_with("0.0% (0 of 4;"));
+    assert_eq!(
+        row(robots_table, "robot collisions per episode"),
+        format!("{:.2}", mean(others))
+    );
+    assert_eq!(
+        row(robots_table, "wall collisions per episode"),
+        format!("{:.2}", mean(walls))
+    );
+    // Every robot episode counted once: 4 = successes + time-outs + stuck + deadlocks.
+    let counted: usize = ["time-outs", "stuck (gave up)", "deadlocks"]
+        .iter()
+        .map(|n| row(robots_table, n).parse::<usize>().unwrap())
+        .sum();
+    assert_eq!(counted, 4, "{robots_table}");
+    assert!(
+        !robots_table.contains("\ncollisions per episode"),
+        "{robots_table}"
+    );
+
+    let among = &summary(&out)["among_robots"];
+    assert_eq!(among["deadlocks"], 4);
+    assert_eq!(
+        among["robot_collisions_per_episode"].as_f64(),
+        Some(mean(others))
+    );
+}
+
+#[test]
+fn a_lone_run_s_table_and_summary_have_nothing_of_a_team() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("lone");
+    let printed = ok(&ronap(&[
+        "run",
+        "--policy",
+        "apf",
+        "--seeds",
+        "3",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    assert!(row(&printed, "collisions per episode")
+        .parse::<f64>()
+        .is_ok());
+    for name in ["deadlocks", "robot collisions", "wall collisions"] {
+        assert!(!printed.contains(name), "{name} in:\n{printed}");
+    }
+    let json = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    assert!(!json.contains("among_robots"), "{json}");
+}
+
 #[test]
 fn team_runs_are_the_same_on_one_and_two_threads() {
     let dir = tempfile::tempdir().unwrap();

@@ -1,20 +1,26 @@
-//! The terminal commands driven as a person would: `ronap` runs in an 80x24 tmux pane, keys are
-//! sent with `send-keys`, and the screen is read with `capture-pane`. Each test has its own tmux
-//! server. Without tmux the tests print a notice and pass; CI installs it (.ci/run).
+//! The terminal commands driven as a person would: `ronap` runs in a tmux pane (80x24 unless a
+//! test asks for another size), keys are sent with `send-keys`, and the screen is read with
+//! `capture-pane`. Each test has its own tmux server. Without tmux the tests print a notice and
+//! pass; CI installs it (.ci/run).
 
-use crate::util::BIN;
+use crate::util::{col, ok, repo_root, ronap, rows, BIN};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-/// A tmux server with one 80x24 pane running a plain shell.
+/// A tmux server with one pane running a plain shell.
 struct Tmux {
     socket: String,
     socket_path: String,
 }
 
 impl Tmux {
-    /// A new server, or `None` (with a notice) when tmux is not installed.
+    /// A new server with an 80x24 pane, or `None` (with a notice) when tmux is not installed.
     fn start(name: &str) -> Option<Self> {
+        Self::start_sized(name, 80, 24)
+    }
+
+    /// [`Tmux::start`] with a pane of `width` x `height` cells.
+    fn start_sized(name: &str, width: u16, height: u16) -> Option<Self> {
         if Command::new("tmux").arg("-V").output().is_err() {
             eprintln!("tmux is not installed: skipping the terminal test {name}");
             return None;
@@ -27,9 +33,9 @@ impl Tmux {
             "new-session",
             "-d",
             "-x",
-            "80",
+            &width.to_string(),
             "-y",
-            "24",
+            &height.to_string(),
             "env",
             "-i",
             &format!("PATH={}", std::env::var("PATH").unwrap_or_default()),
@@ -237,9 +243,11 @@ fn view_of_a_team_shows_every_robot_follows_another_on_tab_and_quits() {
     let screen = tmux.wait("the team's whole scene", 30, |s| {
         s.contains("whole scene · seed 3") && s.contains("at goal 0/8")
     });
-    assert!(screen.contains("robots     8"), "{screen}");
-    assert!(screen.contains("robot 0"), "{screen}");
-    assert!(screen.contains("robots ● 0 ● 1"), "{screen}");
+    assert!(screen.contains("at goal    0 / 8"), "{screen}");
+    assert!(screen.contains("robot 0 · geodesic"), "{screen}");
+    // At 80x24 the colour legend gives way to the keys.
+    assert!(!screen.contains("robots ● 0 ● 1"), "{screen}");
+    assert!(screen.contains("tab     follow the next robot"), "{screen}");
     tmux.keys(&["Tab"]);
     tmux.wait("robot 1 followed", 10, |s| s.contains("robot 1"));
     tmux.keys(&["M"]);
@@ -248,6 +256,134 @@ fn view_of_a_team_shows_every_robot_follows_another_on_tab_and_quits() {
     });
     tmux.keys(&["q"]);
     assert_restored(&tmux, "after-view rc=0");
+}
+
+/// Runs the team view of `scenario` (geodesic, seed 0) to its end in a `width` x `height` pane
+/// and checks that every key is explained and the whole end-of-episode status line is on screen,
+/// its collisions with walls and with robots those robots.csv records for the same episode, and
+/// the followed robot's those of its own row. Returns the screen at the end (empty without tmux).
+fn team_view_ends_fitted(name: &str, scenario: &str, width: u16, height: u16) -> String {
+    let Some(tmux) = Tmux::start_sized(name, width, height) else {
+        return String::new();
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = repo_root().join("scenarios").join(scenario);
+    let scenario = scenario.to_str().unwrap();
+    let run = dir.path().join("run");
+    ok(&ronap(&[
+        "run",
+        "--scenario",
+        scenario,
+        "--policy",
+        "geodesic",
+        "--seeds",
+        "1",
+        "--out",
+        run.to_str().unwrap(),
+    ]));
+    let robots = rows(&run.join("robots.csv"));
+    let count = |c: &str| -> Vec<u64> {
+        let c = col(&robots, c);
+        robots[1..].iter().map(|r| r[c].parse().unwrap()).collect()
+    };
+    let (walls, others) = (count("collisions"), count("robot_collisions"));
+    let team = format!(
+        "collisions: walls {}, robots {}",
+        walls.iter().sum::<u64>(),
+        others.iter().sum::<u64>()
+    );
+    assert!(others.iter().sum::<u64>() > 0, "{robots:?}");
+
+    tmux.line(&format!("cd {}", dir.path().display()));
+    tmux.line(&format!(
+        "{BIN} view --policy geodesic --scenario {scenario} --seed 0 --speed 1000; \
+         echo after-view rc=$?"
+    ));
+    let screen = tmux.wait("the end of the team episode", 60, |s| s.contains("■ ended"));
+    let lines: Vec<&str> = screen.lines().collect();
+    assert_eq!(lines.len(), usize::from(height), "{screen}");
+    for line in &lines {
+        assert!(line.chars().count() <= usize::from(width), "{screen}");
+    }
+    // The status rows at the bottom, below the panels.
+    let status = status_rows(&screen);
+    assert!(!status.is_empty(), "{screen}");
+    assert!(
+        lines[lines.len() - status.len() - 1].starts_with('└'),
+        "{screen}"
+    );
+    let joined = status.join(" ");
+    assert!(joined.contains(&team), "{team} not in:\n{screen}");
+    assert!(joined.contains("step "), "{screen}");
+    assert!(joined.contains("at goal "), "{screen}");
+    assert!(joined.contains("1000 steps/s"), "{screen}");
+    assert!(
+        joined.contains("deadlock: no robot moved")
+            || joined.contains("TaskComplete")
+            || joined.contains("robots at their goals"),
+        "{screen}"
+    );
+    // Every key, with what it does.
+    for (key, what) in [
+        ("space", "pause / resume"),
+        ("+ -", "faster / slower"),
+        ("tab", "follow the next robot"),
+        ("m", "whole scene / first person"),
+        ("s", "one step, when paused"),
+        ("r n", "restart / next seed"),
+        ("q", "quit"),
+    ] {
+        let help = format!("│{key:<8}{what}");
+        assert!(screen.contains(&help), "{help:?} not in:\n{screen}");
+    }
+    // The followed robot, robot 0: its own row.
+    let own = format!("collisions walls {}, robots {}", walls[0], others[0]);
+    assert!(screen.contains(&own), "{own} not in:\n{screen}");
+    assert!(screen.contains(&format!("collisions {}", &team["collisions: ".len()..])));
+    tmux.keys(&["q"]);
+    tmux.wait("the shell", 15, |s| s.contains("after-view rc=0"));
+    screen
+}
+
+/// The rows of an ended view's status line: from the one that starts with the mark to the
+/// bottom.
+fn status_rows(screen: &str) -> Vec<String> {
+    let lines: Vec<&str> = screen.lines().collect();
+    lines
+        .iter()
+        .position(|l| l.starts_with(" ■ ended"))
+        .map_or_else(Vec::new, |first| {
+            lines[first..].iter().map(|l| l.to_string()).collect()
+        })
+}
+
+#[test]
+fn team_view_at_80_by_24_shows_every_key_and_the_whole_end_of_episode_status() {
+    let screen = team_view_ends_fitted("view-team-80", "corridor-swap.toml", 80, 24);
+    let status = status_rows(&screen);
+    if let Some(first) = status.first() {
+        // Too long for one row of 80: the message goes on the next row, whole.
+        assert_eq!(status.len(), 2, "{status:?}");
+        assert!(first.contains("collisions: walls"), "{status:?}");
+        assert!(status[1].contains("deadlock: no robot moved"), "{status:?}");
+    }
+}
+
+#[test]
+fn team_view_at_120_by_40_shows_every_key_and_the_whole_end_of_episode_status() {
+    let screen = team_view_ends_fitted("view-team-120", "hall-robots.toml", 120, 40);
+    if !screen.is_empty() {
+        let status = status_rows(&screen);
+        // Room for the colour legend too.
+        assert!(screen.contains("robots ● 0 ● 1"), "{screen}");
+        assert!(status.len() <= 2, "{status:?}");
+        assert!(
+            status
+                .join(" ")
+                .contains("ended with 25 of 100 robots at their goals"),
+            "{status:?}"
+        );
+    }
 }
 
 #[test]

@@ -99,8 +99,14 @@ const SIDE_MAX: u16 = 44;
 /// Splits `area`: a status line at the bottom, above it the scene panel (a square of dots, so
 /// twice as many columns as rows) and the side panel to its right.
 pub fn layout(area: Rect) -> Areas {
-    let main_h = area.height.saturating_sub(1);
-    let status = Rect::new(area.x, area.y + main_h, area.width, area.height.min(1));
+    layout_with_status(area, 1)
+}
+
+/// [`layout`] with `status_rows` rows for the status line.
+pub fn layout_with_status(area: Rect, status_rows: u16) -> Areas {
+    let status_h = status_rows.min(area.height);
+    let main_h = area.height - status_h;
+    let status = Rect::new(area.x, area.y + main_h, area.width, status_h);
     let square = main_h.saturating_sub(2).saturating_mul(2).saturating_add(2);
     let (scene_w, side_w) = if area.width >= square + SIDE_MIN {
         let side = (area.width - square).min(SIDE_MAX);
@@ -620,6 +626,101 @@ pub fn side_panel_with(
     fields
 }
 
+/// A side panel that fits its height, its parts in the order they give way when it is short.
+pub struct SidePanel<'a> {
+    /// The figures, always shown (first).
+    pub fields: Vec<Line<'static>>,
+    /// The colour legend, the first to go.
+    pub legend: Vec<Line<'static>>,
+    /// Each key with what it does, shown last and kept.
+    pub keys: &'a [(&'a str, &'a str)],
+}
+
+impl SidePanel<'_> {
+    /// The panel's lines for `height` rows: [`side_panel_with`] when everything fits; else
+    /// without the legend; else without the blank line before the keys.
+    pub fn lines(self, height: usize) -> Vec<Line<'static>> {
+        let (fields, keys) = (self.fields.len(), self.keys.len());
+        if fields + 1 + self.legend.len() + 1 + keys <= height {
+            return side_panel_with(self.fields, self.legend, self.keys);
+        }
+        let mut lines = self.fields;
+        if fields + 1 + keys <= height {
+            lines.push(Line::raw(""));
+        }
+        lines.extend(self.keys.iter().map(|(k, what)| key_help(k, what)));
+        lines
+    }
+}
+
+/// A status line in parts: ended, paused or running, then each of `figures`, then `message` in
+/// its colour, separated by ` · `.
+pub struct Status {
+    /// Whether the episode is over.
+    pub finished: bool,
+    /// Whether stepping is paused.
+    pub paused: bool,
+    /// The figures, each a part.
+    pub figures: Vec<String>,
+    /// How the episode ended (or the message of the moment), in its colour.
+    pub message: Option<(String, Color)>,
+}
+
+impl Status {
+    /// The status on as many rows of `width` cells as it needs, broken between parts only (a
+    /// part wider than a row is cut by the screen). On one row it reads as [`status_line`].
+    pub fn rows(&self, width: u16) -> Vec<Line<'static>> {
+        let (mark, mark_style) = state_mark(self.finished, self.paused);
+        let mut parts = vec![Span::styled(mark, mark_style)];
+        parts.extend(self.figures.iter().map(|f| Span::raw(f.clone())));
+        if let Some((text, colour)) = &self.message {
+            parts.push(Span::styled(
+                text.clone(),
+                Style::default().fg(*colour).add_modifier(Modifier::BOLD),
+            ));
+        }
+        let mut rows: Vec<Line<'static>> = Vec::new();
+        for part in parts {
+            let gap = Span::raw(" · ");
+            match rows.last_mut() {
+                Some(row) if row.width() + gap.width() + part.width() <= usize::from(width) => {
+                    row.spans.extend([gap, part]);
+                }
+                _ => rows.push(Line::from(vec![Span::raw(" "), part])),
+            }
+        }
+        rows
+    }
+}
+
+/// A whole screen fitted to the terminal: the status on the rows its width needs (at most a
+/// third of the screen), the side panel titled `name` fitted to its height when there is room
+/// for one, and the scene panel, which `draw_scene` draws into the area it is given, in the rest.
+pub fn fitted_screen(
+    frame: &mut Frame,
+    name: &str,
+    side: SidePanel<'_>,
+    status: &Status,
+    draw_scene: impl FnOnce(&mut Frame, Rect),
+) {
+    if too_small(frame) {
+        return;
+    }
+    let area = frame.area();
+    let mut rows = status.rows(area.width);
+    rows.truncate(usize::from((area.height / 3).max(1)));
+    let areas = layout_with_status(area, rows.len() as u16);
+    draw_scene(frame, areas.scene);
+    if let Some(panel) = areas.side {
+        let lines = side.lines(usize::from(panel.height.saturating_sub(2)));
+        frame.render_widget(
+            Paragraph::new(lines).block(Block::bordered().title(format!(" {name} "))),
+            panel,
+        );
+    }
+    frame.render_widget(Paragraph::new(rows), areas.status);
+}
+
 /// A whole screen: the scene of `episode` (with `path`, titled with the mode and seed), the side
 /// panel titled `name` when there is room, and the status line.
 pub fn screen(
@@ -667,13 +768,7 @@ pub fn status_line(
     figures: String,
     message: Option<(String, Color)>,
 ) -> Line<'static> {
-    let (mark, mark_style) = if finished {
-        ("■ ended", Style::default().add_modifier(Modifier::BOLD))
-    } else if paused {
-        ("❚❚ paused", Style::default().fg(Color::Yellow))
-    } else {
-        ("▶ running", Style::default().fg(Color::Green))
-    };
+    let (mark, mark_style) = state_mark(finished, paused);
     let mut spans = vec![
         Span::raw(" "),
         Span::styled(mark, mark_style),
@@ -687,6 +782,17 @@ pub fn status_line(
         ));
     }
     Line::from(spans)
+}
+
+/// Ended, paused or running, in its style.
+fn state_mark(finished: bool, paused: bool) -> (&'static str, Style) {
+    if finished {
+        ("■ ended", Style::default().add_modifier(Modifier::BOLD))
+    } else if paused {
+        ("❚❚ paused", Style::default().fg(Color::Yellow))
+    } else {
+        ("▶ running", Style::default().fg(Color::Green))
+    }
 }
 
 /// The message shown when the terminal is too small for anything useful.
@@ -722,6 +828,91 @@ mod tests {
         let narrow = layout(Rect::new(0, 0, 50, 24));
         assert_eq!(narrow.side, None);
         assert_eq!(narrow.scene.width, 50);
+    }
+
+    #[test]
+    fn a_status_too_long_for_one_row_breaks_between_its_parts() {
+        let status = Status {
+            finished: true,
+            paused: false,
+            figures: vec!["step 12".to_string(), "collisions: walls 0".to_string()],
+            message: Some(("deadlock: no robot moved".to_string(), Color::Yellow)),
+        };
+        let text = |rows: Vec<Line<'static>>| -> Vec<String> {
+            rows.iter().map(|l| l.to_string()).collect()
+        };
+        let one = " ■ ended · step 12 · collisions: walls 0 · deadlock: no robot moved";
+        assert_eq!(text(status.rows(80)), [one]);
+        let as_before = status_line(
+            true,
+            false,
+            " · step 12 · collisions: walls 0".to_string(),
+            status.message.clone(),
+        );
+        assert_eq!(as_before.to_string(), one);
+        assert_eq!(
+            text(status.rows(50)),
+            [
+                " ■ ended · step 12 · collisions: walls 0",
+                " deadlock: no robot moved"
+            ]
+        );
+        assert_eq!(
+            text(status.rows(10)),
+            [
+                " ■ ended",
+                " step 12",
+                " collisions: walls 0",
+                " deadlock: no robot moved"
+            ]
+        );
+    }
+
+    #[test]
+    fn a_short_side_panel_gives_up_its_legend_then_its_blank_line_but_keeps_its_keys() {
+        let panel = || SidePanel {
+            fields: vec![field("a", "1"), field("b", "2")],
+            legend: vec![Line::raw("legend 1"), Line::raw("legend 2")],
+            keys: &[("q", "quit"), ("m", "map")],
+        };
+        let text = |height| -> Vec<String> {
+            panel()
+                .lines(height)
+                .iter()
+                .map(|l| l.to_string().trim_end().to_string())
+                .collect()
+        };
+        let all = [
+            "a          1",
+            "b          2",
+            "",
+            "legend 1",
+            "legend 2",
+            "",
+            "q       quit",
+            "m       map",
+        ];
+        assert_eq!(text(8), all);
+        assert_eq!(text(20), all);
+        assert_eq!(
+            text(7),
+            [
+                "a          1",
+                "b          2",
+                "",
+                "q       quit",
+                "m       map"
+            ]
+        );
+        assert_eq!(
+            text(4),
+            [
+                "a          1",
+                "b          2",
+                "q       quit",
+                "m       map"
+            ]
+        );
     }
 
     #[test]

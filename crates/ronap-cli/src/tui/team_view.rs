@@ -1,7 +1,9 @@
 //! `ronap view` of a scenario with `[[robots]]`: the whole team live in the terminal, each robot
 //! with its path and goal in its own colour, one robot followed (Tab for the next) whose rays are
-//! drawn and whose first-person view `M` shows; a side panel of team figures and a status line
-//! with the step, the robots at their goals, the collisions and how the episode ended.
+//! drawn and whose first-person view `M` shows; a side panel of team figures and keys and a
+//! status line with the step, the robots at their goals, the collisions (with walls and with
+//! each other, as robots.csv counts them) and how the episode ended, fitted to the terminal so
+//! that at 80x24 the keys and the whole status line are on screen.
 //!
 //! [`TeamViewState`] is everything on screen and [`draw`] a pure function of it; [`TeamWatch`]
 //! steps the policies for [`crate::tui::view::ViewApp`], the loop the lone view runs too.
@@ -19,7 +21,7 @@ use ronap_core::policy::TeamPolicy;
 use ronap_core::run::team::TeamRollout;
 use ronap_core::run::RunError;
 use ronap_core::sim::team::Team;
-use ronap_core::Status;
+use ronap_core::{Episode, Status};
 
 /// Everything the team view shows.
 pub struct TeamViewState {
@@ -97,23 +99,33 @@ impl TeamViewState {
     }
 }
 
-/// The status line: state, step, robots at their goals, collisions, speed and how it ended.
-pub fn status_line(state: &TeamViewState) -> Line<'static> {
+/// Walls and other robots that blocked `robots`' steps, as `walls W, robots R` (the
+/// `collisions` and `robot_collisions` of robots.csv, summed).
+fn collisions<'a>(robots: impl IntoIterator<Item = &'a Episode>) -> String {
+    let (walls, others) = robots.into_iter().fold((0u64, 0u64), |(w, o), r| {
+        (
+            w + u64::from(r.collisions()),
+            o + u64::from(r.robot_collisions()),
+        )
+    });
+    format!("walls {walls}, robots {others}")
+}
+
+/// The status line: state, step, robots at their goals, collisions with walls and with each
+/// other, speed and how it ended, in as many parts as the screen's width needs rows.
+pub fn status(state: &TeamViewState) -> draw::Status {
     let team = state.team();
-    let collisions: u32 = team.robots().iter().map(|r| r.collisions()).sum();
-    draw::status_line(
-        state.finished(),
-        state.controls.paused,
-        format!(
-            " · step {} · at goal {}/{} · collisions {} · {} steps/s",
-            team.steps(),
-            state.arrived(),
-            team.robots().len(),
-            collisions,
-            state.controls.speed
-        ),
-        message(state),
-    )
+    draw::Status {
+        finished: state.finished(),
+        paused: state.controls.paused,
+        figures: vec![
+            format!("step {}", team.steps()),
+            format!("at goal {}/{}", state.arrived(), team.robots().len()),
+            format!("collisions: {}", collisions(team.robots())),
+            format!("{} steps/s", state.controls.speed),
+        ],
+        message: message(state),
+    }
 }
 
 /// How the episode ended, in its colour (nothing while it runs).
@@ -144,15 +156,24 @@ fn message(state: &TeamViewState) -> Option<(String, Color)> {
     })
 }
 
-/// The side panel's lines: the team, then the followed robot.
-fn side_lines(state: &TeamViewState) -> Vec<Line<'static>> {
+/// The keys of the team view and what they do.
+const KEYS: [(&str, &str); 7] = [
+    ("space", "pause / resume"),
+    ("+ -", "faster / slower"),
+    ("tab", "follow the next robot"),
+    ("m", "whole scene / first person"),
+    ("s", "one step, when paused"),
+    ("r n", "restart / next seed"),
+    ("q", "quit"),
+];
+
+/// The side panel: the team, then the followed robot, the legend and the keys.
+fn side_panel(state: &TeamViewState) -> draw::SidePanel<'static> {
     let team = state.team();
     let k = state.focus;
     let r = team.robot(k);
-    let collisions: u32 = team.robots().iter().map(|r| r.collisions()).sum();
-    let lines = vec![
+    let fields = vec![
         draw::field("seed", state.seed.to_string()),
-        draw::field("robots", team.robots().len().to_string()),
         draw::field(
             "step",
             format!("{} / {}", team.steps(), r.config().episode.max_steps),
@@ -161,38 +182,35 @@ fn side_lines(state: &TeamViewState) -> Vec<Line<'static>> {
             "at goal",
             format!("{} / {}", state.arrived(), team.robots().len()),
         ),
-        draw::field("collisions", collisions.to_string()),
+        draw::field("collisions", collisions(team.robots())),
         draw::field("speed", format!("{} steps/s", state.controls.speed)),
         Line::raw(""),
-        Line::from(Span::styled(
-            format!("robot {k}"),
-            Style::default()
-                .fg(draw::robot_colour(k))
-                .add_modifier(Modifier::BOLD),
-        )),
-        draw::field("policy", state.names.get(k).cloned().unwrap_or_default()),
+        Line::from(vec![
+            Span::styled(
+                format!("robot {k}"),
+                Style::default()
+                    .fg(draw::robot_colour(k))
+                    .add_modifier(Modifier::BOLD),
+            ),
+            Span::raw(format!(
+                " · {}",
+                state.names.get(k).map_or("", String::as_str)
+            )),
+        ]),
         draw::field("status", status_word(team, k)),
         draw::field(
             "goals",
             format!("{} / {}", r.goals_reached(), team.goals(k).len().max(1)),
         ),
         draw::field("distance", format!("{:.1} px", r.distance_px())),
-        draw::field("collisions", r.collisions().to_string()),
+        draw::field("collisions", collisions([r])),
         draw::field("path", format!("{:.1} px", r.path_length_px())),
     ];
-    draw::side_panel_with(
-        lines,
-        draw::team_legend(team.robots().len(), team.movers().is_some()),
-        &[
-            ("space", "pause / resume"),
-            ("+ -", "faster / slower"),
-            ("tab", "follow the next robot"),
-            ("m", "whole scene / first person"),
-            ("s", "one step, when paused"),
-            ("r n", "restart / next seed"),
-            ("q", "quit"),
-        ],
-    )
+    draw::SidePanel {
+        fields,
+        legend: draw::team_legend(team.robots().len(), team.movers().is_some()),
+        keys: &KEYS,
+    }
 }
 
 /// Robot `k`'s state in a word.
@@ -223,11 +241,11 @@ pub fn draw(frame: &mut Frame, state: &TeamViewState) {
             state.seed
         ),
     };
-    draw::screen_with(
+    draw::fitted_screen(
         frame,
         "ronap view",
-        side_lines(state),
-        status_line(state),
+        side_panel(state),
+        &status(state),
         |frame, area| {
             draw::team_scene(
                 frame,
@@ -439,6 +457,53 @@ mod tests {
         assert_eq!(watch.state.team().steps(), 0);
         assert_eq!(watch.state.controls.speed, 100);
         assert!(!watch.finished());
+    }
+
+    #[test]
+    fn robot_collisions_are_shown_as_the_run_records_them_with_every_key_at_80_by_24() {
+        let evaluator = evaluator("corridor-swap.toml");
+        let policies = TeamPolicies::new(evaluator.config(), "geodesic").unwrap();
+        let mut watch = TeamWatch::start(&evaluator, &policies, 1, 20).unwrap();
+        while !watch.finished() && watch.state.team().steps() < 100_000 {
+            watch.advance();
+        }
+        let mut policy = policies.start().unwrap();
+        let record = evaluator
+            .run_team_episode(
+                policy.as_mut(),
+                &policies.names,
+                1,
+                ronap_core::eval::Recording::default(),
+            )
+            .unwrap();
+        assert!(record.robot_collisions > 0, "{record:?}");
+        let team = format!(
+            "walls {}, robots {}",
+            record.collisions, record.robot_collisions
+        );
+        for (w, h) in [(80, 24), (120, 40)] {
+            let screen = text(&render(&watch.state, w, h));
+            let lines: Vec<&str> = screen.lines().collect();
+            let first = lines
+                .iter()
+                .position(|l| l.starts_with(" ■ ended"))
+                .unwrap();
+            let status = lines[first..].join(" ");
+            assert!(status.contains(&format!("collisions: {team}")), "{screen}");
+            assert!(status.contains("deadlock: no robot moved"), "{screen}");
+            assert!(screen.contains(&format!("collisions {team}")), "{screen}");
+            let own = &record.robots[0];
+            let own = format!(
+                "collisions walls {}, robots {}",
+                own.collisions, own.robot_collisions
+            );
+            assert!(screen.contains(&own), "{screen}");
+            for (key, what) in KEYS {
+                assert!(screen.contains(&format!("{key:<8}{what}")), "{screen}");
+            }
+            // The legend when there is room for it.
+            assert_eq!(screen.contains("rays  ━ far"), h >= 40, "{screen}");
+        }
     }
 
     #[test]

@@ -13,7 +13,7 @@ pub mod summary;
 pub mod team;
 
 pub use record::{EpisodeRecord, Outcome, Recording, StepLog};
-pub use summary::{Figures, Summary, Tally};
+pub use summary::{AmongRobots, Figures, Summary, Tally};
 pub use team::{
     RobotFigures, RobotRecord, TeamFigures, TeamRecord, TeamRunResult, TeamSummary, TeamTally,
 };

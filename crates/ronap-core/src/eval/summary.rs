@@ -42,6 +42,10 @@ pub struct Summary {
     /// Figures among moving obstacles, when the episodes had some.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub moving: Option<MovingSummary>,
+    /// Figures among the other robots of a team, when the episodes were robots' of a team of two
+    /// or more.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub among_robots: Option<AmongRobots>,
     /// The mean of each metric the configuration asked for beyond these (docs/model.md "Crowd
     /// metrics"), in column order.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -60,6 +64,16 @@ pub struct MovingSummary {
     pub mean_min_clearance_px: f64,
     /// Mean fraction of steps spent within `safety_radius_px` of a moving obstacle.
     pub near_moving_fraction: f64,
+}
+
+/// Summary figures of a team's robots' episodes that a lone robot's have no use for: the steps
+/// other robots blocked (wall collisions are `collisions_per_episode`) and the deadlocks.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AmongRobots {
+    /// Mean steps another robot blocked, per robot episode.
+    pub robot_collisions_per_episode: f64,
+    /// Robot episodes that ended in a deadlock ([`Outcome::Deadlock`]).
+    pub deadlocks: usize,
 }
 
 /// The 95% Wilson score interval for `k` successes in `n` trials.
@@ -276,6 +290,7 @@ impl Tally {
                 0.0
             },
             moving,
+            among_robots: None,
             metrics: self
                 .kinds
                 .iter()
@@ -372,6 +387,23 @@ impl Summary {
                 (m.name.as_str(), value)
             }),
         );
+        if let Some(t) = &self.among_robots {
+            // A team's robots also collide with each other: both kinds, named apart.
+            if let Some(at) = rows
+                .iter()
+                .position(|(k, _)| *k == "collisions per episode")
+            {
+                rows[at].0 = "wall collisions per episode";
+                rows.insert(
+                    at + 1,
+                    (
+                        "robot collisions per episode",
+                        format!("{:.2}", t.robot_collisions_per_episode),
+                    ),
+                );
+                rows.insert(at, ("deadlocks", t.deadlocks.to_string()));
+            }
+        }
         if self.collision_ends > 0 {
             rows.insert(4, ("ended by collision", self.collision_ends.to_string()));
         }
@@ -388,6 +420,68 @@ impl Summary {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn figures(outcome: Outcome, collisions: u32) -> Figures {
+        Figures {
+            outcome,
+            steps: 10,
+            collisions,
+            path_length_px: 5.0,
+            spl: 0.0,
+            total_reward: -1.0,
+            dynamic: None,
+            metrics: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_team_s_robots_table_names_wall_and_robot_collisions_apart_and_counts_deadlocks() {
+        let mut tally = Tally::default();
+        for f in [
+            figures(Outcome::Deadlock, 1),
+            figures(Outcome::Deadlock, 0),
+            figures(Outcome::Success, 0),
+        ] {
+            tally.add(&f);
+        }
+        let lone = tally.summary(1.0, 30);
+        let table = lone.table();
+        assert!(table.contains("collisions per episode  0.33\n"), "{table}");
+        assert!(!table.contains("robot collisions"), "{table}");
+        assert!(!table.contains("deadlocks"), "{table}");
+        assert!(!serde_json::to_string(&lone)
+            .expect("serialises")
+            .contains("among_robots"));
+
+        let team = Summary {
+            among_robots: Some(AmongRobots {
+                robot_collisions_per_episode: 12.5,
+                deadlocks: 2,
+            }),
+            ..lone
+        };
+        let table = team.table();
+        let rows: Vec<&str> = table.lines().collect();
+        let at = |name: &str| {
+            rows.iter()
+                .position(|r| r.starts_with(&format!("{name}  ")))
+                .unwrap_or_else(|| panic!("no row {name}:\n{table}"))
+        };
+        assert_eq!(
+            rows[at("deadlocks")].split_whitespace().last(),
+            Some("2"),
+            "{table}"
+        );
+        assert!(rows[at("wall collisions per episode")].ends_with("  0.33"));
+        assert!(rows[at("robot collisions per episode")].ends_with("  12.50"));
+        assert_eq!(at("stuck (gave up)") + 1, at("deadlocks"));
+        assert_eq!(at("deadlocks") + 1, at("wall collisions per episode"));
+        assert!(!table.contains("\ncollisions per episode"), "{table}");
+        let json = serde_json::to_value(&team).expect("serialises");
+        assert_eq!(json["among_robots"]["deadlocks"], 2);
+        let back: Summary = serde_json::from_value(json).expect("reads back");
+        assert_eq!(back, team);
+    }
 
     #[test]
     fn wilson_interval_matches_known_values() {

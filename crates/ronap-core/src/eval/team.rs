@@ -3,7 +3,7 @@
 //! deadlocks), and their summary.
 
 use crate::eval::record::Before;
-use crate::eval::summary::wilson95;
+use crate::eval::summary::{wilson95, AmongRobots};
 use crate::eval::{
     stream_seeds, EvalOptions, Evaluator, Failure, Outcome, Recording, RunEnd, Runs, StepLog,
 };
@@ -221,6 +221,7 @@ pub struct TeamTally {
     team_successes: usize,
     robots: usize,
     robot_successes: usize,
+    robot_deadlocks: usize,
     deadlocks: usize,
     makespans: usize,
     makespan_sum: f64,
@@ -240,6 +241,7 @@ impl Default for TeamTally {
             team_successes: 0,
             robots: 0,
             robot_successes: 0,
+            robot_deadlocks: 0,
             deadlocks: 0,
             makespans: 0,
             makespan_sum: zero,
@@ -272,8 +274,10 @@ impl TeamTally {
         self.collisions += f64::from(f.collisions);
         for r in &f.robots {
             self.robots += 1;
-            if r.outcome == Outcome::Success {
-                self.robot_successes += 1;
+            match r.outcome {
+                Outcome::Success => self.robot_successes += 1,
+                Outcome::Deadlock => self.robot_deadlocks += 1,
+                _ => {}
             }
             self.spl += r.spl;
             self.robot_steps += u64::from(r.steps);
@@ -283,6 +287,19 @@ impl TeamTally {
     /// Robot steps of the episodes counted.
     pub fn robot_steps(&self) -> u64 {
         self.robot_steps
+    }
+
+    /// What the robots' own [`crate::eval::Summary`] adds for a team: the steps other robots
+    /// blocked per robot episode, and the robots that ended deadlocked.
+    pub fn among_robots(&self) -> AmongRobots {
+        AmongRobots {
+            robot_collisions_per_episode: if self.robots == 0 {
+                0.0
+            } else {
+                self.robot_collisions / self.robots as f64
+            },
+            deadlocks: self.robot_deadlocks,
+        }
     }
 
     /// The summary of the episodes counted, over a run that took `wall_time_s` to simulate
@@ -668,6 +685,48 @@ mod tests {
             .iter()
             .all(|r| r.robots.iter().all(|x| x.goals == 1 && x.tour.is_none())));
         assert!(summary.robot_success_rate > 0.5, "{summary:?}");
+    }
+
+    #[test]
+    fn the_robots_figures_among_each_other_count_robot_episodes() {
+        let robot = |outcome| RobotFigures {
+            outcome,
+            steps: 40,
+            spl: 0.0,
+        };
+        let episode = |robot_collisions, robots: Vec<RobotFigures>| TeamFigures {
+            outcome: Outcome::Deadlock,
+            deadlock: true,
+            makespan: None,
+            path_length_px: 0.0,
+            collisions: 3,
+            robot_collisions,
+            robots,
+        };
+        let mut tally = TeamTally::default();
+        tally.add(&episode(
+            30,
+            vec![robot(Outcome::Deadlock), robot(Outcome::Deadlock)],
+        ));
+        tally.add(&episode(
+            10,
+            vec![robot(Outcome::Success), robot(Outcome::Deadlock)],
+        ));
+        // 40 blocked steps over 4 robot episodes; 3 of them deadlocked.
+        assert_eq!(
+            tally.among_robots(),
+            AmongRobots {
+                robot_collisions_per_episode: 10.0,
+                deadlocks: 3,
+            }
+        );
+        assert_eq!(tally.summary(1.0, 0).robot_collisions_per_episode, 20.0);
+        assert_eq!(
+            TeamTally::default()
+                .among_robots()
+                .robot_collisions_per_episode,
+            0.0
+        );
     }
 
     #[test]

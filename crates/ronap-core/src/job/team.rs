@@ -64,9 +64,14 @@ pub fn evaluate_team_into(
     let team = teams
         .team
         .summary(wall, teams.team.robot_steps() - teams.robot_steps_before);
-    let summary = teams
-        .robots
-        .summary(wall, teams.robots.steps() - teams.steps_before);
+    // A team of one is the lone robot: no robot to collide with or deadlock against, and the
+    // same figures.
+    let summary = Summary {
+        among_robots: (teams.size > 1).then(|| teams.team.among_robots()),
+        ..teams
+            .robots
+            .summary(wall, teams.robots.steps() - teams.steps_before)
+    };
     if let (Some(w), None) = (&request.writer, &write_error) {
         let mut m = manifest(config, &options, request.info, &run, &summary);
         m.team = Some(team.clone());
