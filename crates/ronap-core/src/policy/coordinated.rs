@@ -44,6 +44,9 @@ pub const NAME: &str = "coordinated";
 
 /// ORCA's horizon among the robots, steps: short, since the plan keeps them apart.
 const TIME_HORIZON_STEPS: f64 = 2.0;
+/// How far from its last stop's centre a robot that stopped for good may stand and still hold
+/// only that cell (on a goal within it), px.
+const CELL_HOLD_PX: f64 = 5.0;
 /// Most plans an episode makes after its first, before its robots fall back to `orca`.
 const MAX_REPLANS: u32 = 50;
 
@@ -56,16 +59,14 @@ fn reach_px(me: &Episode, actions: PlannerActions) -> f64 {
     }
 }
 
-/// Largest angle between a unicycle's axis (forwards or backwards) and the way it is to go
-/// that it drives along an arc; beyond it, it turns on the spot first, so that it neither
-/// swings wide of a turn in its plan nor sweeps sideways into a wall. Degrees.
-const ARC_MAX_DEG: f64 = 30.0;
-
-/// The action that follows velocity `v` (towards `aim` when standing): for continuous actions,
-/// a turn on the spot while the robot's axis is more than [`ARC_MAX_DEG`] off the way to go,
-/// else the `orca` policy's tracking command.
+/// The action that follows velocity `v` on the way to `aim`: for continuous actions, a turn on
+/// the spot while the robot's axis (forwards or backwards) is more than half its largest turn
+/// off `v` (off the way to `aim` while `v` is about nought), else the `orca` policy's tracking command. Within half a turn, that
+/// command's arc ends exactly on the way (its chord turns by half the arc's turn), so the robot
+/// neither swings wide of a turn in its plan nor sweeps sideways into a rack beside it.
 fn drive(me: &Episode, v: Vector, aim: Vector, actions: PlannerActions) -> Action {
-    let way = if v.norm() > 1e-9 { v } else { aim };
+    // The way it goes: its velocity, or, standing, where it is to go.
+    let way = if v.norm() > 0.05 { v } else { aim };
     if actions == PlannerActions::Continuous && way.norm() > 1e-9 {
         let error = turn_to(me, way);
         // Off the axis, forwards or backwards.
@@ -74,8 +75,8 @@ fn drive(me: &Episode, v: Vector, aim: Vector, actions: PlannerActions) -> Actio
         } else {
             error
         };
-        if off.abs() > ARC_MAX_DEG {
-            let w_max = me.config().robot.max_angular_speed_deg;
+        let w_max = me.config().robot.max_angular_speed_deg;
+        if off.abs() > w_max / 2.0 {
             return Action::Continuous {
                 v: 0.0,
                 w_deg: off.clamp(-w_max, w_max),
@@ -89,15 +90,20 @@ fn drive(me: &Episode, v: Vector, aim: Vector, actions: PlannerActions) -> Actio
 #[derive(Debug)]
 struct Following {
     schedule: Schedule,
-    /// Each robot's stops: the point to drive to at each.
+    /// Each robot's stops: the cell centre to drive to at each.
     points: Vec<Vec<Point>>,
-    /// Whether each stop reaches a goal (driven onto, never through).
-    goals: Vec<Vec<bool>>,
+    /// At each stop that reaches a goal, the goal's number among the robot's goals (counted
+    /// as the episode counts them) and the point within the goal's tolerance the robot drives
+    /// to from the centre and back; such stops are driven onto, never through.
+    goals: Vec<Vec<Option<(u32, Point)>>>,
     /// The stop each robot heads to (`u32::MAX` once it left the scene, or for a robot not
     /// planned).
     heading: Vec<u32>,
-    /// Whether a robot stopped for good short of its plan's end (within its goal's tolerance
-    /// on the way to its last stop): the others are planned again around it.
+    /// Whether each robot, at a goal's stop, has reached its centre (and now drives onto the
+    /// goal and back).
+    at_centre: Vec<bool>,
+    /// Whether a robot stopped for good short of its plan's end: the others are planned again
+    /// around it.
     stopped_short: bool,
 }
 
@@ -113,31 +119,35 @@ impl Following {
         let h = self.heading[k] as usize;
         let n = self.points[k].len();
         let mut e = h;
-        while e + 1 < n && !self.goals[k][e] && self.open(k, e + 1) {
+        while e + 1 < n && self.goals[k][e].is_none() && self.open(k, e + 1) {
             e += 1;
         }
         e
     }
 
-    /// Moves each robot's heading on past the stops it has reached: within reach of a stop, or,
-    /// driving through it, past it (beyond the start of the segment that leaves it).
+    /// Moves each robot's heading on past the stops it has reached: within reach of a stop's
+    /// centre (and, at a goal's stop, back there with the goal counted), or, driving through a
+    /// stop, past it (beyond the start of the segment that leaves it).
     fn advance(&mut self, team: &Team) {
         for (k, r) in team.robots().iter().enumerate() {
             if !team.present(k) {
                 self.heading[k] = u32::MAX;
                 continue;
             }
-            // A robot that came within the goal's tolerance short of its last stop stays
-            // where it is: it holds its last stop's cell from now on.
+            let end = self.points[k].len() as u32;
+            let p = r.pose().position();
+            // A robot that stopped for good holds its last stop's cell when it stands on it
+            // (on its goal within that cell); elsewhere, the others plan again around it.
             if !team.running(k) {
-                let end = self.points[k].len() as u32;
-                if self.heading[k] < end {
+                let on_last = self.points[k]
+                    .last()
+                    .is_some_and(|&c| self.heading[k] + 1 >= end && (c - p).norm() <= CELL_HOLD_PX);
+                if self.heading[k] < end && !on_last {
                     self.stopped_short = true;
                 }
                 self.heading[k] = self.heading[k].max(end);
                 continue;
             }
-            let p = r.pose().position();
             let config = r.config();
             let reach = reach_px(r, config.orca.actions);
             // Past a stop it drives through, it is within its lookahead of it.
@@ -147,22 +157,35 @@ impl Following {
                 let Some(&stop) = self.points[k].get(h) else {
                     break;
                 };
-                let passed = h < self.open_end(k) && (stop - p).norm() <= through && {
-                    let next = self.points[k][h + 1];
-                    (p - stop).dot(&(next - stop)) > 0.0
+                let near = (stop - p).norm() <= reach;
+                let reached = match self.goals[k][h] {
+                    Some((g, _)) => {
+                        if near {
+                            self.at_centre[k] = true;
+                        }
+                        near && r.goals_reached() > g
+                    }
+                    None => {
+                        let passed = h < self.open_end(k) && (stop - p).norm() <= through && {
+                            let next = self.points[k][h + 1];
+                            (p - stop).dot(&(next - stop)) > 0.0
+                        };
+                        near || (passed && self.open(k, h))
+                    }
                 };
-                if (stop - p).norm() <= reach || (passed && self.open(k, h)) {
-                    self.heading[k] += 1;
-                } else {
+                if !reached {
                     break;
                 }
+                self.heading[k] += 1;
+                self.at_centre[k] = false;
             }
         }
     }
 
     /// Where robot `me` (`k`) drives this step: `lookahead` px along its plan's open stops
     /// past where it is (pure pursuit), ending on the last open one; where it is while its
-    /// next stop is closed; its goal once past its last stop.
+    /// next stop is closed; at a goal's stop, from its centre onto the goal and back; its goal
+    /// once past its last stop.
     fn aim(&self, k: usize, me: &Episode, lookahead: f64) -> Point {
         let h = self.heading[k] as usize;
         let points = &self.points[k];
@@ -173,8 +196,13 @@ impl Following {
         if !self.open(k, h) {
             return points[h - 1];
         }
-        if h == 0 {
-            return points[0];
+        if let Some((g, onto)) = self.goals[k][h] {
+            if self.at_centre[k] && me.goals_reached() <= g {
+                return onto;
+            }
+        }
+        if h == 0 || self.at_centre[k] {
+            return points[h];
         }
         let e = self.open_end(k);
         // Along the segment into stop h from where the robot projects onto it.
@@ -188,8 +216,7 @@ impl Following {
         };
         let mut left = lookahead + along;
         let mut from = a;
-        for q in h..=e {
-            let to = points[q];
+        for &to in &points[h..=e] {
             let seg = (to - from).norm();
             if left <= seg && seg > 0.0 {
                 return from + (to - from) * (left / seg);
@@ -297,10 +324,18 @@ fn tasks(
         let mut goals = Vec::new();
         for (g, p) in points.iter().enumerate() {
             let last = g + 1 == points.len();
+            // A goal's cell: the nearest whose way onto the goal's tolerance is clear.
+            let tolerance = r.config().episode.goal_tolerance_px;
+            let radius = r.config().robot.radius_px;
             let mut cells = grid
                 .nearest_free(*p, reach)
                 .into_iter()
-                .filter(|c| !blocked.contains(c));
+                .filter(|c| !blocked.contains(c))
+                .filter(|&c| {
+                    let from = grid.center(c);
+                    r.scene()
+                        .sweep_clear(from, stop_point(from, Some(*p), tolerance), radius)
+                });
             let cell = if last && !vanish {
                 cells.find(|c| parks_taken.insert(*c))?
             } else {
@@ -473,13 +508,14 @@ impl Coordinated {
             schedule: Schedule::new(&by_robot),
             points: by_robot
                 .iter()
-                .enumerate()
-                .map(|(k, stops)| self::points(grid, team, k, stops))
+                .map(|stops| self::points(grid, stops))
                 .collect(),
             goals: by_robot
                 .iter()
-                .map(|stops| stops.iter().map(|s| s.goal.is_some()).collect())
+                .enumerate()
+                .map(|(k, stops)| goal_stops(grid, team, k, stops))
                 .collect(),
+            at_centre: vec![false; n],
             heading: (0..n)
                 .map(|k| if team.running(k) { 0 } else { u32::MAX })
                 .collect(),
@@ -551,13 +587,24 @@ impl Coordinated {
     }
 }
 
-/// The points robot `k` drives to along `stops`.
-fn points(grid: &PlanGrid, team: &Team, k: usize, stops: &[Stop]) -> Vec<Point> {
+/// The cell centres robot `k` drives to along `stops`.
+fn points(grid: &PlanGrid, stops: &[Stop]) -> Vec<Point> {
+    stops.iter().map(|s| grid.center(s.cell)).collect()
+}
+
+/// At each of robot `k`'s `stops` that reaches a goal: the goal's number as the episode counts
+/// goals, and the point within the goal's tolerance that the robot drives onto.
+fn goal_stops(grid: &PlanGrid, team: &Team, k: usize, stops: &[Stop]) -> Vec<Option<(u32, Point)>> {
+    let r = team.robot(k);
     let goals = goal_points(team, k);
-    let tolerance = team.robot(k).config().episode.goal_tolerance_px;
+    let tolerance = r.config().episode.goal_tolerance_px;
     stops
         .iter()
-        .map(|s| stop_point(grid.center(s.cell), s.goal.and_then(|g| goals.get(g).copied()), tolerance))
+        .map(|s| {
+            let g = s.goal?;
+            let onto = stop_point(grid.center(s.cell), goals.get(g).copied(), tolerance);
+            Some((r.goals_reached() + g as u32, onto))
+        })
         .collect()
 }
 
@@ -623,7 +670,19 @@ impl TeamPolicy for Coordinated {
             } else {
                 to * (speed.min(dist) / dist)
             };
-            let v = match self.slot[k] {
+            let range = config.orca.sense_range_px.unwrap_or(config.laser.range_px);
+            // Alone, it follows its plan as planned: the plan's moves keep clear of the still
+            // scene, and ORCA's obstacle lines would only nudge it off them.
+            let alone = |slot: usize| {
+                let at = self.agents[slot].position;
+                self.agents.iter().enumerate().all(|(j, a)| {
+                    j == slot || {
+                        let d = a.position - at;
+                        (d.x * d.x + d.y * d.y).sqrt() > range + a.radius
+                    }
+                })
+            };
+            let v = match self.slot[k].filter(|&s| !alone(s)) {
                 Some(slot) => self.avoider.velocity(
                     me.scene(),
                     &Avoid {
@@ -636,10 +695,7 @@ impl TeamPolicy for Coordinated {
                             max_speed: speed,
                             time_step: 1.0,
                         },
-                        neighbour_dist: config
-                            .orca
-                            .sense_range_px
-                            .unwrap_or(config.laser.range_px),
+                        neighbour_dist: range,
                         max_neighbours: config.orca.max_neighbours as usize,
                         margin: 0.0,
                         candidates: None,
