@@ -47,6 +47,9 @@ const TIME_HORIZON_STEPS: f64 = 2.0;
 /// How far from its last stop's centre a robot that stopped for good may stand and still hold
 /// only that cell (on a goal within it), px.
 const CELL_HOLD_PX: f64 = 5.0;
+/// Steps a robot free to go on may fail to reach its next stop before the team is planned
+/// again.
+const STALL_STEPS: u32 = 60;
 /// Most plans an episode makes after its first, before its robots fall back to `orca`.
 const MAX_REPLANS: u32 = 50;
 
@@ -90,8 +93,10 @@ fn drive(me: &Episode, v: Vector, aim: Vector, actions: PlannerActions) -> Actio
 #[derive(Debug)]
 struct Following {
     schedule: Schedule,
-    /// Each robot's stops: the cell centre to drive to at each.
+    /// Each robot's stops: the cell centre to drive to at each...
     points: Vec<Vec<Point>>,
+    /// ... and the cell.
+    cells: Vec<Vec<usize>>,
     /// At each stop that reaches a goal, the goal's number among the robot's goals (counted
     /// as the episode counts them) and the point within the goal's tolerance the robot drives
     /// to from the centre and back; such stops are driven onto, never through.
@@ -105,6 +110,8 @@ struct Following {
     /// Whether a robot stopped for good short of its plan's end: the others are planned again
     /// around it.
     stopped_short: bool,
+    /// Steps each robot has been free to go on to its next stop without reaching it.
+    stalled: Vec<u32>,
 }
 
 impl Following {
@@ -178,6 +185,11 @@ impl Following {
                 }
                 self.heading[k] += 1;
                 self.at_centre[k] = false;
+                self.stalled[k] = 0;
+            }
+            let h = self.heading[k] as usize;
+            if h < self.points[k].len() && self.open(k, h) {
+                self.stalled[k] += 1;
             }
         }
     }
@@ -258,6 +270,8 @@ pub struct Coordinated {
     rng: Option<crate::sim::rng::Rng>,
     /// Plans made since the first.
     replans: u32,
+    /// Each robot's cells that no goal of it may be planned on (tried and found blocked).
+    banned: Vec<HashSet<usize>>,
     /// Every robot's centre at the last decision (its velocity is its displacement since), then
     /// every moving obstacle's.
     last: Vec<Option<Point>>,
@@ -300,11 +314,12 @@ fn stop_point(c: Point, goal: Option<Point>, tolerance: f64) -> Point {
 
 /// The tasks of the running robots of `team` on `grid` (and which robot each is for): starts
 /// on distinct cells, last goals of robots that stay on distinct cells, none on a `blocked`
-/// cell; `None` when a start or goal has no such cell near it.
+/// cell, no goal of robot `k` on its `banned[k]` cells; `None` when a start or goal has no such cell near it.
 fn tasks(
     grid: &PlanGrid,
     team: &Team,
     blocked: &HashSet<usize>,
+    banned: &[HashSet<usize>],
 ) -> Option<(Vec<usize>, Vec<Task>)> {
     let reach = grid.cell_px() * 1.5;
     let mut starts_taken = blocked.clone();
@@ -330,7 +345,7 @@ fn tasks(
             let mut cells = grid
                 .nearest_free(*p, reach)
                 .into_iter()
-                .filter(|c| !blocked.contains(c))
+                .filter(|c| !blocked.contains(c) && !banned.get(k).is_some_and(|b| b.contains(c)))
                 .filter(|&c| {
                     let from = grid.center(c);
                     r.scene()
@@ -420,6 +435,7 @@ impl Coordinated {
         self.fallback = None;
         self.infeasible = None;
         self.replans = 0;
+        self.banned = vec![HashSet::new(); team.robots().len()];
         self.worlds = worlds.to_vec();
         let actions = worlds[0].config().orca.actions;
         let max_radius = team
@@ -474,7 +490,7 @@ impl Coordinated {
                 blocked.extend(blocked_by(grid, r.pose().position()));
             }
         }
-        let (robots, tasks) = tasks(grid, team, &blocked)?;
+        let (robots, tasks) = tasks(grid, team, &blocked, &self.banned)?;
         let blocked: Vec<usize> = blocked.into_iter().collect();
         let rng = self
             .rng
@@ -506,6 +522,10 @@ impl Coordinated {
         }
         self.following = Some(Following {
             schedule: Schedule::new(&by_robot),
+            cells: by_robot
+                .iter()
+                .map(|stops| stops.iter().map(|s| s.cell).collect())
+                .collect(),
             points: by_robot
                 .iter()
                 .map(|stops| self::points(grid, stops))
@@ -520,6 +540,7 @@ impl Coordinated {
                 .map(|k| if team.running(k) { 0 } else { u32::MAX })
                 .collect(),
             stopped_short: false,
+            stalled: vec![0; n],
         });
         Ok(())
     }
@@ -632,7 +653,20 @@ impl TeamPolicy for Coordinated {
             return Ok(());
         };
         f.advance(team);
-        if f.stopped_short {
+        // A robot held up for long (by a moving obstacle, or short of a goal another robot
+        // stands by) has the team planned again; one stuck by its goal's cell tries another.
+        let stalled: Vec<usize> = (0..f.stalled.len())
+            .filter(|&k| f.stalled[k] > STALL_STEPS)
+            .collect();
+        for &k in &stalled {
+            let h = f.heading[k] as usize;
+            if f.at_centre[k] {
+                if let Some(&c) = f.cells[k].get(h) {
+                    self.banned[k].insert(c);
+                }
+            }
+        }
+        if f.stopped_short || !stalled.is_empty() {
             self.replan(team)?;
             if let Some(p) = &mut self.fallback {
                 return p.act(team, decisions);
