@@ -112,12 +112,16 @@ struct Following {
     stopped_short: bool,
     /// Steps each robot has been free to go on to its next stop without reaching it.
     stalled: Vec<u32>,
+    /// Whether every robot has reached its start cell.
+    started: bool,
 }
 
 impl Following {
-    /// Whether robot `k` may move to its stop `p`.
+    /// Whether robot `k` may move to its stop `p`: its start cell at once; the others once
+    /// every robot stands on its start cell (until then robots stand anywhere near theirs, so
+    /// the plan's spacing does not hold yet) and the robots before it there have moved on.
     fn open(&self, k: usize, p: usize) -> bool {
-        p == 0 || self.schedule.may_go(k, p, &self.heading)
+        p == 0 || (self.started && self.schedule.may_go(k, p, &self.heading))
     }
 
     /// The last stop robot `k` may drive on to without halting: from the one it heads to,
@@ -136,6 +140,16 @@ impl Following {
     /// centre (and, at a goal's stop, back there with the goal counted), or, driving through a
     /// stop, past it (beyond the start of the segment that leaves it).
     fn advance(&mut self, team: &Team) {
+        self.advance_robots(team);
+        if !self.started && self.heading.iter().all(|&h| h >= 1) {
+            self.started = true;
+            // Now they may drive on.
+            self.advance_robots(team);
+        }
+    }
+
+    /// [`Following::advance`] of each robot.
+    fn advance_robots(&mut self, team: &Team) {
         for (k, r) in team.robots().iter().enumerate() {
             if !team.present(k) {
                 self.heading[k] = u32::MAX;
@@ -541,6 +555,7 @@ impl Coordinated {
                 .collect(),
             stopped_short: false,
             stalled: vec![0; n],
+            started: false,
         });
         Ok(())
     }
