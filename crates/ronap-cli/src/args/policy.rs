@@ -2,7 +2,8 @@
 
 use anyhow::Result;
 use ronap_core::policy::{
-    coordinated, Builtin, PerRobot, PolicyError, PolicyFactory, PolicyNameError, TeamPolicy, TeamPolicyFactory,
+    coordinated, Builtin, PerRobot, PolicyError, PolicyFactory, PolicyNameError, TeamPolicy,
+    TeamPolicyFactory,
 };
 use ronap_core::ValidConfig;
 

@@ -27,13 +27,13 @@ use super::{Decision, Policy, PolicyError};
 use crate::config::{OnArrival, PlannerActions};
 use crate::geometry::orca::{Agent, Horizon, V2};
 use crate::geometry::{Point, Vector};
-use crate::sim::robot::Action;
 use crate::plan::team::{
     pair_feasible, plan_team, Limits, Pair, PlanFailure, PlanGrid, Schedule, Stop, Task,
 };
 use crate::sim::avoid::{Avoid, Avoider};
 use crate::sim::episode::Episode;
 use crate::sim::rng::{stream, Stream};
+use crate::sim::robot::Action;
 use crate::sim::team::Team;
 use crate::sim::world::World;
 use std::collections::HashSet;
@@ -254,6 +254,37 @@ impl Following {
     }
 }
 
+/// Whether robot `k`'s step `v` towards its start cell keeps clear of the other robots: by a
+/// hair of those standing, and, of those with a lower number also on their way to their
+/// start cells and driving, by as far as they may drive in the step too (they go first; one
+/// that stood still last step does not hold the others up; the plan's spacing
+/// holds only once every robot is on its cell).
+/// `agents` and `slot` as [`Coordinated`] keeps them.
+fn initial_step_clear(
+    agents: &[Agent<f64>],
+    slot: &[Option<usize>],
+    k: usize,
+    v: Vector,
+    heading: &[u32],
+    speed: f64,
+) -> bool {
+    let Some(me) = slot[k].map(|s| agents[s]) else {
+        return true;
+    };
+    let a = Point::new(me.position.x, me.position.y);
+    let b = a + v;
+    slot.iter().enumerate().all(|(j, slot)| {
+        let Some(other) = slot.filter(|_| j != k).map(|s| agents[s]) else {
+            return true;
+        };
+        let q = Point::new(other.position.x, other.position.y);
+        // It may drive on this step if it drove the last one.
+        let moving = j < k && heading[j] == 0 && other.velocity.x.hypot(other.velocity.y) > 1e-3;
+        let need = me.radius + other.radius + 0.5 + if moving { speed } else { 0.0 };
+        crate::geometry::point_segment_distance_squared(q, a, b) >= need * need
+    })
+}
+
 /// A planning of the running robots: which robots, their tasks, and their plans or the
 /// planner's failure.
 struct Planned {
@@ -424,8 +455,16 @@ fn passage(grid: &PlanGrid, tasks: &[Task], a: usize, b: usize) -> String {
         .map(|&c| grid.center(c))
         .collect();
     let (lo, hi) = shared.iter().fold(
-        (Point::new(f64::INFINITY, f64::INFINITY), Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY)),
-        |(lo, hi), p| (Point::new(lo.x.min(p.x), lo.y.min(p.y)), Point::new(hi.x.max(p.x), hi.y.max(p.y))),
+        (
+            Point::new(f64::INFINITY, f64::INFINITY),
+            Point::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| {
+            (
+                Point::new(lo.x.min(p.x), lo.y.min(p.y)),
+                Point::new(hi.x.max(p.x), hi.y.max(p.y)),
+            )
+        },
     );
     let place = if shared.is_empty() {
         String::new()
@@ -694,11 +733,25 @@ impl TeamPolicy for Coordinated {
         let Some(f) = &mut self.following else {
             return Ok(());
         };
-        if std::env::var("RONAP_DEBUG_STEP").ok().and_then(|s| s.parse::<u32>().ok()) == Some(team.steps()) {
+        if std::env::var("RONAP_DEBUG_STEP")
+            .ok()
+            .and_then(|s| s.parse::<u32>().ok())
+            == Some(team.steps())
+        {
             for (k, r) in team.robots().iter().enumerate() {
-                if !team.running(k) { continue; }
+                if !team.running(k) {
+                    continue;
+                }
                 let h = f.heading[k] as usize;
-                eprintln!("robot {k} heading {h}/{} at {:?} next {:?} prev {:?} waits {:?} goal {:?}", f.points[k].len(), r.pose().position(), f.points[k].get(h), h.checked_sub(1).and_then(|i| f.points[k].get(i)), f.schedule.waits(k, h), r.goal());
+                eprintln!(
+                    "robot {k} heading {h}/{} at {:?} next {:?} prev {:?} waits {:?} goal {:?}",
+                    f.points[k].len(),
+                    r.pose().position(),
+                    f.points[k].get(h),
+                    h.checked_sub(1).and_then(|i| f.points[k].get(i)),
+                    f.schedule.waits(k, h),
+                    r.goal()
+                );
             }
         }
         for (k, d) in decisions.iter_mut().enumerate() {
@@ -751,6 +804,13 @@ impl TeamPolicy for Coordinated {
                     },
                 ),
                 None => preferred,
+            };
+            let v = if f.heading[k] == 0
+                && !initial_step_clear(&self.agents, &self.slot, k, v, &f.heading, speed)
+            {
+                Vector::zeros()
+            } else {
+                v
             };
             *d = Some(Decision::Act(drive(me, v, to, actions)));
         }

@@ -3,8 +3,8 @@
 //! Uses `config`, `geometry`, `scene`, `sim` and `plan`.
 
 pub mod apf;
-pub mod coordinated;
 pub mod batched;
+pub mod coordinated;
 pub mod dodge;
 pub mod dwa;
 pub mod follow;

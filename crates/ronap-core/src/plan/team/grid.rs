@@ -84,7 +84,14 @@ impl PlanGrid {
                 best = Some((free, g));
             }
         }
-        best.map(|(_, g)| g).unwrap_or_else(|| Self::new(scene, radius, cell_px, Point::new(cell_px / 2.0, cell_px / 2.0)))
+        best.map(|(_, g)| g).unwrap_or_else(|| {
+            Self::new(
+                scene,
+                radius,
+                cell_px,
+                Point::new(cell_px / 2.0, cell_px / 2.0),
+            )
+        })
     }
 
     /// Cells.
@@ -133,7 +140,9 @@ impl PlanGrid {
     /// The cells one open move from `i`, with the move's index.
     pub fn neighbours(&self, i: usize) -> impl Iterator<Item = (usize, usize)> + '_ {
         let links = self.links[i];
-        (0..8).filter(move |d| links & (1 << d) != 0).filter_map(move |d| self.step(i, d).map(|j| (d, j)))
+        (0..8)
+            .filter(move |d| links & (1 << d) != 0)
+            .filter_map(move |d| self.step(i, d).map(|j| (d, j)))
     }
 
     /// The corner a diagonal move `d` from cell `i` crosses (an index over the grid's corners),

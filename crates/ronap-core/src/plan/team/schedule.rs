@@ -38,7 +38,8 @@ impl Schedule {
                 }
             }
         }
-        let mut waits: Vec<Vec<Vec<Wait>>> = plans.iter().map(|s| vec![Vec::new(); s.len()]).collect();
+        let mut waits: Vec<Vec<Vec<Wait>>> =
+            plans.iter().map(|s| vec![Vec::new(); s.len()]).collect();
         let mut link = |events: &mut Vec<(u32, usize, usize)>, after: u32| {
             events.sort_unstable();
             for pair in events.windows(2) {

@@ -170,12 +170,23 @@ impl Search<'_> {
     /// The leg from `from` at tick `t0` to `goal` (`h`: each cell's moves to it); `park`: the
     /// robot stays on the goal for good, so no one may come there later. The cells of each tick
     /// from `t0` on, with the move taken into each (8 for a wait).
-    fn leg(&self, from: usize, t0: u32, goal: usize, park: bool, h: &[u32]) -> Option<Vec<(usize, u8)>> {
+    fn leg(
+        &self,
+        from: usize,
+        t0: u32,
+        goal: usize,
+        park: bool,
+        h: &[u32],
+    ) -> Option<Vec<(usize, u8)>> {
         let res = self.res;
         if h[from] == u32::MAX {
             return None;
         }
-        let earliest = if park { res.last[goal].saturating_add(2) } else { 0 };
+        let earliest = if park {
+            res.last[goal].saturating_add(2)
+        } else {
+            0
+        };
         let horizon = t0 + 2 * h[from] + 64 + earliest.saturating_sub(t0);
         let mut nodes = vec![Node {
             cell: from,
@@ -321,7 +332,13 @@ pub fn plan_team(
             tables.entry(g).or_insert_with(|| grid.moves_to(g));
         }
     }
-    let h_of = |k: usize| -> Vec<&[u32]> { tasks[k].goals.iter().map(|g| tables[g].as_slice()).collect() };
+    let h_of = |k: usize| -> Vec<&[u32]> {
+        tasks[k]
+            .goals
+            .iter()
+            .map(|g| tables[g].as_slice())
+            .collect()
+    };
     let way = |k: usize| -> u64 {
         let mut at = tasks[k].start;
         let mut sum = 0u64;
