@@ -124,13 +124,25 @@ impl Following {
         p == 0 || (self.started && self.schedule.may_go(k, p, &self.heading))
     }
 
+    /// Whether robot `k` may drive through its stop `p` without halting on it: neither a goal's
+    /// stop nor a sharp turn (more than 45 degrees; cutting it would come too close to the
+    /// cells beside).
+    fn through(&self, k: usize, p: usize) -> bool {
+        let points = &self.points[k];
+        if p == 0 || p + 1 >= points.len() || self.goals[k][p].is_some() {
+            return false;
+        }
+        let (a, b) = (points[p] - points[p - 1], points[p + 1] - points[p]);
+        a.dot(&b) > 0.75 * a.norm() * b.norm()
+    }
+
     /// The last stop robot `k` may drive on to without halting: from the one it heads to,
-    /// through open stops, up to the first goal (driven onto, never through).
+    /// through open stops, up to the first it must halt on (a goal's, a sharp turn).
     fn open_end(&self, k: usize) -> usize {
         let h = self.heading[k] as usize;
         let n = self.points[k].len();
         let mut e = h;
-        while e + 1 < n && self.goals[k][e].is_none() && self.open(k, e + 1) {
+        while e + 1 < n && self.through(k, e) && self.open(k, e + 1) {
             e += 1;
         }
         e
@@ -187,10 +199,13 @@ impl Following {
                         near && r.goals_reached() > g
                     }
                     None => {
-                        let passed = h < self.open_end(k) && (stop - p).norm() <= through && {
-                            let next = self.points[k][h + 1];
-                            (p - stop).dot(&(next - stop)) > 0.0
-                        };
+                        let passed = h < self.open_end(k)
+                            && self.through(k, h)
+                            && (stop - p).norm() <= through
+                            && {
+                                let next = self.points[k][h + 1];
+                                (p - stop).dot(&(next - stop)) > 0.0
+                            };
                         near || (passed && self.open(k, h))
                     }
                 };
@@ -281,7 +296,9 @@ fn initial_step_clear(
         // It may drive on this step if it drove the last one.
         let moving = j < k && heading[j] == 0 && other.velocity.x.hypot(other.velocity.y) > 1e-3;
         let need = me.radius + other.radius + 0.5 + if moving { speed } else { 0.0 };
+        // Clear of it all along, or at least drawing no nearer.
         crate::geometry::point_segment_distance_squared(q, a, b) >= need * need
+            || (b - q).norm_squared() >= (a - q).norm_squared()
     })
 }
 
