@@ -138,7 +138,9 @@ fn message(state: &TeamViewState) -> Option<(String, Color)> {
     }
     let team = state.team();
     let n = team.robots().len();
-    Some(if team.deadlocked() {
+    Some(if let Some(why) = state.rollout.infeasible() {
+        (format!("infeasible: {why}"), Color::Red)
+    } else if team.deadlocked() {
         ("deadlock: no robot moved".to_string(), Color::Yellow)
     } else if state.arrived() == n {
         (
@@ -197,7 +199,14 @@ fn side_panel(state: &TeamViewState) -> draw::SidePanel<'static> {
                 state.names.get(k).map_or("", String::as_str)
             )),
         ]),
-        draw::field("status", status_word(team, k)),
+        draw::field(
+            "status",
+            if state.rollout.infeasible().is_some() {
+                "infeasible".to_string()
+            } else {
+                status_word(team, k)
+            },
+        ),
         draw::field(
             "goals",
             format!("{} / {}", r.goals_reached(), team.goals(k).len().max(1)),

@@ -74,6 +74,14 @@ pub struct AmongRobots {
     pub robot_collisions_per_episode: f64,
     /// Robot episodes that ended in a deadlock ([`Outcome::Deadlock`]).
     pub deadlocks: usize,
+    /// Robot episodes whose team's task was found infeasible ([`Outcome::Infeasible`]).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub infeasible: usize,
+}
+
+/// Whether a count is nought (left out of `summary.json`).
+fn is_zero(n: &usize) -> bool {
+    *n == 0
 }
 
 /// The 95% Wilson score interval for `k` successes in `n` trials.
@@ -402,6 +410,9 @@ impl Summary {
                     ),
                 );
                 rows.insert(at, ("deadlocks", t.deadlocks.to_string()));
+                if t.infeasible > 0 {
+                    rows.insert(at + 1, ("infeasible", t.infeasible.to_string()));
+                }
             }
         }
         if self.collision_ends > 0 {
@@ -457,6 +468,7 @@ mod tests {
             among_robots: Some(AmongRobots {
                 robot_collisions_per_episode: 12.5,
                 deadlocks: 2,
+                infeasible: 0,
             }),
             ..lone
         };

@@ -126,6 +126,11 @@ pub struct TeamRecord {
     pub scene: Option<Arc<crate::Scene>>,
 }
 
+/// Whether a count is nought (left out of `summary.json`).
+fn is_zero(n: &usize) -> bool {
+    *n == 0
+}
+
 /// The figures of a set of team episodes.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TeamSummary {
@@ -143,6 +148,9 @@ pub struct TeamSummary {
     pub robot_success_rate: f64,
     /// Episodes that ended in a deadlock.
     pub deadlocks: usize,
+    /// Episodes the team's policy found infeasible before the first step.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub infeasible: usize,
     /// Mean makespan over the team successes, steps.
     pub mean_makespan: f64,
     /// Mean summed path length, px.
@@ -222,6 +230,8 @@ pub struct TeamTally {
     robots: usize,
     robot_successes: usize,
     robot_deadlocks: usize,
+    infeasible: usize,
+    robot_infeasible: usize,
     deadlocks: usize,
     makespans: usize,
     makespan_sum: f64,
@@ -242,6 +252,8 @@ impl Default for TeamTally {
             robots: 0,
             robot_successes: 0,
             robot_deadlocks: 0,
+            infeasible: 0,
+            robot_infeasible: 0,
             deadlocks: 0,
             makespans: 0,
             makespan_sum: zero,
@@ -265,6 +277,9 @@ impl TeamTally {
         if f.deadlock {
             self.deadlocks += 1;
         }
+        if f.outcome == Outcome::Infeasible {
+            self.infeasible += 1;
+        }
         if let Some(m) = f.makespan {
             self.makespans += 1;
             self.makespan_sum += f64::from(m);
@@ -277,6 +292,7 @@ impl TeamTally {
             match r.outcome {
                 Outcome::Success => self.robot_successes += 1,
                 Outcome::Deadlock => self.robot_deadlocks += 1,
+                Outcome::Infeasible => self.robot_infeasible += 1,
                 _ => {}
             }
             self.spl += r.spl;
@@ -299,6 +315,7 @@ impl TeamTally {
                 self.robot_collisions / self.robots as f64
             },
             deadlocks: self.robot_deadlocks,
+            infeasible: self.robot_infeasible,
         }
     }
 
@@ -319,6 +336,7 @@ impl TeamTally {
                 self.robot_successes as f64 / self.robots as f64
             },
             deadlocks: self.deadlocks,
+            infeasible: self.infeasible,
             mean_makespan: if self.makespans == 0 {
                 0.0
             } else {
@@ -355,7 +373,7 @@ impl TeamSummary {
     /// The summary as an aligned two-column table.
     pub fn table(&self) -> String {
         let pct = |x: f64| format!("{:.1}%", 100.0 * x);
-        let rows: Vec<(&str, String)> = vec![
+        let mut rows: Vec<(&str, String)> = vec![
             (
                 "episodes",
                 format!("{} ({} robots each)", self.episodes, self.robots),
@@ -373,6 +391,10 @@ impl TeamSummary {
             ),
             ("robots arrived", pct(self.robot_success_rate)),
             ("deadlocks", self.deadlocks.to_string()),
+            (
+                "infeasible",
+                format!("{} (each one's reason in robots.csv)", self.infeasible),
+            ),
             (
                 "mean makespan",
                 if self.team_successes > 0 {
@@ -400,6 +422,10 @@ impl TeamSummary {
                 format!("{:.0}", self.robot_steps_per_second),
             ),
         ];
+        // Only where the team's policy found some.
+        if self.infeasible == 0 {
+            rows.retain(|(k, _)| *k != "infeasible");
+        }
         let width = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
         rows.iter()
             .map(|(k, v)| format!("{k:<width$}  {v}\n"))
@@ -718,6 +744,7 @@ mod tests {
             AmongRobots {
                 robot_collisions_per_episode: 10.0,
                 deadlocks: 3,
+                infeasible: 0,
             }
         );
         assert_eq!(tally.summary(1.0, 0).robot_collisions_per_episode, 20.0);

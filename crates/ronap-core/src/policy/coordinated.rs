@@ -487,13 +487,13 @@ fn passage(grid: &PlanGrid, tasks: &[Task], a: usize, b: usize) -> String {
         String::new()
     } else {
         format!(
-            " in the passage from ({:.0}, {:.0}) to ({:.0}, {:.0})",
+            " between ({:.0}, {:.0}) and ({:.0}, {:.0})",
             lo.x, lo.y, hi.x, hi.y
         )
     };
     format!(
-        "robots {a} and {b} cannot both reach their goals{place}: no way for the two alone to pass \
-         each other (a complete search on {:.1} px cells)",
+        "robots {a} and {b} cannot pass each other{place} (no way for the two alone: a \
+         complete search on {:.1} px cells)",
         grid.cell_px()
     )
 }
