@@ -750,27 +750,6 @@ impl TeamPolicy for Coordinated {
         let Some(f) = &mut self.following else {
             return Ok(());
         };
-        if std::env::var("RONAP_DEBUG_STEP")
-            .ok()
-            .and_then(|s| s.parse::<u32>().ok())
-            == Some(team.steps())
-        {
-            for (k, r) in team.robots().iter().enumerate() {
-                if !team.running(k) {
-                    continue;
-                }
-                let h = f.heading[k] as usize;
-                eprintln!(
-                    "robot {k} heading {h}/{} at {:?} next {:?} prev {:?} waits {:?} goal {:?}",
-                    f.points[k].len(),
-                    r.pose().position(),
-                    f.points[k].get(h),
-                    h.checked_sub(1).and_then(|i| f.points[k].get(i)),
-                    f.schedule.waits(k, h),
-                    r.goal()
-                );
-            }
-        }
         for (k, d) in decisions.iter_mut().enumerate() {
             if !team.running(k) {
                 continue;

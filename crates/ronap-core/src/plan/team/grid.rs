@@ -35,6 +35,24 @@ impl PlanGrid {
     /// The grid of `scene` for discs of `radius` px with cells of `cell_px`, cell `(0, 0)`
     /// centred at `origin` (within one cell of the scene's corner).
     pub fn new(scene: &Scene, radius: f64, cell_px: f64, origin: Point) -> Self {
+        let mut grid = Self::cells(scene, radius, cell_px, origin);
+        for i in 0..grid.len() {
+            if !grid.free[i] {
+                continue;
+            }
+            for (d, _) in MOVES.iter().enumerate() {
+                if let Some(j) = grid.step(i, d) {
+                    if grid.free[j] && scene.sweep_clear(grid.center(i), grid.center(j), radius) {
+                        grid.links[i] |= 1 << d;
+                    }
+                }
+            }
+        }
+        grid
+    }
+
+    /// The grid's cells, free or not, without their links.
+    fn cells(scene: &Scene, radius: f64, cell_px: f64, origin: Point) -> Self {
         let count = |extent: f64, o: f64| (((extent - o) / cell_px).floor() as usize + 1).max(1);
         let cols = count(scene.width(), origin.x);
         let rows = count(scene.height(), origin.y);
@@ -54,18 +72,6 @@ impl PlanGrid {
                 && p.y <= scene.height()
                 && scene.disc_clear(p, radius);
         }
-        for i in 0..cols * rows {
-            if !grid.free[i] {
-                continue;
-            }
-            for (d, _) in MOVES.iter().enumerate() {
-                if let Some(j) = grid.step(i, d) {
-                    if grid.free[j] && scene.sweep_clear(grid.center(i), grid.center(j), radius) {
-                        grid.links[i] |= 1 << d;
-                    }
-                }
-            }
-        }
         grid
     }
 
@@ -76,22 +82,16 @@ impl PlanGrid {
         for a in anchors.iter().take(8) {
             origins.push(Point::new(a.x.rem_euclid(cell_px), a.y.rem_euclid(cell_px)));
         }
-        let mut best: Option<(usize, PlanGrid)> = None;
+        let mut best: Option<(usize, Point)> = None;
         for o in origins {
-            let g = Self::new(scene, radius, cell_px, o);
+            let g = Self::cells(scene, radius, cell_px, o);
             let free = g.free.iter().filter(|&&f| f).count();
-            if best.as_ref().is_none_or(|(n, _)| free > *n) {
-                best = Some((free, g));
+            if best.is_none_or(|(n, _)| free > n) {
+                best = Some((free, o));
             }
         }
-        best.map(|(_, g)| g).unwrap_or_else(|| {
-            Self::new(
-                scene,
-                radius,
-                cell_px,
-                Point::new(cell_px / 2.0, cell_px / 2.0),
-            )
-        })
+        let origin = best.map_or(Point::new(cell_px / 2.0, cell_px / 2.0), |(_, o)| o);
+        Self::new(scene, radius, cell_px, origin)
     }
 
     /// Cells.

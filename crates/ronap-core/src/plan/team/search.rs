@@ -135,7 +135,9 @@ impl Reservations {
 
 #[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 struct Open {
-    /// Negated for the max-heap: least ticks to the goal, then least length, then latest.
+    /// For the max-heap: least ticks to the goal, then least length to the goal (its octile
+    /// estimate: straight ways first among the many of equal ticks on a grid), both negated;
+    /// then the latest.
     f: std::cmp::Reverse<(u32, u32)>,
     t: u32,
     node: u32,
@@ -188,6 +190,13 @@ impl Search<'_> {
             0
         };
         let horizon = t0 + 2 * h[from] + 64 + earliest.saturating_sub(t0);
+        // The length of a straight and diagonal way to the goal, thousandths of a cell.
+        let (cols, _) = self.grid.size();
+        let octile = |i: usize| -> u32 {
+            let dx = (i % cols).abs_diff(goal % cols) as u32;
+            let dy = (i / cols).abs_diff(goal / cols) as u32;
+            1000 * dx.max(dy) + 414 * dx.min(dy)
+        };
         let mut nodes = vec![Node {
             cell: from,
             t: t0,
@@ -198,7 +207,7 @@ impl Search<'_> {
         let mut seen: KeyMap<()> = KeyMap::default();
         let mut open = BinaryHeap::new();
         open.push(Open {
-            f: std::cmp::Reverse((t0 + h[from], 0)),
+            f: std::cmp::Reverse((t0 + h[from], octile(from))),
             t: t0,
             node: 0,
         });
@@ -240,7 +249,7 @@ impl Search<'_> {
                 });
                 lengths.push(l);
                 open.push(Open {
-                    f: std::cmp::Reverse((t + 1 + h[to], l)),
+                    f: std::cmp::Reverse((t + 1 + h[to], l + octile(to))),
                     t: t + 1,
                     node: (nodes.len() - 1) as u32,
                 });
