@@ -471,3 +471,133 @@ fn a_team_of_one_runs_as_the_lone_robot_column_for_column() {
         assert_eq!(figures(&lone), figures(&team), "{name} {policy}: summary");
     }
 }
+
+/// `ronap run --scenario FILE --policy coordinated --seeds N` into `out`: its table.
+fn coordinated(scenario: &str, out: &Path, seeds: &str) -> String {
+    ok(&ronap(&[
+        "run",
+        "--scenario",
+        repo_root()
+            .join("scenarios")
+            .join(scenario)
+            .to_str()
+            .unwrap(),
+        "--policy",
+        "coordinated",
+        "--seeds",
+        seeds,
+        "--out",
+        out.to_str().unwrap(),
+    ]))
+}
+
+#[test]
+fn coordinated_names_the_corridor_swap_infeasible_before_its_first_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("swap");
+    let table = coordinated("corridor-swap.toml", &out, "3");
+    assert_eq!(
+        row(&table, "infeasible"),
+        "3 (each one's reason in robots.csv)"
+    );
+    assert_eq!(row(&table, "deadlocks"), "0");
+    let episodes = rows(&out.join("episodes.csv"));
+    let (outcome, steps) = (col(&episodes, "outcome"), col(&episodes, "steps"));
+    for r in &episodes[1..] {
+        assert_eq!(
+            (r[outcome].as_str(), r[steps].as_str()),
+            ("infeasible", "0")
+        );
+    }
+    let robots = rows(&out.join("robots.csv"));
+    let (outcome, reason) = (col(&robots, "outcome"), col(&robots, "reason"));
+    for r in &robots[1..] {
+        assert_eq!(r[outcome], "infeasible");
+        assert!(
+            r[reason].starts_with("robots 0 and 1 cannot pass each other between ("),
+            "{}",
+            r[reason]
+        );
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(json["team"]["infeasible"], 3);
+    assert_eq!(summary(&out)["among_robots"]["infeasible"], 6);
+}
+
+#[test]
+fn coordinated_brings_both_robots_through_the_corridor_with_a_bay() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("bay");
+    let table = coordinated("corridor-bay.toml", &out, "3");
+    assert!(
+        table.contains("team success            100.0% (3 of 3"),
+        "{table}"
+    );
+    assert_eq!(row(&table, "robot collisions"), "0.00 per episode");
+    assert_eq!(row(&table, "wall collisions"), "0.00 per episode");
+}
+
+#[test]
+fn coordinated_brings_every_warehouse_team_home_with_no_deadlock() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("warehouse");
+    let table = coordinated("warehouse-team.toml", &out, "10");
+    assert!(
+        table.contains("team success            100.0% (10 of 10"),
+        "{table}"
+    );
+    assert_eq!(row(&table, "deadlocks"), "0");
+    // The same bytes again, and on one thread.
+    let again = dir.path().join("again");
+    ok(&ronap(&[
+        "run",
+        "--scenario",
+        repo_root()
+            .join("scenarios/warehouse-team.toml")
+            .to_str()
+            .unwrap(),
+        "--policy",
+        "coordinated",
+        "--seeds",
+        "10",
+        "--threads",
+        "1",
+        "--out",
+        again.to_str().unwrap(),
+    ]));
+    for f in ["episodes.csv", "robots.csv"] {
+        assert_eq!(
+            std::fs::read(out.join(f)).unwrap(),
+            std::fs::read(again.join(f)).unwrap(),
+            "{f}"
+        );
+    }
+}
+
+#[test]
+fn coordinated_is_refused_for_a_lone_robot_and_beside_another_policy() {
+    assert_rejected(
+        &["run", "--policy", "coordinated", "--seeds", "1"],
+        &["--policy coordinated: a team planner, for scenarios with [[robots]]"],
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("mixed.toml");
+    std::fs::write(
+        &file,
+        "[[robots]]\ncount = 2\n\n[[robots]]\npolicy = \"geodesic\"\n",
+    )
+    .unwrap();
+    assert_rejected(
+        &[
+            "run",
+            "--scenario",
+            file.to_str().unwrap(),
+            "--policy",
+            "coordinated",
+            "--seeds",
+            "1",
+        ],
+        &["robot 2: policy geodesic beside coordinated"],
+    );
+}

@@ -862,3 +862,93 @@ impl TeamPolicyFactory for CoordinatedFactory {
         vec![NAME.to_string(); self.robots]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::TeamRobotConfig;
+    use crate::eval::{EvalOptions, Evaluator, Outcome};
+    use crate::sim::world::Scenes;
+    use std::sync::atomic::AtomicBool;
+
+    /// `robots` robots (leaving on arrival or staying) in an open hall of `side` px, or a
+    /// `cols` x `cols` maze, run by `coordinated` on seeds `0..seeds`.
+    fn run(
+        maze: bool,
+        cols: u32,
+        robots: u32,
+        vanish: bool,
+        seeds: u64,
+    ) -> Vec<crate::eval::TeamRecord> {
+        let mut c = crate::SimConfig::default();
+        if maze {
+            c.maze.cols = cols;
+            c.maze.rows = cols;
+        } else {
+            c.maze.cols = 1;
+            c.maze.rows = 1;
+            c.maze.cell_px = 100.0 * f64::from(cols);
+        }
+        c.episode.min_goal_distance_px = 50.0;
+        c.robots = vec![TeamRobotConfig {
+            count: robots,
+            on_arrival: if vanish {
+                OnArrival::Vanish
+            } else {
+                OnArrival::Stay
+            },
+            ..Default::default()
+        }];
+        let ev = Evaluator::new(c.validate().expect("valid"), Scenes::MazePerSeed);
+        let factory = CoordinatedFactory::new(robots as usize);
+        let options = EvalOptions {
+            seeds: (0..seeds).collect::<Vec<_>>().into(),
+            ..Default::default()
+        };
+        ev.run_team(&factory, &options, &AtomicBool::new(false), &|_| {})
+            .expect("runs")
+            .records
+    }
+
+    #[test]
+    fn in_open_halls_and_mazes_robots_arrive_and_never_touch() {
+        for (maze, cols, robots, vanish) in [
+            (false, 3, 2, false),
+            (false, 4, 12, true),
+            (false, 6, 30, false),
+            (true, 4, 5, false),
+            (true, 5, 12, true),
+            (true, 6, 30, false),
+        ] {
+            let records = run(maze, cols, robots, vanish, 3);
+            assert_eq!(records.len(), 3);
+            for r in records {
+                let what = format!("maze {maze}, {cols} cols, {robots} robots, seed {}", r.seed);
+                assert_eq!(r.robot_collisions, 0, "{what}");
+                assert_eq!(r.collisions, 0, "{what}: walls");
+                assert!(!r.deadlock, "{what}");
+                assert_eq!(r.outcome, Outcome::Success, "{what}");
+                assert_eq!(r.robots.len(), robots as usize);
+            }
+        }
+    }
+
+    #[test]
+    fn the_same_seed_gives_the_same_team_episode() {
+        let a = run(true, 5, 10, false, 2);
+        let b = run(true, 5, 10, false, 2);
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!((x.steps, x.makespan), (y.steps, y.makespan));
+            assert_eq!(x.path_length_px.to_bits(), y.path_length_px.to_bits());
+        }
+    }
+
+    #[test]
+    fn a_goal_stop_drives_just_within_the_goal_s_tolerance() {
+        let c = Point::new(0.0, 0.0);
+        assert_eq!(stop_point(c, None, 10.0), c);
+        assert_eq!(stop_point(c, Some(Point::new(5.0, 0.0)), 10.0), c);
+        let p = stop_point(c, Some(Point::new(13.0, 0.0)), 10.0);
+        assert!((p.x - 4.0).abs() < 1e-12 && p.y == 0.0, "{p:?}");
+    }
+}

@@ -412,3 +412,109 @@ pub fn plan_team(
         attempts: limits.attempts.max(1),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Point;
+    use crate::sim::world::World;
+    use proptest::prelude::*;
+    use rand::SeedableRng;
+
+    /// Robot `stops`' centre at half-tick `h` (tick `h / 2`, or half way through a move).
+    fn at(grid: &PlanGrid, stops: &[Stop], h: u32) -> Point {
+        let t = h / 2;
+        let k = stops.iter().rposition(|s| s.arrive <= t).unwrap_or(0);
+        let here = grid.center(stops[k].cell);
+        match stops.get(k + 1) {
+            // Leaving at tick t, it is half way at t + 1/2.
+            Some(next) if h % 2 == 1 && stops[k].leave == t => {
+                (here + grid.center(next.cell).coords) * 0.5
+            }
+            _ => here,
+        }
+    }
+
+    /// A scene: an open hall, or a maze of `cols` x `cols` cells, with its grid for discs of
+    /// radius 5.
+    fn scene(maze: bool, cols: u32, seed: u64) -> PlanGrid {
+        let mut c = crate::SimConfig::default();
+        if maze {
+            c.maze.cols = cols;
+            c.maze.rows = cols;
+        } else {
+            c.maze.cols = 1;
+            c.maze.rows = 1;
+            c.maze.cell_px = 60.0 * f64::from(cols);
+        }
+        let world = World::maze(c.validate().expect("valid"), seed);
+        PlanGrid::best(world.scene(), 5.5, 18.4, &[])
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(24))]
+
+        /// On random open and maze scenes with 2-30 robots (random starts and goals on free
+        /// cells, staying or leaving), a plan found never puts two robots' discs (radius 5)
+        /// in contact, at a tick or half way through a move, and never has two robots on one
+        /// cell within a tick of each other.
+        #[test]
+        fn a_plan_keeps_every_two_robots_apart(
+            maze in any::<bool>(),
+            cols in 3u32..8,
+            robots in 2usize..31,
+            seed in 0u64..1000,
+            vanish in any::<bool>(),
+        ) {
+            let grid = scene(maze, cols, seed);
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+            let free: Vec<usize> = (0..grid.len()).filter(|&i| grid.is_free(i)).collect();
+            prop_assume!(free.len() >= 2 * robots + 2);
+            let mut cells = free.clone();
+            cells.shuffle(&mut rng);
+            let tasks: Vec<Task> = (0..robots)
+                .map(|k| Task {
+                    start: cells[k],
+                    goals: vec![cells[robots + k]],
+                    vanish,
+                })
+                .collect();
+            let Ok(plans) = plan_team(&grid, &tasks, &[], &Limits::default(), &mut rng) else {
+                return Ok(());
+            };
+            let end = plans
+                .iter()
+                .flat_map(|p| p.iter().map(|s| s.arrive))
+                .max()
+                .unwrap_or(0);
+            for h in 0..=2 * end + 2 {
+                for i in 0..robots {
+                    for j in i + 1..robots {
+                        // A robot that left is gone after its last arrival.
+                        let gone = |k: usize| vanish && h / 2 > plans[k].last().map_or(0, |s| s.arrive);
+                        if gone(i) || gone(j) {
+                            continue;
+                        }
+                        let d = (at(&grid, &plans[i], h) - at(&grid, &plans[j], h)).norm();
+                        prop_assert!(d >= 10.0, "robots {i} and {j} {d} px apart at half-tick {h}");
+                    }
+                }
+            }
+            for (i, a) in plans.iter().enumerate() {
+                for (j, b) in plans.iter().enumerate().skip(i + 1) {
+                    for s in a {
+                        for u in b.iter().filter(|u| u.cell == s.cell) {
+                            let apart = s.leave.saturating_add(1) < u.arrive
+                                || u.leave.saturating_add(1) < s.arrive;
+                            prop_assert!(apart, "robots {i} and {j} on cell {} at {s:?} and {u:?}", s.cell);
+                        }
+                    }
+                }
+            }
+            // Every robot ends on its goal.
+            for (k, p) in plans.iter().enumerate() {
+                prop_assert_eq!(p.last().map(|s| s.cell), Some(tasks[k].goals[0]));
+            }
+        }
+    }
+}
