@@ -55,6 +55,12 @@ pub struct RobotRecord {
     pub shortest_px: Option<f64>,
     /// SPL.
     pub spl: f64,
+    /// The fewest steps its own task takes alone: its shortest path (through every goal of a
+    /// list, cut by the tolerance as `shortest_px` is) at its largest step, whatever the
+    /// outcome; `None` without a path.
+    pub lower_bound_steps: Option<u32>,
+    /// Steps it acted without moving (waiting, turning on the spot, blocked).
+    pub waiting_steps: u32,
     /// Summed reward.
     pub total_reward: f64,
     /// Start pose.
@@ -106,6 +112,15 @@ pub struct TeamRecord {
     pub steps: u32,
     /// The step the last robot arrived at, when all did.
     pub makespan: Option<u32>,
+    /// Flow: each robot's arrival step, summed, when all arrived.
+    pub sum_of_costs: Option<u64>,
+    /// The makespan's lower bound: the longest of the robots' own lower bounds
+    /// ([`RobotRecord::lower_bound_steps`]), when each has one.
+    pub makespan_lower_bound: Option<u32>,
+    /// The flow's lower bound: the robots' own lower bounds summed, when each has one.
+    pub sum_of_costs_lower_bound: Option<u64>,
+    /// Summed steps robots acted without moving.
+    pub waiting_steps: u64,
     /// Summed distance driven, px.
     pub path_length_px: f64,
     /// Summed steps walls blocked.
@@ -124,6 +139,15 @@ pub struct TeamRecord {
     pub step_logs: Vec<Vec<StepLog>>,
     /// The scene, when paths were recorded (for pictures).
     pub scene: Option<Arc<crate::Scene>>,
+}
+
+/// `sum / n`, or 0 for none.
+fn over(sum: f64, n: usize) -> f64 {
+    if n == 0 {
+        0.0
+    } else {
+        sum / n as f64
+    }
 }
 
 /// Whether a count is nought (left out of `summary.json`).
@@ -153,6 +177,22 @@ pub struct TeamSummary {
     pub infeasible: usize,
     /// Mean makespan over the team successes, steps.
     pub mean_makespan: f64,
+    /// Over the team successes: the mean lower bound of the makespan (the longest robot's own
+    /// shortest way), steps...
+    #[serde(default)]
+    pub mean_makespan_lower_bound: f64,
+    /// ... the mean ratio of makespan to it...
+    #[serde(default)]
+    pub mean_makespan_ratio: f64,
+    /// ... the mean flow (each robot's arrival step, summed), steps...
+    #[serde(default)]
+    pub mean_sum_of_costs: f64,
+    /// ... and its mean lower bound (the robots' own shortest ways, summed), steps.
+    #[serde(default)]
+    pub mean_sum_of_costs_lower_bound: f64,
+    /// Mean steps a robot acted without moving, per robot episode.
+    #[serde(default)]
+    pub mean_waiting_steps: f64,
     /// Mean summed path length, px.
     pub mean_path_length_px: f64,
     /// Mean robot collisions (blocked robot steps) per episode.
@@ -193,8 +233,23 @@ pub struct TeamFigures {
     pub collisions: u32,
     /// Summed steps other robots blocked.
     pub robot_collisions: u32,
+    /// Its makespan and flow against their lower bounds, and its waiting.
+    pub flow: Flow,
     /// Each robot's figures.
     pub robots: Vec<RobotFigures>,
+}
+
+/// A team episode's flow ([`TeamRecord`]'s fields of the same names).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Flow {
+    /// Each robot's arrival step, summed, when all arrived.
+    pub sum_of_costs: Option<u64>,
+    /// The longest of the robots' own lower bounds.
+    pub makespan_lower_bound: Option<u32>,
+    /// The robots' own lower bounds, summed.
+    pub sum_of_costs_lower_bound: Option<u64>,
+    /// Summed steps robots acted without moving.
+    pub waiting_steps: u64,
 }
 
 impl TeamFigures {
@@ -207,6 +262,12 @@ impl TeamFigures {
             path_length_px: record.path_length_px,
             collisions: record.collisions,
             robot_collisions: record.robot_collisions,
+            flow: Flow {
+                sum_of_costs: record.sum_of_costs,
+                makespan_lower_bound: record.makespan_lower_bound,
+                sum_of_costs_lower_bound: record.sum_of_costs_lower_bound,
+                waiting_steps: record.waiting_steps,
+            },
             robots: record
                 .robots
                 .iter()
@@ -235,6 +296,14 @@ pub struct TeamTally {
     deadlocks: usize,
     makespans: usize,
     makespan_sum: f64,
+    /// Over the team successes with lower bounds: how many, and the sums of the lower bound,
+    /// of the makespan's ratio to it, of the flow and of its lower bound.
+    bounded: usize,
+    makespan_bound_sum: f64,
+    makespan_ratio_sum: f64,
+    flow_sum: f64,
+    flow_bound_sum: f64,
+    waiting_steps: u64,
     path_length_px: f64,
     robot_collisions: f64,
     collisions: f64,
@@ -257,6 +326,12 @@ impl Default for TeamTally {
             deadlocks: 0,
             makespans: 0,
             makespan_sum: zero,
+            bounded: 0,
+            makespan_bound_sum: zero,
+            makespan_ratio_sum: zero,
+            flow_sum: zero,
+            flow_bound_sum: zero,
+            waiting_steps: 0,
             path_length_px: zero,
             robot_collisions: zero,
             collisions: zero,
@@ -283,7 +358,19 @@ impl TeamTally {
         if let Some(m) = f.makespan {
             self.makespans += 1;
             self.makespan_sum += f64::from(m);
+            if let (Some(lb), Some(flow), Some(flow_lb)) = (
+                f.flow.makespan_lower_bound,
+                f.flow.sum_of_costs,
+                f.flow.sum_of_costs_lower_bound,
+            ) {
+                self.bounded += 1;
+                self.makespan_bound_sum += f64::from(lb);
+                self.makespan_ratio_sum += f64::from(m) / f64::from(lb.max(1));
+                self.flow_sum += flow as f64;
+                self.flow_bound_sum += flow_lb as f64;
+            }
         }
+        self.waiting_steps += f.flow.waiting_steps;
         self.path_length_px += f.path_length_px;
         self.robot_collisions += f64::from(f.robot_collisions);
         self.collisions += f64::from(f.collisions);
@@ -342,6 +429,11 @@ impl TeamTally {
             } else {
                 self.makespan_sum / self.makespans as f64
             },
+            mean_makespan_lower_bound: over(self.makespan_bound_sum, self.bounded),
+            mean_makespan_ratio: over(self.makespan_ratio_sum, self.bounded),
+            mean_sum_of_costs: over(self.flow_sum, self.bounded),
+            mean_sum_of_costs_lower_bound: over(self.flow_bound_sum, self.bounded),
+            mean_waiting_steps: over(self.waiting_steps as f64, self.robots),
             mean_path_length_px: per(self.path_length_px),
             robot_collisions_per_episode: per(self.robot_collisions),
             collisions_per_episode: per(self.collisions),
@@ -402,6 +494,32 @@ impl TeamSummary {
                 } else {
                     "none (no team success)".to_string()
                 },
+            ),
+            (
+                "makespan / bound",
+                if self.mean_makespan_lower_bound > 0.0 {
+                    format!(
+                        "{:.2} (lower bound {:.1} steps: the longest robot's own shortest way)",
+                        self.mean_makespan_ratio, self.mean_makespan_lower_bound
+                    )
+                } else {
+                    "none (no team success)".to_string()
+                },
+            ),
+            (
+                "sum of costs",
+                if self.mean_sum_of_costs_lower_bound > 0.0 {
+                    format!(
+                        "{:.1} steps (lower bound {:.1}: the robots' own shortest ways)",
+                        self.mean_sum_of_costs, self.mean_sum_of_costs_lower_bound
+                    )
+                } else {
+                    "none (no team success)".to_string()
+                },
+            ),
+            (
+                "waiting",
+                format!("{:.1} steps per robot", self.mean_waiting_steps),
             ),
             (
                 "mean summed path",
@@ -481,7 +599,11 @@ impl Evaluator {
             }
         };
         note(rollout.team(), &mut tracks);
+        let mut waiting = vec![0u32; n];
+        let mut at: Vec<Point> = Vec::with_capacity(n);
         loop {
+            at.clear();
+            at.extend(rollout.team().robots().iter().map(|r| r.pose().position()));
             // Each running robot's state before the step, for its step log.
             let before: Vec<Option<Before>> = if recording.steps {
                 let team = rollout.team();
@@ -495,6 +617,11 @@ impl Evaluator {
                 break;
             }
             let team = rollout.team();
+            for (k, w) in waiting.iter_mut().enumerate() {
+                if rollout.last_actions()[k].is_some() && team.robot(k).pose().position() == at[k] {
+                    *w += 1;
+                }
+            }
             for (k, b) in before.into_iter().enumerate() {
                 if let (Some(b), Some(action)) = (b, rollout.last_actions()[k]) {
                     let step = team.robot(k).steps();
@@ -522,13 +649,16 @@ impl Evaluator {
             // Each goal counts as reached within the tolerance: a tour of n goals can be cut by
             // up to the tolerance on arriving at each and on leaving each but the last.
             let goals = team.goals(k).len().max(1) as f64;
-            let shortest_px = (outcome == Outcome::Success)
-                .then(|| match tour {
-                    Some(t) => Some(t.optimal).filter(|l| l.is_finite()),
-                    None => shortest_path_px(rollout.world(k), r.start().position(), r.goal()),
-                })
-                .flatten()
-                .map(|l| (l - tolerance * (2.0 * goals - 1.0)).max(0.0));
+            // Its own task's length: on success for SPL, whatever the outcome for the bound.
+            let own_px = match tour {
+                Some(t) => Some(t.optimal).filter(|l| l.is_finite()),
+                None => shortest_path_px(rollout.world(k), r.start().position(), r.goal()),
+            }
+            .map(|l| (l - tolerance * (2.0 * goals - 1.0)).max(0.0));
+            let shortest_px = own_px.filter(|_| outcome == Outcome::Success);
+            let robot = &r.config().robot;
+            let step_px = robot.move_speed_px.max(robot.max_linear_speed_px);
+            let lower_bound_steps = own_px.map(|l| (l / step_px).ceil() as u32);
             let spl = match shortest_px {
                 Some(l) if r.path_length_px() > 0.0 => l / l.max(r.path_length_px()),
                 Some(_) => 1.0,
@@ -560,6 +690,8 @@ impl Evaluator {
                 path_length_px: r.path_length_px(),
                 shortest_px,
                 spl,
+                lower_bound_steps,
+                waiting_steps: waiting[k],
                 total_reward: r.total_reward(),
                 start: r.start(),
                 end: r.pose(),
@@ -594,6 +726,23 @@ impl Evaluator {
                     .max()
                     .unwrap_or(0)
             }),
+            sum_of_costs: all_arrived.then(|| {
+                robots
+                    .iter()
+                    .filter_map(|r| r.arrived_at)
+                    .map(u64::from)
+                    .sum()
+            }),
+            makespan_lower_bound: robots
+                .iter()
+                .map(|r| r.lower_bound_steps)
+                .collect::<Option<Vec<u32>>>()
+                .map(|b| b.into_iter().max().unwrap_or(0)),
+            sum_of_costs_lower_bound: robots
+                .iter()
+                .map(|r| r.lower_bound_steps.map(u64::from))
+                .sum(),
+            waiting_steps: robots.iter().map(|r| u64::from(r.waiting_steps)).sum(),
             path_length_px: robots.iter().map(|r| r.path_length_px).sum(),
             collisions: robots.iter().map(|r| r.collisions).sum(),
             robot_collisions: robots.iter().map(|r| r.robot_collisions).sum(),
@@ -727,6 +876,7 @@ mod tests {
             path_length_px: 0.0,
             collisions: 3,
             robot_collisions,
+            flow: Flow::default(),
             robots,
         };
         let mut tally = TeamTally::default();

@@ -24,7 +24,7 @@ pub const LONE_COLUMNS: [&str; 10] = [
     "near_steps",
 ];
 
-const TEAM_BASE: [&str; 7] = [
+const TEAM_BASE: [&str; 11] = [
     "seed",
     "outcome",
     "deadlock",
@@ -32,6 +32,10 @@ const TEAM_BASE: [&str; 7] = [
     "path_length_bits",
     "collisions",
     "robot_collisions",
+    "sum_of_costs",
+    "makespan_lower_bound",
+    "sum_of_costs_lower_bound",
+    "waiting_steps",
 ];
 
 const ROBOT_FIELDS: [&str; 9] = [
@@ -110,6 +114,16 @@ pub fn team_row(seed: u64, team: &TeamFigures, robots: &[Figures]) -> Vec<String
         bits(team.path_length_px),
         team.collisions.to_string(),
         team.robot_collisions.to_string(),
+        team.flow
+            .sum_of_costs
+            .map_or(String::new(), |m| m.to_string()),
+        team.flow
+            .makespan_lower_bound
+            .map_or(String::new(), |m| m.to_string()),
+        team.flow
+            .sum_of_costs_lower_bound
+            .map_or(String::new(), |m| m.to_string()),
+        team.flow.waiting_steps.to_string(),
     ];
     for r in robots {
         row.extend([
@@ -251,6 +265,12 @@ pub fn parse_team(
         path_length_px: f.bits()?,
         collisions: f.parse()?,
         robot_collisions: f.parse()?,
+        flow: crate::eval::team::Flow {
+            sum_of_costs: f.optional()?,
+            makespan_lower_bound: f.optional()?,
+            sum_of_costs_lower_bound: f.optional()?,
+            waiting_steps: f.parse()?,
+        },
         robots: Vec::with_capacity(robots),
     };
     let mut lone = Vec::with_capacity(robots);
@@ -325,6 +345,12 @@ mod tests {
             path_length_px: 12.5,
             collisions: 1,
             robot_collisions: 4,
+            flow: crate::eval::team::Flow {
+                sum_of_costs: Some(40),
+                makespan_lower_bound: None,
+                sum_of_costs_lower_bound: Some(7),
+                waiting_steps: 3,
+            },
             robots: vec![RobotFigures {
                 outcome: Outcome::Stuck,
                 steps: 17,

@@ -51,7 +51,7 @@ pub fn write_team_episodes(records: &[TeamRecord], out: &mut dyn Write) -> std::
 }
 
 /// Columns of a team run's `robots.csv` (one row per robot per episode).
-pub const ROBOT_COLUMNS: [&str; 24] = [
+pub const ROBOT_COLUMNS: [&str; 26] = [
     "seed",
     "robot",
     "policy",
@@ -76,6 +76,8 @@ pub const ROBOT_COLUMNS: [&str; 24] = [
     "goal_x",
     "goal_y",
     "reason",
+    "lower_bound_steps",
+    "waiting_steps",
 ];
 
 /// The columns of `robots.csv` measuring the metrics of `kinds`: [`ROBOT_COLUMNS`], then one
@@ -118,6 +120,8 @@ pub fn robot_rows(r: &TeamRecord, kinds: &[Kind]) -> Vec<Vec<String>> {
                 format!("{:.4}", x.spl),
             ];
             row.extend(start_goal_cells(x.start, x.goal, x.reason.as_deref()));
+            row.push(x.lower_bound_steps.map_or(String::new(), |b| b.to_string()));
+            row.push(x.waiting_steps.to_string());
             row.extend(metric_cells(kinds, &x.metrics));
             row
         })
