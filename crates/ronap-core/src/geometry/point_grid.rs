@@ -39,6 +39,11 @@ impl PointGrid {
         }
     }
 
+    /// The cell side, px.
+    pub fn cell(&self) -> f64 {
+        self.cell
+    }
+
     /// The column and row of `p`, clamped to the grid.
     fn cell_of(&self, x: f64, y: f64) -> (usize, usize) {
         let clamp = |v: f64, n: usize| {

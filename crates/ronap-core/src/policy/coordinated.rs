@@ -26,6 +26,7 @@ use super::team::{PerRobot, RobotError, TeamPolicy, TeamPolicyFactory};
 use super::{Decision, Policy, PolicyError};
 use crate::config::{OnArrival, PlannerActions};
 use crate::geometry::orca::{Agent, Horizon, V2};
+use crate::geometry::point_grid::PointGrid;
 use crate::geometry::{Point, Vector};
 use crate::plan::team::{
     pair_feasible, plan_team, Limits, Pair, PlanFailure, PlanGrid, Schedule, Stop, Task,
@@ -338,6 +339,11 @@ pub struct Coordinated {
     /// every moving obstacle's.
     last: Vec<Option<Point>>,
     agents: Vec<Agent<f64>>,
+    /// The agents by where they are, and the largest one's radius.
+    agent_grid: PointGrid,
+    max_agent_radius: f64,
+    /// Scratch: the agents near one robot.
+    near: Vec<u32>,
     /// The place of each robot in `agents`.
     slot: Vec<Option<usize>>,
     avoider: Avoider,
@@ -676,6 +682,26 @@ impl Coordinated {
                 seen(n + i, at, o.body().bounding_radius(), &mut self.agents);
             }
         }
+        // Cells of the largest sensing range.
+        let scene = team.robot(0).scene();
+        let range = team
+            .robots()
+            .iter()
+            .map(|r| {
+                let c = r.config();
+                c.orca.sense_range_px.unwrap_or(c.laser.range_px)
+            })
+            .fold(1.0, f64::max);
+        if self.agent_grid.cell() != range {
+            self.agent_grid = PointGrid::new(scene.width(), scene.height(), range);
+        }
+        self.agent_grid.fill(
+            self.agents
+                .iter()
+                .enumerate()
+                .map(|(i, a)| (i, Point::new(a.position.x, a.position.y))),
+        );
+        self.max_agent_radius = self.agents.iter().map(|a| a.radius).fold(0.0, f64::max);
     }
 }
 
@@ -771,16 +797,23 @@ impl TeamPolicy for Coordinated {
             let range = config.orca.sense_range_px.unwrap_or(config.laser.range_px);
             // Alone, it follows its plan as planned: the plan's moves keep clear of the still
             // scene, and ORCA's obstacle lines would only nudge it off them.
-            let alone = |slot: usize| {
-                let at = self.agents[slot].position;
-                self.agents.iter().enumerate().all(|(j, a)| {
-                    j == slot || {
+            // The agents that may lie within its range, from the grid.
+            let near = &mut self.near;
+            let agents = &self.agents;
+            let alone = |slot: usize, near: &mut Vec<u32>| {
+                let at = agents[slot].position;
+                let centre = Point::new(at.x, at.y);
+                self.agent_grid
+                    .near(centre, range + self.max_agent_radius, near);
+                near.iter().all(|&j| {
+                    let a = &agents[j as usize];
+                    j as usize == slot || {
                         let d = a.position - at;
                         (d.x * d.x + d.y * d.y).sqrt() > range + a.radius
                     }
                 })
             };
-            let v = match self.slot[k].filter(|&s| !alone(s)) {
+            let v = match self.slot[k].filter(|&s| !alone(s, near)) {
                 Some(slot) => self.avoider.velocity(
                     me.scene(),
                     &Avoid {
@@ -796,7 +829,7 @@ impl TeamPolicy for Coordinated {
                         neighbour_dist: range,
                         max_neighbours: config.orca.max_neighbours as usize,
                         margin: 0.0,
-                        candidates: None,
+                        candidates: Some(near),
                     },
                 ),
                 None => preferred,
