@@ -387,39 +387,32 @@ impl PyPolicyFactory {
         pool: &ProcessPool,
         batched: Vec<bool>,
         others: Vec<Option<Box<dyn Policy>>>,
-    ) -> Result<BatchedTeam, PolicyError> {
+    ) -> Result<ronap_core::policy::Joint, PolicyError> {
         let idle = pool.0.lock().ok().and_then(|mut p| p.pop());
         let process = match idle {
             Some(p) => p,
             None => self.spawn().map_err(PolicyError::Failed)?,
         };
-        Ok(BatchedTeam {
+        let pooled = Pooled {
             process: Some(process),
             pool: pool.clone(),
+        };
+        Ok(ronap_core::policy::Joint::new(
+            Box::new(pooled),
             batched,
             others,
-            rows: Vec::new(),
-            robots: Vec::new(),
-            actions: Vec::new(),
-        })
+        ))
     }
 }
 
-/// A team whose robots of one Python function are decided together, one call a step (see
-/// [`PyPolicyFactory::batched_team`]).
-pub struct BatchedTeam {
+/// A Python process of a pool, handed back to the pool when its team episode ends (unless it
+/// failed).
+struct Pooled {
     process: Option<PyProcess>,
     pool: ProcessPool,
-    batched: Vec<bool>,
-    others: Vec<Option<Box<dyn Policy>>>,
-    /// The observations of this step's call, row after row.
-    rows: Vec<f32>,
-    /// The robot of each row.
-    robots: Vec<usize>,
-    actions: Vec<Action>,
 }
 
-impl Drop for BatchedTeam {
+impl Drop for Pooled {
     fn drop(&mut self) {
         if let (Some(p), Ok(mut pool)) = (self.process.take(), self.pool.0.lock()) {
             pool.push(p);
@@ -427,107 +420,22 @@ impl Drop for BatchedTeam {
     }
 }
 
-impl ronap_core::policy::TeamPolicy for BatchedTeam {
-    fn reset(
+impl BatchPolicy for Pooled {
+    fn act_batch(
         &mut self,
-        team: &ronap_core::sim::team::Team,
-        worlds: &[std::sync::Arc<World>],
-    ) -> Result<(), ronap_core::policy::RobotError> {
-        let n = team.robots().len();
-        if self.batched.len() != n || self.others.len() != n {
-            return Err((
-                0,
-                PolicyError::Failed(format!(
-                    "policies for {} robots, not {n}",
-                    self.batched.len()
-                )),
-            ));
-        }
-        let mut width = None;
-        for (k, world) in worlds.iter().enumerate().take(n) {
-            if let Some(policy) = &mut self.others[k] {
-                policy.reset(world, team.robot(k)).map_err(|e| (k, e))?;
-            } else if self.batched[k] {
-                let w = team.robot(k).observation().len();
-                if *width.get_or_insert(w) != w {
-                    return Err((
-                        k,
-                        PolicyError::Failed(
-                            "--batch needs every batched robot's observation to be the same size \
-                             (its laser has another beam count)"
-                                .into(),
-                        ),
-                    ));
-                }
-            }
-        }
-        Ok(())
-    }
-
-    fn act(
-        &mut self,
-        team: &ronap_core::sim::team::Team,
-        decisions: &mut [Option<Decision>],
-    ) -> Result<(), ronap_core::policy::RobotError> {
-        self.rows.clear();
-        self.robots.clear();
-        for (k, decision) in decisions.iter_mut().enumerate() {
-            if !team.running(k) {
-                continue;
-            }
-            if let Some(policy) = &mut self.others[k] {
-                policy.hear(team.inbox(k));
-                *decision = Some(policy.act(team.robot(k)).map_err(|e| (k, e))?);
-            } else if self.batched[k] {
-                self.rows.extend_from_slice(team.robot(k).observation());
-                self.robots.push(k);
-            }
-        }
-        let Some(&first) = self.robots.first() else {
-            return Ok(());
-        };
-        let width = self.rows.len() / self.robots.len();
+        observations: &[f32],
+        width: usize,
+        actions: &mut Vec<Action>,
+    ) -> Result<(), PolicyError> {
         let process = self
             .process
             .as_mut()
-            .ok_or((first, PolicyError::Failed("no Python process".into())))?;
-        self.actions.clear();
-        if let Err(e) = process.act_batch(&self.rows, width, &mut self.actions) {
+            .ok_or_else(|| PolicyError::Failed("no Python process".into()))?;
+        let result = process.act_batch(observations, width, actions);
+        if result.is_err() {
             // A process that failed (or exited) is not handed to the next episode.
             self.process = None;
-            return Err((first, e));
         }
-        if self.actions.len() != self.robots.len() {
-            return Err((
-                first,
-                PolicyError::Failed(format!(
-                    "returned {} actions for {} robots, expected one per row",
-                    self.actions.len(),
-                    self.robots.len()
-                )),
-            ));
-        }
-        for (&k, &a) in self.robots.iter().zip(&self.actions) {
-            decisions[k] = Some(Decision::Act(a));
-        }
-        Ok(())
-    }
-
-    fn message(&mut self, robot: usize, out: &mut [f32]) {
-        if let Some(policy) = &mut self.others[robot] {
-            policy.message(out);
-        }
-    }
-
-    fn next_goal(
-        &mut self,
-        robot: usize,
-        world: &World,
-        episode: &Episode,
-    ) -> Result<(), PolicyError> {
-        match &mut self.others[robot] {
-            Some(policy) => policy.reset(world, episode),
-            None => Ok(()),
-        }
+        result
     }
 }

@@ -7,13 +7,19 @@ use crate::kwargs::Options;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
+use ronap_core::eval::TeamRecord;
 use ronap_core::eval::{EvalOptions, Evaluator};
 use ronap_core::io::run_dir::{
     BlockRun, EpisodeRows, Layout, Pictures, RunFiles, RunInfo, RunWriter,
 };
+use ronap_core::io::team_rows::{robot_columns, robot_rows, team_episode_row, TEAM_COLUMNS};
+use ronap_core::job::evaluate_team_into;
 use ronap_core::job::{evaluate_into, RunRequest};
 use ronap_core::policy::batched::{BatchPolicy, Batched};
-use ronap_core::policy::{Decision, Policy, PolicyError, PolicyFactory};
+use ronap_core::policy::coordinated;
+use ronap_core::policy::{
+    Decision, JointFactory, Policy, PolicyError, PolicyFactory, TeamPolicyFactory,
+};
 use ronap_core::sim::world::Scenes;
 use ronap_core::{Action, Episode, ValidConfig, World};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -269,6 +275,24 @@ pub fn evaluate<'py>(
     let map_path = map_path.as_deref();
     let config = config.valid();
     let first = first_seed(&seeds)?;
+    if config.team_size() > 0 {
+        if batch > 0 {
+            return Err(errors::ConfigError::new_err(format!(
+                "batch = {batch}: a team's callable already decides for every robot at once"
+            )));
+        }
+        let run = TeamRun {
+            maze_seed,
+            map_path,
+            threads,
+            continuous,
+            out: out.as_deref(),
+            png,
+            log_steps,
+            force,
+        };
+        return evaluate_team(py, policy, seeds, config, &run);
+    }
     let (factory, name) = if batch > 0 {
         if !policy.is_callable() || policy.extract::<String>().is_ok() {
             return Err(errors::ConfigError::new_err(format!(
@@ -377,6 +401,223 @@ pub fn evaluate<'py>(
             all.append((e.seed, e.episode, e.timing, e.figures))?;
         }
         d.set_item("rows", all)?;
+    }
+    Ok(d)
+}
+
+/// How a team evaluation runs (as [`evaluate`]'s options name them).
+struct TeamRun<'a> {
+    maze_seed: Option<u64>,
+    map_path: Option<&'a str>,
+    threads: usize,
+    continuous: bool,
+    out: Option<&'a std::path::Path>,
+    png: Option<String>,
+    log_steps: bool,
+    force: bool,
+}
+
+/// The team policy `policy` names or is, with the name reports give it: `coordinated`, another
+/// built-in or network name for the robots whose entries name none (entries that name one keep
+/// it), or a callable deciding for every robot at once (a `(robots, observation size)` array of
+/// the running robots' observations in, one action per row out).
+fn team_factory(
+    policy: &Bound<'_, PyAny>,
+    config: &ValidConfig,
+    continuous: bool,
+) -> PyResult<(Box<dyn TeamPolicyFactory>, String)> {
+    let py = policy.py();
+    let n = config.team_size();
+    if let Ok(name) = policy.extract::<String>() {
+        if name == coordinated::NAME {
+            return Ok((Box::new(coordinated::CoordinatedFactory::new(n)), name));
+        }
+        let mut factories: Vec<Box<dyn PolicyFactory>> = Vec::new();
+        let mut names = Vec::new();
+        let mut of_robot = Vec::new();
+        for (i, entry) in config.robots.iter().enumerate() {
+            let own = entry.policy.clone().unwrap_or_else(|| name.clone());
+            let factory = ronap_core::policy::factory(
+                &own,
+                config.team_robot(names.len()).observation_size(),
+            )
+            .map_err(|e| errors::ConfigError::new_err(format!("robots[{i}]: {e}")))?;
+            factories.push(factory);
+            for _ in 0..entry.count {
+                names.push(own.clone());
+                of_robot.push(factories.len() - 1);
+            }
+        }
+        return Ok((
+            Box::new(Owned {
+                factories,
+                of_robot,
+                names,
+            }),
+            name,
+        ));
+    }
+    if !policy.is_callable() {
+        return Err(errors::ConfigError::new_err(format!(
+            "policy {policy}: expected a built-in policy name or a callable (the robots' \
+             observations -> their actions)"
+        )));
+    }
+    let name = policy_name(policy);
+    let callable = policy.clone().unbind();
+    let check = py
+        .import("ronap.env")?
+        .getattr(if continuous {
+            "continuous_actions"
+        } else {
+            "discrete_actions"
+        })?
+        .unbind();
+    let robot = &config.team_robot(0).robot;
+    let speeds = (robot.max_linear_speed_px, robot.max_angular_speed_deg);
+    let make = move || -> Result<Box<dyn BatchPolicy>, PolicyError> {
+        Ok(Python::with_gil(|py| {
+            Box::new(PyBatchPolicy {
+                callable: callable.clone_ref(py),
+                continuous,
+                check: check.clone_ref(py),
+                speeds,
+            }) as Box<dyn BatchPolicy>
+        }))
+    };
+    Ok((
+        Box::new(JointFactory::new(Box::new(make), n, name.clone())),
+        name,
+    ))
+}
+
+/// Each robot driven by a policy of its own, from factories this owns.
+struct Owned {
+    factories: Vec<Box<dyn PolicyFactory>>,
+    /// Robot `k`'s factory, as an index into `factories`.
+    of_robot: Vec<usize>,
+    names: Vec<String>,
+}
+
+impl TeamPolicyFactory for Owned {
+    fn make(&self) -> Result<Box<dyn ronap_core::policy::TeamPolicy>, PolicyError> {
+        let policies = self
+            .of_robot
+            .iter()
+            .map(|&i| self.factories[i].make())
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Box::new(ronap_core::policy::PerRobot::new(policies)))
+    }
+
+    fn names(&self) -> Vec<String> {
+        self.names.clone()
+    }
+}
+
+/// [`evaluate`] of a team scenario: {"summary": the robots' figures, "team": the team's,
+/// "episodes": a dict per team episode (its `episodes.csv` row, and "robots": a dict per robot,
+/// its `robots.csv` row)}; the run files of `ronap run` in `run.out` when given.
+fn evaluate_team<'py>(
+    py: Python<'py>,
+    policy: &Bound<'py, PyAny>,
+    seeds: Vec<u64>,
+    config: &ValidConfig,
+    run: &TeamRun<'_>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let first = first_seed(&seeds)?;
+    let (factory, name) = team_factory(policy, config, run.continuous)?;
+    let pictures: Option<Pictures> = run
+        .png
+        .as_deref()
+        .map(str::parse)
+        .transpose()
+        .map_err(|e| errors::ConfigError::new_err(format!("png = {e}")))?;
+    let (info, scenes) = run_info(name, config, run.maze_seed, run.map_path)?;
+    let writer = run
+        .out
+        .map(|dir| {
+            let files = RunFiles {
+                pictures,
+                steps: run.log_steps,
+                gifs: false,
+            };
+            RunWriter::create(dir, files, first, run.force).map_err(errors::out_dir)
+        })
+        .transpose()?;
+    let evaluator = Evaluator::new(config.clone(), scenes);
+    let options = EvalOptions {
+        seeds: seeds.into(),
+        threads: run.threads,
+        ..EvalOptions::default()
+    };
+    let cancel = AtomicBool::new(false);
+    let records = Mutex::new(Vec::new());
+    let evaluation = py
+        .allow_threads(|| {
+            let request = RunRequest {
+                evaluator: &evaluator,
+                options: &options,
+                info: &info,
+                writer,
+                cancel: &cancel,
+            };
+            let keep = |r: &TeamRecord| {
+                if let Ok(mut all) = records.lock() {
+                    all.push((r.seed, team_episode_row(r), robot_rows(r, &[])));
+                }
+            };
+            evaluate_team_into(request, factory.as_ref(), &keep)
+        })
+        .map_err(|e| errors::PolicyError::new_err(e.to_string()))?;
+    if let Some(e) = &evaluation.write_error {
+        return Err(errors::output(e));
+    }
+    if let Some(e) = &evaluation.result.error {
+        return Err(errors::run(e));
+    }
+    let d = PyDict::new(py);
+    let summary = serde_json::to_value(&evaluation.summary).unwrap_or_default();
+    d.set_item("summary", conv::json(py, &summary)?)?;
+    let team = serde_json::to_value(&evaluation.team).unwrap_or_default();
+    d.set_item("team", conv::json(py, &team)?)?;
+    let mut all = records.into_inner().unwrap_or_default();
+    all.sort_by_key(|(seed, _, _)| *seed);
+    let robot_columns = robot_columns(&[]);
+    let episodes = PyList::empty(py);
+    for (_, row, robots) in all {
+        let e = cells(py, &TEAM_COLUMNS, &row)?;
+        let list = PyList::empty(py);
+        for r in robots {
+            list.append(cells(py, &robot_columns, &r)?)?;
+        }
+        e.set_item("robots", list)?;
+        episodes.append(e)?;
+    }
+    d.set_item("episodes", episodes)?;
+    Ok(d)
+}
+
+/// A dict of `columns` to a CSV row's cells: integers and numbers as such, an empty cell as
+/// None, `true`/`false` as booleans, other text as it is.
+fn cells<'py, S: AsRef<str>>(
+    py: Python<'py>,
+    columns: &[S],
+    row: &[String],
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    for (c, v) in columns.iter().zip(row) {
+        let key = c.as_ref();
+        if v.is_empty() {
+            d.set_item(key, py.None())?;
+        } else if let Ok(i) = v.parse::<i64>() {
+            d.set_item(key, i)?;
+        } else if let Ok(x) = v.parse::<f64>() {
+            d.set_item(key, x)?;
+        } else if v == "true" || v == "false" {
+            d.set_item(key, v == "true")?;
+        } else {
+            d.set_item(key, v)?;
+        }
     }
     Ok(d)
 }

@@ -183,3 +183,54 @@ def test_vector_form_plays_the_same_episodes_on_any_thread_count():
         o, r, _, _, _ = single.step({f"robot_{k}": int(actions[1, k]) for k in range(2)})
         np.testing.assert_array_equal(runs[0][1 + 6 * t][1], np.stack([o["robot_0"], o["robot_1"]]))
         np.testing.assert_array_equal(runs[0][2 + 6 * t][1], [r["robot_0"], r["robot_1"]])
+
+
+JOINT = '''
+import numpy as np
+
+def act(obs):
+    """Every robot AHEAD unless the beam straight ahead sees a wall close, then LEFT."""
+    obs = np.asarray(obs)
+    assert obs.ndim == 2
+    return np.where(obs[:, 8] > 0.3, 1, 0)
+'''
+
+
+def test_evaluate_runs_a_team_with_the_team_planner():
+    r = ronap.evaluate("coordinated", seeds=range(3), scenario=WAREHOUSE)
+    assert r["team"]["team_success_rate"] == 1.0
+    assert r["team"]["deadlocks"] == 0
+    assert r["team"]["mean_makespan_ratio"] >= 1.0
+    assert [e["seed"] for e in r["episodes"]] == [0, 1, 2]
+    first = r["episodes"][0]
+    assert first["outcome"] == "success" and len(first["robots"]) == 8
+    assert all(x["lower_bound_steps"] <= x["arrived_at"] for x in first["robots"])
+    swap = ronap.evaluate("coordinated", seeds=range(2), scenario=CORRIDOR)
+    assert swap["team"]["infeasible"] == 2
+    assert swap["episodes"][0]["robots"][0]["reason"].startswith("robots 0 and 1 cannot pass each other")
+
+
+def test_a_joint_callable_plays_the_episodes_of_ronap_run_batch(ronap_bin, tmp_path, monkeypatch):
+    """A callable deciding for every robot at once ((robots, obs) in, one action per row out)
+    plays the same team episodes as `ronap run --batch` with the same function."""
+    (tmp_path / "joint.py").write_text(JOINT)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import joint
+
+    ronap.evaluate(joint.act, seeds=range(4), scenario=WAREHOUSE, out=str(tmp_path / "py"))
+    import os
+    import sys
+
+    subprocess.run(
+        [ronap_bin, "run", "--scenario", str(WAREHOUSE), "--policy", f"py:{tmp_path / 'joint.py'}:act", "--batch", "1", "--seeds", "4", "--out", str(tmp_path / "cli")],
+        check=True,
+        capture_output=True,
+        env={**os.environ, "RONAP_PYTHON": sys.executable},
+    )
+    assert (tmp_path / "py" / "episodes.csv").read_bytes() == (tmp_path / "cli" / "episodes.csv").read_bytes()
+    py_rows = list(csv.DictReader(open(tmp_path / "py" / "robots.csv")))
+    cli_rows = list(csv.DictReader(open(tmp_path / "cli" / "robots.csv")))
+    assert len(py_rows) == 32
+    for a, b in zip(py_rows, cli_rows):
+        a.pop("policy"), b.pop("policy")  # `act` and `py:.../joint.py:act`
+        assert a == b

@@ -18,7 +18,9 @@ pub mod social_force;
 pub mod team;
 
 pub use name::{factory, Builtin, PolicyNameError};
-pub use team::{PerRobot, PerRobotFactory, RobotError, TeamPolicy, TeamPolicyFactory};
+pub use team::{
+    Joint, JointFactory, PerRobot, PerRobotFactory, RobotError, TeamPolicy, TeamPolicyFactory,
+};
 
 use crate::sim::episode::Episode;
 use crate::sim::robot::Action;

@@ -3,6 +3,7 @@
 //! [`TeamPolicy`] directly; the common case, each robot driven by a [`Policy`] of its own, is
 //! [`PerRobot`]. The team rollout and the evaluator only ever see a [`TeamPolicy`].
 
+use crate::policy::batched::BatchPolicy;
 use crate::policy::{Decision, Policy, PolicyError, PolicyFactory};
 use crate::sim::episode::Episode;
 use crate::sim::team::Team;
@@ -154,6 +155,157 @@ impl TeamPolicyFactory for PerRobotFactory<'_> {
 
     fn names(&self) -> Vec<String> {
         self.names.clone()
+    }
+}
+
+/// A team whose robots marked `joint` are decided together by one [`BatchPolicy`] call a step
+/// (a `(robots, observation size)` array of those running, in robot order: `ronap run --batch`
+/// on a team scenario, a joint Python function), the others each by a [`Policy`] of their own.
+pub struct Joint {
+    batch: Box<dyn BatchPolicy>,
+    joint: Vec<bool>,
+    others: Vec<Option<Box<dyn Policy>>>,
+    rows: Vec<f32>,
+    robots: Vec<usize>,
+    actions: Vec<crate::sim::robot::Action>,
+}
+
+impl Joint {
+    /// Robots `k` with `joint[k]` decided by `batch`, the others by `others[k]`.
+    pub fn new(
+        batch: Box<dyn BatchPolicy>,
+        joint: Vec<bool>,
+        others: Vec<Option<Box<dyn Policy>>>,
+    ) -> Self {
+        Self {
+            batch,
+            joint,
+            others,
+            rows: Vec::new(),
+            robots: Vec::new(),
+            actions: Vec::new(),
+        }
+    }
+}
+
+impl TeamPolicy for Joint {
+    fn reset(&mut self, team: &Team, worlds: &[Arc<World>]) -> Result<(), RobotError> {
+        let n = team.robots().len();
+        if self.joint.len() != n || self.others.len() != n {
+            return Err((
+                0,
+                PolicyError::Failed(format!("policies for {} robots, not {n}", self.joint.len())),
+            ));
+        }
+        let mut width = None;
+        for (k, world) in worlds.iter().enumerate().take(n) {
+            if let Some(policy) = &mut self.others[k] {
+                policy.reset(world, team.robot(k)).map_err(|e| (k, e))?;
+            } else if self.joint[k] {
+                let w = team.robot(k).observation().len();
+                if *width.get_or_insert(w) != w {
+                    return Err((
+                        k,
+                        PolicyError::Failed(
+                            "robots decided together need observations of one size (its laser \
+                             has another beam count)"
+                                .into(),
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn act(&mut self, team: &Team, decisions: &mut [Option<Decision>]) -> Result<(), RobotError> {
+        self.rows.clear();
+        self.robots.clear();
+        for (k, decision) in decisions.iter_mut().enumerate() {
+            if !team.running(k) {
+                continue;
+            }
+            if let Some(policy) = &mut self.others[k] {
+                policy.hear(team.inbox(k));
+                *decision = Some(policy.act(team.robot(k)).map_err(|e| (k, e))?);
+            } else if self.joint[k] {
+                self.rows.extend_from_slice(team.robot(k).observation());
+                self.robots.push(k);
+            }
+        }
+        let Some(&first) = self.robots.first() else {
+            return Ok(());
+        };
+        let width = self.rows.len() / self.robots.len();
+        self.actions.clear();
+        self.batch
+            .act_batch(&self.rows, width, &mut self.actions)
+            .map_err(|e| (first, e))?;
+        if self.actions.len() != self.robots.len() {
+            return Err((
+                first,
+                PolicyError::Failed(format!(
+                    "returned {} actions for {} robots, expected one per row",
+                    self.actions.len(),
+                    self.robots.len()
+                )),
+            ));
+        }
+        for (&k, &a) in self.robots.iter().zip(&self.actions) {
+            decisions[k] = Some(Decision::Act(a));
+        }
+        Ok(())
+    }
+
+    fn message(&mut self, robot: usize, out: &mut [f32]) {
+        if let Some(policy) = &mut self.others[robot] {
+            policy.message(out);
+        }
+    }
+
+    fn next_goal(
+        &mut self,
+        robot: usize,
+        world: &World,
+        episode: &Episode,
+    ) -> Result<(), PolicyError> {
+        match &mut self.others[robot] {
+            Some(policy) => policy.reset(world, episode),
+            None => Ok(()),
+        }
+    }
+}
+
+/// Makes [`Joint`] team policies of every robot together: a fresh [`BatchPolicy`] from `make`
+/// for each team episode, every robot named `name`.
+pub struct JointFactory {
+    make: Box<dyn Fn() -> Result<Box<dyn BatchPolicy>, PolicyError> + Sync>,
+    robots: usize,
+    name: String,
+}
+
+impl JointFactory {
+    /// `robots` robots decided together by batch policies from `make`, named `name`.
+    pub fn new(
+        make: Box<dyn Fn() -> Result<Box<dyn BatchPolicy>, PolicyError> + Sync>,
+        robots: usize,
+        name: String,
+    ) -> Self {
+        Self { make, robots, name }
+    }
+}
+
+impl TeamPolicyFactory for JointFactory {
+    fn make(&self) -> Result<Box<dyn TeamPolicy>, PolicyError> {
+        Ok(Box::new(Joint::new(
+            (self.make)()?,
+            vec![true; self.robots],
+            (0..self.robots).map(|_| None).collect(),
+        )))
+    }
+
+    fn names(&self) -> Vec<String> {
+        vec![self.name.clone(); self.robots]
     }
 }
 

@@ -62,6 +62,16 @@ def evaluate(
     The episodes and files are the same as unbatched for a policy that decides each row by itself;
     ``threads`` is then N.
 
+    A team scenario (``[[robots]]`` entries) is run as ``ronap run --scenario`` runs it, with
+    ``"coordinated"`` (the team planner), any other built-in or network name for the robots whose
+    entries name no policy of their own, or a callable that decides for every robot at once: it
+    gets a ``(robots, observation_size)`` float32 array of the running robots' observations, in
+    robot order, and returns one action per row (the same episodes as ``ronap run --batch`` with
+    the same function). It returns ``{"summary": {...}, "team": {...}, "episodes": [...]}``: the
+    robots' figures, the team's (team success, deadlocks, makespan against its lower bound, ...),
+    and a dict per team episode (its ``episodes.csv`` row, with ``"robots"``: a dict per robot,
+    its ``robots.csv`` row).
+
     A policy that raises or returns an invalid action or NaN raises ``PolicyError`` naming the seed
     and step.
     """
