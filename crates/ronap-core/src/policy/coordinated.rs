@@ -344,6 +344,8 @@ pub struct Coordinated {
     max_agent_radius: f64,
     /// Scratch: the agents near one robot.
     near: Vec<u32>,
+    /// How many of `agents` are robots (the moving obstacles follow them).
+    robot_agents: usize,
     /// The place of each robot in `agents`.
     slot: Vec<Option<usize>>,
     avoider: Avoider,
@@ -676,6 +678,7 @@ impl Coordinated {
             let s = seen(k, at, r.config().robot.radius_px, &mut self.agents);
             self.slot.push(s);
         }
+        self.robot_agents = self.agents.len();
         if let Some(m) = team.movers() {
             for (i, o) in m.items().enumerate() {
                 let at = o.present().then(|| o.position());
@@ -813,25 +816,36 @@ impl TeamPolicy for Coordinated {
                     }
                 })
             };
+            let robot_agents = self.robot_agents;
             let v = match self.slot[k].filter(|&s| !alone(s, near)) {
-                Some(slot) => self.avoider.velocity(
-                    me.scene(),
-                    &Avoid {
-                        agents: &self.agents,
-                        me: slot,
-                        preferred,
-                        horizon: Horizon {
-                            agents: TIME_HORIZON_STEPS,
-                            obstacles: config.orca.obstacle_time_horizon_steps,
-                            max_speed: speed,
-                            time_step: 1.0,
+                Some(slot) => {
+                    // Among moving obstacles, which no plan keeps clear, ORCA as the `orca`
+                    // policy takes it: its horizon and margin.
+                    let mover_near = near.iter().any(|&j| j as usize >= robot_agents);
+                    let (horizon, margin) = if mover_near {
+                        (config.orca.time_horizon_steps, config.orca.safety_margin_px)
+                    } else {
+                        (TIME_HORIZON_STEPS, 0.0)
+                    };
+                    self.avoider.velocity(
+                        me.scene(),
+                        &Avoid {
+                            agents: &self.agents,
+                            me: slot,
+                            preferred,
+                            horizon: Horizon {
+                                agents: horizon,
+                                obstacles: config.orca.obstacle_time_horizon_steps,
+                                max_speed: speed,
+                                time_step: 1.0,
+                            },
+                            neighbour_dist: range,
+                            max_neighbours: config.orca.max_neighbours as usize,
+                            margin,
+                            candidates: Some(near),
                         },
-                        neighbour_dist: range,
-                        max_neighbours: config.orca.max_neighbours as usize,
-                        margin: 0.0,
-                        candidates: Some(near),
-                    },
-                ),
+                    )
+                }
                 None => preferred,
             };
             let v = if f.heading[k] == 0
