@@ -141,6 +141,30 @@ struct PyBatchPolicy {
 }
 
 impl PyBatchPolicy {
+    /// `callable` deciding for rows of observations, its actions checked as `continuous` or
+    /// discrete ones, normalised continuous ones scaled to `robot`'s full speeds.
+    fn new(
+        callable: &Bound<'_, PyAny>,
+        continuous: bool,
+        robot: &ronap_core::config::RobotConfig,
+    ) -> PyResult<Self> {
+        let check = callable
+            .py()
+            .import("ronap.env")?
+            .getattr(if continuous {
+                "continuous_actions"
+            } else {
+                "discrete_actions"
+            })?
+            .unbind();
+        Ok(Self {
+            callable: callable.clone().unbind(),
+            continuous,
+            check,
+            speeds: (robot.max_linear_speed_px, robot.max_angular_speed_deg),
+        })
+    }
+
     fn decide(
         &self,
         py: Python<'_>,
@@ -300,21 +324,7 @@ pub fn evaluate<'py>(
             )));
         }
         let name = policy_name(policy);
-        let robot = &config.robot;
-        let check = py
-            .import("ronap.env")?
-            .getattr(if continuous {
-                "continuous_actions"
-            } else {
-                "discrete_actions"
-            })?
-            .unbind();
-        let decide = PyBatchPolicy {
-            callable: policy.clone().unbind(),
-            continuous,
-            check,
-            speeds: (robot.max_linear_speed_px, robot.max_angular_speed_deg),
-        };
+        let decide = PyBatchPolicy::new(policy, continuous, &config.robot)?;
         let factory: Box<dyn PolicyFactory> =
             Box::new(Batched::new(Box::new(decide), batch, name.clone()));
         (factory, name)
@@ -426,7 +436,6 @@ fn team_factory(
     config: &ValidConfig,
     continuous: bool,
 ) -> PyResult<(Box<dyn TeamPolicyFactory>, String)> {
-    let py = policy.py();
     let n = config.team_size();
     if let Ok(name) = policy.extract::<String>() {
         if name == coordinated::NAME {
@@ -464,24 +473,13 @@ fn team_factory(
         )));
     }
     let name = policy_name(policy);
-    let callable = policy.clone().unbind();
-    let check = py
-        .import("ronap.env")?
-        .getattr(if continuous {
-            "continuous_actions"
-        } else {
-            "discrete_actions"
-        })?
-        .unbind();
-    let robot = &config.team_robot(0).robot;
-    let speeds = (robot.max_linear_speed_px, robot.max_angular_speed_deg);
+    let decide = PyBatchPolicy::new(policy, continuous, &config.team_robot(0).robot)?;
     let make = move || -> Result<Box<dyn BatchPolicy>, PolicyError> {
         Ok(Python::with_gil(|py| {
             Box::new(PyBatchPolicy {
-                callable: callable.clone_ref(py),
-                continuous,
-                check: check.clone_ref(py),
-                speeds,
+                callable: decide.callable.clone_ref(py),
+                check: decide.check.clone_ref(py),
+                ..decide
             }) as Box<dyn BatchPolicy>
         }))
     };
