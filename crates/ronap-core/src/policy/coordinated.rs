@@ -11,14 +11,19 @@
 //!   is searched alone, completely: two robots that cannot reach their goals even without the
 //!   rest (two robots swapping ends of a corridor too narrow to pass) make the task infeasible,
 //!   reported before the first step with the robots and the passage.
-//! - **Execution.** Each robot drives from cell centre to cell centre, moving on to its next
-//!   cell only once the robot planned there before it has left ([`Schedule`]), so delays
-//!   (turning, giving way to what moves) never bring two robots into one cell nor into a
-//!   deadlock. The velocity towards the next centre goes through ORCA (`[orca]` settings, a
-//!   short horizon and a small margin: the plan already keeps the robots apart) among the other
-//!   robots and the moving obstacles, and becomes the robot's action as for the `orca` policy.
+//! - **Execution.** Once every robot stands on its start cell, each drives from cell centre to
+//!   cell centre (pure pursuit along its open cells, halting on goals and sharp turns), moving
+//!   on to its next cell only once the robot planned there before it has left ([`Schedule`]),
+//!   so delays (turning, giving way to what moves) never bring two robots into one cell nor
+//!   into a deadlock. With another agent within sensing range, the velocity goes through ORCA:
+//!   among robots alone a 2-step horizon and no margin (the plan already keeps them apart), near
+//!   a moving obstacle the `[orca]` horizon and margin; it becomes the robot's action as for the
+//!   `orca` policy, a unicycle turning on the spot first when its way is more than half its
+//!   largest turn off its axis.
+//! - **Re-planning.** A robot that ends short of its plan, or one free to go on held up for
+//!   [`STALL_STEPS`], has the running robots planned again from where they stand.
 //! - **Fallback.** When no plan is found and none is proved impossible (or a robot's start or
-//!   goal has no cell), every robot runs the `orca` policy instead.
+//!   goal has no cell, or after [`MAX_REPLANS`]), every robot runs the `orca` policy instead.
 
 use super::local::{action, planner_speed, turn_to};
 use super::orca::Orca;
