@@ -70,9 +70,10 @@ fn reach_px(me: &Episode, actions: PlannerActions) -> f64 {
 
 /// The action that follows velocity `v` on the way to `aim`: for continuous actions, a turn on
 /// the spot while the robot's axis (forwards or backwards) is more than half its largest turn
-/// off `v` (off the way to `aim` while `v` is about nought), else the `orca` policy's tracking command. Within half a turn, that
-/// command's arc ends exactly on the way (its chord turns by half the arc's turn), so the robot
-/// neither swings wide of a turn in its plan nor sweeps sideways into a rack beside it.
+/// off `v` (off the way to `aim` while `v` is about nought), else the `orca` policy's tracking
+/// command. Within half a turn, that command's arc ends exactly on the way (its chord turns by
+/// half the arc's turn), so the robot neither swings wide of a turn in its plan nor sweeps
+/// sideways into a rack beside it.
 fn drive(me: &Episode, v: Vector, aim: Vector, actions: PlannerActions) -> Action {
     // The way it goes: its velocity, or, standing, where it is to go.
     let way = if v.norm() > 0.05 { v } else { aim };
@@ -275,11 +276,11 @@ impl Following {
     }
 }
 
-/// Whether robot `k`'s step `v` towards its start cell keeps clear of the other robots: by a
-/// hair of those standing, and, of those with a lower number also on their way to their
-/// start cells and driving, by as far as they may drive in the step too (they go first; one
-/// that stood still last step does not hold the others up; the plan's spacing
-/// holds only once every robot is on its cell).
+/// Whether robot `k`'s step `v` towards its start cell keeps clear of the other robots (the
+/// plan's spacing holds only once every robot is on its cell): by a hair of those standing,
+/// and, of those with a lower number also on their way to their start cells and driving, by as
+/// far as they may drive in the step too (they go first; one that stood still last step does
+/// not hold the others up). A step that draws no nearer to a robot is always clear of it.
 /// `agents` and `slot` as [`Coordinated`] keeps them.
 fn initial_step_clear(
     agents: &[Agent<f64>],
