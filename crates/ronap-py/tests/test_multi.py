@@ -234,3 +234,14 @@ def test_a_joint_callable_plays_the_episodes_of_ronap_run_batch(ronap_bin, tmp_p
     for a, b in zip(py_rows, cli_rows):
         a.pop("policy"), b.pop("policy")  # `act` and `py:.../joint.py:act`
         assert a == b
+
+
+def test_spaces_by_agent_and_a_vector_reset_without_a_seed():
+    env = ronap.MultiNavEnv(scenario=WAREHOUSE)
+    assert set(env.observation_spaces) == set(env.possible_agents) == set(env.action_spaces)
+    assert env.observation_spaces["robot_0"] == env.observation_space("robot_0")
+    vec = ronap.VecMultiNavEnv(2, scenario=WAREHOUSE)
+    obs, _ = vec.reset(seed=None)
+    assert obs.shape[:2] == (2, 8) and isinstance(vec.seed_used, int)
+    again, _ = ronap.VecMultiNavEnv(2, scenario=WAREHOUSE).reset(seed=vec.seed_used)
+    assert np.array_equal(obs, again)

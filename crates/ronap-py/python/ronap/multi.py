@@ -109,6 +109,16 @@ class MultiNavEnv(_Base):
     def action_space(self, agent: str) -> spaces.Space[Any]:
         return self._action_spaces[agent]
 
+    @property
+    def observation_spaces(self) -> dict[str, spaces.Space[Any]]:
+        """Every agent's observation space, by agent (PettingZoo's dict attribute)."""
+        return dict(self._observation_spaces)
+
+    @property
+    def action_spaces(self) -> dict[str, spaces.Space[Any]]:
+        """Every agent's action space, by agent (PettingZoo's dict attribute)."""
+        return dict(self._action_spaces)
+
     def reset(
         self, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, np.ndarray], dict[str, dict[str, Any]]]:
@@ -246,9 +256,16 @@ class VecMultiNavEnv:
         self.single_observation_space = spaces.Box(-np.inf, np.inf, (d,), np.float32)
         self.single_action_space = spaces.Discrete(3)
         self._started = False
+        self.seed_used: int | None = None
 
-    def reset(self, seed: int = 0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    def reset(self, seed: int | None = 0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """Restarts every environment: environment ``i`` plays seeds ``seed + i``, ``seed + i +
+        num_envs``, ...; ``seed=None`` draws the first seed at random (as Gymnasium's vector
+        environments do), reported as ``seed_used``."""
+        if seed is None:
+            seed = int(np.random.default_rng().integers(0, 2**62))
         seed = checked_int("seed", seed)
+        self.seed_used = seed
         self._started = True
         return self._vec.reset(seed)
 
