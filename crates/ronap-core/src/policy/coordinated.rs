@@ -823,11 +823,12 @@ impl TeamPolicy for Coordinated {
                 })
             };
             let robot_agents = self.robot_agents;
+            let mut mover_near = false;
             let v = match self.slot[k].filter(|&s| !alone(s, near)) {
                 Some(slot) => {
                     // Among moving obstacles, which no plan keeps clear, ORCA as the `orca`
                     // policy takes it: its horizon and margin.
-                    let mover_near = near.iter().any(|&j| j as usize >= robot_agents);
+                    mover_near = near.iter().any(|&j| j as usize >= robot_agents);
                     let (horizon, margin) = if mover_near {
                         (config.orca.time_horizon_steps, config.orca.safety_margin_px)
                     } else {
@@ -861,7 +862,12 @@ impl TeamPolicy for Coordinated {
             } else {
                 v
             };
-            *d = Some(Decision::Act(drive(me, v, to, actions)));
+            // Dodging what moves, it tracks its velocity as the `orca` policy does, arcs and all.
+            *d = Some(Decision::Act(if mover_near {
+                action(me, v, to, actions)
+            } else {
+                drive(me, v, to, actions)
+            }));
         }
         Ok(())
     }
