@@ -296,26 +296,25 @@ pub fn evaluate<'py>(
     let rows: bool = o.take("rows", false)?;
     let force: bool = o.take("force", false)?;
     o.finish()?;
-    let map_path = map_path.as_deref();
     let config = config.valid();
-    let first = first_seed(&seeds)?;
+    let run = Run {
+        first: first_seed(&seeds)?,
+        maze_seed,
+        map_path: map_path.as_deref(),
+        // A batch of N is N episodes under way, a worker each.
+        threads: if batch > 0 { batch } else { threads },
+        out: out.as_deref(),
+        png,
+        log_steps,
+        force,
+    };
     if config.team_size() > 0 {
         if batch > 0 {
             return Err(errors::ConfigError::new_err(format!(
                 "batch = {batch}: a team's callable already decides for every robot at once"
             )));
         }
-        let run = TeamRun {
-            maze_seed,
-            map_path,
-            threads,
-            continuous,
-            out: out.as_deref(),
-            png,
-            log_steps,
-            force,
-        };
-        return evaluate_team(py, policy, seeds, config, &run);
+        return evaluate_team(py, policy, seeds, config, continuous, &run);
     }
     let (factory, name) = if batch > 0 {
         if !policy.is_callable() || policy.extract::<String>().is_ok() {
@@ -331,66 +330,22 @@ pub fn evaluate<'py>(
     } else {
         policy_factory(policy, config, continuous, thread_safe)?
     };
-    // A batch of N is N episodes under way, a worker each.
-    let threads = if batch > 0 { batch } else { threads };
-    let pictures: Option<Pictures> = png
-        .as_deref()
-        .map(str::parse)
-        .transpose()
-        .map_err(|e| errors::ConfigError::new_err(format!("png = {e}")))?;
-    let (info, scenes) = run_info(name, config, maze_seed, map_path)?;
-    let writer = out
-        .as_deref()
-        .map(|dir| {
-            let files = RunFiles {
-                pictures,
-                steps: log_steps,
-                gifs: false,
-            };
-            RunWriter::create(dir, files, first, force).map_err(errors::out_dir)
-        })
-        .transpose()?;
-    let evaluator = Evaluator::new(config.clone(), scenes);
-    let options = EvalOptions {
-        seeds: seeds.into(),
-        threads,
-        ..EvalOptions::default()
-    };
+    let mut prepared = run.prepare(name, config, seeds)?;
     let cancel = AtomicBool::new(false);
-    let main = std::thread::current().id();
-    let interrupt = std::sync::Mutex::new(None);
+    let interrupt = Interrupt::here();
     let evaluation = py
         .allow_threads(|| {
-            let request = RunRequest {
-                evaluator: &evaluator,
-                options: &options,
-                info: &info,
-                writer,
-                cancel: &cancel,
-            };
-            // A Ctrl-C (Python's KeyboardInterrupt) stops the run as `ronap run`'s does: the
-            // episodes under way finish, the files are written, then the interrupt is raised.
-            // Python hears signals on its main thread, which takes the records in order here.
             let keep = |_: &_| {
-                if std::thread::current().id() == main && !cancel.load(Ordering::SeqCst) {
-                    if let Err(e) = Python::with_gil(|py| py.check_signals()) {
-                        cancel.store(true, Ordering::SeqCst);
-                        if let Ok(mut i) = interrupt.lock() {
-                            *i = Some(e);
-                        }
-                    }
-                }
+                interrupt.watch(&cancel);
                 true
             };
-            evaluate_into(request, factory.as_ref(), &|_| {}, &keep)
+            evaluate_into(prepared.request(&cancel), factory.as_ref(), &|_| {}, &keep)
         })
         .map_err(|e| errors::PolicyError::new_err(e.to_string()))?;
     if let Some(e) = &evaluation.write_error {
         return Err(errors::output(e));
     }
-    if let Some(e) = interrupt.into_inner().ok().flatten() {
-        return Err(e);
-    }
+    interrupt.raise()?;
     if let Some(e) = &evaluation.result.error {
         return Err(errors::run(e));
     }
@@ -415,16 +370,110 @@ pub fn evaluate<'py>(
     Ok(d)
 }
 
-/// How a team evaluation runs (as [`evaluate`]'s options name them).
-struct TeamRun<'a> {
+/// How a run of [`evaluate`] runs and what it writes (as its options name them).
+struct Run<'a> {
+    /// The first seed (where a resumed run's files start).
+    first: u64,
     maze_seed: Option<u64>,
     map_path: Option<&'a str>,
     threads: usize,
-    continuous: bool,
     out: Option<&'a std::path::Path>,
     png: Option<String>,
     log_steps: bool,
     force: bool,
+}
+
+/// A run ready to go: what its files record, its writer (given `out`), evaluator and options.
+struct Prepared {
+    info: RunInfo,
+    writer: Option<RunWriter>,
+    evaluator: Evaluator,
+    options: EvalOptions,
+}
+
+impl Run<'_> {
+    /// The run of the policy reports call `name` over `seeds` under `config`.
+    fn prepare(&self, name: String, config: &ValidConfig, seeds: Vec<u64>) -> PyResult<Prepared> {
+        let pictures: Option<Pictures> = self
+            .png
+            .as_deref()
+            .map(str::parse)
+            .transpose()
+            .map_err(|e| errors::ConfigError::new_err(format!("png = {e}")))?;
+        let (info, scenes) = run_info(name, config, self.maze_seed, self.map_path)?;
+        let writer = self
+            .out
+            .map(|dir| {
+                let files = RunFiles {
+                    pictures,
+                    steps: self.log_steps,
+                    gifs: false,
+                };
+                RunWriter::create(dir, files, self.first, self.force).map_err(errors::out_dir)
+            })
+            .transpose()?;
+        Ok(Prepared {
+            info,
+            writer,
+            evaluator: Evaluator::new(config.clone(), scenes),
+            options: EvalOptions {
+                seeds: seeds.into(),
+                threads: self.threads,
+                ..EvalOptions::default()
+            },
+        })
+    }
+}
+
+impl Prepared {
+    /// The request that runs it (its writer handed over), stopped by `cancel`.
+    fn request<'a>(&'a mut self, cancel: &'a AtomicBool) -> RunRequest<'a> {
+        RunRequest {
+            evaluator: &self.evaluator,
+            options: &self.options,
+            info: &self.info,
+            writer: self.writer.take(),
+            cancel,
+        }
+    }
+}
+
+/// A Ctrl-C (Python's KeyboardInterrupt) stops a run as `ronap run`'s does: the episodes under
+/// way finish, the files are written, then the interrupt is raised. Python hears signals on its
+/// main thread, which takes the records in seed order ([`Interrupt::watch`] from `keep`).
+struct Interrupt {
+    main: std::thread::ThreadId,
+    caught: Mutex<Option<PyErr>>,
+}
+
+impl Interrupt {
+    /// Watching for signals on this thread.
+    fn here() -> Self {
+        Self {
+            main: std::thread::current().id(),
+            caught: Mutex::new(None),
+        }
+    }
+
+    /// On the main thread: a pending signal's error, kept, cancels the run.
+    fn watch(&self, cancel: &AtomicBool) {
+        if std::thread::current().id() == self.main && !cancel.load(Ordering::SeqCst) {
+            if let Err(e) = Python::with_gil(|py| py.check_signals()) {
+                cancel.store(true, Ordering::SeqCst);
+                if let Ok(mut i) = self.caught.lock() {
+                    *i = Some(e);
+                }
+            }
+        }
+    }
+
+    /// The error of the signal that stopped the run, if one did.
+    fn raise(self) -> PyResult<()> {
+        match self.caught.into_inner().ok().flatten() {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
 }
 
 /// The team policy `policy` names or is, with the name reports give it: `coordinated`, another
@@ -438,7 +487,7 @@ fn team_factory(
 ) -> PyResult<(Box<dyn TeamPolicyFactory>, String)> {
     let n = config.team_size();
     if let Ok(name) = policy.extract::<String>() {
-        if name == coordinated::NAME {
+        if coordinated::drives(config, &name).map_err(errors::ConfigError::new_err)? {
             return Ok((Box::new(coordinated::CoordinatedFactory::new(n)), name));
         }
         let mut factories: Vec<Box<dyn PolicyFactory>> = Vec::new();
@@ -520,56 +569,32 @@ fn evaluate_team<'py>(
     policy: &Bound<'py, PyAny>,
     seeds: Vec<u64>,
     config: &ValidConfig,
-    run: &TeamRun<'_>,
+    continuous: bool,
+    run: &Run<'_>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let first = first_seed(&seeds)?;
-    let (factory, name) = team_factory(policy, config, run.continuous)?;
-    let pictures: Option<Pictures> = run
-        .png
-        .as_deref()
-        .map(str::parse)
-        .transpose()
-        .map_err(|e| errors::ConfigError::new_err(format!("png = {e}")))?;
-    let (info, scenes) = run_info(name, config, run.maze_seed, run.map_path)?;
-    let writer = run
-        .out
-        .map(|dir| {
-            let files = RunFiles {
-                pictures,
-                steps: run.log_steps,
-                gifs: false,
-            };
-            RunWriter::create(dir, files, first, run.force).map_err(errors::out_dir)
-        })
-        .transpose()?;
-    let evaluator = Evaluator::new(config.clone(), scenes);
-    let options = EvalOptions {
-        seeds: seeds.into(),
-        threads: run.threads,
-        ..EvalOptions::default()
-    };
+    let (factory, name) = team_factory(policy, config, continuous)?;
+    let mut prepared = run.prepare(name, config, seeds)?;
     let cancel = AtomicBool::new(false);
-    let records = Mutex::new(Vec::new());
-    let evaluation = py
+    let interrupt = Interrupt::here();
+    let (evaluation, rows) = py
         .allow_threads(|| {
-            let request = RunRequest {
-                evaluator: &evaluator,
-                options: &options,
-                info: &info,
-                writer,
-                cancel: &cancel,
-            };
+            // Each episode's rows, in seed order (the records themselves are not kept).
+            let rows = std::cell::RefCell::new(Vec::new());
             let keep = |r: &TeamRecord| {
-                if let Ok(mut all) = records.lock() {
-                    all.push((r.seed, team_episode_row(r), robot_rows(r, &[])));
-                }
+                interrupt.watch(&cancel);
+                rows.borrow_mut()
+                    .push((team_episode_row(r), robot_rows(r, &[])));
+                false
             };
-            evaluate_team_into(request, factory.as_ref(), &keep)
+            let request = prepared.request(&cancel);
+            evaluate_team_into(request, factory.as_ref(), &|_| {}, &keep)
+                .map(|e| (e, rows.into_inner()))
         })
         .map_err(|e| errors::PolicyError::new_err(e.to_string()))?;
     if let Some(e) = &evaluation.write_error {
         return Err(errors::output(e));
     }
+    interrupt.raise()?;
     if let Some(e) = &evaluation.result.error {
         return Err(errors::run(e));
     }
@@ -578,11 +603,9 @@ fn evaluate_team<'py>(
     d.set_item("summary", conv::json(py, &summary)?)?;
     let team = serde_json::to_value(&evaluation.team).unwrap_or_default();
     d.set_item("team", conv::json(py, &team)?)?;
-    let mut all = records.into_inner().unwrap_or_default();
-    all.sort_by_key(|(seed, _, _)| *seed);
     let robot_columns = robot_columns(&[]);
     let episodes = PyList::empty(py);
-    for (_, row, robots) in all {
+    for (row, robots) in rows {
         let e = cells(py, &TEAM_COLUMNS, &row)?;
         let list = PyList::empty(py);
         for r in robots {

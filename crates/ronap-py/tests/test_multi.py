@@ -205,6 +205,9 @@ def test_evaluate_runs_a_team_with_the_team_planner():
     first = r["episodes"][0]
     assert first["outcome"] == "success" and len(first["robots"]) == 8
     assert all(x["lower_bound_steps"] <= x["arrived_at"] for x in first["robots"])
+    mixed = {"robots": [{"count": 2}, {"policy": "geodesic"}]}
+    with pytest.raises(ronap.ConfigError, match="robot 2: policy geodesic beside coordinated"):
+        ronap.evaluate("coordinated", seeds=range(1), scenario=mixed)
     swap = ronap.evaluate("coordinated", seeds=range(2), scenario=CORRIDOR)
     assert swap["team"]["infeasible"] == 2
     assert swap["episodes"][0]["robots"][0]["reason"].startswith("robots 0 and 1 cannot pass each other")

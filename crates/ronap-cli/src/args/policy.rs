@@ -78,26 +78,7 @@ impl TeamPolicies {
             batched: Vec::new(),
             coordinated: false,
         };
-        // The team planner drives every robot or none.
-        let named = |e: &ronap_core::config::TeamRobotConfig| {
-            e.policy.clone().unwrap_or_else(|| default.to_string())
-        };
-        if config.robots.iter().any(|e| named(e) == coordinated::NAME) {
-            if let Some((k, other)) = config
-                .robots
-                .iter()
-                .scan(0usize, |first, e| {
-                    let k = *first;
-                    *first += e.count as usize;
-                    Some((k, named(e)))
-                })
-                .find(|(_, n)| n != coordinated::NAME)
-            {
-                anyhow::bail!(
-                    "[[robots]] entry with robot {k}: policy {other} beside coordinated, which plans \
-                     the whole team: give every robot coordinated (or none)"
-                );
-            }
+        if coordinated::drives(config, default).map_err(anyhow::Error::msg)? {
             team.names = vec![coordinated::NAME.to_string(); config.team_size()];
             team.coordinated = true;
             return Ok(team);

@@ -459,7 +459,7 @@ fn run_team(
         writer: Some(writer),
         cancel: &cancel,
     };
-    let evaluation = evaluate_team_into(request, &policies, &|_| bar.inc(1))?;
+    let evaluation = evaluate_team_into(request, &policies, &|_| bar.inc(1), &|_| false)?;
     bar.finish_and_clear();
     let mut stdout = std::io::stdout().lock();
     writeln!(

@@ -564,13 +564,17 @@ fn run_team(
     request: RunRequest<'_>,
 ) -> Result<PolicyResult, CompareError> {
     let dir = request.writer.as_ref().map(|w| w.dir().to_path_buf());
-    let seeds = std::sync::Mutex::new(Vec::new());
-    let evaluation = evaluate_team_into(request, team, &|r| {
-        if let Ok(mut s) = seeds.lock() {
-            s.push(SeedResult::of_team(r));
-        }
-        (setting.progress)(Progress::Episode);
-    })
+    // Each seed's figures, in seed order (the records themselves are not kept).
+    let seeds = std::cell::RefCell::new(Vec::new());
+    let evaluation = evaluate_team_into(
+        request,
+        team,
+        &|_| (setting.progress)(Progress::Episode),
+        &|r| {
+            seeds.borrow_mut().push(SeedResult::of_team(r));
+            false
+        },
+    )
     .map_err(|source| CompareError::Policy {
         policy: c.name.clone(),
         source,
@@ -581,8 +585,7 @@ fn run_team(
         cancelled: evaluation.result.cancelled,
     };
     end.check(c, dir.as_deref(), setting.out)?;
-    let mut seeds = seeds.into_inner().unwrap_or_default();
-    seeds.sort_by_key(|s| s.seed);
+    let seeds = seeds.into_inner();
     Ok(PolicyResult {
         name: c.name.clone(),
         label: label.to_string(),

@@ -17,7 +17,7 @@ use std::sync::atomic::AtomicBool;
 /// A finished team evaluation.
 #[derive(Debug)]
 pub struct TeamEvaluation {
-    /// How the run stopped (no records are kept: they went to the run files).
+    /// How the run stopped, with the records `keep` kept, in seed order.
     pub result: TeamRunResult,
     /// The team figures.
     pub team: TeamSummary,
@@ -30,11 +30,14 @@ pub struct TeamEvaluation {
 /// Runs a team evaluation (each episode driven by a team policy from `factory`) and, given a
 /// `writer`, writes `episodes.csv` (team rows), `robots.csv` and `timing.csv` row by row in seed
 /// order as [`crate::job::evaluate_into`] does, pictures and step logs (one per robot) as episodes
-/// finish and `summary.json` at the end.
+/// finish and `summary.json` at the end. As [`crate::job::evaluate_into`]: `on_record` hears
+/// every episode as it finishes (any order, any thread), `keep` each in seed order on the
+/// calling thread, and the records it returns true for are kept in the result.
 pub fn evaluate_team_into(
     request: RunRequest<'_>,
     factory: &dyn TeamPolicyFactory,
     on_record: &(dyn Fn(&TeamRecord) + Sync),
+    keep: &dyn Fn(&TeamRecord) -> bool,
 ) -> Result<TeamEvaluation, PolicyError> {
     let config = request.evaluator.config();
     let metrics = crate::eval::metric::kinds(config);
@@ -45,6 +48,8 @@ pub fn evaluate_team_into(
         robots: Tally::measuring(metrics),
         robot_steps_before: 0,
         steps_before: 0,
+        keep,
+        kept: Vec::new(),
     };
     let episodes = TeamEpisodes {
         evaluator: request.evaluator,
@@ -78,7 +83,7 @@ pub fn evaluate_team_into(
         write_error = finish(w, streams, &m, &run).err();
     }
     let result = TeamRunResult {
-        records: Vec::new(),
+        records: teams.kept,
         cancelled: run.cancelled,
         error: run.error,
         wall_time_s: wall,
@@ -118,17 +123,19 @@ impl Episodes<TeamRecord> for TeamEpisodes<'_> {
     }
 }
 
-/// A team's rows and figures: the team's, and every robot's.
-struct Teams {
+/// A team's rows and figures: the team's, and every robot's; and the records kept.
+struct Teams<'a> {
     size: usize,
     metrics: &'static [crate::eval::metric::Kind],
     team: TeamTally,
     robots: Tally,
     robot_steps_before: u64,
     steps_before: u64,
+    keep: &'a dyn Fn(&TeamRecord) -> bool,
+    kept: Vec<TeamRecord>,
 }
 
-impl Tallies<TeamRecord> for Teams {
+impl Tallies<TeamRecord> for Teams<'_> {
     fn headers(&self) -> [Option<Vec<String>>; 4] {
         let strings = |h: &[&str]| Some(h.iter().map(|c| c.to_string()).collect());
         [
@@ -172,6 +179,9 @@ impl Tallies<TeamRecord> for Teams {
         self.team.add(&t);
         for f in &lone {
             self.robots.add(f);
+        }
+        if (self.keep)(&r) {
+            self.kept.push(r);
         }
         true
     }

@@ -21,9 +21,9 @@
 //!   `orca` policy, a unicycle turning on the spot first when its way is more than half its
 //!   largest turn off its axis.
 //! - **Re-planning.** A robot that ends short of its plan, or one free to go on held up for
-//!   [`STALL_STEPS`], has the running robots planned again from where they stand.
+//!   60 steps, has the running robots planned again from where they stand.
 //! - **Fallback.** When no plan is found and none is proved impossible (or a robot's start or
-//!   goal has no cell, or after [`MAX_REPLANS`]), every robot runs the `orca` policy instead.
+//!   goal has no cell, or after 50 plans), every robot runs the `orca` policy instead.
 
 use super::local::{action, planner_speed, turn_to};
 use super::orca::Orca;
@@ -883,6 +883,28 @@ impl TeamPolicy for Coordinated {
             Some(p) => p.next_goal(robot, world, episode),
             None => Ok(()),
         }
+    }
+}
+
+/// Whether the planner drives the team of `config` whose entries without a `policy` of their
+/// own run `default`: it drives every robot or none, so an entry naming another policy beside
+/// it is an error naming the entry's first robot and that policy.
+pub fn drives(config: &crate::ValidConfig, default: &str) -> Result<bool, String> {
+    let mut first = 0usize;
+    let mut entries = Vec::new();
+    for e in &config.robots {
+        entries.push((first, e.policy.as_deref().unwrap_or(default)));
+        first += e.count as usize;
+    }
+    if !entries.iter().any(|&(_, n)| n == NAME) {
+        return Ok(false);
+    }
+    match entries.iter().find(|&&(_, n)| n != NAME) {
+        Some((k, other)) => Err(format!(
+            "[[robots]] entry with robot {k}: policy {other} beside coordinated, which plans the \
+             whole team: give every robot coordinated (or none)"
+        )),
+        None => Ok(true),
     }
 }
 
