@@ -15,7 +15,8 @@ pyo3::create_exception!(
     ConfigError,
     RonapError,
     "A configuration value is out of range or unknown, or a scenario file cannot be read; the message \
-     names the field and value (and the file and line for a value a scenario file sets)."
+     names the field and value (and the file and line for a value a scenario file sets). Also a \
+     `ValueError`."
 );
 pyo3::create_exception!(
     ronap,
@@ -33,7 +34,7 @@ pyo3::create_exception!(
     ronap,
     ActionError,
     RonapError,
-    "An action passed to step() is not one the environment takes."
+    "An action passed to step() is not one the environment takes. Also a `ValueError`."
 );
 pyo3::create_exception!(
     ronap,
@@ -51,6 +52,12 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("PolicyError", py.get_type::<PolicyError>())?;
     m.add("ActionError", py.get_type::<ActionError>())?;
     m.add("OutputError", py.get_type::<OutputError>())?;
+    // A bad value is also a `ValueError`, so `except ValueError` catches it as it catches
+    // numpy's and Gymnasium's (a class of pyo3's takes one base; this gives it the second).
+    let value_error = py.get_type::<pyo3::exceptions::PyValueError>();
+    for class in [py.get_type::<ConfigError>(), py.get_type::<ActionError>()] {
+        class.setattr("__bases__", (py.get_type::<RonapError>(), &value_error))?;
+    }
     Ok(())
 }
 

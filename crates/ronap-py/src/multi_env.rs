@@ -295,6 +295,7 @@ impl VecMultiEnv {
         infos.set_item("active", grid(&|s| s.running)?)?;
         infos.set_item("acted", grid(&|s| s.acted)?)?;
         infos.set_item("collided", grid(&|s| s.collided)?)?;
+        infos.set_item("success", grid(&|s| s.success)?)?;
         let rollouts = (0..n).map(|i| b.rollout(i));
         let seeds: Vec<u64> = rollouts
             .clone()

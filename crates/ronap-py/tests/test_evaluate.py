@@ -91,7 +91,7 @@ def test_evaluate_input_errors():
         ronap.evaluate("teleport", range(2))
     with pytest.raises(ronap.ConfigError, match="empty"):
         ronap.evaluate("apf", [])
-    with pytest.raises(ronap.SceneError, match="nowhere.png"):
+    with pytest.raises(ronap.MissingFileError, match="nowhere.png"):  # also a FileNotFoundError
         ronap.evaluate("apf", range(2), map="nowhere.png")
 
 

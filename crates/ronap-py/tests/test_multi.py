@@ -89,8 +89,9 @@ def test_messages_arrive_a_step_late_and_only_within_range():
     stand = {"action": None}
     obs, _, _, _, infos = env.step({"robot_0": {"action": 0, "message": np.array([7.0, 8.0], np.float32)}, "robot_1": stand})
     # Sent this step, heard after it: robot_1 sees robot_0's message, robot_0 hears robot_1's zeros.
-    assert [m["from"] for m in infos["robot_1"]["inbox"]] == [0]
-    np.testing.assert_array_equal(infos["robot_1"]["inbox"][0]["message"], [7.0, 8.0])
+    assert [m["from"] for m in env.inbox("robot_1")] == [0]
+    np.testing.assert_array_equal(env.inbox("robot_1")[0]["message"], [7.0, 8.0])
+    assert "inbox" not in infos["robot_1"]  # numbers only, unless text_infos=True
     np.testing.assert_array_equal(obs["robot_1"][-2:], [7.0, 8.0])
     assert obs["robot_1"][-3] == 1.0  # the slot is filled
     # Robot 0 is 85 px behind robot 1, which faces it: straight ahead in its frame, 85 / 200.
@@ -103,7 +104,7 @@ def test_messages_arrive_a_step_late_and_only_within_range():
     far = corridor(15.0, 100.0, team_message_size=2, team_neighbours=1, team_comm_range_px=50.0)
     far.reset(seed=0)
     obs, _, _, _, infos = far.step({"robot_0": {"action": 1, "message": np.array([7.0, 8.0], np.float32)}, "robot_1": 1})
-    assert infos["robot_1"]["inbox"] == []
+    assert far.inbox("robot_1") == []
     np.testing.assert_array_equal(obs["robot_1"][18:], np.zeros(6, np.float32))
 
 
@@ -116,9 +117,16 @@ def test_corridor_swap_ends_as_a_deadlock_and_agents_leave():
         steps += 1
         assert steps < 1000
     assert all(trunc.values()) and not any(term.values())
+    assert {env.status(a) for a in infos} == {"deadlock"}
+    texts = ronap.MultiNavEnv(scenario=CORRIDOR, text_infos=True)
+    texts.reset(seed=0)
+    while texts.agents:
+        *_, infos = texts.step({a: 1 for a in texts.agents})
     assert {i["status"] for i in infos.values()} == {"deadlock"}
-    with pytest.raises(ronap.RonapError, match="no agents left"):
-        env.step({})
+    assert all(i["inbox"] == [] or isinstance(i["inbox"], list) for i in infos.values())
+    assert env.step({}) == ({}, {}, {}, {}, {})  # all done: nothing left to step
+    with pytest.raises(ronap.ActionError, match="every agent is done"):
+        env.step({"robot_0": 1})
 
 
 def test_render_draws_the_scene():

@@ -8,7 +8,7 @@ import ronap
 import stable_baselines3  # noqa: E402,F401  (crates/ronap-py/requirements-dev.txt installs it)
 import ronap.sb3  # noqa: E402
 from stable_baselines3.common.monitor import Monitor  # noqa: E402
-from stable_baselines3.common.vec_env import VecCheckNan, VecMonitor  # noqa: E402
+from stable_baselines3.common.vec_env import VecCheckNan, VecMonitor, VecNormalize  # noqa: E402
 
 
 def test_steps_equal_single_environments_with_sb3s_conventions():
@@ -81,7 +81,9 @@ def test_attributes_images_and_wrappers():
     env = ronap.sb3.VecEnv(2, render_mode="rgb_array", maze_cols=4, maze_rows=4)
     assert env.get_attr("render_mode") == ["rgb_array", "rgb_array"]
     assert env.get_attr("continuous", indices=[1]) == [False]
-    assert env.env_is_wrapped(Monitor) == [False, False]
+    # It writes what a Monitor writes (info["episode"]), so it says it is wrapped by one.
+    assert env.env_is_wrapped(Monitor) == [True, True]
+    assert env.env_is_wrapped(VecNormalize) == [False, False]
     env.reset()
     images = env.get_images()
     assert len(images) == 2 and images[0].ndim == 3

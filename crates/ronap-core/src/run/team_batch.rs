@@ -11,6 +11,7 @@
 use crate::config::ValidConfig;
 use crate::run::team::TeamRollout;
 use crate::run::RunError;
+use crate::sim::episode::Status;
 use crate::sim::robot::Action;
 use crate::sim::world::Worlds;
 use rayon::prelude::*;
@@ -33,6 +34,8 @@ pub struct RobotStep {
     pub running: bool,
     /// Collided in this step.
     pub collided: bool,
+    /// The robot's episode ended at its goal (so far, or at this step).
+    pub success: bool,
 }
 
 /// One environment with its observation rows and robot step records.
@@ -278,6 +281,7 @@ impl Ctx<'_> {
             o.truncated = status.is_truncated();
             o.running = team.running(k);
             o.collided = o.acted && team.collided(k);
+            o.success = status == Status::Success;
         }
     }
 }

@@ -21,7 +21,9 @@ obstacles, robot, laser, episode, reward), which keyword arguments (``laser_beam
 ``config={...}``, ``maze_seed=``, ``map=``) override.
 
 Every error is a ``RonapError``; configuration errors (``ConfigError``) name the field and value,
-and the file and line for a value a scenario file sets.
+and the file and line for a value a scenario file sets. A bad value (``ConfigError``,
+``ActionError``) is also a ``ValueError``, a missing file (``MissingFileError``) also a
+``FileNotFoundError``.
 """
 
 from ._ronap import (
@@ -34,7 +36,7 @@ from ._ronap import (
     __version__,
 )
 from .compare import compare
-from .config import default_config, make_config
+from .config import MissingFileError, default_config, make_config
 from .env import NavEnv, VecNavEnv
 from .evaluate import evaluate
 from .export import export_policy, import_torch, mlp_outputs
@@ -45,6 +47,7 @@ from .scenes import maze_image, maze_occupancy, policies
 __all__ = [
     "ActionError",
     "ConfigError",
+    "MissingFileError",
     "MultiNavEnv",
     "NavEnv",
     "OutputError",

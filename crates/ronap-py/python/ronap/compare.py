@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any, Callable, Iterable, Mapping, Sequence
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_seeds
+from .config import ScenarioLike, checked_config, checked_path, checked_seeds, refuse_sb3_thread_safe
 
 
 def compare(
@@ -53,6 +53,8 @@ def compare(
     configuration is given as for ``evaluate``.
     """
     seeds = checked_seeds(seeds)
+    for policy in policies:
+        refuse_sb3_thread_safe(policy, thread_safe)
     command = _call(policies, seeds, scenario=scenario, config=config, maze_seed=maze_seed, map=map,
                     continuous=continuous, runs=list(runs), by_difficulty=by_difficulty, bins=bins,
                     resamples=resamples, **fields)
@@ -61,7 +63,7 @@ def compare(
         seeds,
         checked_config(config, fields, scenario),
         maze_seed=maze_seed,
-        map_path=None if map is None else str(map),
+        map_path=checked_path("map", map),
         threads=threads,
         continuous=continuous,
         out=None if out is None else str(out),

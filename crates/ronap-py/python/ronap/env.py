@@ -2,17 +2,19 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from typing import Any, Mapping
 
 import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
+from gymnasium.envs.registration import EnvSpec
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_int
+from .config import ScenarioLike, checked_config, checked_path, checked_int
 
 _SEED_LIMIT = 2**63
 
@@ -76,7 +78,7 @@ class NavEnv(gym.Env[np.ndarray, Any]):
         if render_view not in ("top", "first_person"):
             raise _ronap.ConfigError(f"render_view {render_view!r}: expected 'top' or 'first_person'")
         checked = checked_config(config, fields, scenario)
-        self._env = _ronap.Env(checked, maze_seed, None if map is None else str(map), continuous)
+        self._env = _ronap.Env(checked, maze_seed, checked_path("map", map), continuous)
         # What pickling needs to build this environment again (see __getstate__).
         self._init_args = dict(
             render_mode=render_mode,
@@ -104,6 +106,22 @@ class NavEnv(gym.Env[np.ndarray, Any]):
             self.action_space = spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
         else:
             self.action_space = spaces.Discrete(3)
+
+    @property  # type: ignore[override]
+    def spec(self) -> EnvSpec:
+        """Gymnasium's ``EnvSpec`` of this environment: the one ``gymnasium.make`` gave, else
+        ``ronap/Nav-v0`` with these arguments; ``max_episode_steps`` is the environment's own
+        limit, ``episode_max_steps``."""
+        given = self.__dict__.get("_spec")
+        limit = int(self.config["episode"]["max_steps"])
+        if given is None:
+            kwargs = {k: v for k, v in self._init_args.items() if k != "render_mode"}
+            return EnvSpec("ronap/Nav-v0", entry_point="ronap.env:NavEnv", vector_entry_point="ronap.env:VecNavEnv", max_episode_steps=limit, kwargs=kwargs)
+        return dataclasses.replace(given, max_episode_steps=limit)
+
+    @spec.setter
+    def spec(self, value: EnvSpec | None) -> None:
+        self.__dict__["_spec"] = value
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
@@ -241,7 +259,7 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
             num_envs,
             checked,
             maze_seed=maze_seed,
-            map_path=None if map is None else str(map),
+            map_path=checked_path("map", map),
             threads=threads,
             autoreset=_AUTORESET[mode],
             continuous=bool(continuous),
@@ -266,6 +284,24 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         self._all = np.ones(num_envs, dtype=bool)
         self._rng = np.random.default_rng()
         self._started = False
+        # What pickling needs: the arguments, and the calls into Rust since the last reset of
+        # every environment (replayed by __setstate__; 8 bytes per environment and step).
+        self._init_args = dict(
+            num_envs=num_envs,
+            scenario=scenario,
+            config=config,
+            maze_seed=maze_seed,
+            map=map,
+            threads=threads,
+            continuous=continuous,
+            autoreset_mode=mode,
+            render_mode=render_mode,
+            render_view=render_view,
+            render_scale=render_scale,
+            max_episode_steps=None,
+            **fields,
+        )
+        self._calls: list[tuple[str, Any, Any]] = []
 
     def _infos(self, infos: dict[str, Any], mask: np.ndarray) -> dict[str, Any]:
         """Gymnasium's vector infos: every value an array over the environments, and beside each
@@ -316,7 +352,11 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
                 if not self._started and not mask.all():
                     raise _ronap.ConfigError("reset_mask: the first reset() starts every environment")
         seeds = self._seeds(seed, mask)
-        obs, infos, _ = self._vec.reset(seeds, None if mask is None else [bool(m) for m in mask])
+        flags = None if mask is None else [bool(m) for m in mask]
+        obs, infos, _ = self._vec.reset(seeds, flags)
+        if flags is None:
+            self._calls.clear()
+        self._calls.append(("reset", seeds, flags))
         self._started = True
         return obs, self._infos(infos, self._all if mask is None else mask.copy())
 
@@ -328,6 +368,7 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         else:
             a = discrete_actions(actions, (self.num_envs,))
         obs, rewards, terminated, truncated, infos, finals = self._vec.step(a)
+        self._calls.append(("step", a, None))
         infos = self._infos(infos, self._all)
         if finals is not None:
             ended, last, final_infos = finals
@@ -339,6 +380,23 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
             infos["final_info"] = self._infos(final_infos, ended)
             infos["_final_info"] = ended
         return obs, rewards, terminated, truncated, infos
+
+    def __getstate__(self) -> dict[str, Any]:
+        """How to build this vector environment again and bring every environment to where it
+        is: its arguments and the resets and actions since the last reset of them all (the
+        model is deterministic), for ``pickle`` and ``copy.deepcopy``."""
+        return {"init": self._init_args, "calls": self._calls, "rng": self._rng, "started": self._started}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__(**state["init"])  # type: ignore[misc]
+        for kind, a, b in state["calls"]:
+            if kind == "reset":
+                self._vec.reset(a, b)
+            else:
+                self._vec.step(a)
+        self._calls = list(state["calls"])
+        self._rng = state["rng"]
+        self._started = state["started"]
 
     def render(self) -> tuple[np.ndarray, ...] | None:  # type: ignore[override]
         """One picture per environment (``render_mode="rgb_array"``), else None."""

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any, Callable, Iterable, Mapping
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_int, checked_seeds
+from .config import ScenarioLike, checked_config, checked_path, checked_int, checked_seeds, refuse_sb3_thread_safe
 
 
 def evaluate(
@@ -35,7 +35,8 @@ def evaluate(
     ``(v / v_max, w / w_max)`` in [-1, 1] with ``continuous=True``, as ``NavEnv``'s action space).
     The simulation runs on ``threads`` threads (0: all cores); a Python policy is called by one of
     them at a time, even when it releases the GIL inside (torch, SB3's ``predict``), unless it is
-    declared ``thread_safe=True`` (a pure function of the observation, say). With ``out``, writes ``episodes.csv``,
+    declared ``thread_safe=True`` (a pure function of the observation, say; refused for a
+    Stable-Baselines3 model, whose ``predict`` shares state between calls: use ``batch=N``). With ``out``, writes ``episodes.csv``,
     ``timing.csv``, ``summary.json`` and, as asked, ``png/`` pictures (``png``: a count, ``"failures"``
     or ``"all"``) and ``steps/`` logs, as ``ronap run`` does. ``out`` must be new or empty unless
     ``force=True`` (as ``ronap run --force``): a finished run there is replaced once the first
@@ -76,13 +77,14 @@ def evaluate(
     and step.
     """
     seeds = checked_seeds(seeds)
+    refuse_sb3_thread_safe(policy, thread_safe)
     batch = checked_int("batch", batch, least=0, below=1 << 16)
     return _ronap.evaluate(
         policy,
         seeds,
         checked_config(config, fields, scenario),
         maze_seed=maze_seed,
-        map_path=None if map is None else str(map),
+        map_path=checked_path("map", map),
         threads=threads,
         continuous=continuous,
         out=None if out is None else str(out),

@@ -9,7 +9,7 @@ import numpy as np
 from gymnasium import spaces
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_int
+from .config import ScenarioLike, checked_config, checked_path, checked_int
 from .env import discrete_actions
 
 if TYPE_CHECKING:
@@ -36,14 +36,21 @@ class MultiNavEnv(_Base):
     2 RIGHT), or ``Box(-1, 1, (2,))`` with ``continuous=True`` (``v / v_max, w / w_max`` of that
     robot). With ``team.message_size = m > 0`` an action is a dict ``{"action": a, "message":
     float32[m]}``: the message goes out with the robot's pose and goal to every robot within
-    ``comm_range_px`` and arrives the next step (in their observations and in ``infos[agent]
-    ["inbox"]``).
+    ``comm_range_px`` and arrives the next step (in their observations and in ``inbox(agent)``).
 
     All robots move at once; robots whose motions would touch stay put and count a collision.
-    An agent leaves ``agents`` after the step that ends its episode: ``terminated`` on success
+    An agent leaves ``agents`` after the step that ends its episode (once all have left,
+    ``step({})`` returns empty dicts until ``reset()``): ``terminated`` on success
     (or a collision under ``robot_on_collision="terminate"``), ``truncated`` at the time-out or
     a deadlock (no robot moved for ``episode.deadlock_steps`` steps). A robot that arrived stays
     in the scene as an obstacle, or leaves it with ``on_arrival = "vanish"``.
+
+    Infos hold numbers only (distance, collided, success, pose, goal, steps, collisions, seed,
+    robot, present, goals_reached, goals), as torchrl's ``PettingZooWrapper`` and BenchMARL
+    need; ``status(agent)`` and ``inbox(agent)`` give the episode status text and the messages
+    heard, and ``text_infos=True`` puts them in the infos as ``status`` and ``inbox``.
+    ``state()`` is the global state for centralised critics (``state_space``). Copies
+    (``pickle``, ``copy.deepcopy``) continue where the original is.
 
     Configure it as ``NavEnv``: ``scenario`` (a TOML file or a nested dict with ``robots``
     entries), ``config`` and keyword overrides. ``reset(seed=s)`` plays team episode ``s``,
@@ -67,12 +74,29 @@ class MultiNavEnv(_Base):
         maze_seed: int | None = None,
         map: str | None = None,
         render_scale: float = 0.5,
+        text_infos: bool = False,
         **fields: Any,
     ) -> None:
         if render_mode not in (None, "rgb_array"):
             raise _ronap.ConfigError(f"render_mode {render_mode!r}: expected None or 'rgb_array'")
         checked = checked_config(config, fields, scenario)
-        self._env = _ronap.MultiEnv(checked, maze_seed, None if map is None else str(map), continuous)
+        self.text_infos: bool = bool(text_infos)
+        self._status: dict[str, str] = {}
+        self._inbox: dict[str, list[dict[str, Any]]] = {}
+        self._env = _ronap.MultiEnv(checked, maze_seed, checked_path("map", map), continuous)
+        # What pickling needs to build this environment again (see __getstate__).
+        self._init_args = dict(
+            render_mode=render_mode,
+            scenario=scenario,
+            config=config,
+            continuous=continuous,
+            maze_seed=maze_seed,
+            map=map,
+            render_scale=render_scale,
+            text_infos=text_infos,
+            **fields,
+        )
+        self._episode: tuple[int, list[tuple[list[Any], Any]]] | None = None
         self.config = json.loads(checked.json)
         self.render_mode = render_mode
         self.render_scale = render_scale
@@ -88,6 +112,9 @@ class MultiNavEnv(_Base):
             for a, size in zip(self.possible_agents, self._env.observation_sizes)
         }
         self._action_spaces = {a: self._make_action_space() for a in self.possible_agents}
+        self._state_parts = [space.shape[0] for space in self._observation_spaces.values()]
+        self.state_space: spaces.Box = spaces.Box(-np.inf, np.inf, (sum(self._state_parts),), np.float32)
+        self._last_obs: list[np.ndarray] = [np.zeros(n, np.float32) for n in self._state_parts]
         self._scales = [np.array(limits, np.float64) for limits in self._env.speed_limits]
         self._rng = np.random.default_rng()
         self.seed_used: int | None = None
@@ -129,11 +156,38 @@ class MultiNavEnv(_Base):
             episode_seed = int(self._rng.integers(0, _SEED_LIMIT))
         self.seed_used = episode_seed
         obs, infos = self._env.reset(episode_seed)
+        self._episode = (episode_seed, [])
         self.agents = list(self.possible_agents)
+        self._last_obs = [np.asarray(o, np.float32) for o in obs]
         return (
             {a: obs[k] for k, a in enumerate(self.possible_agents)},
-            {a: infos[k] for k, a in enumerate(self.possible_agents)},
+            {a: self._info(a, infos[k]) for k, a in enumerate(self.possible_agents)},
         )
+
+    def _info(self, agent: str, info: dict[str, Any]) -> dict[str, Any]:
+        """The agent's info, its text (``status``) and inbox kept aside unless ``text_infos``."""
+        self._status[agent] = info["status"]
+        self._inbox[agent] = info.get("inbox", [])
+        if self.text_infos:
+            return info
+        del info["status"]
+        info.pop("inbox", None)
+        return info
+
+    def status(self, agent: str) -> str:
+        """The agent's episode status after the latest step: "running", "success", "timeout",
+        "collision", "deadlock", ... (in ``infos`` too with ``text_infos=True``)."""
+        return self._status[agent]
+
+    def inbox(self, agent: str) -> list[dict[str, Any]]:
+        """The messages the agent heard in the latest step, each ``{"from", "pose", "goal",
+        "message"}`` (in ``infos`` too with ``text_infos=True``)."""
+        return self._inbox[agent]
+
+    def state(self) -> np.ndarray:
+        """The global state: every robot's latest observation, in agent order, concatenated
+        (``state_space``), for centralised critics; a robot that is done keeps its last one."""
+        return np.concatenate(self._last_obs)
 
     def step(
         self, actions: Mapping[str, Any]
@@ -145,7 +199,13 @@ class MultiNavEnv(_Base):
         dict[str, dict[str, Any]],
     ]:
         if not self.agents:
-            raise _ronap.RonapError("step() with no agents left: call reset()")
+            if self._episode is None:
+                raise _ronap.RonapError("step() before reset(): call reset(seed=...) first")
+            # Every agent is done: nothing moves, nothing is returned (as PettingZoo's own
+            # parallel environments do; SuperSuit's black_death steps once more to see it).
+            if actions:
+                raise _ronap.ActionError(f"actions for {sorted(actions)}: every agent is done; call reset()")
+            return {}, {}, {}, {}, {}
         unknown = [a for a in actions if a not in self._index]
         if unknown:
             raise _ronap.ActionError(f"unknown agent {unknown[0]!r}: expected one of {self.possible_agents}")
@@ -162,15 +222,46 @@ class MultiNavEnv(_Base):
                 action = action.get("action")
             moves[k] = self._scale(k, action) if self.continuous else _discrete(agent, action)
         obs, rewards, terminated, truncated, infos = self._env.step(moves, messages)
+        if self._episode is not None:
+            self._episode[1].append((moves, messages))
         live = self.agents
         self.agents = [a for a in live if not (terminated[self._index[a]] or truncated[self._index[a]])]
+        for a in live:
+            self._last_obs[self._index[a]] = np.asarray(obs[self._index[a]], np.float32)
         return (
             {a: obs[self._index[a]] for a in live},
             {a: float(rewards[self._index[a]]) for a in live},
             {a: bool(terminated[self._index[a]]) for a in live},
             {a: bool(truncated[self._index[a]]) for a in live},
-            {a: infos[self._index[a]] for a in live},
+            {a: self._info(a, infos[self._index[a]]) for a in live},
         )
+
+    def __getstate__(self) -> dict[str, Any]:
+        """How to build this environment again and replay its episode so far: the model is
+        deterministic, so a copy (``pickle``, ``copy.deepcopy``, SuperSuit's and Ray's workers)
+        continues exactly where this one is. A scenario given as a file is read again where the
+        copy is made."""
+        return {
+            "init": self._init_args,
+            "episode": self._episode,
+            "agents": list(self.agents),
+            "rng": self._rng,
+            "seed_used": self.seed_used,
+            "latest": (self._last_obs, self._status, self._inbox),
+        }
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__(**state["init"])  # type: ignore[misc]
+        self._rng = state["rng"]
+        self.seed_used = state["seed_used"]
+        if state["episode"] is not None:
+            seed, steps = state["episode"]
+            self._env.reset(seed)
+            for moves, messages in steps:
+                self._env.step(moves, messages)
+            self._episode = (seed, list(steps))
+        self.agents = list(state["agents"])
+        self._last_obs, self._status, self._inbox = state["latest"]
 
     def _scale(self, k: int, action: Any) -> list[float] | None:
         if action is None:
@@ -217,7 +308,8 @@ class VecMultiNavEnv:
     truncated ``[num_envs, num_agents]``. ``actions`` is ``int[num_envs, num_agents]`` (0 LEFT,
     1 AHEAD, 2 RIGHT; ignored for robots that are done); with ``team.message_size = m > 0``,
     ``messages=float32[num_envs, num_agents, m]`` sends messages. ``infos["active"]`` says which
-    robots are still going after the step (mask the others out of a loss), ``infos["acted"]``
+    robots are still going after the step (mask the others out of a loss), ``infos["success"]``
+    which reached their goal, ``infos["collided"]`` which collided in the step, ``infos["acted"]``
     whose action counted, ``infos["reset"]`` which environments started a new episode,
     ``infos["seed"]`` and ``infos["steps"]`` each environment's episode.
 
@@ -229,6 +321,7 @@ class VecMultiNavEnv:
 
     config: dict[str, Any]
     possible_agents: list[str]
+    render_mode: str | None = None
     single_observation_space: spaces.Box
     single_action_space: spaces.Space[Any]
 
@@ -246,7 +339,7 @@ class VecMultiNavEnv:
         num_envs = checked_int("num_envs", num_envs, least=1, below=2**31)
         threads = checked_int("threads", threads, below=2**16)
         checked = checked_config(config, fields, scenario)
-        self._vec = _ronap.VecMultiEnv(int(num_envs), checked, maze_seed, None if map is None else str(map), int(threads))
+        self._vec = _ronap.VecMultiEnv(int(num_envs), checked, maze_seed, checked_path("map", map), int(threads))
         self.config = json.loads(checked.json)
         self.num_envs: int = self._vec.num_envs
         self.num_agents: int = self._vec.robots
@@ -257,6 +350,9 @@ class VecMultiNavEnv:
         self.single_action_space = spaces.Discrete(3)
         self._started = False
         self.seed_used: int | None = None
+        # What pickling needs: the arguments and the calls since the last reset (see __getstate__).
+        self._init_args = dict(num_envs=num_envs, scenario=scenario, config=config, maze_seed=maze_seed, map=map, threads=threads, **fields)
+        self._calls: list[tuple[Any, Any]] = []
 
     def reset(self, seed: int | None = 0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Restarts every environment: environment ``i`` plays seeds ``seed + i``, ``seed + i +
@@ -267,6 +363,7 @@ class VecMultiNavEnv:
         seed = checked_int("seed", seed)
         self.seed_used = seed
         self._started = True
+        self._calls = []
         return self._vec.reset(seed)
 
     def step(
@@ -282,7 +379,21 @@ class VecMultiNavEnv:
             if m.shape != (*shape, self.message_size):
                 raise _ronap.ActionError(f"messages of shape {m.shape}: expected {(*shape, self.message_size)}")
             flat_messages = m.reshape(-1)
+        self._calls.append((a.reshape(-1), flat_messages))
         return self._vec.step(a.reshape(-1), flat_messages)
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Its arguments, seed and the actions since the last reset, replayed where the copy is
+        made (``pickle``, ``copy.deepcopy``): the copy continues exactly where this one is."""
+        return {"init": self._init_args, "seed": self.seed_used if self._started else None, "calls": self._calls}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__(**state["init"])  # type: ignore[misc]
+        if state["seed"] is not None:
+            self.reset(state["seed"])
+            for actions, messages in state["calls"]:
+                self._vec.step(actions, messages)
+            self._calls = list(state["calls"])
 
     def close(self) -> None:
         pass
