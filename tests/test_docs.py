@@ -4,7 +4,7 @@
   ``<!-- doctest -->`` just before a ```` ```sh ```` or ```` ```python ```` block. Shell blocks run
   in bash with ``ronap`` on the PATH resolving to $RONAP_BIN, Python blocks in this interpreter
   (with the ``ronap`` module installed). The blocks of one page run in order in one temporary
-  directory holding copies of ``scenarios/`` and ``policies/``, so a page's later commands may use
+  directory holding copies of ``scenarios/``, ``policies/`` and ``examples/``, so a page's later commands may use
   what its earlier ones wrote. Large counts are cut before running (``--seeds 1000`` runs as
   ``--seeds 3``, ``seeds=range(1000)`` as ``seeds=range(3)``, and so on: see ``SMALLER``); the page shows the
   command a user runs.
@@ -78,7 +78,7 @@ def test_some_pages_have_marked_blocks():
 
 @pytest.mark.parametrize("page", MARKED, ids=lambda p: str(p.relative_to(ROOT)))
 def test_marked_blocks_run(page, tmp_path, ronap_bin):
-    for folder in ("scenarios", "policies"):
+    for folder in ("scenarios", "policies", "examples"):
         shutil.copytree(ROOT / folder, tmp_path / folder)
     bin_dir = tmp_path / ".bin"
     bin_dir.mkdir()
