@@ -696,3 +696,73 @@ fn the_crowd_scenarios_run_and_bad_crowd_entries_are_named() {
         assert!(!err.contains("panick"), "{err}");
     }
 }
+
+#[test]
+fn split_names_a_seed_space_and_trained_seeds_are_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let seeds_of = |split: &str, start: &str| {
+        let out = dir.path().join(format!("{split}-{start}"));
+        let o = ronap(&[
+            "run",
+            "--policy",
+            "geodesic",
+            "--seeds",
+            "3",
+            "--split",
+            split,
+            "--seed-start",
+            start,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        let table = rows(&out.join("episodes.csv"));
+        let c = col(&table, "seed");
+        table[1..].iter().map(|r| r[c].clone()).collect::<Vec<_>>()
+    };
+    assert_eq!(seeds_of("test", "0"), ["0", "1", "2"]);
+    assert_eq!(seeds_of("validation", "5"), ["500005", "500006", "500007"]);
+    assert_eq!(seeds_of("train", "0"), ["1000000", "1000001", "1000002"]);
+    let over = ronap(&[
+        "run",
+        "--policy",
+        "apf",
+        "--split",
+        "test",
+        "--seed-start",
+        "499999",
+        "--seeds",
+        "2",
+    ]);
+    assert!(!over.status.success());
+    let err = text(&over.stderr);
+    assert!(err.contains("0..=499999"), "{err}");
+    assert_rejected(
+        &["run", "--policy", "apf", "--split", "dev"],
+        &["dev", "test, validation or train"],
+    );
+    // The shipped DQN network records its training and validation seeds: a run on them warns,
+    // a run on the test split does not.
+    let policy = concat!(
+        "mlp:",
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../policies/dqn.safetensors"
+    );
+    for (split, warned) in [("validation", true), ("test", false)] {
+        let out = dir.path().join(format!("dqn-{split}"));
+        let o = ronap(&[
+            "run",
+            "--policy",
+            policy,
+            "--seeds",
+            "2",
+            "--split",
+            split,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        let err = text(&o.stderr);
+        assert_eq!(err.contains("are among those"), warned, "{split}: {err}");
+    }
+}

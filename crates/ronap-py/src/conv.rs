@@ -303,6 +303,7 @@ pub fn info<'py>(
     d.set_item("steps", episode.steps())?;
     d.set_item("collisions", episode.collisions())?;
     d.set_item("seed", episode.seed())?;
+    d.set_item("return", episode.total_reward())?;
     if let Some(dynamic) = episode.dynamic_metrics() {
         d.set_item("dynamic_collisions", dynamic.collisions)?;
     }

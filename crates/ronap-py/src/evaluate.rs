@@ -330,6 +330,7 @@ pub fn evaluate<'py>(
     } else {
         policy_factory(policy, config, continuous, thread_safe)?
     };
+    warn_if_not_held_out(py, &name, factory.as_ref(), &seeds)?;
     let mut prepared = run.prepare(name, config, seeds)?;
     let cancel = AtomicBool::new(false);
     let interrupt = Interrupt::here();
@@ -691,6 +692,7 @@ pub fn compare<'py>(
     let mut contenders = Vec::new();
     for policy in &policies {
         let (factory, name) = policy_factory(policy, config, continuous, thread_safe)?;
+        warn_if_not_held_out(py, &name, factory.as_ref(), &seeds)?;
         contenders.push(Contender {
             name,
             factory,
@@ -756,6 +758,32 @@ pub fn compare<'py>(
     let value = serde_json::to_value(&comparison)
         .map_err(|e| errors::OutputError::new_err(e.to_string()))?;
     conv::json(py, &value)
+}
+
+/// A `UserWarning` when some of `seeds` are among those the policy was trained or chosen on.
+fn warn_if_not_held_out(
+    py: Python<'_>,
+    name: &str,
+    factory: &dyn PolicyFactory,
+    seeds: &[u64],
+) -> PyResult<()> {
+    let seen = factory.seeds_seen();
+    if seen.is_empty() {
+        return Ok(());
+    }
+    let run = ronap_core::eval::Seeds::List(seeds.to_vec());
+    match ronap_core::eval::held_out_warning(name, &seen, &run) {
+        Some(w) => {
+            let category = py.get_type::<pyo3::exceptions::PyUserWarning>();
+            PyErr::warn(
+                py,
+                &category,
+                &std::ffi::CString::new(w).unwrap_or_default(),
+                1,
+            )
+        }
+        None => Ok(()),
+    }
 }
 
 /// The first of `seeds`; an empty list is refused.

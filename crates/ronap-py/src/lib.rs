@@ -68,6 +68,13 @@ fn maze_picture(seed: u64, config: &Config, scale: f64) -> PyResult<image::RgbIm
     Ok(ronap_core::render::Canvas::new(&scene, scale).into_image())
 }
 
+/// The first and last seed of a named split (`test`, `validation`, `train`).
+#[pyfunction]
+fn split_range(name: &str) -> PyResult<(u64, u64)> {
+    let split = ronap_core::sim::split::Split::parse(name).map_err(errors::ConfigError::new_err)?;
+    Ok((*split.range().start(), *split.range().end()))
+}
+
 /// The built-in policies: (name, description).
 #[pyfunction]
 fn builtin_policies() -> Vec<(&'static str, &'static str)> {
@@ -89,6 +96,7 @@ fn _ronap(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<multi_env::MultiEnv>()?;
     m.add_class::<multi_env::VecMultiEnv>()?;
     m.add_function(wrap_pyfunction!(default_config_json, m)?)?;
+    m.add_function(wrap_pyfunction!(split_range, m)?)?;
     m.add_function(wrap_pyfunction!(maze_occupancy, m)?)?;
     m.add_function(wrap_pyfunction!(maze_image, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_policies, m)?)?;

@@ -91,10 +91,11 @@ fn infos<'py>(py: Python<'py>, records: &[EnvStep]) -> PyResult<Bound<'py, PyDic
         PyArray1::from_vec(py, collisions),
     )?;
     d.set_item(intern!(py, "seed"), PyArray1::from_vec(py, seed))?;
-    d.set_item(
-        intern!(py, "total_reward"),
-        PyArray1::from_vec(py, total_reward),
-    )?;
+    // "return", as every info and result names the summed reward; "total_reward" is its
+    // earlier name, kept for code written against it.
+    let summed = PyArray1::from_vec(py, total_reward);
+    d.set_item(intern!(py, "return"), &summed)?;
+    d.set_item(intern!(py, "total_reward"), summed)?;
     if any_dynamic {
         let dynamic = each(records, |s| u64::from(s.dynamic_collisions.unwrap_or(0)));
         d.set_item(

@@ -89,7 +89,7 @@ def test_team_vec_env_closes_each_robots_episode_and_its_wait():
     env.seed(4)
     obs = env.reset()
     assert obs.shape == (24, 18)
-    team = ronap.MultiNavEnv(scenario=WAREHOUSE, episode_max_steps=60)
+    team = ronap.MultiNavEnv(scenario=WAREHOUSE, episode_max_steps=60, split="train")
     team.reset(seed=5)  # team episode 1 of env.seed(4): seed 4 + 1
     np.testing.assert_array_equal(obs[8:16], np.stack([team.state()[k * 18 : (k + 1) * 18] for k in range(8)]))
     rng = np.random.default_rng(2)
@@ -181,3 +181,25 @@ def test_spec_max_episode_steps_is_the_environments_limit():
     made = gym.make("ronap/Nav-v0", episode_max_steps=400)
     assert made.spec.max_episode_steps == 400
     assert gym.make(ronap.NavEnv(episode_max_steps=250).spec).spec.max_episode_steps == 250
+
+
+def test_one_vocabulary_across_infos_and_results():
+    keys = {"seed", "steps", "collisions", "return", "success", "distance", "pose", "goal", "collided"}
+    env = ronap.NavEnv(episode_max_steps=5)
+    _, info = env.reset(seed=4)
+    total = 0.0
+    for _ in range(5):
+        _, reward, *_, info = env.step(1)
+        total += reward
+    assert keys <= set(info) and info["status"] == "timeout"
+    assert info["return"] == pytest.approx(total)
+    vec = ronap.VecNavEnv(2, episode_max_steps=5)
+    vec.reset(seed=4)
+    _, _, _, _, infos = vec.step(np.ones(2, int))
+    assert keys <= set(infos) and infos["return"] is infos["total_reward"]
+    row = ronap.evaluate(lambda obs: 1, [4], episode_max_steps=5)["episodes"][0]
+    assert {"seed", "steps", "collisions", "return", "outcome"} <= set(row)
+    assert row["return"] == pytest.approx(info["return"]) and row["outcome"] == info["status"]
+    multi = ronap.MultiNavEnv(scenario=WAREHOUSE)
+    _, infos = multi.reset(seed=0)
+    assert keys <= set(infos["robot_0"]) and multi.status("robot_0") == "running"

@@ -2,6 +2,7 @@
 NavEnvs of the same seeds, through SB3's own wrappers, and with short PPO runs."""
 
 import numpy as np
+import pytest
 
 import ronap
 
@@ -16,7 +17,7 @@ def test_steps_equal_single_environments_with_sb3s_conventions():
     env = ronap.sb3.VecEnv(n, episode_max_steps=15)
     env.seed(100)
     obs = env.reset()
-    singles = [ronap.NavEnv(episode_max_steps=15) for _ in range(n)]
+    singles = [ronap.NavEnv(episode_max_steps=15, split="train") for _ in range(n)]  # its default split
     next_seed = [100 + i for i in range(n)]
     for i, single in enumerate(singles):
         o, _ = single.reset(seed=next_seed[i])
@@ -50,7 +51,9 @@ def test_steps_equal_single_environments_with_sb3s_conventions():
 def test_sb3_wrappers_and_a_short_ppo_run():
     from stable_baselines3 import PPO
 
-    env = VecMonitor(VecCheckNan(ronap.sb3.VecEnv(4, episode_max_steps=32), raise_exception=True))
+    # VecMonitor is not needed (the VecEnv writes Monitor's info itself) and says so; it works.
+    with pytest.warns(UserWarning, match="already wrapped with a `Monitor`"):
+        env = VecMonitor(VecCheckNan(ronap.sb3.VecEnv(4, episode_max_steps=32), raise_exception=True))
     model = PPO("MlpPolicy", env, n_steps=64, batch_size=64, n_epochs=1, seed=0, device="cpu")
     model.learn(512)
     assert len(model.ep_info_buffer) > 0

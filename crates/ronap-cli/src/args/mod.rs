@@ -11,6 +11,9 @@ pub use policy::{named_policy, policy_factory, TeamPolicies};
 pub use sim::{EpisodeArgs, SceneArgs, SimArgs};
 
 use clap::Args;
+use ronap_core::eval::{held_out_warning, Seeds};
+use ronap_core::policy::PolicyFactory;
+use ronap_core::sim::split::Split;
 
 /// Parses a positive, finite number of px.
 pub fn positive(s: &str) -> Result<f64, String> {
@@ -82,6 +85,66 @@ pub fn seed_range(first: u64, count: u64) -> anyhow::Result<Vec<u64>> {
     })?;
     seeds.extend(first..end);
     Ok(seeds)
+}
+
+/// Parses a seed split's name.
+pub fn split(s: &str) -> Result<Split, String> {
+    Split::parse(s)
+}
+
+/// The episodes' seeds: how many, from which, in which split.
+#[derive(Args, Debug, Clone, Copy)]
+pub struct SeedArgs {
+    /// Number of episodes; episode i has seed seed-start + i.
+    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 1000, value_parser = count)]
+    pub seeds: u64,
+    /// First seed (with --split, counted from the split's first seed).
+    #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 0, value_parser = seed)]
+    pub seed_start: u64,
+    /// Play the seeds of a named split, which never meet: test (0..=499999), validation
+    /// (500000..=999999) or train (1000000 and up) [default: the seeds as given; the default
+    /// ones are the test split's].
+    #[arg(long, value_name = "SPLIT", value_parser = split)]
+    pub split: Option<Split>,
+}
+
+impl SeedArgs {
+    /// The first seed: `--seed-start`, or with `--split` that many seeds into the split; an
+    /// error when the range passes 2^64 or leaves the split.
+    pub fn first(&self) -> anyhow::Result<u64> {
+        let first = match self.split {
+            Some(split) => split.start(self.seed_start, self.seeds).map_err(|e| {
+                anyhow::anyhow!(
+                    "--split {split} --seed-start {} --seeds {}: {e}",
+                    self.seed_start,
+                    self.seeds
+                )
+            })?,
+            None => self.seed_start,
+        };
+        first.checked_add(self.seeds).ok_or_else(|| {
+            anyhow::anyhow!(
+                "--seed-start {first} --seeds {}: the seed range passes 2^64",
+                self.seeds
+            )
+        })?;
+        Ok(first)
+    }
+
+    /// The seeds, as a range.
+    pub fn range(&self) -> anyhow::Result<Seeds> {
+        Ok(Seeds::Range {
+            start: self.first()?,
+            count: self.seeds,
+        })
+    }
+}
+
+/// Warns on stderr when some of `seeds` are among those the policy was trained or chosen on.
+pub fn warn_if_not_held_out(name: &str, factory: &dyn PolicyFactory, seeds: &Seeds) {
+    if let Some(w) = held_out_warning(name, &factory.seeds_seen(), seeds) {
+        eprintln!("warning: {w}");
+    }
 }
 
 /// The worker-thread flag.

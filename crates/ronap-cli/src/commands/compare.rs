@@ -1,7 +1,10 @@
 //! `ronap compare`: several policies on the same seeds, with paired statistics, pictures and a
 //! report.
 
-use crate::args::{count, policy_factory, seed, seed_range, EpisodeArgs, TeamPolicies, ThreadArgs};
+use crate::args::{
+    policy_factory, seed_range, warn_if_not_held_out, EpisodeArgs, SeedArgs, TeamPolicies,
+    ThreadArgs,
+};
 use crate::output::cancel_on_ctrl_c;
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
@@ -36,12 +39,8 @@ pub struct CompareArgs {
     /// Its policy joins the comparison if not named by --policy. Repeatable.
     #[arg(long, value_name = "DIR")]
     run: Vec<PathBuf>,
-    /// Number of episodes per policy; episode i has seed seed-start + i.
-    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 1000, value_parser = count)]
-    seeds: u64,
-    /// First seed.
-    #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 0, value_parser = seed)]
-    seed_start: u64,
+    #[command(flatten)]
+    seeds: SeedArgs,
     #[command(flatten)]
     threads: ThreadArgs,
     #[command(flatten)]
@@ -94,9 +93,13 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
             reuse,
         });
     }
-    let first = args.seed_start;
-    let seeds = seed_range(first, args.seeds)?;
-    let end = first + args.seeds;
+    let first = args.seeds.first()?;
+    let seeds = seed_range(first, args.seeds.seeds)?;
+    let end = first + args.seeds.seeds;
+    let range = args.seeds.range()?;
+    for c in contenders.iter().filter(|c| c.reuse.is_none()) {
+        warn_if_not_held_out(&c.name, c.factory.as_ref(), &range);
+    }
     let evaluator = Evaluator::new(config.clone(), scenes);
     if team {
         // A team that cannot be placed fails the same way for every seed: say so now.
@@ -127,7 +130,7 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
     let cancel = cancel_on_ctrl_c("finishing running episodes and saving the runs");
     let to_run = contenders.iter().filter(|c| c.reuse.is_none()).count() as u64;
     let bar = crate::output::progress_bar(
-        args.seeds * to_run,
+        args.seeds.seeds * to_run,
         "{prefix} {wide_bar} {pos}/{len} episodes, {per_sec}, eta {eta}",
         "ronap compare".to_string(),
     );

@@ -1,7 +1,9 @@
 //! `ronap run`: evaluate a policy over many seeded episodes and write what happened, as it
 //! happens; `--resume` finishes a run stopped short.
 
-use crate::args::{count, fraction, policy_factory, seed, EpisodeArgs, ThreadArgs};
+use crate::args::{
+    fraction, policy_factory, seed, warn_if_not_held_out, EpisodeArgs, SeedArgs, ThreadArgs,
+};
 use crate::output::cancel_on_ctrl_c;
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -34,12 +36,8 @@ pub struct RunArgs {
     /// $RONAP_PYTHON or python3).
     #[arg(long, value_name = "NAME", required_unless_present = "resume")]
     policy: Option<String>,
-    /// Number of episodes; episode i has seed seed-start + i.
-    #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 1000, value_parser = count)]
-    seeds: u64,
-    /// First seed.
-    #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 0, value_parser = seed)]
-    seed_start: u64,
+    #[command(flatten)]
+    seeds: SeedArgs,
     #[command(flatten)]
     threads: ThreadArgs,
     #[command(flatten)]
@@ -91,23 +89,14 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
     // Everything that can be wrong with the input is checked before anything is written.
     let (config, scenes, map) = args.episodes.resolve()?;
     let policy = args.policy.clone().unwrap_or_default();
-    let first = args.seed_start;
-    first.checked_add(args.seeds).ok_or_else(|| {
-        anyhow::anyhow!(
-            "--seed-start {first} --seeds {}: the seed range passes 2^64",
-            args.seeds
-        )
-    })?;
+    let seeds = args.seeds.range()?;
     let job = Job {
         out_dir: match &args.out {
             Some(d) => d.clone(),
             None => default_out_dir(&policy),
         },
         policy,
-        seeds: Seeds::Range {
-            start: first,
-            count: args.seeds,
-        },
+        seeds,
         threads: args.threads.count(),
         info_scenes: args.episodes.scenes.spec(&config),
         map,
@@ -380,6 +369,7 @@ fn run_lone(
         }
         _ => (policy_factory(&job.policy, &config)?, job.threads),
     };
+    warn_if_not_held_out(&job.policy, factory.as_ref(), &job.seeds);
     let evaluator = Evaluator::new(config.clone(), scenes);
     let (first, last) = job.span();
     // A scene with no room for a start and goal fails the same way for every seed: say so now.

@@ -11,6 +11,7 @@ use ronap_core::io::atomic::{save_network, OutputError};
 use ronap_core::io::datalog;
 use ronap_core::io::training::{Curves, TrainingLog};
 use ronap_core::policy::mlp::{observation_layout, DecisionRule, Mlp};
+use ronap_core::sim::split::{SeedRanges, Split};
 use ronap_learn::bc::{self, BcOptions};
 use ronap_learn::dqn::{self, DqnOptions, Loss, Priorities, Validation};
 use ronap_learn::net::TrainActivation;
@@ -290,6 +291,25 @@ fn metadata(output: &str, decision: DecisionRule, trained: String) -> HashMap<St
     ])
 }
 
+/// Notes on stderr when training or validation seeds leave the split meant for them.
+fn note_split(seeds: &SeedRanges, split: Split, what: &str) {
+    let outside: Vec<String> = seeds
+        .0
+        .iter()
+        .filter(|r| Split::of(*r.start()) != split || Split::of(*r.end()) != split)
+        .map(|r| SeedRanges(vec![r.clone()]).to_string())
+        .collect();
+    if !outside.is_empty() {
+        eprintln!(
+            "note: {what}: seeds {} are not all in the {split} split ({}..={}); scores on the \
+             test split stay held out only if training never sees it",
+            outside.join(","),
+            split.range().start(),
+            split.range().end()
+        );
+    }
+}
+
 /// Checks the output can be written before any training time is spent.
 fn check_out(path: &Path) -> Result<()> {
     if path.is_dir() || path.as_os_str().to_string_lossy().ends_with('/') {
@@ -389,6 +409,7 @@ fn train_bc(args: BcArgs) -> Result<ExitCode> {
                 all.observations.extend_from_slice(&d.observations);
                 all.actions.extend_from_slice(&d.actions);
                 all.skipped += d.skipped;
+                all.seeds.extend(d.seeds);
             }
         }
     }
@@ -437,13 +458,18 @@ fn train_bc(args: BcArgs) -> Result<ExitCode> {
     );
     let cancel =
         crate::output::cancel_on_ctrl_c("stopping after this batch and saving the network");
-    let metadata = metadata(
+    let mut metadata = metadata(
         "logits",
         args.net
             .decision
             .unwrap_or(DecisionRule::Sample { temperature: 2.0 }),
         format!("behaviour cloning on {}", described.join(", ")),
     );
+    let seeds = data.seed_ranges();
+    if !seeds.is_empty() {
+        note_split(&seeds, Split::Train, "the data's episode seeds");
+        metadata.insert("training_seeds".into(), seeds.to_string());
+    }
     let mut log = TrainingLog::new(
         &args.net.out,
         format!("ronap train bc: {}", args.net.out.display()),
@@ -614,6 +640,17 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
             args.steps, args.seed_start
         ),
     );
+    let training = SeedRanges(vec![args.seed_start..=u64::MAX]);
+    note_split(&training, Split::Train, "--seed-start");
+    metadata.insert("training_seeds".into(), training.to_string());
+    if options.validation.is_some() {
+        let last = args
+            .eval_seed_start
+            .saturating_add(args.eval_seeds.saturating_sub(1));
+        let chosen = SeedRanges(vec![args.eval_seed_start..=last]);
+        note_split(&chosen, Split::Validation, "--eval-seed-start");
+        metadata.insert("validation_seeds".into(), chosen.to_string());
+    }
     let history = evaluator.config().observation.history;
     if history > 1 {
         let layout = observation_layout(evaluator.config().laser.beams as usize);

@@ -26,6 +26,7 @@ use crate::run::RunError;
 use crate::sim::episode::Episode;
 use crate::sim::moving::Track;
 use crate::sim::robot::{Action, Pose};
+use crate::sim::split::SeedRanges;
 use crate::sim::world::{Scenes, World, Worlds};
 use ordered::{run_in_order, Ordered, Window};
 use std::sync::atomic::AtomicBool;
@@ -107,6 +108,27 @@ impl Seeds {
     pub fn iter(&self) -> impl Iterator<Item = u64> + '_ {
         (0..self.len()).filter_map(|i| self.get(i))
     }
+
+    /// How many of these seeds lie in `ranges`, and the first of them.
+    pub fn overlap(&self, ranges: &SeedRanges) -> (u64, Option<u64>) {
+        match self {
+            Self::Range { start, count } => ranges.overlap_range(*start, *count),
+            Self::List(v) => ranges.overlap_list(v.iter().copied()),
+        }
+    }
+}
+
+/// A warning for a run of `policy` (by name) over `seeds` when some of them are among the seeds
+/// it was trained or chosen on (`seen`): its scores on them are not held out.
+pub fn held_out_warning(policy: &str, seen: &SeedRanges, seeds: &Seeds) -> Option<String> {
+    let (count, first) = seeds.overlap(seen);
+    let first = first?;
+    Some(format!(
+        "{count} of this run's {} seeds (the first: {first}) are among those {policy} was trained \
+         or chosen on ({seen}): its scores on them are not held out (the test split, seeds \
+         0..=499999, is)",
+        seeds.len()
+    ))
 }
 
 /// What an evaluation runs: which seeds, on how many threads, keeping what.

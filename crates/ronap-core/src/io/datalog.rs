@@ -12,6 +12,7 @@
 use crate::geometry::{wrap_deg, Point};
 use crate::sim::episode::Episode;
 use crate::sim::robot::{DiscreteAction, Pose};
+use crate::sim::split::SeedRanges;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -169,6 +170,8 @@ pub struct DataSet {
     pub actions: Vec<u8>,
     /// Rows left out: the original's `WARNING` rows and ronap's collided rows.
     pub skipped: usize,
+    /// The episode seeds the rows came from, where the log records them (ronap's format).
+    pub seeds: std::collections::BTreeSet<u64>,
 }
 
 impl DataSet {
@@ -200,6 +203,19 @@ impl DataSet {
         debug_assert_eq!(observation.len(), self.width);
         self.observations.extend_from_slice(observation);
         self.actions.push(action as u8);
+    }
+
+    /// The episode seeds of the rows, as ranges of consecutive seeds (empty when the log does not
+    /// record them).
+    pub fn seed_ranges(&self) -> SeedRanges {
+        let mut ranges: Vec<std::ops::RangeInclusive<u64>> = Vec::new();
+        for &s in &self.seeds {
+            match ranges.last_mut() {
+                Some(r) if r.end().checked_add(1) == Some(s) => *r = *r.start()..=s,
+                _ => ranges.push(s..=s),
+            }
+        }
+        SeedRanges(ranges)
     }
 
     /// Rows per action, LEFT, AHEAD, RIGHT.
@@ -313,6 +329,13 @@ pub fn parse(text: &str, path: &Path, range_px: f64) -> Result<(DataSet, Format)
             ));
         }
         data.push(&observation, action);
+        let seed = columns
+            .as_ref()
+            .and_then(|c| c.seed)
+            .and_then(|i| record.get(i));
+        if let Some(seed) = seed.and_then(|s| s.parse::<u64>().ok()) {
+            data.seeds.insert(seed);
+        }
     }
     if data.is_empty() {
         return Err(DataLogError::Empty {
@@ -355,6 +378,7 @@ struct RonapColumns {
     bearing: usize,
     action: usize,
     collided: Option<usize>,
+    seed: Option<usize>,
 }
 
 impl RonapColumns {
@@ -368,6 +392,7 @@ impl RonapColumns {
             bearing: need("bearing")?,
             action: need("action")?,
             collided: find("collided"),
+            seed: find("seed"),
         })
     }
 

@@ -123,4 +123,11 @@ pub trait PolicyFactory: Sync {
     fn side_by_side(&self) -> usize {
         1
     }
+
+    /// The episode seeds the policy was trained or chosen on, where it records them (a trained
+    /// network's `training_seeds` and `validation_seeds`): a run over any of them is warned
+    /// about ([`crate::eval::held_out_warning`]).
+    fn seeds_seen(&self) -> crate::sim::split::SeedRanges {
+        crate::sim::split::SeedRanges::default()
+    }
 }

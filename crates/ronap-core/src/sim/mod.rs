@@ -13,5 +13,6 @@ pub mod moving;
 pub mod placement;
 pub mod rng;
 pub mod robot;
+pub mod split;
 pub mod team;
 pub mod world;

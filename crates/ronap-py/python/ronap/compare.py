@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any, Callable, Iterable, Mapping, Sequence
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_path, checked_seeds, refuse_sb3_thread_safe
+from .config import ScenarioLike, checked_config, checked_path, checked_seeds, refuse_sb3_thread_safe, split_seed
 
 
 def compare(
@@ -25,6 +25,7 @@ def compare(
     resamples: int = 10_000,
     sheet: int = 6,
     thread_safe: bool = False,
+    split: str | None = None,
     force: bool = False,
     **fields: Any,
 ) -> dict[str, Any]:
@@ -50,9 +51,9 @@ def compare(
     ``ronap compare --out`` writes: ``runs/<policy>/``, ``compare.png``, ``outcomes.png``,
     ``disagreements.png``, ``seeds.csv``, ``compare.json``, ``report.md`` and ``report.html``.
     ``out`` must be new or empty unless ``force=True`` (as ``ronap compare --force``). The
-    configuration is given as for ``evaluate``.
+    configuration, ``split`` and ``thread_safe`` are given as for ``evaluate``.
     """
-    seeds = checked_seeds(seeds)
+    seeds = [split_seed(split, s, f"seeds[{i}]") for i, s in enumerate(checked_seeds(seeds))]
     for policy in policies:
         refuse_sb3_thread_safe(policy, thread_safe)
     command = _call(policies, seeds, scenario=scenario, config=config, maze_seed=maze_seed, map=map,

@@ -171,6 +171,39 @@ def _merged(
 
 _U64 = 2**64
 
+SPLITS = ("test", "validation", "train")
+"""The seed splits, three disjoint spaces of episode seeds: ``test`` 0..=499999 (what
+``ronap run --seeds N`` plays by default), ``validation`` 500000..=999999, ``train`` 1000000 and
+up (docs/model.md, "Seed splits")."""
+
+
+def split_range(split: str) -> tuple[int, int]:
+    """The first and last seed of a split; ``ConfigError`` for a name that is not one."""
+    if split not in SPLITS:
+        raise ConfigError(f"split = {split!r}: expected one of {', '.join(SPLITS)} (or None for seeds as given)")
+    first, last = _ronap.split_range(split)
+    return int(first), int(last)
+
+
+def split_seed(split: str | None, seed: int, name: str = "seed") -> int:
+    """Episode seed ``seed`` of ``split`` (counted from the split's first seed), or ``seed`` as
+    given with no split; ``ConfigError`` when the split has no such seed."""
+    if split is None:
+        return seed
+    first, last = split_range(split)
+    if seed > last - first:
+        raise ConfigError(f"{name} = {seed}: the {split} split holds {last - first + 1} seeds ({first}..={last})")
+    return first + seed
+
+
+def split_draw_limit(split: str | None, room: int = 1) -> int:
+    """How far a random seed index may go in ``split`` leaving ``room`` seeds after it (2^63 with
+    no split)."""
+    if split is None:
+        return 2**63
+    first, last = split_range(split)
+    return max(1, min(last - first + 2 - room, 2**63))
+
 
 def _sb3_object(value: Any) -> bool:
     module = type(value).__module__ or ""

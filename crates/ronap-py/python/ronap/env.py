@@ -14,9 +14,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_path, checked_int
-
-_SEED_LIMIT = 2**63
+from .config import ScenarioLike, checked_config, checked_path, checked_int, split_draw_limit, split_range, split_seed
 
 
 class NavEnv(gym.Env[np.ndarray, Any]):
@@ -44,7 +42,10 @@ class NavEnv(gym.Env[np.ndarray, Any]):
     line when a scenario file sets it.
 
     ``reset(seed=s)`` plays the episode of seed ``s`` (the same as ``ronap run`` seed ``s``);
-    ``reset()`` draws the next episode seed from the environment's generator.
+    ``reset()`` draws the next episode seed from the environment's generator. With
+    ``split="train"`` (or ``"validation"``, ``"test"``) seeds count from that split's first
+    (``reset(seed=0)`` of the train split is episode seed 1000000, as ``ronap run --split train``
+    plays it) and drawn seeds stay in it; ``info["seed"]`` is the episode's own seed.
 
     The episode limit is ``episode_max_steps`` (default 2000), after which ``truncated`` is
     true and ``info["status"]`` is "timeout". ``gymnasium.make("ronap/Nav-v0",
@@ -71,12 +72,16 @@ class NavEnv(gym.Env[np.ndarray, Any]):
         map: str | None = None,
         render_view: str = "top",
         render_scale: float = 0.5,
+        split: str | None = None,
         **fields: Any,
     ) -> None:
         if render_mode not in (None, "rgb_array"):
             raise _ronap.ConfigError(f"render_mode {render_mode!r}: expected None or 'rgb_array'")
         if render_view not in ("top", "first_person"):
             raise _ronap.ConfigError(f"render_view {render_view!r}: expected 'top' or 'first_person'")
+        if split is not None:
+            split_range(split)
+        self.split = split
         checked = checked_config(config, fields, scenario)
         self._env = _ronap.Env(checked, maze_seed, checked_path("map", map), continuous)
         # What pickling needs to build this environment again (see __getstate__).
@@ -89,6 +94,7 @@ class NavEnv(gym.Env[np.ndarray, Any]):
             map=map,
             render_view=render_view,
             render_scale=render_scale,
+            split=split,
             **fields,
         )
         self._episode: tuple[int, list[Any]] | None = None
@@ -129,7 +135,10 @@ class NavEnv(gym.Env[np.ndarray, Any]):
         if seed is not None:
             seed = checked_int("seed", seed)
         super().reset(seed=seed)
-        episode_seed = seed if seed is not None else int(self.np_random.integers(0, _SEED_LIMIT))
+        if seed is not None:
+            episode_seed = split_seed(self.split, seed)
+        else:
+            episode_seed = split_seed(self.split, int(self.np_random.integers(0, split_draw_limit(self.split))))
         self._episode = (int(episode_seed), [])
         return self._env.reset(int(episode_seed))
 
@@ -195,7 +204,8 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
     Seeds: ``reset(seed=s)`` gives environment ``i`` the episode seeds ``s + i``, ``s + i + n``,
     ``s + i + 2n``, ... (``n`` environments); ``reset(seed=[s0, s1, ...])`` starts environment
     ``i`` at ``s_i`` (then ``s_i + n``, ...), ``None`` in the list meaning its next seed;
-    ``reset()`` draws the base seed from the vector environment's generator.
+    ``reset()`` draws the base seed from the vector environment's generator. ``split=`` counts
+    these seeds from a split's first, as ``NavEnv`` does.
     ``reset(options={"reset_mask": mask})`` restarts only the environments ``mask`` selects, each
     with its next seed unless ``seed`` gives one.
 
@@ -242,9 +252,13 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         render_view: str = "top",
         render_scale: float = 0.5,
         max_episode_steps: int | None = None,
+        split: str | None = None,
         **fields: Any,
     ) -> None:
         num_envs = checked_int("num_envs", num_envs, least=1, below=2**31)
+        if split is not None:
+            split_range(split)
+        self.split = split
         threads = checked_int("threads", threads, below=2**16)
         mode = _autoreset_mode(autoreset_mode)
         if render_mode not in (None, "rgb_array"):
@@ -299,6 +313,7 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
             render_view=render_view,
             render_scale=render_scale,
             max_episode_steps=None,
+            split=split,
             **fields,
         )
         self._calls: list[tuple[str, Any, Any]] = []
@@ -313,11 +328,15 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         return infos
 
     def _seeds(self, seed: Any, mask: np.ndarray | None) -> list[int | None]:
+        """The episode seeds a reset asks for, in the split when there is one."""
+        return [None if s is None else split_seed(self.split, s, f"seed of environment {i}") for i, s in enumerate(self._given_seeds(seed, mask))]
+
+    def _given_seeds(self, seed: Any, mask: np.ndarray | None) -> list[int | None]:
         n = self.num_envs
         if seed is None:
             if mask is not None and self._started:
                 return [None] * n
-            base = int(self._rng.integers(0, _SEED_LIMIT))
+            base = int(self._rng.integers(0, split_draw_limit(self.split, n)))
             return [base + i for i in range(n)]
         if isinstance(seed, (int, np.integer)) and not isinstance(seed, (bool, np.bool_)):
             base = checked_int("seed", seed)

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any, Callable, Iterable, Mapping
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_path, checked_int, checked_seeds, refuse_sb3_thread_safe
+from .config import ScenarioLike, checked_config, checked_path, checked_int, checked_seeds, refuse_sb3_thread_safe, split_seed
 
 
 def evaluate(
@@ -22,6 +22,7 @@ def evaluate(
     png: int | str | None = None,
     log_steps: bool = False,
     thread_safe: bool = False,
+    split: str | None = None,
     batch: int = 0,
     force: bool = False,
     **fields: Any,
@@ -73,10 +74,16 @@ def evaluate(
     and a dict per team episode (its ``episodes.csv`` row, with ``"robots"``: a dict per robot,
     its ``robots.csv`` row).
 
+    ``split="test"`` (or ``"validation"``, ``"train"``) counts ``seeds`` from that split's first
+    seed, as ``ronap run --split`` does (the default seeds, ``range(1000)``, are the test split's
+    as given). A trained network that records the seeds it was trained and chosen on
+    (``training_seeds``, ``validation_seeds``) gives a ``UserWarning`` when some of the run's
+    seeds are among them.
+
     A policy that raises or returns an invalid action or NaN raises ``PolicyError`` naming the seed
     and step.
     """
-    seeds = checked_seeds(seeds)
+    seeds = [split_seed(split, s, f"seeds[{i}]") for i, s in enumerate(checked_seeds(seeds))]
     refuse_sb3_thread_safe(policy, thread_safe)
     batch = checked_int("batch", batch, least=0, below=1 << 16)
     return _ronap.evaluate(

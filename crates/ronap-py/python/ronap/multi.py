@@ -9,7 +9,7 @@ import numpy as np
 from gymnasium import spaces
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_path, checked_int
+from .config import ScenarioLike, checked_config, checked_path, checked_int, split_draw_limit, split_range, split_seed
 from .env import discrete_actions
 
 if TYPE_CHECKING:
@@ -21,8 +21,6 @@ else:
         from pettingzoo import ParallelEnv as _Base
     except ImportError:  # pragma: no cover - exercised only without pettingzoo
         _Base = object
-
-_SEED_LIMIT = 2**63
 
 
 class MultiNavEnv(_Base):
@@ -54,7 +52,8 @@ class MultiNavEnv(_Base):
 
     Configure it as ``NavEnv``: ``scenario`` (a TOML file or a nested dict with ``robots``
     entries), ``config`` and keyword overrides. ``reset(seed=s)`` plays team episode ``s``,
-    the same as seed ``s`` of ``ronap run --scenario``.
+    the same as seed ``s`` of ``ronap run --scenario``; with ``split="train"`` (or
+    ``"validation"``, ``"test"``) seeds count from that split's first, as ``ronap run --split``.
     """
 
     metadata: dict[str, Any] = {"name": "ronap_multi_nav_v0", "render_modes": ["rgb_array"], "render_fps": 30}
@@ -75,10 +74,14 @@ class MultiNavEnv(_Base):
         map: str | None = None,
         render_scale: float = 0.5,
         text_infos: bool = False,
+        split: str | None = None,
         **fields: Any,
     ) -> None:
         if render_mode not in (None, "rgb_array"):
             raise _ronap.ConfigError(f"render_mode {render_mode!r}: expected None or 'rgb_array'")
+        if split is not None:
+            split_range(split)
+        self.split = split
         checked = checked_config(config, fields, scenario)
         self.text_infos: bool = bool(text_infos)
         self._status: dict[str, str] = {}
@@ -94,6 +97,7 @@ class MultiNavEnv(_Base):
             map=map,
             render_scale=render_scale,
             text_infos=text_infos,
+            split=split,
             **fields,
         )
         self._episode: tuple[int, list[tuple[list[Any], Any]]] | None = None
@@ -150,10 +154,10 @@ class MultiNavEnv(_Base):
         self, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, np.ndarray], dict[str, dict[str, Any]]]:
         if seed is not None:
-            episode_seed = checked_int("seed", seed)
+            episode_seed = split_seed(self.split, checked_int("seed", seed))
             self._rng = np.random.default_rng(episode_seed)
         else:
-            episode_seed = int(self._rng.integers(0, _SEED_LIMIT))
+            episode_seed = split_seed(self.split, int(self._rng.integers(0, split_draw_limit(self.split))))
         self.seed_used = episode_seed
         obs, infos = self._env.reset(episode_seed)
         self._episode = (episode_seed, [])
@@ -334,10 +338,14 @@ class VecMultiNavEnv:
         maze_seed: int | None = None,
         map: str | None = None,
         threads: int = 0,
+        split: str | None = None,
         **fields: Any,
     ) -> None:
         num_envs = checked_int("num_envs", num_envs, least=1, below=2**31)
         threads = checked_int("threads", threads, below=2**16)
+        if split is not None:
+            split_range(split)
+        self.split = split
         checked = checked_config(config, fields, scenario)
         self._vec = _ronap.VecMultiEnv(int(num_envs), checked, maze_seed, checked_path("map", map), int(threads))
         self.config = json.loads(checked.json)
@@ -351,16 +359,17 @@ class VecMultiNavEnv:
         self._started = False
         self.seed_used: int | None = None
         # What pickling needs: the arguments and the calls since the last reset (see __getstate__).
-        self._init_args = dict(num_envs=num_envs, scenario=scenario, config=config, maze_seed=maze_seed, map=map, threads=threads, **fields)
+        self._init_args = dict(num_envs=num_envs, scenario=scenario, config=config, maze_seed=maze_seed, map=map, threads=threads, split=split, **fields)
         self._calls: list[tuple[Any, Any]] = []
 
     def reset(self, seed: int | None = 0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Restarts every environment: environment ``i`` plays seeds ``seed + i``, ``seed + i +
-        num_envs``, ...; ``seed=None`` draws the first seed at random (as Gymnasium's vector
-        environments do), reported as ``seed_used``."""
+        num_envs``, ... (counted from the split's first seed with ``split=``); ``seed=None``
+        draws the first seed at random (as Gymnasium's vector environments do); the episode seed
+        of environment 0 is reported as ``seed_used``."""
         if seed is None:
-            seed = int(np.random.default_rng().integers(0, 2**62))
-        seed = checked_int("seed", seed)
+            seed = int(np.random.default_rng().integers(0, min(2**62, split_draw_limit(self.split, self.num_envs))))
+        seed = split_seed(self.split, checked_int("seed", seed))
         self.seed_used = seed
         self._started = True
         self._calls = []
@@ -390,7 +399,9 @@ class VecMultiNavEnv:
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__init__(**state["init"])  # type: ignore[misc]
         if state["seed"] is not None:
-            self.reset(state["seed"])
+            self._vec.reset(state["seed"])
+            self.seed_used = state["seed"]
+            self._started = True
             for actions, messages in state["calls"]:
                 self._vec.step(actions, messages)
             self._calls = list(state["calls"])

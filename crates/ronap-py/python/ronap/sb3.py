@@ -19,8 +19,11 @@ episode ends is reset within the same step, and its info holds ``terminal_observ
 are empty, which keeps a step cheap. ``env_is_wrapped(Monitor)`` is true for that reason, so
 ``evaluate_policy`` counts the episodes' own returns and lengths without warning.
 
-Seeds: ``env.seed(s)`` before ``reset()`` gives environment ``i`` the episode seeds ``s + i``,
-``s + i + n``, ... (``ronap run`` seeds), so a run is reproducible.
+Seeds: training plays the train split (``split="train"``, the default): ``env.seed(s)`` before
+``reset()`` (as SB3's ``seed=s`` does) gives environment ``i`` the train split's seeds ``s + i``,
+``s + i + n``, ... (episode seeds 1000000 + s + i, ...; ``ronap run --split train`` plays them),
+so a run is reproducible and never trains on the test split that ``ronap run --seeds N`` and
+``ronap.evaluate`` score by default. ``split=None`` takes the seeds as given.
 
 ``TeamVecEnv(n, scenario=...)`` does the same for team scenarios (``[[robots]]`` entries) with
 one policy shared by every robot: see its class.
@@ -90,9 +93,9 @@ class VecEnv(_Shared):
     render_mode: str | None
     reset_infos: list[dict[str, Any]]
 
-    def __init__(self, num_envs: int, **config: Any) -> None:
+    def __init__(self, num_envs: int, split: str | None = "train", **config: Any) -> None:
         config.pop("autoreset_mode", None)
-        self.venv = VecNavEnv(num_envs, autoreset_mode="same_step", **config)
+        self.venv = VecNavEnv(num_envs, autoreset_mode="same_step", split=split, **config)
         self.render_mode = self.venv.render_mode
         super().__init__(self.venv.num_envs, self.venv.single_observation_space, self.venv.single_action_space)
         self._actions: np.ndarray | None = None
@@ -128,7 +131,7 @@ class VecEnv(_Shared):
                 info["terminal_observation"] = infos["final_obs"][i]
                 info["TimeLimit.truncated"] = bool(truncated[i] and not terminated[i])
                 info["is_success"] = bool(info["success"])
-                info["episode"] = {"r": float(info["total_reward"]), "l": int(info["steps"]), "t": elapsed}
+                info["episode"] = {"r": float(info["return"]), "l": int(info["steps"]), "t": elapsed}
                 out[i] = info
         return obs, rewards.astype(np.float32), dones, out
 
@@ -161,16 +164,16 @@ class TeamVecEnv(_Shared):
     closed; the waiting steps count towards ``total_timesteps``.
 
     Seeds: ``env.seed(s)`` before ``reset()`` (as SB3's ``seed=`` does) gives team environment
-    ``e`` the episode seeds ``s + e``, ``s + e + num_envs``, ...: the seeds of ``ronap run
-    --scenario``.
+    ``e`` the train split's seeds ``s + e``, ``s + e + num_envs``, ... (``split="train"``, the
+    default, as ``VecEnv``): the seeds of ``ronap run --scenario ... --split train``.
     """
 
     venv: VecMultiNavEnv
     render_mode: str | None = None
     reset_infos: list[dict[str, Any]]
 
-    def __init__(self, num_envs: int, **config: Any) -> None:
-        self.venv = VecMultiNavEnv(num_envs, **config)
+    def __init__(self, num_envs: int, split: str | None = "train", **config: Any) -> None:
+        self.venv = VecMultiNavEnv(num_envs, split=split, **config)
         self.teams: int = self.venv.num_envs
         self.robots: int = self.venv.num_agents
         super().__init__(self.teams * self.robots, self.venv.single_observation_space, self.venv.single_action_space)

@@ -2,10 +2,14 @@
 //! metadata (the format is described in [`crate::policy::mlp`]).
 
 use crate::policy::mlp::network::{Activation, DecisionRule, Layer, Mlp, FORMAT};
+use crate::sim::split::SeedRanges;
 use nalgebra::{DMatrix, DVector};
 use safetensors::tensor::{Dtype, TensorView};
 use safetensors::SafeTensors;
 use std::path::{Path, PathBuf};
+
+/// Metadata keys that record seeds a network was trained and chosen on.
+const SEEDS_KEYS: [&str; 2] = ["training_seeds", "validation_seeds"];
 
 /// A weights file that cannot be used.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
@@ -114,6 +118,11 @@ impl Mlp {
                 ));
             }
         }
+        for key in SEEDS_KEYS {
+            if let Some(text) = metadata.get(key) {
+                SeedRanges::parse(text).map_err(|e| format!("metadata {key} = {text:?}: {e}"))?;
+            }
+        }
         let mlp = Self::new(layers, activation, metadata.clone())?;
         if let Some(size) = metadata.get("observation_size") {
             if size.parse::<usize>().ok() != Some(mlp.inputs()) {
@@ -124,6 +133,22 @@ impl Mlp {
             }
         }
         Ok(mlp)
+    }
+
+    /// The seeds the network was trained and chosen on, as its metadata records them
+    /// (`training_seeds`, `validation_seeds`; none for a file that records neither).
+    pub fn seeds_seen(&self) -> SeedRanges {
+        let mut seen = SeedRanges::default();
+        for key in SEEDS_KEYS {
+            if let Some(ranges) = self
+                .metadata
+                .get(key)
+                .and_then(|t| SeedRanges::parse(t).ok())
+            {
+                seen.extend(ranges);
+            }
+        }
+        seen
     }
 
     /// The file's bytes.

@@ -30,6 +30,7 @@ pub use network::{
 use crate::policy::{Decision, Policy, PolicyError, PolicyFactory};
 use crate::sim::episode::Episode;
 use crate::sim::robot::DiscreteAction;
+use crate::sim::split::SeedRanges;
 use crate::sim::world::World;
 use std::path::Path;
 use std::sync::Arc;
@@ -229,6 +230,10 @@ impl PolicyFactory for MlpFactory {
 
     fn side_by_side(&self) -> usize {
         SIDE_BY_SIDE
+    }
+
+    fn seeds_seen(&self) -> SeedRanges {
+        self.mlp.seeds_seen()
     }
 }
 
