@@ -135,7 +135,7 @@ def test_the_command_line(cluster, ronap_bin, tmp_path):
         cwd=ROOT,
     )
     assert r.returncode == 0, r.stderr
-    assert "success rate" in r.stdout and "20/20 episodes" in r.stderr
+    assert "success rate" in r.stdout and "20/20 episodes" in r.stderr and f"joined the Ray cluster at {cluster}" in r.stderr
     ronap_run(ronap_bin, tmp_path / "one", "--policy", "random", "--seeds", "20")
     assert (tmp_path / "ray" / "episodes.csv").read_bytes() == (tmp_path / "one" / "episodes.csv").read_bytes()
     bad = subprocess.run([sys.executable, "-m", "ronap.ray", "--policy", "nope", "--seeds", "2", "--out", str(tmp_path / "b"), "--address", cluster], capture_output=True, text=True)
@@ -193,7 +193,8 @@ def test_without_an_address_a_local_instance_starts_whatever_a_stale_file_names(
             timeout=120,
         )
         assert r.returncode == 0, r.stderr
-        assert "6/6 episodes" in r.stderr and os.listdir(os.path.join(temp, "ray")) != ["ray_current_cluster"]
+        assert "started a local Ray instance in" in r.stderr and "6/6 episodes" in r.stderr
+        assert os.listdir(os.path.join(temp, "ray")) != ["ray_current_cluster"]
     finally:
         shutil.rmtree(temp, ignore_errors=True)
     ronap_run(ronap_bin, tmp_path / "one", "--policy", "apf", "--seeds", "6")

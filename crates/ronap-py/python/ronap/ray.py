@@ -140,9 +140,10 @@ def evaluate(
     removed, when None). Uses the Ray instance this process already started, else connects to the
     cluster at ``address`` (``"auto"``: the one this machine belongs to), else (``None``) starts
     a local one bound to 127.0.0.1, kept for later calls. A team scenario is refused
-    (``ConfigError``) before Ray starts. Returns ``{"summary": ..., "table": ..., "out": ...}``. ``out`` must be new or empty unless
-    ``force=True``, as for ``ronap.evaluate``. The configuration keywords are
-    ``ronap.evaluate``'s."""
+    (``ConfigError``) before Ray starts. Returns ``{"summary": ..., "table": ..., "out": ...}``;
+    the summary's wall time is the run's, Ray's start left out (``progress=True`` prints it, and
+    the episodes done, on stderr). ``out`` must be new or empty unless ``force=True``, as for
+    ``ronap.evaluate``. The configuration keywords are ``ronap.evaluate``'s."""
     import ray
 
     seeds = checked_seeds(seeds)
@@ -157,7 +158,11 @@ def evaluate(
     _ronap.check_policy(policy, checked)
     payload = _payload(policy)
     if not ray.is_initialized():
+        started = time.perf_counter()
         _init(address)
+        if progress:  # Ray's start is not the run's: the summary's wall time leaves it out
+            how = "started a local Ray instance" if address is None else f"joined the Ray cluster at {address}"
+            print(f"{how} in {time.perf_counter() - started:.1f} s", file=sys.stderr)
     remote = ray.remote(_block).options(num_cpus=cpus_per_task, max_retries=retries)
     blocks = [seeds[i : i + block] for i in range(0, len(seeds), block)]
     temporary = tempfile.TemporaryDirectory(prefix="ronap-ray-") if out is None else None
@@ -225,6 +230,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--maze-seed", type=int, default=None, help="one maze for every episode")
     p.add_argument("--map", default=None, help="an image or ROS map file (same path on every machine)")
     args = p.parse_args(argv)
+    import ray
+
+    ours = not ray.is_initialized()
     try:
         result = evaluate(
             args.policy,
@@ -242,8 +250,13 @@ def main(argv: list[str] | None = None) -> int:
     except _ronap.RonapError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2 if isinstance(e, _ronap.ConfigError) else 1
-    print(result["table"])
-    return 0
+    else:
+        print(result["table"], flush=True)
+        return 0
+    finally:
+        # Ray's own shutdown at exit first sleeps 0.5 s for logs the driver does not show.
+        if ours and ray.is_initialized():
+            ray.shutdown()
 
 
 if __name__ == "__main__":
