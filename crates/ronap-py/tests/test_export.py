@@ -342,6 +342,7 @@ def test_a_modules_own_code_and_keys_that_are_no_linear_layer_are_refused(tmp_pa
         "scale": (Net(scale=True).state_dict(), "scale: not a Linear layer's weight or bias"),
         "chain": ({"a.weight": torch.ones(8, 18), "b.weight": torch.ones(3, 9)}, "b.weight takes 9 inputs but a.weight gives 8 outputs"),
         "log_std": ({**Net().state_dict(), "log_std": torch.zeros(3)}, "log_std: not a Linear layer's weight or bias"),
+        "checkpoint": ({"epoch": 3, "weights": Net().state_dict()}, "epoch = 3 is not a tensor: not a state_dict"),
     }
     for name, (state, message) in cases.items():
         torch.save(state, tmp_path / f"{name}.pt")

@@ -594,7 +594,10 @@ def _state_dict_layer(prefix: str, params: dict[str, Any]) -> tuple[np.ndarray, 
             raise ModelError(f"layer {prefix or '(top)'} is a BatchNorm ({at(name)}); {_NETWORK}, and nothing else")
     for name, value in params.items():
         if not _is_tensor(value):
-            raise ModelError(f"{at(name)} is a {type(value).__name__}, not a tensor: not a state_dict")
+            raise ModelError(
+                f"{at(name)} = {value!r:.40} is not a tensor: not a state_dict (a checkpoint's is read "
+                "from its state_dict, model_state_dict, model, net or policy entry)"
+            )
         if name not in ("weight", "bias"):
             raise ModelError(f"{at(name)}: not a Linear layer's weight or bias; {_NETWORK}, and nothing else")
     if "weight" not in params:
