@@ -203,9 +203,17 @@ def test_bad_torch_files_are_config_errors(tmp_path):
     with pytest.raises(FileNotFoundError) as missing:
         ronap.import_torch(tmp_path / "nowhere.pt", path)
     assert isinstance(missing.value, ronap.ConfigError) and missing.value.filename == str(tmp_path / "nowhere.pt")
-    assert "import_torch" in str(missing.value)
+    assert missing.value.errno == 2 and str(missing.value).startswith("[Errno 2] import_torch: no such file")
     copy = pickle.loads(pickle.dumps(missing.value))
     assert type(copy) is ronap.export.MissingFileError and copy.filename == missing.value.filename
+    # Still so once ConfigError is also a ValueError (as issue 47 asks of it).
+    check = (
+        "import ronap; ronap.ConfigError.__bases__ = (ronap.RonapError, ValueError)\n"
+        "e = ronap.export.MissingFileError(2, 'no such file', 'f.pt')\n"
+        "assert (e.errno, e.filename, str(e)) == (2, 'f.pt', \"[Errno 2] no such file: 'f.pt'\"), (e.errno, e.filename, str(e))"
+    )
+    r = subprocess.run([sys.executable, "-c", check], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
     with pytest.raises(ValueError, match="bad.pt"):
         ronap.import_torch(bad, path)
     assert not path.exists()

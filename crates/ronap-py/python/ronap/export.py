@@ -57,9 +57,13 @@ class ModelError(ConfigError, ValueError):
     ``ValueError``."""
 
 
-class MissingFileError(ConfigError, FileNotFoundError):
+class MissingFileError(FileNotFoundError, ConfigError):
     """A file ronap was given does not exist: a ``ConfigError`` that is also a
     ``FileNotFoundError`` (``filename`` names it)."""
+
+    # FileNotFoundError first: OSError's constructor, message and pickling must come before any
+    # plain exception's in the MRO (a ConfigError that is also a ValueError would otherwise win,
+    # leaving errno and filename None and the message a tuple).
 
 
 # What the hidden activation modules are called in ronap's weights file.
