@@ -1,16 +1,21 @@
-"""ronap.ray on a local Ray cluster of 2 CPUs: the same episodes.csv bytes and summary figures as
-one `ronap run`, policies that travel as weights or pickled callables, a killed worker's task run
-again without a duplicated or lost episode, a failing policy's error as ronap's exception."""
+"""ronap.ray on a local Ray cluster of 2 CPUs bound to 127.0.0.1: the same episodes.csv bytes and
+summary figures as one `ronap run`, policies that travel as weights or pickled callables, a killed
+worker's task run again without a duplicated or lost episode, a failing policy's error as ronap's
+exception, a local instance (never a stale cluster) without an address, team scenarios refused
+before Ray starts."""
 
 import json
 import os
 import pathlib
 import pickle
+import shutil
 import subprocess
 import sys
+import tempfile
 
 import pytest
 import ray
+from ray.thirdparty_files import psutil  # Ray's own copy
 
 import ronap
 import ronap.ray
@@ -21,9 +26,21 @@ TIMING = {"wall_time_s", "steps_per_second"}
 
 @pytest.fixture(scope="module")
 def cluster():
-    context = ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    """A local Ray instance of 2 CPUs, as `python -m ronap.ray` starts one: bound to 127.0.0.1."""
+    context = ronap.ray._init(num_cpus=2)
     yield context.address_info["address"]
     ray.shutdown()
+
+
+def test_the_local_instance_listens_on_127_0_0_1_only(cluster):
+    assert cluster.startswith("127.0.0.1:")
+    listening = [
+        (p.name(), c.laddr.ip)
+        for p in psutil.Process().children(recursive=True)
+        for c in p.net_connections(kind="inet")
+        if c.status == psutil.CONN_LISTEN
+    ]
+    assert listening and all(ip in ("127.0.0.1", "::ffff:127.0.0.1") for _, ip in listening), listening
 
 
 def figures(run_dir):
@@ -118,7 +135,7 @@ def test_the_command_line(cluster, ronap_bin, tmp_path):
         cwd=ROOT,
     )
     assert r.returncode == 0, r.stderr
-    assert "success rate" in r.stdout and "20/20 episodes" in r.stderr
+    assert "success rate" in r.stdout and "20/20 episodes" in r.stderr and f"joined the Ray cluster at {cluster}" in r.stderr
     ronap_run(ronap_bin, tmp_path / "one", "--policy", "random", "--seeds", "20")
     assert (tmp_path / "ray" / "episodes.csv").read_bytes() == (tmp_path / "one" / "episodes.csv").read_bytes()
     bad = subprocess.run([sys.executable, "-m", "ronap.ray", "--policy", "nope", "--seeds", "2", "--out", str(tmp_path / "b"), "--address", cluster], capture_output=True, text=True)
@@ -155,3 +172,45 @@ def test_a_failed_run_or_resume_leaves_the_directory_as_it_was(cluster, ronap_bi
     r = subprocess.run([ronap_bin, "run", "--resume", str(stopped)], capture_output=True, text=True, cwd=ROOT)
     assert r.returncode != 0 and "panicked" not in r.stderr, r.stderr
     assert _files(stopped) == before
+
+
+def test_without_an_address_a_local_instance_starts_whatever_a_stale_file_names(ronap_bin, tmp_path):
+    """Ray's temporary directory names a dead cluster (as after a crash), and RAY_ADDRESS too: the
+    command starts its own instance instead of hanging on it."""
+    temp = tempfile.mkdtemp(prefix="ray-", dir="/tmp")  # short: Ray's socket paths live in it
+    try:
+        os.makedirs(os.path.join(temp, "ray"))
+        with open(os.path.join(temp, "ray", "ray_current_cluster"), "w") as f:
+            f.write("127.0.0.1:1")
+        env = {**os.environ, "RAY_TMPDIR": temp, "RAY_ADDRESS": "127.0.0.1:1"}
+        out = tmp_path / "ray"
+        r = subprocess.run(
+            [sys.executable, "-m", "ronap.ray", "--policy", "apf", "--seeds", "6", "--block", "3", "--out", str(out)],
+            capture_output=True,
+            text=True,
+            cwd=ROOT,
+            env=env,
+            timeout=120,
+        )
+        assert r.returncode == 0, r.stderr
+        assert "started a local Ray instance in" in r.stderr and "6/6 episodes" in r.stderr
+        assert os.listdir(os.path.join(temp, "ray")) != ["ray_current_cluster"]
+    finally:
+        shutil.rmtree(temp, ignore_errors=True)
+    ronap_run(ronap_bin, tmp_path / "one", "--policy", "apf", "--seeds", "6")
+    assert (out / "episodes.csv").read_bytes() == (tmp_path / "one" / "episodes.csv").read_bytes()
+
+
+def test_a_team_scenario_is_refused_before_ray_starts(tmp_path):
+    team = str(ROOT / "scenarios" / "warehouse-team.toml")
+    with pytest.raises(ronap.ConfigError, match=r"a team of 8 \(\[\[robots\]\]\).*ronap.evaluate"):
+        ronap.ray.evaluate("coordinated", range(4), out=tmp_path / "ray", scenario=team)
+    assert not (tmp_path / "ray").exists()
+    r = subprocess.run(
+        [sys.executable, "-m", "ronap.ray", "--policy", "apf", "--seeds", "4", "--scenario", team, "--out", str(tmp_path / "cli")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert r.returncode == 2 and "a team of 8" in r.stderr and not (tmp_path / "cli").exists()
+    assert "Started a local Ray instance" not in r.stderr

@@ -39,7 +39,7 @@ from .compare import compare
 from .config import MissingFileError, default_config, make_config
 from .env import NavEnv, VecNavEnv
 from .evaluate import evaluate
-from .export import export_policy, import_torch, mlp_outputs
+from .export import ModelError, export_policy, import_torch, mlp_outputs
 from .multi import MultiNavEnv, VecMultiNavEnv
 from .orca import orca_step
 from .scenes import maze_image, maze_occupancy, policies
@@ -48,6 +48,7 @@ __all__ = [
     "ActionError",
     "ConfigError",
     "MissingFileError",
+    "ModelError",
     "MultiNavEnv",
     "NavEnv",
     "OutputError",

@@ -3,6 +3,7 @@ on top of an optional scenario (a TOML file or a dict of the same structure)."""
 
 from __future__ import annotations
 
+import errno
 import json
 import math
 import numbers
@@ -16,22 +17,12 @@ ScenarioLike = Union[str, "os.PathLike[str]", Mapping[str, Any]]
 """A scenario: the path of a TOML scenario file (as ``ronap run --scenario`` takes) or a dict
 nested like it (``{"scene": {"kind": "warehouse"}, "moving": [{"count": 5}]}``)."""
 
-class MissingFileError(ConfigError, FileNotFoundError):
-    """A file ronap was given does not exist: a ``ConfigError`` that is also a
-    ``FileNotFoundError`` (``filename`` names it)."""
+class MissingFileError(FileNotFoundError, ConfigError):
+    """A file ronap was given does not exist: a ``FileNotFoundError`` (``errno``, ``filename``)
+    that is also a ``ConfigError`` (so a ``RonapError`` and a ``ValueError``)."""
 
-    def __init__(self, what: str, path: str) -> None:
-        super().__init__(f"{what} {path}: no such file")
-        # OSError's fields, set by name: the class's constructor is ConfigError's.
-        for field, value in (("errno", 2), ("strerror", "No such file or directory"), ("filename", path)):
-            setattr(self, field, value)
-        self._what = what
-
-    def __str__(self) -> str:
-        return str(self.args[0])
-
-    def __reduce__(self) -> tuple[Any, ...]:
-        return (type(self), (self._what, self.filename))
+    # FileNotFoundError first: OSError's constructor, message and pickling come before the plain
+    # exception's of ConfigError in the MRO.
 
 
 MissingFileError.__module__ = "ronap"
@@ -43,7 +34,7 @@ def checked_path(name: str, path: str | os.PathLike[str] | None) -> str | None:
         return None
     text = os.fspath(path)
     if not os.path.exists(text):
-        raise MissingFileError(name, text)
+        raise MissingFileError(errno.ENOENT, f"{name}: no such file", text)
     return text
 
 

@@ -7,6 +7,11 @@ bytes and the same summary figures as one ``ronap run`` of the same seeds.
 
 or ``ronap.ray.evaluate("apf", range(100_000), out="runs/apf")``.
 
+Without an address it starts a Ray instance of its own on this machine, every server bound to
+127.0.0.1 (never joining a cluster that ``RAY_ADDRESS`` or a file in Ray's temporary directory
+names: a stale one would hang the run); ``--address auto`` joins the cluster this machine
+belongs to, ``--address HOST:PORT`` that one.
+
 Policies travel as what they are: a built-in name; ``mlp:FILE`` as the file's bytes (workers
 need not share a disk); a Python callable as Ray pickles it (cloudpickle). A map file
 (``map=``) must be at the same path on every machine. A task whose worker dies is run again
@@ -14,6 +19,9 @@ need not share a disk); a Python callable as Ray pickles it (cloudpickle). A map
 duplicates an episode and the run is complete only when every seed's rows came. A task that
 fails (a policy that raises) stops the run: the finished blocks stay, written in order, and the
 error is raised as the ronap exception it was (``isinstance(e, ronap.PolicyError)`` holds).
+A team scenario (``[[robots]]``) is refused before Ray starts: its run files (``robots.csv``,
+the team's figures) are not written block by block yet; ``ronap.evaluate`` and ``ronap run``
+run it.
 
 On a cluster, start Ray with its own tools (``ray start --head`` on one machine and ``ray start
 --address HEAD:6379`` on the others, or ``ray up cluster.yaml``), install ronap on every
@@ -23,6 +31,7 @@ machine, then run the command above with ``--address auto`` on the head.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 import tempfile
@@ -59,6 +68,41 @@ def _block(payload: Any, seeds: list[int], config_json: str, maze_seed: int | No
         return run(f"mlp:{path}" + (f"@{rule}" if rule else ""))["rows"]
 
 
+def _init(address: str | None = None, num_cpus: int | None = None) -> Any:
+    """Starts Ray in this process and returns its context: with no ``address``, a Ray instance
+    of this machine alone, its servers bound to 127.0.0.1 (``address="local"`` keeps Ray from
+    joining a cluster that ``RAY_ADDRESS`` or its temporary directory names); else joins the
+    cluster at ``address`` (``"auto"``: the one this machine belongs to).
+
+    Ray binds to its node's address, which on Linux is the outward one unless the node is declared
+    no cluster's (as Ray declares it on macOS and Windows); a driver joining a cluster at
+    127.0.0.1 must take its node as 127.0.0.1 too. Both are declared while Ray starts."""
+    import ray
+    from ray._private import ray_constants
+
+    host = "127.0.0.1" if address is None else address.rpartition(":")[0].strip("[]")
+    loopback = host in ("localhost", "::1") or host.startswith("127.")
+    cluster = getattr(ray_constants, "ENABLE_RAY_CLUSTER", True)
+    ray_constants.ENABLE_RAY_CLUSTER = cluster and not loopback
+    try:
+        if address is None:
+            return ray.init(address="local", num_cpus=num_cpus, include_dashboard=False, log_to_driver=False)
+        return ray.init(address=address, log_to_driver=False)
+    finally:
+        ray_constants.ENABLE_RAY_CLUSTER = cluster
+
+
+def _check_single_robot(checked: Any) -> None:
+    """Refuses a team scenario, before any task starts."""
+    robots = json.loads(checked.json).get("robots") or []
+    if robots:
+        team = sum(int(r.get("count", 1)) for r in robots)
+        raise _ronap.ConfigError(
+            f"robots: a team of {team} ([[robots]]): ronap.ray writes single-robot runs only (a team's robots.csv "
+            "and figures are not written block by block yet); run it with ronap.evaluate(...) or `ronap run --scenario`"
+        )
+
+
 def _payload(policy: str | Callable[[Any], Any]) -> tuple[str, Any]:
     """How `policy` travels to the workers."""
     if isinstance(policy, str) and policy.startswith("mlp:"):
@@ -93,11 +137,13 @@ def evaluate(
 ) -> dict[str, Any]:
     """Runs ``policy`` over ``seeds`` as Ray tasks of ``block`` seeds each (``cpus_per_task``
     CPUs each) and writes the run into ``out`` as ``ronap run --out`` does (a temporary directory,
-    removed, when None). Connects to the Ray cluster at ``address`` (``"auto"``: the one this
-    machine belongs to), or uses the one this process already started, or starts a local one.
-    Returns ``{"summary": ..., "table": ..., "out": ...}``. ``out`` must be new or empty unless
-    ``force=True``, as for ``ronap.evaluate``. The configuration keywords are
-    ``ronap.evaluate``'s."""
+    removed, when None). Uses the Ray instance this process already started, else connects to the
+    cluster at ``address`` (``"auto"``: the one this machine belongs to), else (``None``) starts
+    a local one bound to 127.0.0.1, kept for later calls. A team scenario is refused
+    (``ConfigError``) before Ray starts. Returns ``{"summary": ..., "table": ..., "out": ...}``;
+    the summary's wall time is the run's, Ray's start left out (``progress=True`` prints it, and
+    the episodes done, on stderr). ``out`` must be new or empty unless ``force=True``, as for
+    ``ronap.evaluate``. The configuration keywords are ``ronap.evaluate``'s."""
     import ray
 
     seeds = checked_seeds(seeds)
@@ -108,10 +154,15 @@ def evaluate(
     if not cpus_per_task > 0:
         raise _ronap.ConfigError(f"cpus_per_task = {cpus_per_task!r}: must be above 0")
     checked = checked_config(config, fields, scenario)
+    _check_single_robot(checked)
     _ronap.check_policy(policy, checked)
     payload = _payload(policy)
     if not ray.is_initialized():
-        ray.init(address=address, log_to_driver=False, include_dashboard=False)
+        started = time.perf_counter()
+        _init(address)
+        if progress:  # Ray's start is not the run's: the summary's wall time leaves it out
+            how = "started a local Ray instance" if address is None else f"joined the Ray cluster at {address}"
+            print(f"{how} in {time.perf_counter() - started:.1f} s", file=sys.stderr)
     remote = ray.remote(_block).options(num_cpus=cpus_per_task, max_retries=retries)
     blocks = [seeds[i : i + block] for i in range(0, len(seeds), block)]
     temporary = tempfile.TemporaryDirectory(prefix="ronap-ray-") if out is None else None
@@ -169,7 +220,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--seeds", type=int, default=1000, help="how many seeds")
     p.add_argument("--seed-start", type=int, default=0, help="the first seed")
     p.add_argument("--out", required=True, help="the run directory to write")
-    p.add_argument("--address", default=None, help="the Ray cluster (auto: the one this machine is in); none: start a local one")
+    p.add_argument(
+        "--address", default=None, help="the Ray cluster to join (auto: the one this machine is in); none: start a local one on 127.0.0.1"
+    )
     p.add_argument("--block", type=int, default=1000, help="seeds per Ray task")
     p.add_argument("--cpus-per-task", type=float, default=1, help="CPUs each task asks for and runs on")
     p.add_argument("--retries", type=int, default=3, help="times a task whose worker died is run again")
@@ -177,6 +230,9 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--maze-seed", type=int, default=None, help="one maze for every episode")
     p.add_argument("--map", default=None, help="an image or ROS map file (same path on every machine)")
     args = p.parse_args(argv)
+    import ray
+
+    ours = not ray.is_initialized()
     try:
         result = evaluate(
             args.policy,
@@ -194,8 +250,13 @@ def main(argv: list[str] | None = None) -> int:
     except _ronap.RonapError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2 if isinstance(e, _ronap.ConfigError) else 1
-    print(result["table"])
-    return 0
+    else:
+        print(result["table"], flush=True)
+        return 0
+    finally:
+        # Ray's own shutdown at exit first sleeps 0.5 s for logs the driver does not show.
+        if ours and ray.is_initialized():
+            ray.shutdown()
 
 
 if __name__ == "__main__":
