@@ -203,3 +203,25 @@ def test_one_vocabulary_across_infos_and_results():
     multi = ronap.MultiNavEnv(scenario=WAREHOUSE)
     _, infos = multi.reset(seed=0)
     assert keys <= set(infos["robot_0"]) and multi.status("robot_0") == "running"
+
+
+def test_gymnasiums_own_vector_envs_play_vecnavenvs_episodes_with_seed_step():
+    import gymnasium as gym
+
+    n = 3
+    ours = ronap.VecNavEnv(n, episode_max_steps=12, maze_cols=4, maze_rows=4)
+    theirs = gym.make_vec("ronap/Nav-v0", num_envs=n, vectorization_mode="sync", seed_step=n, episode_max_steps=12, maze_cols=4, maze_rows=4)
+    a, _ = ours.reset(seed=20)
+    b, _ = theirs.reset(seed=20)
+    np.testing.assert_array_equal(a, b)
+    rng = np.random.default_rng(3)
+    seeds_seen = set()
+    for _ in range(60):  # several autoresets each
+        actions = rng.integers(0, 3, n)
+        a, ra, ta, tra, ia = ours.step(actions)
+        b, rb, tb, trb, ib = theirs.step(actions)
+        np.testing.assert_array_equal(a, b)
+        np.testing.assert_array_equal(ra, rb)
+        seeds_seen.update(int(s) for s in ia["seed"])
+        assert list(ia["seed"]) == list(ib["seed"])
+    assert len(seeds_seen) > 2 * n

@@ -45,7 +45,10 @@ class NavEnv(gym.Env[np.ndarray, Any]):
     ``reset()`` draws the next episode seed from the environment's generator. With
     ``split="train"`` (or ``"validation"``, ``"test"``) seeds count from that split's first
     (``reset(seed=0)`` of the train split is episode seed 1000000, as ``ronap run --split train``
-    plays it) and drawn seeds stay in it; ``info["seed"]`` is the episode's own seed.
+    plays it) and drawn seeds stay in it; ``info["seed"]`` is the episode's own seed. With
+    ``seed_step=n``, ``reset()`` after ``reset(seed=s)`` plays ``s + n``, ``s + 2n``, ... instead
+    of drawing: ``gymnasium.make_vec("ronap/Nav-v0", num_envs=n, vectorization_mode="sync",
+    seed_step=n)`` (or an ``AsyncVectorEnv``) then plays the very episodes ``VecNavEnv(n)`` plays.
 
     The episode limit is ``episode_max_steps`` (default 2000), after which ``truncated`` is
     true and ``info["status"]`` is "timeout". ``gymnasium.make("ronap/Nav-v0",
@@ -73,6 +76,7 @@ class NavEnv(gym.Env[np.ndarray, Any]):
         render_view: str = "top",
         render_scale: float = 0.5,
         split: str | None = None,
+        seed_step: int | None = None,
         **fields: Any,
     ) -> None:
         if render_mode not in (None, "rgb_array"):
@@ -82,6 +86,8 @@ class NavEnv(gym.Env[np.ndarray, Any]):
         if split is not None:
             split_range(split)
         self.split = split
+        self.seed_step = None if seed_step is None else checked_int("seed_step", seed_step, least=1)
+        self._index: int | None = None
         checked = checked_config(config, fields, scenario)
         self._env = _ronap.Env(checked, maze_seed, checked_path("map", map), continuous)
         # What pickling needs to build this environment again (see __getstate__).
@@ -95,6 +101,7 @@ class NavEnv(gym.Env[np.ndarray, Any]):
             render_view=render_view,
             render_scale=render_scale,
             split=split,
+            seed_step=seed_step,
             **fields,
         )
         self._episode: tuple[int, list[Any]] | None = None
@@ -136,9 +143,13 @@ class NavEnv(gym.Env[np.ndarray, Any]):
             seed = checked_int("seed", seed)
         super().reset(seed=seed)
         if seed is not None:
-            episode_seed = split_seed(self.split, seed)
+            index = seed
+        elif self.seed_step is not None and self._index is not None:
+            index = self._index + self.seed_step
         else:
-            episode_seed = split_seed(self.split, int(self.np_random.integers(0, split_draw_limit(self.split))))
+            index = int(self.np_random.integers(0, split_draw_limit(self.split)))
+        episode_seed = split_seed(self.split, index)
+        self._index = index
         self._episode = (int(episode_seed), [])
         return self._env.reset(int(episode_seed))
 
@@ -159,11 +170,12 @@ class NavEnv(gym.Env[np.ndarray, Any]):
         """How to build this environment again and replay its episode so far: the model is
         deterministic, so the copy continues exactly where this one is (for Ray, multiprocessing
         and copy.deepcopy). A scenario given as a file is read again where the copy is made."""
-        return {"init": self._init_args, "episode": self._episode, "np_random": self._np_random}
+        return {"init": self._init_args, "episode": self._episode, "np_random": self._np_random, "index": self._index}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__init__(**state["init"])  # type: ignore[misc]
         self._np_random = state["np_random"]
+        self._index = state.get("index")
         if state["episode"] is not None:
             seed, actions = state["episode"]
             self._env.reset(seed)

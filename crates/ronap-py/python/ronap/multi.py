@@ -362,7 +362,7 @@ class VecMultiNavEnv:
         self._init_args = dict(num_envs=num_envs, scenario=scenario, config=config, maze_seed=maze_seed, map=map, threads=threads, split=split, **fields)
         self._calls: list[tuple[Any, Any]] = []
 
-    def reset(self, seed: int | None = 0) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    def reset(self, seed: int | None = None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Restarts every environment: environment ``i`` plays seeds ``seed + i``, ``seed + i +
         num_envs``, ... (counted from the split's first seed with ``split=``); ``seed=None``
         draws the first seed at random (as Gymnasium's vector environments do); the episode seed
