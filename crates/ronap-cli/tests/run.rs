@@ -766,3 +766,40 @@ fn split_names_a_seed_space_and_trained_seeds_are_warned_about() {
         assert_eq!(err.contains("are among those"), warned, "{split}: {err}");
     }
 }
+
+#[test]
+fn a_crowd_pattern_the_robot_follows_out_of_the_scene_is_named_by_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let text =
+        std::fs::read_to_string(crate::util::repo_root().join("scenarios/circle-crossing.toml"))
+            .unwrap()
+            .replace("pattern_radius_px = 80.0", "pattern_radius_px = 8000.0");
+    let line = 1 + text
+        .lines()
+        .position(|l| l.contains("pattern_radius_px"))
+        .unwrap();
+    let bad = dir.path().join("wide.toml");
+    std::fs::write(&bad, text).unwrap();
+    let out = dir.path().join("out");
+    let o = ronap(&[
+        "run",
+        "--scenario",
+        bad.to_str().unwrap(),
+        "--policy",
+        "orca",
+        "--seeds",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = crate::util::stderr(&o);
+    assert!(!o.status.success());
+    for part in [
+        format!("wide.toml:{line}"),
+        "crowd[0].pattern_radius_px = 8000".to_string(),
+        "the robot's start".to_string(),
+    ] {
+        assert!(err.contains(&part), "{part:?} not in {err}");
+    }
+    assert!(!out.exists());
+}

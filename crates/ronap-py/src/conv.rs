@@ -71,6 +71,8 @@ impl Scenario {
 #[pyclass(module = "ronap._ronap", frozen)]
 pub struct Config {
     valid: ValidConfig,
+    /// The scenario file the configuration was built on, if any.
+    file: Option<ConfigFile>,
 }
 
 #[pymethods]
@@ -89,7 +91,14 @@ impl Config {
             .clone()
             .validate()
             .map_err(|e| errors::ConfigError::new_err(invalid(e, &sim, scenario)))?;
-        Ok(Self { valid })
+        let file = scenario.and_then(|s| s.file.clone());
+        Ok(Self { valid, file })
+    }
+
+    /// `path:line` of the scenario file's `[[moving]]` or `[[crowd]]` field an error message
+    /// names, if the file sets it (for errors found once the scene is built).
+    fn line_of(&self, message: &str) -> Option<String> {
+        self.file.as_ref().and_then(|f| f.line_of(message))
     }
 
     /// The complete configuration as JSON text.

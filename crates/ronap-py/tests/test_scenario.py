@@ -320,3 +320,19 @@ def test_a_scene_seed_override_is_recorded(tmp_path, scenario, ronap_bin):
         capture_output=True,
     )
     assert (cli / "episodes.csv").read_bytes() == (run / "episodes.csv").read_bytes()
+
+
+def test_a_crowd_pattern_that_leaves_the_scene_is_named_by_file_line_key_and_value(tmp_path):
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[3] / "scenarios" / "circle-crossing.toml").read_text()
+    bad = tmp_path / "wide.toml"
+    bad.write_text(text.replace("pattern_radius_px = 80.0", "pattern_radius_px = 8000.0"))
+    line = next(i + 1 for i, l in enumerate(bad.read_text().splitlines()) if "pattern_radius_px" in l)
+    want = rf"wide\.toml:{line}: .*crowd\[0\]\.pattern_radius_px = 8000: the robot's start"
+    with pytest.raises(ronap.SceneError, match=want):
+        ronap.NavEnv(scenario=bad).reset(seed=0)
+    with pytest.raises(ronap.SceneError, match=want):
+        ronap.evaluate("orca", range(2), scenario=bad)
+    with pytest.raises(ronap.SceneError, match=want):
+        ronap.VecNavEnv(2, scenario=bad).reset(seed=0)

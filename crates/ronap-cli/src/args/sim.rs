@@ -121,20 +121,11 @@ impl SimArgs {
 /// `e` (an episode that could not start) with the file and line of the scenario entry it blames
 /// (`moving[2]`, `crowd[0].pattern_radius_px`) put in front, when it blames one the file sets.
 pub fn locate_in_scenario(e: anyhow::Error, scenario: Option<&std::path::Path>) -> anyhow::Error {
-    let Some(path) = scenario else {
+    let Some(file) = scenario.and_then(|path| ConfigFile::read(path).ok()) else {
         return e;
     };
-    let root = e.root_cause().to_string();
-    let head = root.split(": ").next().unwrap_or("");
-    let key = head.split(" = ").next().unwrap_or("");
-    if !(key.starts_with("moving[") || key.starts_with("crowd[")) {
-        return e;
-    }
-    let Ok(file) = ConfigFile::read(path) else {
-        return e;
-    };
-    match ronap_core::config::key_line(file.text(), key) {
-        Some(line) => e.context(format!("{}:{line}", path.display())),
+    match file.line_of(&e.root_cause().to_string()) {
+        Some(at) => e.context(at),
         None => e,
     }
 }

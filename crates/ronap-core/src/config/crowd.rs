@@ -108,6 +108,8 @@ impl CrowdConfig {
 /// Where a crowd's pattern puts the robot (`robot_follows`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RobotPattern {
+    /// The `[[crowd]]` entry (from 0).
+    pub entry: usize,
     /// The crowd's pattern.
     pub pattern: Pattern,
     /// Its centre; `None`: the scene's centre.
@@ -167,6 +169,7 @@ pub(super) fn validate_crowds(
                 "episode.start and episode.goal already place the robot: leave them unset",
             )?;
             robot = Some(RobotPattern {
+                entry: i,
                 pattern: c.pattern,
                 center: c.pattern_center,
                 radius_px: c.pattern_radius_px,
@@ -260,6 +263,7 @@ mod tests {
     #[test]
     fn the_robot_follows_circle_and_square_not_random() {
         let p = |pattern| RobotPattern {
+            entry: 0,
             pattern,
             center: None,
             radius_px: 80.0,

@@ -40,6 +40,19 @@ impl ConfigFile {
         &self.path
     }
 
+    /// `path:line` of the `[[moving]]` or `[[crowd]]` field an error `message` names (a part of
+    /// it reading `crowd[0].pattern_radius_px = 8000: ...`), when this file sets it: how an error
+    /// found only once the scene is built (a crowd pattern that leaves it) names the file and
+    /// line, as a bad value does when the file is read.
+    pub fn line_of(&self, message: &str) -> Option<String> {
+        let key = message
+            .split(": ")
+            .find(|part| part.starts_with("moving[") || part.starts_with("crowd["))?
+            .split(" = ")
+            .next()?;
+        key_line(&self.text, key).map(|line| format!("{}:{line}", self.path.display()))
+    }
+
     /// The file's text.
     pub fn text(&self) -> &str {
         &self.text

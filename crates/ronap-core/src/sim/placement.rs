@@ -2,6 +2,7 @@
 //! placement stream (or fixed by the configuration), with clearance for the robot and in one
 //! connected free region.
 
+use crate::config::RobotPattern;
 use crate::config::ValidConfig;
 use crate::geometry::{Point, Vector};
 use crate::scene::freespace::FreeGrid;
@@ -61,6 +62,31 @@ pub enum EpisodeError {
         /// Robots in the team.
         robots: usize,
     },
+    /// A crowd's pattern the robot follows put its start or goal where it is not free.
+    #[error(
+        "crowd[{entry}].pattern_radius_px = {pattern_radius_px}: the robot's {which} on that \
+         pattern, ({x}, {y}), is not free: a robot of radius {radius_px} px there touches an \
+         obstacle or leaves the {width} x {height} px scene (a smaller pattern_radius_px, or a \
+         pattern_center inside the scene)"
+    )]
+    PatternBlocked {
+        /// The `[[crowd]]` entry.
+        entry: usize,
+        /// Its `pattern_radius_px`.
+        pattern_radius_px: f64,
+        /// `start` or `goal`.
+        which: &'static str,
+        /// x, px.
+        x: f64,
+        /// y, px.
+        y: f64,
+        /// Robot radius, px.
+        radius_px: f64,
+        /// Scene width, px.
+        width: f64,
+        /// Scene height, px.
+        height: f64,
+    },
     /// A fixed start or goal touches an obstacle or lies outside the scene.
     #[error("{}.{which} = ({x}, {y}) is not free: a robot of radius {radius_px} px there touches an obstacle or leaves the scene", section(*.entry))]
     Blocked {
@@ -84,6 +110,30 @@ fn section(entry: Option<usize>) -> String {
 }
 
 impl EpisodeError {
+    /// This error with a start or goal that is not free blamed on the crowd pattern that put
+    /// it there (`pattern`), in a scene of `width` x `height` px.
+    pub(crate) fn of_pattern(self, pattern: &RobotPattern, width: f64, height: f64) -> Self {
+        match self {
+            Self::Blocked {
+                which,
+                entry: None,
+                x,
+                y,
+                radius_px,
+            } => Self::PatternBlocked {
+                entry: pattern.entry,
+                pattern_radius_px: pattern.radius_px,
+                which,
+                x,
+                y,
+                radius_px,
+                width,
+                height,
+            },
+            other => other,
+        }
+    }
+
     /// This error with a fixed start or goal named as `[[robots]]` entry `entry`'s.
     pub(crate) fn of_entry(mut self, entry: usize) -> Self {
         if let Self::Blocked { entry: of, .. } = &mut self {

@@ -2,7 +2,7 @@
 //! computed on first use and shared by placement, planners and path metrics; and [`Scenes`], which
 //! says where each seed's episode takes place.
 
-use crate::config::{ObstacleConfig, SceneConfig, SceneKind, ValidConfig};
+use crate::config::{ObstacleConfig, Pattern, SceneConfig, SceneKind, ValidConfig};
 use crate::geometry::shape::Shape;
 use crate::geometry::{Aabb, Point};
 use crate::scene::freespace::FreeGrid;
@@ -116,8 +116,14 @@ impl World {
         let both_fixed = self.config.start_and_goal_fixed();
         let grid =
             (!both_fixed && needs_region_grid(&self.config, &self.scene)).then(|| self.grid());
-        let placement = sample_placement(&self.config, &self.scene, grid, seed)?;
-        Episode::with_placement(&self.config, self.scene.clone(), seed, placement)
+        let blame = |e: EpisodeError| match self.config.robot_pattern() {
+            Some(p) if p.pattern != Pattern::Random => {
+                e.of_pattern(p, self.scene.width(), self.scene.height())
+            }
+            _ => e,
+        };
+        let placement = sample_placement(&self.config, &self.scene, grid, seed).map_err(blame)?;
+        Episode::with_placement(&self.config, self.scene.clone(), seed, placement).map_err(blame)
     }
 }
 

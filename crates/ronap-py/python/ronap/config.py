@@ -101,6 +101,14 @@ def load_scenario(scenario: ScenarioLike | _ronap.Scenario | None) -> _ronap.Sce
     raise ConfigError(f"scenario {scenario!r}: expected the path of a TOML scenario file or a dict nested like one")
 
 
+def located(error: Exception, config: _ronap.Config) -> Exception:
+    """``error`` with the scenario file and line of the ``[[moving]]`` / ``[[crowd]]`` field it
+    names in front (a crowd pattern that leaves the scene is found only once the scene is built),
+    or ``error`` as it is."""
+    at = config.line_of(str(error))
+    return type(error)(f"{at}: {error}") if at else error
+
+
 def checked_config(
     config: Mapping[str, Any] | None,
     fields: Mapping[str, Any],

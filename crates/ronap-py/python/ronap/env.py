@@ -14,7 +14,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_path, checked_int, split_draw_limit, split_range, split_seed
+from .config import ScenarioLike, checked_config, checked_path, checked_int, located, split_draw_limit, split_range, split_seed
 
 
 class NavEnv(gym.Env[np.ndarray, Any]):
@@ -89,6 +89,7 @@ class NavEnv(gym.Env[np.ndarray, Any]):
         self.seed_step = None if seed_step is None else checked_int("seed_step", seed_step, least=1)
         self._index: int | None = None
         checked = checked_config(config, fields, scenario)
+        self._checked = checked
         self._env = _ronap.Env(checked, maze_seed, checked_path("map", map), continuous)
         # What pickling needs to build this environment again (see __getstate__).
         self._init_args = dict(
@@ -151,7 +152,10 @@ class NavEnv(gym.Env[np.ndarray, Any]):
         episode_seed = split_seed(self.split, index)
         self._index = index
         self._episode = (int(episode_seed), [])
-        return self._env.reset(int(episode_seed))
+        try:
+            return self._env.reset(int(episode_seed))
+        except _ronap.SceneError as e:
+            raise located(e, self._checked) from None
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         if isinstance(action, (bool, np.bool_)):
@@ -280,6 +284,7 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         if max_episode_steps is not None:
             fields = {**fields, "episode_max_steps": max_episode_steps}
         checked = checked_config(config, fields, scenario)
+        self._checked = checked
         self.config = json.loads(checked.json)
         self._vec = _ronap.VecEnv(
             num_envs,
@@ -384,7 +389,10 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
                     raise _ronap.ConfigError("reset_mask: the first reset() starts every environment")
         seeds = self._seeds(seed, mask)
         flags = None if mask is None else [bool(m) for m in mask]
-        obs, infos, _ = self._vec.reset(seeds, flags)
+        try:
+            obs, infos, _ = self._vec.reset(seeds, flags)
+        except _ronap.SceneError as e:
+            raise located(e, self._checked) from None
         if flags is None:
             self._calls.clear()
         self._calls.append(("reset", seeds, flags))

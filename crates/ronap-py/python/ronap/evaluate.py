@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any, Callable, Iterable, Mapping
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_path, checked_int, checked_seeds, refuse_sb3_thread_safe, split_seed
+from .config import ScenarioLike, checked_config, checked_path, checked_int, checked_seeds, located, refuse_sb3_thread_safe, split_seed
 
 
 def evaluate(
@@ -86,18 +86,22 @@ def evaluate(
     seeds = [split_seed(split, s, f"seeds[{i}]") for i, s in enumerate(checked_seeds(seeds))]
     refuse_sb3_thread_safe(policy, thread_safe)
     batch = checked_int("batch", batch, least=0, below=1 << 16)
-    return _ronap.evaluate(
-        policy,
-        seeds,
-        checked_config(config, fields, scenario),
-        maze_seed=maze_seed,
-        map_path=checked_path("map", map),
-        threads=threads,
-        continuous=continuous,
-        out=None if out is None else str(out),
-        png=None if png is None else str(png),
-        log_steps=log_steps,
-        thread_safe=thread_safe,
-        batch=batch,
-        force=force,
-    )
+    checked = checked_config(config, fields, scenario)
+    try:
+        return _ronap.evaluate(
+            policy,
+            seeds,
+            checked,
+            maze_seed=maze_seed,
+            map_path=checked_path("map", map),
+            threads=threads,
+            continuous=continuous,
+            out=None if out is None else str(out),
+            png=None if png is None else str(png),
+            log_steps=log_steps,
+            thread_safe=thread_safe,
+            batch=batch,
+            force=force,
+        )
+    except _ronap.SceneError as e:
+        raise located(e, checked) from None
