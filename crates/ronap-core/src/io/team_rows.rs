@@ -7,7 +7,7 @@ use crate::io::run_dir::{metric_cells, start_goal_cells};
 use std::io::Write;
 
 /// Columns of a team run's `episodes.csv` (one row per team episode).
-pub const TEAM_COLUMNS: [&str; 10] = [
+pub const TEAM_COLUMNS: [&str; 11] = [
     "seed",
     "outcome",
     "robots",
@@ -18,9 +18,11 @@ pub const TEAM_COLUMNS: [&str; 10] = [
     "collisions",
     "robot_collisions",
     "deadlock",
+    "reason",
 ];
 
-/// The team `episodes.csv` row of `r`.
+/// The team `episodes.csv` row of `r`. Its `reason` is the first robot's whose outcome is the
+/// team's (an infeasible task's names the robots and the passage), empty when none gives one.
 pub fn team_episode_row(r: &TeamRecord) -> Vec<String> {
     vec![
         r.seed.to_string(),
@@ -37,6 +39,11 @@ pub fn team_episode_row(r: &TeamRecord) -> Vec<String> {
         r.collisions.to_string(),
         r.robot_collisions.to_string(),
         r.deadlock.to_string(),
+        r.robots
+            .iter()
+            .filter(|x| x.outcome == r.outcome)
+            .find_map(|x| x.reason.clone())
+            .unwrap_or_default(),
     ]
 }
 
