@@ -55,6 +55,11 @@ impl Pedestrian {
         }
     }
 
+    /// Where it heads now.
+    pub(super) fn goal(&self) -> Point {
+        self.goal
+    }
+
     /// The pedestrian `m` describes, heading for `goal`.
     pub(super) fn new(m: &MovingConfig, goal: Point) -> Self {
         Self {
