@@ -225,3 +225,93 @@ pub(crate) fn write_if_asked(
         writer.player(seed, outcome, page.as_deref().map_err(Clone::clone));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::Recording;
+    use crate::policy::{Builtin, PolicyFactory};
+    use crate::sim::world::Scenes;
+
+    const STEPS: Recording = Recording {
+        trajectory: false,
+        steps: true,
+    };
+
+    #[test]
+    fn a_lone_trace_holds_every_logged_pose_and_the_end() {
+        let evaluator = Evaluator::new(Default::default(), Scenes::MazePerSeed);
+        let mut policy = Builtin::Apf.make().expect("apf");
+        let record = evaluator
+            .run_episode(policy.as_mut(), 3, STEPS)
+            .expect("runs");
+        let logged: Vec<LoggedStep> = record
+            .step_log
+            .iter()
+            .map(|s| LoggedStep {
+                seed: 3,
+                step: s.step,
+                pose: s.pose,
+                action: s.action,
+            })
+            .collect();
+        let episode = evaluator.worlds().episode(3).expect("placed");
+        let trace = play_lone(episode, &logged).expect("replays");
+        assert_eq!(trace.frames(), logged.len() + 1);
+        for (f, s) in logged.iter().enumerate() {
+            let p = trace.position(0, f).expect("frame");
+            assert_eq!((p.x, p.y), (s.pose.x, s.pose.y), "frame {f}");
+        }
+        let end = trace.position(0, logged.len()).expect("last frame");
+        assert_eq!((end.x, end.y), (record.end.x, record.end.y));
+        assert_eq!(trace.headline[0].1, record.outcome.name());
+        // A log moved by a hair is refused at its step.
+        let mut bent = logged.clone();
+        bent[4].pose.y += 0.01;
+        let episode = evaluator.worlds().episode(3).expect("placed");
+        assert!(matches!(
+            play_lone(episode, &bent),
+            Err(AnimationError::Diverged { step: 5, .. })
+        ));
+        // The page is self-contained: no address to fetch anything from.
+        let page = String::from_utf8(single_page(trace).expect("page")).expect("utf-8");
+        for outside in ["http:", "https:", "src=", "href=", "@import", "url("] {
+            assert!(!page.contains(outside), "the page holds {outside:?}");
+        }
+    }
+
+    #[test]
+    fn a_team_trace_from_a_run_record_is_the_record_replayed() {
+        let config = crate::SimConfig {
+            robots: vec![crate::config::TeamRobotConfig {
+                count: 3,
+                ..Default::default()
+            }],
+            ..Default::default()
+        }
+        .validate()
+        .expect("valid");
+        let size = config.observation_size();
+        let evaluator = Evaluator::new(config, Scenes::MazePerSeed);
+        let geodesic = crate::policy::factory("geodesic", size).expect("geodesic");
+        let team = crate::policy::PerRobotFactory::new(
+            vec![geodesic.as_ref(); 3],
+            vec!["geodesic".to_string(); 3],
+        );
+        let mut policy = crate::policy::TeamPolicyFactory::make(&team).expect("policies");
+        let names = crate::policy::TeamPolicyFactory::names(&team);
+        let record = evaluator
+            .run_team_episode(policy.as_mut(), &names, 1, STEPS)
+            .expect("runs");
+        let trace = team_record(&evaluator, &record, "geodesic").expect("replays");
+        assert_eq!(trace.robots(), 3);
+        assert_eq!(trace.frames(), record.steps as usize + 1);
+        for (k, log) in record.step_logs.iter().enumerate() {
+            for (f, s) in log.iter().enumerate() {
+                let p = trace.position(k, f).expect("frame");
+                assert_eq!((p.x, p.y), (s.pose.x, s.pose.y), "robot {k} frame {f}");
+            }
+        }
+        assert_eq!(trace.headline[0].1, record.outcome.name());
+    }
+}

@@ -170,6 +170,11 @@ pub(crate) struct ReplayStep<'a> {
     pub actions: &'a [Option<Action>],
 }
 
+/// What a team replay shows each state to: the team, and the step that led there (`None` for the
+/// team as placed).
+pub(crate) type TeamWatch<'a> =
+    dyn FnMut(&Team, Option<ReplayStep<'_>>) -> Result<(), ReplayError> + 'a;
+
 /// Steps team episode `seed` of `evaluator` through `logs` (one for every robot of the team),
 /// holding every logged pose to the model's, and shows `watch` the placed team (with `None`) and
 /// the team after each step. A robot whose log ends while it still runs gives up there, as its
@@ -178,7 +183,7 @@ pub(crate) fn drive_team(
     evaluator: &Evaluator,
     seed: u64,
     logs: &[RobotLog],
-    watch: &mut dyn FnMut(&Team, Option<ReplayStep<'_>>) -> Result<(), ReplayError>,
+    watch: &mut TeamWatch<'_>,
 ) -> Result<u32, ReplayError> {
     let mut rollout = TeamRollout::placed(evaluator.config(), evaluator.worlds().team(seed), seed)
         .map_err(|source| ReplayError::Start { seed, source })?;
