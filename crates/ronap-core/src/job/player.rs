@@ -130,7 +130,8 @@ fn drive_lone(
 }
 
 /// The figures above a lone episode's player: its outcome, steps, collisions, path length, total
-/// reward, goals reached (of `goals`, on a tour) and, from the run's record, SPL.
+/// reward, contacts with moving obstacles and the least clearance (among them), goals
+/// reached (of `goals`, on a tour) and, from the run's record, SPL and why the policy gave up.
 fn lone_headline(
     episode: &Episode,
     goals: usize,
@@ -151,6 +152,15 @@ fn lone_headline(
             format!("{:.3}", episode.total_reward()),
         ),
     ];
+    if let Some(d) = episode.dynamic_metrics() {
+        headline.push(("moving-obstacle contacts".into(), d.collisions.to_string()));
+        let clearance = if d.min_clearance_px.is_finite() {
+            format!("{:.1} px", d.min_clearance_px)
+        } else {
+            "nothing within laser range".into()
+        };
+        headline.push(("least clearance".into(), clearance));
+    }
     if goals > 1 {
         headline.push((
             "goals reached".into(),

@@ -416,18 +416,6 @@ impl Movers {
         })
     }
 
-    /// Each obstacle's goal, when it is a reactive pedestrian (`None` for the others).
-    pub fn pedestrian_goals(&self) -> impl Iterator<Item = Option<Point>> + '_ {
-        self.pedestrians
-            .iter()
-            .map(|p| p.as_ref().map(pedestrian::Pedestrian::goal))
-            .chain(std::iter::repeat_n(
-                None,
-                self.entries.len().saturating_sub(self.pedestrians.len()),
-            ))
-            .take(self.entries.len())
-    }
-
     /// Adds where each obstacle is now to `tracks` (one per obstacle, made on the first call).
     pub fn record(&self, tracks: &mut Vec<Track>) {
         if tracks.is_empty() {

@@ -390,6 +390,21 @@ impl Crowd {
     }
 }
 
+// Kept here rather than in mod.rs, which is long already: what the player shows of pedestrians.
+impl super::Movers {
+    /// Each obstacle's goal, when it is a reactive pedestrian (`None` for the others).
+    pub fn pedestrian_goals(&self) -> impl Iterator<Item = Option<Point>> + '_ {
+        self.pedestrians
+            .iter()
+            .map(|p| p.as_ref().map(Pedestrian::goal))
+            .chain(std::iter::repeat_n(
+                None,
+                self.entries.len().saturating_sub(self.pedestrians.len()),
+            ))
+            .take(self.entries.len())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use crate::config::{MotionKind, MovingConfig, Pattern};
