@@ -1,4 +1,5 @@
-//! `ronap replay`: a logged episode as an animated GIF, from above or first-person.
+//! `ronap replay`: a logged episode as an animated GIF, from above or first-person, or as an
+//! HTML player (`--html`).
 //!
 //! The log gives the actions; the run's `summary.json` gives the configuration and the scenes;
 //! the model steps the actions again from the episode's start and every logged pose is checked
@@ -11,7 +12,7 @@ use clap::Args;
 use ronap_core::eval::Evaluator;
 use ronap_core::io::manifest::RunManifest;
 use ronap_core::io::steplog::read_steps;
-use ronap_core::job::{replay_team, RobotLog};
+use ronap_core::job::{play_lone, play_team, replay_team, single_page, RobotLog};
 use ronap_core::render::gif::{animate, GifOptions, View};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -49,6 +50,12 @@ pub struct ReplayArgs {
     /// seed-<seed>-first.gif; for a team, seed-<seed>-team-top.gif].
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
+    /// Write an HTML player of the episode to FILE (ending in .html) instead of a GIF: one
+    /// self-contained page (no network) to play, pause, step and scrub the episode (space and
+    /// the arrow keys), follow a robot (f), show the laser rays, the obstacles' tracks and each
+    /// step's observation, action, reward and collision.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["out", "view", "stride", "scale", "size", "fps"])]
+    html: Option<PathBuf>,
 }
 
 fn view(s: &str) -> Result<View, String> {
@@ -94,6 +101,11 @@ pub fn run(args: ReplayArgs) -> Result<ExitCode> {
     let (config, scenes) = RunManifest::read(&summary)
         .and_then(|m| m.setting(&summary))
         .context("replay needs the run's configuration (pass --summary FILE)")?;
+    if let Some(html) = &args.html {
+        if html.extension().and_then(|e| e.to_str()) != Some("html") {
+            bail!("--html {}: the file name must end in .html", html.display());
+        }
+    }
     let out = args.out.clone().unwrap_or_else(|| {
         // A team's logs are one per robot; its animation is the team's: seed-<seed>-team-top.gif.
         let stem = args.steps.with_extension("");
@@ -125,6 +137,9 @@ pub fn run(args: ReplayArgs) -> Result<ExitCode> {
         );
     };
     let evaluator = Evaluator::new(config, scenes);
+    if let Some(html) = &args.html {
+        return write_player(&evaluator, &args.steps, &steps, seed, html);
+    }
     let options = options(args.view, args.stride, args.scale, args.size, args.fps);
     if evaluator.config().team_size() > 0 {
         if args.view == View::FirstPerson {
@@ -169,6 +184,41 @@ pub fn run(args: ReplayArgs) -> Result<ExitCode> {
         args.view.name(),
         args.stride,
         animation.bytes.len() as f64 / 1024.0
+    )?;
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `ronap replay --html`: the player of the episode of `seed` whose log (`steps`, read from
+/// `log`) and, for a team, its other robots' logs beside it, written to `html`.
+fn write_player(
+    evaluator: &Evaluator,
+    log: &Path,
+    steps: &[ronap_core::io::steplog::LoggedStep],
+    seed: u64,
+    html: &Path,
+) -> Result<ExitCode> {
+    let trace = if evaluator.config().team_size() > 0 {
+        let logs = team_logs(log, seed)?;
+        play_team(evaluator, seed, &logs)
+            .with_context(|| format!("cannot replay {}", log.display()))?
+    } else {
+        let episode = evaluator
+            .worlds()
+            .episode(seed)
+            .with_context(|| format!("cannot start the episode of seed {seed}"))?;
+        play_lone(episode, steps).with_context(|| format!("cannot replay {}", log.display()))?
+    };
+    let (robots, frames) = (trace.robots(), trace.frames());
+    let page = single_page(trace).map_err(anyhow::Error::msg)?;
+    ronap_core::io::atomic::write_atomic(html, |w| w.write_all(&page))
+        .with_context(|| format!("cannot write the player to {}", html.display()))?;
+    writeln!(
+        std::io::stdout().lock(),
+        "{}: seed {seed}, {}, {} steps, {:.0} KB",
+        html.display(),
+        crate::output::counted(robots as u64, "robot"),
+        frames.saturating_sub(1),
+        page.len() as f64 / 1024.0
     )?;
     Ok(ExitCode::SUCCESS)
 }

@@ -69,6 +69,14 @@ pub struct RunArgs {
     /// views and strides: `--log-steps` and `ronap replay`) [default: none].
     #[arg(long, allow_negative_numbers = true, value_name = "SEED", value_parser = seed)]
     gif: Vec<u64>,
+    /// Also write an HTML player of episodes to html/seed-<seed>-<outcome>.html, chosen as
+    /// --png chooses pictures: the first N seeds of the run, `failures` (every episode that did
+    /// not succeed) or `all`. Each is one self-contained page (no network) to play, pause, step
+    /// and scrub the episode, follow a robot, show the laser, the obstacles' tracks and the
+    /// step's observation, action and reward (ronap replay --html makes one from a step log)
+    /// [default: none].
+    #[arg(long, allow_negative_numbers = true, value_name = "N|failures|all")]
+    html: Option<Pictures>,
     /// For a py: policy, run N episodes side by side and call the function once for all of
     /// those waiting for an action, with an (n, observation size) array (n up to N), expecting n
     /// actions: the same episodes as unbatched, with far fewer calls (0: one call per step). On a
@@ -103,6 +111,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         png: args.png,
         log_steps: args.log_steps,
         gif: args.gif,
+        html: args.html,
         min_success: args.min_success,
         batch: usize::from(args.batch),
         force: args.force,
@@ -134,6 +143,8 @@ struct Job {
     png: Option<Pictures>,
     log_steps: bool,
     gif: Vec<u64>,
+    /// The episodes that get an HTML player.
+    html: Option<Pictures>,
     min_success: Option<f64>,
     /// Episodes a py: policy decides for at once (0: one at a time).
     batch: usize,
@@ -154,7 +165,12 @@ impl Job {
 
     /// What `ronap run` keeps in the plan beyond the core's fields, for `--resume`.
     fn front_end(&self) -> serde_json::Value {
-        serde_json::json!({ "gif": self.gif, "min_success": self.min_success, "batch": self.batch })
+        let mut front = serde_json::json!({ "gif": self.gif, "min_success": self.min_success, "batch": self.batch });
+        // Only a run with players names them, so other runs' plans stay as they were.
+        if let Some(html) = self.html {
+            front["html"] = serde_json::Value::String(html.to_string());
+        }
+        front
     }
 
     /// What every run sets up once its episodes can start: its writer (`writer` taken up again,
@@ -178,7 +194,7 @@ impl Job {
                 gifs: false,
             })?,
         };
-        let writer = writer.animating(self.gif.clone())?;
+        let writer = writer.animating(self.gif.clone())?.playing(self.html)?;
         let done = writer.done() as u64;
         let cancel = cancel_on_ctrl_c("finishing running episodes and writing what is done");
         let bar = crate::output::progress_bar(
@@ -317,6 +333,14 @@ fn resume(dir: &Path) -> Result<ExitCode> {
             .and_then(|b| usize::try_from(b).ok())
             .ok_or_else(|| bad("batch", v))?,
     };
+    let html = match front.get("html") {
+        None | Some(serde_json::Value::Null) => None,
+        Some(v) => Some(
+            v.as_str()
+                .and_then(|t| t.parse::<Pictures>().ok())
+                .ok_or_else(|| bad("html", v))?,
+        ),
+    };
     let png = plan
         .pictures
         .as_deref()
@@ -335,6 +359,7 @@ fn resume(dir: &Path) -> Result<ExitCode> {
         png,
         log_steps: plan.steps,
         gif,
+        html,
         min_success,
         batch,
         force: false,

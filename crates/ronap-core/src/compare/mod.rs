@@ -8,6 +8,7 @@
 //! draws from a fixed seed.
 
 pub mod difficulty;
+mod disagreements;
 pub mod report;
 pub mod result;
 pub mod stats;
@@ -19,10 +20,11 @@ use crate::io::manifest::{ManifestError, RunManifest};
 use crate::io::run_dir::{RunFiles, RunInfo, RunWriter};
 use crate::job::{evaluate_into, evaluate_team_into, RunRequest};
 use crate::policy::{PolicyError, PolicyFactory, TeamPolicyFactory};
-use crate::render::chart;
 use crate::scene::map::MapSource;
 use crate::sim::world::SceneSpec;
 use difficulty::{Difficulty, Figure};
+use disagreements::disagreement_sheet;
+pub use disagreements::disagreements;
 use rayon::prelude::*;
 pub use result::{BinResult, Breakdown, Comparison, PairResult, PolicyResult, SeedResult};
 use stats::ALPHA;
@@ -425,7 +427,8 @@ pub fn compare(
         };
         let sheet = disagreement_sheet(evaluator, contenders, &comparison, rows)?;
         report::remove_earlier(dir)?;
-        report::write_all(dir, &comparison, sheet.as_ref())?;
+        let players = disagreements::write_players(evaluator, contenders, &comparison, dir)?;
+        report::write_all(dir, &comparison, sheet.as_ref(), &players)?;
     }
     Ok(comparison)
 }
@@ -896,81 +899,6 @@ fn breakdown(
         bins,
         unbinned: values.len() - binned,
     }
-}
-
-/// The seeds where the policies disagree most (a split between success and failure first, the
-/// most even splits first, then the widest SPL spread), at most `rows` of them.
-pub fn disagreements(policies: &[PolicyResult], rows: usize) -> Vec<usize> {
-    let n = policies.first().map_or(0, |p| p.seeds.len());
-    let mut scored: Vec<(usize, f64, usize)> = (0..n)
-        .filter_map(|i| {
-            let wins = policies.iter().filter(|p| p.seeds[i].success()).count();
-            let split = wins.min(policies.len() - wins);
-            let spl = policies.iter().map(|p| p.seeds[i].spl);
-            let spread =
-                spl.clone().fold(f64::NEG_INFINITY, f64::max) - spl.fold(f64::INFINITY, f64::min);
-            (split > 0 || spread > 0.05).then_some((split, spread, i))
-        })
-        .collect();
-    scored.sort_by(|a, b| b.0.cmp(&a.0).then(b.1.total_cmp(&a.1)).then(a.2.cmp(&b.2)));
-    scored.into_iter().take(rows).map(|(_, _, i)| i).collect()
-}
-
-/// The contact sheet of the seeds where the policies disagree most: each policy's trajectory
-/// there (the episode run again, recording its path). `None` when they agree everywhere.
-fn disagreement_sheet(
-    evaluator: &Evaluator,
-    contenders: &[Contender],
-    comparison: &Comparison,
-    rows: usize,
-) -> Result<Option<image::RgbImage>, CompareError> {
-    let chosen = disagreements(&comparison.policies, rows);
-    if chosen.is_empty() {
-        return Ok(None);
-    }
-    let mut policies = Vec::new();
-    for c in contenders {
-        policies.push(c.factory.make().map_err(|source| CompareError::Policy {
-            policy: c.name.clone(),
-            source,
-        })?);
-    }
-    let recording = Recording {
-        trajectory: true,
-        steps: false,
-    };
-    let mut sheet_rows = Vec::new();
-    for &i in &chosen {
-        let seed = comparison.policies[0].seeds[i].seed;
-        let mut cells = Vec::new();
-        for policy in policies.iter_mut() {
-            let cell = match evaluator.run_episode(policy.as_mut(), seed, recording) {
-                Ok(record) => {
-                    let scale = 160.0
-                        / record
-                            .world
-                            .as_ref()
-                            .map_or(160.0, |w| w.scene().width().max(w.scene().height()));
-                    let picture = crate::render::trajectory::trajectory_image(&record, scale)
-                        .unwrap_or_else(|| image::RgbImage::new(1, 1));
-                    let caption = format!("{}, {} steps", record.outcome.name(), record.steps);
-                    (picture, caption)
-                }
-                Err(e) => (image::RgbImage::new(1, 1), format!("failed: {e}")),
-            };
-            cells.push(cell);
-        }
-        sheet_rows.push(chart::SheetRow {
-            label: format!("seed {seed}"),
-            cells,
-        });
-    }
-    let columns: Vec<String> = comparison
-        .policies
-        .iter()
-        .map(|p| p.label.clone())
-        .collect();
-    Ok(Some(chart::contact_sheet(&columns, &sheet_rows, 160)))
 }
 
 #[cfg(test)]

@@ -578,11 +578,20 @@ pub fn check_empty(dir: &Path) -> Result<(), OutputError> {
     }
 }
 
-/// Removes what an earlier comparison wrote into `dir` (the files of [`FILES`], not `runs/`), so
-/// a directory never mixes two comparisons.
+/// Removes what an earlier comparison wrote into `dir` (the files of [`FILES`] and the players in
+/// `players/`, not `runs/`), so a directory never mixes two comparisons.
 pub fn remove_earlier(dir: &Path) -> Result<(), OutputError> {
-    for f in FILES {
-        let path = dir.join(f);
+    let players = std::fs::read_dir(dir.join("players"))
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("seed-") && n.ends_with(".html"))
+        });
+    for path in FILES.iter().map(|f| dir.join(f)).chain(players) {
         match std::fs::remove_file(&path) {
             Ok(()) => {}
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
@@ -592,11 +601,13 @@ pub fn remove_earlier(dir: &Path) -> Result<(), OutputError> {
     Ok(())
 }
 
-/// Writes every file of the comparison into `dir`.
+/// Writes every file of the comparison into `dir`; the report links the players of `players`
+/// (seeds, each `players/seed-SEED.html`).
 pub fn write_all(
     dir: &Path,
     c: &Comparison,
     sheet: Option<&image::RgbImage>,
+    players: &[u64],
 ) -> Result<(), OutputError> {
     let mut shown = Vec::new();
     for (file, alt, image) in pictures(c, sheet) {
@@ -617,6 +628,10 @@ pub fn write_all(
         w.write_all(b"\n")
     })?;
     let config = toml::to_string(c.config.as_sim_config()).unwrap_or_default();
+    let shown = Shown {
+        pictures: &shown,
+        players,
+    };
     save_text(&dir.join("report.md"), &markdown(c, &shown, &config))?;
     save_text(&dir.join("report.html"), &html(c, &shown, &config))?;
     Ok(())
@@ -664,7 +679,32 @@ fn runs_note(c: &Comparison) -> Vec<String> {
         .collect()
 }
 
-fn markdown(c: &Comparison, pictures: &[Picture], config: &str) -> String {
+/// What a report shows beside its tables: the pictures, and the seeds whose players it links.
+struct Shown<'a> {
+    pictures: &'a [Picture],
+    players: &'a [u64],
+}
+
+/// The line above the links to the players of `players` (seeds).
+fn players_intro(players: &[u64]) -> String {
+    format!(
+        "Each policy's episode side by side on one timeline (play, step, scrub, follow a robot), \
+         for the {} where the policies disagree most{}:",
+        if players.len() == 1 {
+            "seed".to_string()
+        } else {
+            format!("{} seeds", players.len())
+        },
+        if players.len() == super::disagreements::MAX_PLAYERS {
+            format!(" (at most {})", super::disagreements::MAX_PLAYERS)
+        } else {
+            String::new()
+        }
+    )
+}
+
+fn markdown(c: &Comparison, shown: &Shown<'_>, config: &str) -> String {
+    let pictures = shown.pictures;
     let mut md = String::from("# ronap compare\n\n");
     let _ = writeln!(md, "{}\n\n**{}**\n", intro(c), c.success_rule);
     match c.team_table() {
@@ -680,6 +720,19 @@ fn markdown(c: &Comparison, pictures: &[Picture], config: &str) -> String {
     let _ = writeln!(md, "## Pairs\n\n{}", c.pair_table().markdown());
     for p in pictures {
         let _ = writeln!(md, "![{}]({})\n", p.alt, p.file);
+    }
+    if !shown.players.is_empty() {
+        let links: Vec<String> = shown
+            .players
+            .iter()
+            .map(|s| format!("[seed {s}](players/seed-{s:06}.html)"))
+            .collect();
+        let _ = writeln!(
+            md,
+            "## Players\n\n{}\n{}\n",
+            players_intro(shown.players),
+            links.join(", ")
+        );
     }
     let tables = c.difficulty_tables();
     if !tables.is_empty() {
@@ -700,7 +753,8 @@ fn markdown(c: &Comparison, pictures: &[Picture], config: &str) -> String {
     md
 }
 
-fn html(c: &Comparison, pictures: &[Picture], config: &str) -> String {
+fn html(c: &Comparison, shown: &Shown<'_>, config: &str) -> String {
+    let pictures = shown.pictures;
     let mut h = String::from(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <title>ronap compare</title>\n<style>\n\
@@ -736,6 +790,17 @@ fn html(c: &Comparison, pictures: &[Picture], config: &str) -> String {
             b64.encode(&p.png),
             escape(&p.alt)
         );
+    }
+    if !shown.players.is_empty() {
+        let _ = write!(
+            h,
+            "<h2>Players</h2>\n<p>{}</p>\n<p class=\"players\">",
+            escape(&players_intro(shown.players))
+        );
+        for s in shown.players {
+            let _ = write!(h, " <a href=\"players/seed-{s:06}.html\">seed {s}</a>");
+        }
+        h.push_str("</p>\n");
     }
     let tables = c.difficulty_tables();
     if !tables.is_empty() {

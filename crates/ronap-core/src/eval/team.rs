@@ -700,21 +700,8 @@ impl Evaluator {
         }
         let all_arrived = robots.iter().all(|r| r.outcome == Outcome::Success);
         let deadlock = team.deadlocked();
-        let worst = [
-            Outcome::Infeasible,
-            Outcome::Deadlock,
-            Outcome::Timeout,
-            Outcome::Collision,
-            Outcome::RewardMin,
-            Outcome::Stuck,
-        ]
-        .into_iter()
-        .find(|o| robots.iter().any(|r| r.outcome == *o));
-        let outcome = if all_arrived {
-            Outcome::Success
-        } else {
-            worst.unwrap_or(Outcome::Stuck)
-        };
+        let outcomes: Vec<Outcome> = robots.iter().map(|r| r.outcome).collect();
+        let outcome = team_outcome(&outcomes);
         Ok(TeamRecord {
             seed,
             outcome,
@@ -794,6 +781,25 @@ impl Evaluator {
         };
         stream_seeds(options, cancel, &work, sink)
     }
+}
+
+/// A team's outcome from its robots' `outcomes`: success when every robot arrived, else the
+/// worst of theirs (infeasible, deadlock, time-out, collision, reward floor, stuck, in that order).
+pub(crate) fn team_outcome(outcomes: &[Outcome]) -> Outcome {
+    if outcomes.iter().all(|o| *o == Outcome::Success) {
+        return Outcome::Success;
+    }
+    [
+        Outcome::Infeasible,
+        Outcome::Deadlock,
+        Outcome::Timeout,
+        Outcome::Collision,
+        Outcome::RewardMin,
+        Outcome::Stuck,
+    ]
+    .into_iter()
+    .find(|o| outcomes.contains(o))
+    .unwrap_or(Outcome::Stuck)
 }
 
 #[cfg(test)]

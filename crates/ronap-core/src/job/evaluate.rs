@@ -8,7 +8,7 @@ use crate::io::atomic::OutputError;
 use crate::io::figures;
 use crate::io::manifest::RunManifest;
 use crate::io::run_dir::{finish, lone_headers, manifest, EpisodeRows, Layout, RunWriter};
-use crate::job::{animate, RunRequest};
+use crate::job::{animate, player, RunRequest};
 use crate::policy::{PolicyError, PolicyFactory};
 use std::sync::atomic::AtomicBool;
 
@@ -53,6 +53,7 @@ pub fn evaluate_into(
     let episodes = LoneEpisodes {
         evaluator: request.evaluator,
         factory,
+        policy: &request.info.policy,
     };
     let Ran {
         mut result,
@@ -79,6 +80,8 @@ pub fn evaluate_into(
 struct LoneEpisodes<'a> {
     evaluator: &'a Evaluator,
     factory: &'a dyn PolicyFactory,
+    /// The policy's name, for players' titles.
+    policy: &'a str,
 }
 
 impl Episodes<EpisodeRecord> for LoneEpisodes<'_> {
@@ -97,6 +100,9 @@ impl Episodes<EpisodeRecord> for LoneEpisodes<'_> {
         writer.episode(r);
         animate::write_if_asked(writer, r.seed, r.outcome, || {
             animate::lone(self.evaluator, r)
+        });
+        player::write_if_asked(writer, r.seed, r.outcome, || {
+            player::lone_record(self.evaluator, r, self.policy)
         });
     }
 }

@@ -5,9 +5,10 @@
 //! kind says how its episodes run ([`Episodes`]) and what its rows and figures are
 //! ([`Tallies`]).
 
+use crate::eval::Outcome;
 use crate::eval::{EvalOptions, RunEnd, RunResult};
 use crate::io::atomic::OutputError;
-use crate::io::run_dir::{restore, RunWriter, Streams};
+use crate::io::run_dir::{restore, Pictures, RunWriter, Streams};
 use crate::job::RunRequest;
 use crate::policy::PolicyError;
 use std::sync::atomic::AtomicBool;
@@ -73,6 +74,19 @@ pub(super) fn run_into<R>(
     if let Some(w) = writer {
         options.recording = w.recording();
         options.steps_of = w.gif_seeds().to_vec();
+        // A player shows every step: its episodes' steps are recorded (all of them when the
+        // run's outcome decides, as for `--html failures`).
+        match w.players() {
+            Some(Pictures::First(n)) => options.steps_of.extend(
+                options
+                    .seeds
+                    .iter()
+                    .filter(|s| w.wants_player(*s, Outcome::Success))
+                    .take(n as usize),
+            ),
+            Some(_) => options.recording.steps = true,
+            None => {}
+        }
     }
     let mut write_error = None;
     let mut streams = None;

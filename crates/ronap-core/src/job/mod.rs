@@ -1,7 +1,8 @@
 //! Use-cases, above `io`: running an evaluation into a run directory, a lone robot's
 //! ([`evaluate_into`]) or a team's ([`evaluate_team_into`]), and replaying a team episode from
 //! its robots' step logs ([`replay_team`]), animating a run's chosen episodes from the steps it
-//! recorded: the sequences the command line,
+//! recorded, and the HTML players of episodes ([`play_lone`], [`play_team`]): the sequences the
+//! command line,
 //! Python and `compare` share. A use-case takes one [`RunRequest`] (what to run, where its
 //! results go, how to stop it) rather than a long list of arguments. Uses every layer up to `io`;
 //! `io` reads and writes formats, `render` draws, and neither runs an episode for this layer.
@@ -9,10 +10,13 @@
 mod animate;
 mod evaluate;
 mod into;
+mod player;
 mod replay;
 mod team;
 
 pub use evaluate::{evaluate_into, Evaluation};
+pub(crate) use player::{lone_record, team_record};
+pub use player::{play_lone, play_team, single_page};
 pub use replay::{replay_team, ReplayError, RobotLog};
 pub use team::{evaluate_team_into, TeamEvaluation};
 

@@ -5,11 +5,13 @@
 use crate::eval::Evaluator;
 use crate::geometry::Point;
 use crate::io::steplog::LoggedStep;
-use crate::render::gif::{same_pose, Animation, AnimationError, GifOptions};
+use crate::render::gif::{same_pose, Animation, AnimationError, GifOptions, GifWriter};
 use crate::render::team::{team_frame, team_gif_writer};
 use crate::run::team::TeamRollout;
 use crate::run::RunError;
 use crate::sim::robot::{Action, Pose};
+use crate::sim::team::Team;
+use image::RgbImage;
 
 impl RobotLog {
     /// The logs of every robot of `record`, from the steps it recorded.
@@ -106,6 +108,83 @@ pub fn replay_team(
     logs: &[RobotLog],
     options: &GifOptions,
 ) -> Result<Animation, ReplayError> {
+    let stride = options.stride.max(1);
+    let mut paths: Vec<Vec<Point>> = Vec::new();
+    // Each frame is written when the next one is known, so the last can be held longer.
+    let mut drawing: Option<(GifWriter<Vec<u8>>, RgbImage)> = None;
+    let mut size = (0, 0);
+    let last = drive_team(evaluator, seed, logs, &mut |team, step| {
+        let Some(step) = step else {
+            paths = (0..team.robots().len())
+                .map(|k| vec![team.robot(k).pose().position()])
+                .collect();
+            let first = team_frame(team, &paths, options.scale);
+            size = first.dimensions();
+            drawing = Some((team_gif_writer(size.0, size.1)?, first));
+            return Ok(());
+        };
+        for (k, path) in paths.iter_mut().enumerate() {
+            let p = team.robot(k).pose().position();
+            if team.present(k) && path.last() != Some(&p) {
+                path.push(p);
+            }
+        }
+        // The run drew its last frame when the team was done; robots that gave up after the
+        // last logged step leave it running here, and the run drew no frame for that step.
+        if step.number % stride == 0 || (step.number == step.last && step.finished) {
+            if let Some((writer, pending)) = &mut drawing {
+                let frame = team_frame(team, &paths, options.scale);
+                writer
+                    .add(pending, options.frame_delay_cs)
+                    .map_err(AnimationError::from)?;
+                *pending = frame;
+            }
+        }
+        Ok(())
+    })?;
+    let Some((mut writer, pending)) = drawing else {
+        unreachable!("drive_team shows the placed team before it steps");
+    };
+    writer
+        .add(&pending, options.last_frame_delay_cs)
+        .map_err(AnimationError::from)?;
+    let frames = writer.frames();
+    let bytes = writer.finish().map_err(AnimationError::from)?;
+    Ok(Animation {
+        bytes,
+        frames,
+        steps: last as usize,
+        size,
+    })
+}
+
+/// One step of a team replay, as [`drive_team`] shows it.
+pub(crate) struct ReplayStep<'a> {
+    /// The team step just taken, from 1.
+    pub number: u32,
+    /// The last logged team step.
+    pub last: u32,
+    /// Whether every robot's episode is over (or its policy gave up).
+    pub finished: bool,
+    /// Each robot's action in this step (`None`: it did not act).
+    pub actions: &'a [Option<Action>],
+}
+
+/// What a team replay shows each state to: the team, and the step that led there (`None` for the
+/// team as placed).
+pub(crate) type TeamWatch<'a> =
+    dyn FnMut(&Team, Option<ReplayStep<'_>>) -> Result<(), ReplayError> + 'a;
+
+/// Steps team episode `seed` of `evaluator` through `logs` (one for every robot of the team),
+/// holding every logged pose to the model's, and shows `watch` the placed team (with `None`) and
+/// the team after each step. A robot whose log ends while it still runs gives up there, as its
+/// policy did. Returns the last logged step.
+pub(crate) fn drive_team(
+    evaluator: &Evaluator,
+    seed: u64,
+    logs: &[RobotLog],
+    watch: &mut TeamWatch<'_>,
+) -> Result<u32, ReplayError> {
     let mut rollout = TeamRollout::placed(evaluator.config(), evaluator.worlds().team(seed), seed)
         .map_err(|source| ReplayError::Start { seed, source })?;
     let n = rollout.team().robots().len();
@@ -137,15 +216,7 @@ pub fn replay_team(
         .filter_map(|l| l.steps.last().map(|s| s.step))
         .max()
         .unwrap_or(0);
-    let stride = options.stride.max(1);
-    let mut paths: Vec<Vec<Point>> = (0..n)
-        .map(|k| vec![rollout.team().robot(k).pose().position()])
-        .collect();
-    let first = team_frame(rollout.team(), &paths, options.scale);
-    let (width, height) = first.dimensions();
-    let mut writer = team_gif_writer(width, height)?;
-    // Each frame is written when the next one is known, so the last can be held longer.
-    let mut pending = first;
+    watch(rollout.team(), None)?;
     let mut next = vec![0usize; n];
     for step in 1..=last {
         let mut actions: Vec<Option<Action>> = vec![None; n];
@@ -178,22 +249,13 @@ pub fn replay_team(
             next[k] += 1;
         }
         rollout.step(&actions);
-        let team = rollout.team();
-        for (k, path) in paths.iter_mut().enumerate() {
-            let p = team.robot(k).pose().position();
-            if team.present(k) && path.last() != Some(&p) {
-                path.push(p);
-            }
-        }
-        // The run drew its last frame when the team was done; robots that gave up after the
-        // last logged step leave it running here, and the run drew no frame for that step.
-        if step % stride == 0 || (step == last && rollout.finished()) {
-            let frame = team_frame(team, &paths, options.scale);
-            writer
-                .add(&pending, options.frame_delay_cs)
-                .map_err(AnimationError::from)?;
-            pending = frame;
-        }
+        let shown = ReplayStep {
+            number: step,
+            last,
+            finished: rollout.finished(),
+            actions: &actions,
+        };
+        watch(rollout.team(), Some(shown))?;
     }
     for (k, log) in by_robot.iter().enumerate() {
         let left = log.map_or(0, |l| l.len() - next[k].min(l.len()));
@@ -207,17 +269,7 @@ pub fn replay_team(
             });
         }
     }
-    writer
-        .add(&pending, options.last_frame_delay_cs)
-        .map_err(AnimationError::from)?;
-    let frames = writer.frames();
-    let bytes = writer.finish().map_err(AnimationError::from)?;
-    Ok(Animation {
-        bytes,
-        frames,
-        steps: last as usize,
-        size: (width, height),
-    })
+    Ok(last)
 }
 
 #[cfg(test)]

@@ -10,7 +10,7 @@ use crate::io::atomic::OutputError;
 use crate::io::figures;
 use crate::io::run_dir::{finish, manifest, timing_row, RunWriter, TIMING_COLUMNS};
 use crate::io::team_rows::{robot_columns, robot_rows, team_episode_row, TEAM_COLUMNS};
-use crate::job::{animate, RunRequest};
+use crate::job::{animate, player, RunRequest};
 use crate::policy::{PolicyError, TeamPolicyFactory};
 use std::sync::atomic::AtomicBool;
 
@@ -54,6 +54,7 @@ pub fn evaluate_team_into(
     let episodes = TeamEpisodes {
         evaluator: request.evaluator,
         factory,
+        policy: &request.info.policy,
         // Each robot's beam count, for its step log's columns.
         beams: (0..config.team_size())
             .map(|k| config.team_robot(k).laser.beams as usize)
@@ -101,6 +102,8 @@ struct TeamEpisodes<'a> {
     evaluator: &'a Evaluator,
     factory: &'a dyn TeamPolicyFactory,
     beams: Vec<usize>,
+    /// The policy's name, for players' titles.
+    policy: &'a str,
 }
 
 impl Episodes<TeamRecord> for TeamEpisodes<'_> {
@@ -118,6 +121,9 @@ impl Episodes<TeamRecord> for TeamEpisodes<'_> {
     fn files(&self, writer: &RunWriter, r: &TeamRecord) {
         animate::write_if_asked(writer, r.seed, r.outcome, || {
             animate::team(self.evaluator, r)
+        });
+        player::write_if_asked(writer, r.seed, r.outcome, || {
+            player::team_record(self.evaluator, r, self.policy)
         });
         writer.team_episode(r, &self.beams);
     }

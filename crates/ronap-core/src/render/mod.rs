@@ -10,6 +10,7 @@
 pub mod chart;
 pub mod first_person;
 pub mod gif;
+pub mod player;
 pub mod team;
 pub mod trajectory;
 

@@ -67,14 +67,15 @@ pub(super) fn write_team_files(
 }
 
 /// Removes the per-episode files an earlier run left in `dir` (`png/seed-*.png`,
-/// `steps/seed-*.csv`, the GIFs `ronap replay` drew beside them, `steps/seed-*.gif`, and
-/// `gif/seed-*.gif`), so a reused output directory shows only this run. Nothing else is touched.
+/// `steps/seed-*.csv`, the GIFs `ronap replay` drew beside them, `steps/seed-*.gif`,
+/// `gif/seed-*.gif` and `html/seed-*.html`), so a reused output directory shows only this run. Nothing else is touched.
 pub(super) fn remove_stale_files(dir: &Path) -> Result<(), OutputError> {
     for (sub, ext) in [
         ("png", ".png"),
         ("steps", ".csv"),
         ("steps", ".gif"),
         ("gif", ".gif"),
+        ("html", ".html"),
     ] {
         let Ok(entries) = std::fs::read_dir(dir.join(sub)) else {
             continue;

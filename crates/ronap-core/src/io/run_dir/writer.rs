@@ -2,7 +2,7 @@
 //! finish one stopped short, and the run files it streams row by row until the run ends.
 
 use super::episode_files::{remove_stale_files, write_episode_files, write_team_files};
-use super::{ResumeError, RunFiles, RunInfo, RUN_FILES};
+use super::{Pictures, ResumeError, RunFiles, RunInfo, RUN_FILES};
 use crate::config::ValidConfig;
 use crate::eval::{EpisodeRecord, EvalOptions, Outcome, Recording, RunResult, Seeds, TeamRecord};
 use crate::io::atomic::{write_atomic, OutputError};
@@ -39,6 +39,8 @@ pub struct RunWriter {
     clean: AtomicBool,
     /// The seeds whose episodes are animated into `gif/`.
     gif_seeds: Vec<u64>,
+    /// The episodes whose HTML players go into `html/`.
+    players: Option<Pictures>,
     lock: Option<RunLock>,
 }
 
@@ -113,7 +115,9 @@ impl Holding {
         }
         // The lock, and the empty folders a run that failed at once made, are nothing.
         let empty_folder = |e: &std::fs::DirEntry| {
-            ["png", "steps", "gif"].iter().any(|n| e.file_name() == *n)
+            ["png", "steps", "gif", "html"]
+                .iter()
+                .any(|n| e.file_name() == *n)
                 && std::fs::read_dir(e.path()).is_ok_and(|mut d| d.next().is_none())
         };
         let mut entries = std::fs::read_dir(dir).into_iter().flatten().flatten();
@@ -181,6 +185,7 @@ impl RunWriter {
             ready: Mutex::new(Ready::default()),
             clean: AtomicBool::new(false),
             gif_seeds: Vec::new(),
+            players: None,
             lock: Some(lock),
         })
     }
@@ -308,6 +313,7 @@ impl RunWriter {
             ready: Mutex::new(Ready::default()),
             clean: AtomicBool::new(false),
             gif_seeds: Vec::new(),
+            players: None,
             lock: Some(lock),
         };
         Ok((writer, plan))
@@ -337,6 +343,46 @@ impl RunWriter {
             .join("gif")
             .join(format!("seed-{seed:06}-{}.gif", outcome.name()));
         let written = match bytes {
+            Ok(b) => self
+                .make_ready()
+                .and_then(|()| write_atomic(&path, |w| w.write_all(b))),
+            Err(message) => Err(OutputError::Format { path, message }),
+        };
+        if let Err(e) = written {
+            self.note(e);
+        }
+    }
+
+    /// Writes an HTML player of each episode `players` chooses into
+    /// `html/seed-SEED-OUTCOME.html` as it finishes ([`crate::job::evaluate_into`] and
+    /// [`crate::job::evaluate_team_into`] record their steps).
+    pub fn playing(mut self, players: Option<Pictures>) -> Result<Self, OutputError> {
+        if players.is_some() {
+            make_dir(&self.dir.join("html"))?;
+        }
+        self.players = players;
+        Ok(self)
+    }
+
+    /// The episodes that get a player.
+    pub fn players(&self) -> Option<Pictures> {
+        self.players
+    }
+
+    /// Whether episode `seed`, which ended as `outcome`, gets a player.
+    pub fn wants_player(&self, seed: u64, outcome: Outcome) -> bool {
+        self.players
+            .is_some_and(|p| p.wants_seed(seed, outcome, self.first_seed))
+    }
+
+    /// Writes the player of episode `seed`, which ended as `outcome` (`page`, its HTML, or why it
+    /// could not be made); a failure is kept for the end, as [`RunWriter::episode`] does.
+    pub fn player(&self, seed: u64, outcome: Outcome, page: Result<&[u8], String>) {
+        let path = self
+            .dir
+            .join("html")
+            .join(format!("seed-{seed:06}-{}.html", outcome.name()));
+        let written = match page {
             Ok(b) => self
                 .make_ready()
                 .and_then(|()| write_atomic(&path, |w| w.write_all(b))),

@@ -55,6 +55,11 @@ impl Pedestrian {
         }
     }
 
+    /// Where it heads now.
+    pub(super) fn goal(&self) -> Point {
+        self.goal
+    }
+
     /// The pedestrian `m` describes, heading for `goal`.
     pub(super) fn new(m: &MovingConfig, goal: Point) -> Self {
         Self {
@@ -382,6 +387,21 @@ impl Crowd {
                 }
             };
         }
+    }
+}
+
+// Kept here rather than in mod.rs, which is long already: what the player shows of pedestrians.
+impl super::Movers {
+    /// Each obstacle's goal, when it is a reactive pedestrian (`None` for the others).
+    pub fn pedestrian_goals(&self) -> impl Iterator<Item = Option<Point>> + '_ {
+        self.pedestrians
+            .iter()
+            .map(|p| p.as_ref().map(Pedestrian::goal))
+            .chain(std::iter::repeat_n(
+                None,
+                self.entries.len().saturating_sub(self.pedestrians.len()),
+            ))
+            .take(self.entries.len())
     }
 }
 

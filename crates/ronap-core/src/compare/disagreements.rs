@@ -1,0 +1,165 @@
+//! The seeds where the compared policies disagree: which they are, the contact sheet of their
+//! trajectories, and an HTML player of each (`players/seed-SEED.html`: every policy's episode
+//! side by side on one timeline), each episode run again with the same seed.
+
+use super::{CompareError, Comparison, Contender, PolicyResult};
+use crate::eval::{Evaluator, Recording};
+use crate::io::atomic::{write_atomic, OutputError};
+use crate::render::chart;
+use crate::render::player::{player_page, PlayerPage, Trace};
+use std::path::Path;
+
+/// Most players a comparison writes (each a page of every policy's episode of one seed).
+pub const MAX_PLAYERS: usize = 50;
+
+/// The seeds where the policies disagree most (a split between success and failure first, the
+/// most even splits first, then the widest SPL spread), at most `rows` of them.
+pub fn disagreements(policies: &[PolicyResult], rows: usize) -> Vec<usize> {
+    let n = policies.first().map_or(0, |p| p.seeds.len());
+    let mut scored: Vec<(usize, f64, usize)> = (0..n)
+        .filter_map(|i| {
+            let wins = policies.iter().filter(|p| p.seeds[i].success()).count();
+            let split = wins.min(policies.len() - wins);
+            let spl = policies.iter().map(|p| p.seeds[i].spl);
+            let spread =
+                spl.clone().fold(f64::NEG_INFINITY, f64::max) - spl.fold(f64::INFINITY, f64::min);
+            (split > 0 || spread > 0.05).then_some((split, spread, i))
+        })
+        .collect();
+    scored.sort_by(|a, b| b.0.cmp(&a.0).then(b.1.total_cmp(&a.1)).then(a.2.cmp(&b.2)));
+    scored.into_iter().take(rows).map(|(_, _, i)| i).collect()
+}
+
+/// The contact sheet of the seeds where the policies disagree most: each policy's trajectory
+/// there (the episode run again, recording its path). `None` when they agree everywhere.
+pub(super) fn disagreement_sheet(
+    evaluator: &Evaluator,
+    contenders: &[Contender],
+    comparison: &Comparison,
+    rows: usize,
+) -> Result<Option<image::RgbImage>, CompareError> {
+    let chosen = disagreements(&comparison.policies, rows);
+    if chosen.is_empty() {
+        return Ok(None);
+    }
+    let mut policies = Vec::new();
+    for c in contenders {
+        policies.push(c.factory.make().map_err(|source| CompareError::Policy {
+            policy: c.name.clone(),
+            source,
+        })?);
+    }
+    let recording = Recording {
+        trajectory: true,
+        steps: false,
+    };
+    let mut sheet_rows = Vec::new();
+    for &i in &chosen {
+        let seed = comparison.policies[0].seeds[i].seed;
+        let mut cells = Vec::new();
+        for policy in policies.iter_mut() {
+            let cell = match evaluator.run_episode(policy.as_mut(), seed, recording) {
+                Ok(record) => {
+                    let scale = 160.0
+                        / record
+                            .world
+                            .as_ref()
+                            .map_or(160.0, |w| w.scene().width().max(w.scene().height()));
+                    let picture = crate::render::trajectory::trajectory_image(&record, scale)
+                        .unwrap_or_else(|| image::RgbImage::new(1, 1));
+                    let caption = format!("{}, {} steps", record.outcome.name(), record.steps);
+                    (picture, caption)
+                }
+                Err(e) => (image::RgbImage::new(1, 1), format!("failed: {e}")),
+            };
+            cells.push(cell);
+        }
+        sheet_rows.push(chart::SheetRow {
+            label: format!("seed {seed}"),
+            cells,
+        });
+    }
+    let columns: Vec<String> = comparison
+        .policies
+        .iter()
+        .map(|p| p.label.clone())
+        .collect();
+    Ok(Some(chart::contact_sheet(&columns, &sheet_rows, 160)))
+}
+
+/// Writes the player of each seed where the policies disagree most (at most [`MAX_PLAYERS`],
+/// in [`disagreements`]' order) into `dir/players/seed-SEED.html`: every policy's episode of the
+/// seed, run again recording its steps, side by side on one timeline. Returns those seeds.
+pub(super) fn write_players(
+    evaluator: &Evaluator,
+    contenders: &[Contender],
+    comparison: &Comparison,
+    dir: &Path,
+) -> Result<Vec<u64>, CompareError> {
+    let chosen = disagreements(&comparison.policies, MAX_PLAYERS);
+    if chosen.is_empty() {
+        return Ok(Vec::new());
+    }
+    let players = dir.join("players");
+    std::fs::create_dir_all(&players).map_err(|source| OutputError::Io {
+        path: players.clone(),
+        source,
+    })?;
+    let recording = Recording {
+        trajectory: false,
+        steps: true,
+    };
+    let made = |c: &Contender, e| CompareError::Policy {
+        policy: c.name.clone(),
+        source: e,
+    };
+    let team = evaluator.config().team_size() > 0;
+    let mut seeds = Vec::new();
+    for &i in &chosen {
+        let seed = comparison.policies[0].seeds[i].seed;
+        let path = players.join(format!("seed-{seed:06}.html"));
+        let mut traces: Vec<Trace> = Vec::new();
+        for (c, p) in contenders.iter().zip(&comparison.policies) {
+            let trace = match (&c.team, team) {
+                (Some(factory), true) => {
+                    let mut policy = factory.make().map_err(|e| made(c, e))?;
+                    evaluator
+                        .run_team_episode(policy.as_mut(), &factory.names(), seed, recording)
+                        .map_err(|e| e.to_string())
+                        .and_then(|r| crate::job::team_record(evaluator, &r, &p.label))
+                }
+                _ => {
+                    let mut policy = c.factory.make().map_err(|e| made(c, e))?;
+                    evaluator
+                        .run_episode(policy.as_mut(), seed, recording)
+                        .map_err(|e| e.to_string())
+                        .and_then(|r| crate::job::lone_record(evaluator, &r, &p.label))
+                }
+            };
+            traces.push(trace.map_err(|message| OutputError::Format {
+                path: path.clone(),
+                message: format!("policy {}: {message}", c.name),
+            })?);
+        }
+        let outcomes: Vec<String> = comparison
+            .policies
+            .iter()
+            .map(|p| format!("{} {}", p.label, p.seeds[i].outcome.name()))
+            .collect();
+        let page = PlayerPage {
+            title: format!("ronap compare: seed {seed}"),
+            traces: &traces,
+            note: Some(format!(
+                "{}; every policy's episode of this seed on one timeline",
+                outcomes.join(", ")
+            )),
+        };
+        let html = player_page(&page).map_err(|e| OutputError::Format {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
+        write_atomic(&path, |w| w.write_all(html.as_bytes()))?;
+        seeds.push(seed);
+    }
+    Ok(seeds)
+}
