@@ -370,3 +370,52 @@ fn a_team_scenario_is_compared_on_team_success_with_a_table_per_robot() {
         &["--by difficulty", "team scenarios"],
     );
 }
+
+#[test]
+fn every_seed_one_policy_alone_succeeded_on_gets_a_player_unless_capped() {
+    let dir = tempfile::tempdir().unwrap();
+    let players = |out: &Path| std::fs::read_dir(out.join("players")).map_or(0, |d| d.count());
+    let all = dir.path().join("all");
+    ok(&ronap(&[
+        "compare",
+        "--policy",
+        "apf",
+        "--policy",
+        "geodesic",
+        "--seeds",
+        "12",
+        "--out",
+        all.to_str().unwrap(),
+    ]));
+    let table = rows(&all.join("seeds.csv"));
+    let mixed = table[1..]
+        .iter()
+        .filter(|r| (r[1] == "success") != (r[4] == "success"))
+        .count();
+    assert!(mixed > 2, "{table:?}");
+    assert_eq!(players(&all), mixed);
+    let report = std::fs::read_to_string(all.join("report.md")).unwrap();
+    assert!(
+        report.contains(&format!("the {mixed} seeds where one policy succeeded")),
+        "{report}"
+    );
+    let two = dir.path().join("two");
+    ok(&ronap(&[
+        "compare",
+        "--policy",
+        "apf",
+        "--policy",
+        "geodesic",
+        "--seeds",
+        "12",
+        "--players",
+        "2",
+        "--out",
+        two.to_str().unwrap(),
+    ]));
+    assert_eq!(players(&two), 2);
+    assert_rejected(
+        &["compare", "--policy", "apf", "--players", "lots"],
+        &["lots", "all"],
+    );
+}

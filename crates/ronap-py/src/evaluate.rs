@@ -728,6 +728,7 @@ pub fn compare<'py>(
         difficulty_bins: bins,
         resamples,
         sheet_rows: sheet,
+        players: None,
         replace: force,
     };
     let info = CompareInfo {

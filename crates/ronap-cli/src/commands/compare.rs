@@ -64,6 +64,21 @@ pub struct CompareArgs {
     /// Seeds in the contact sheet of the most disagreeing seeds (disagreements.png); 0 for none.
     #[arg(long, value_name = "N", default_value_t = 6, value_parser = clap::value_parser!(u32).range(0..=50))]
     sheet: u32,
+    /// Side-by-side HTML players (players/seed-<seed>.html, linked from report.html) of the seeds
+    /// where one policy succeeded and another failed: all of them, or the N that disagree most
+    /// (0: none) [default: all].
+    #[arg(long, value_name = "N|all", value_parser = players)]
+    players: Option<usize>,
+}
+
+/// Parses `--players`: a count, or `all`.
+fn players(s: &str) -> Result<usize, String> {
+    match s {
+        "all" => Ok(usize::MAX),
+        _ => s
+            .parse::<usize>()
+            .map_err(|_| format!("{s:?}: expected a number of seeds or all")),
+    }
 }
 
 /// Runs `ronap compare`.
@@ -120,6 +135,7 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
         difficulty_bins: args.bins as usize,
         resamples: args.resamples as usize,
         sheet_rows: args.sheet as usize,
+        players: args.players.filter(|&n| n != usize::MAX),
         replace: args.force,
     };
     let info = CompareInfo {

@@ -9,9 +9,6 @@ use crate::render::chart;
 use crate::render::player::{player_page, PlayerPage, Trace};
 use std::path::Path;
 
-/// Most players a comparison writes (each a page of every policy's episode of one seed).
-pub const MAX_PLAYERS: usize = 50;
-
 /// The seeds where the policies disagree most (a split between success and failure first, the
 /// most even splits first, then the widest SPL spread), at most `rows` of them.
 pub fn disagreements(policies: &[PolicyResult], rows: usize) -> Vec<usize> {
@@ -87,16 +84,30 @@ pub(super) fn disagreement_sheet(
     Ok(Some(chart::contact_sheet(&columns, &sheet_rows, 160)))
 }
 
-/// Writes the player of each seed where the policies disagree most (at most [`MAX_PLAYERS`],
-/// in [`disagreements`]' order) into `dir/players/seed-SEED.html`: every policy's episode of the
-/// seed, run again recording its steps, side by side on one timeline. Returns those seeds.
+/// The seeds where the policies' successes differ (one succeeded, another did not), the most
+/// even splits first, at most `most` of them (`None`: all).
+pub fn success_disagreements(policies: &[PolicyResult], most: Option<usize>) -> Vec<usize> {
+    let n = policies.first().map_or(0, |p| p.seeds.len());
+    let mixed = |i: &usize| {
+        let wins = policies.iter().filter(|p| p.seeds[*i].success()).count();
+        wins > 0 && wins < policies.len()
+    };
+    let all = disagreements(policies, n).into_iter().filter(mixed);
+    all.take(most.unwrap_or(usize::MAX)).collect()
+}
+
+/// Writes the player of each seed where the policies' successes differ (all, or the `most` that
+/// disagree most, in [`disagreements`]' order) into `dir/players/seed-SEED.html`: every policy's
+/// episode of the seed, run again recording its steps, side by side on one timeline. Returns
+/// those seeds.
 pub(super) fn write_players(
     evaluator: &Evaluator,
     contenders: &[Contender],
     comparison: &Comparison,
     dir: &Path,
+    most: Option<usize>,
 ) -> Result<Vec<u64>, CompareError> {
-    let chosen = disagreements(&comparison.policies, MAX_PLAYERS);
+    let chosen = success_disagreements(&comparison.policies, most);
     if chosen.is_empty() {
         return Ok(Vec::new());
     }

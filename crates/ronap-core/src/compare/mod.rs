@@ -62,6 +62,9 @@ pub struct CompareOptions {
     pub resamples: usize,
     /// Seeds in the contact sheet of disagreements.
     pub sheet_rows: usize,
+    /// Most seeds to write a side-by-side player of (`players/`), the most disagreeing first;
+    /// `None`: every seed where the policies' successes differ.
+    pub players: Option<usize>,
     /// Write into an output directory that holds a comparison or other files (an earlier
     /// comparison's runs and report are replaced; other files kept).
     pub replace: bool,
@@ -76,6 +79,7 @@ impl Default for CompareOptions {
             difficulty_bins: 3,
             resamples: 10_000,
             sheet_rows: 6,
+            players: None,
             replace: false,
         }
     }
@@ -427,7 +431,8 @@ pub fn compare(
         };
         let sheet = disagreement_sheet(evaluator, contenders, &comparison, rows)?;
         report::remove_earlier(dir)?;
-        let players = disagreements::write_players(evaluator, contenders, &comparison, dir)?;
+        let players =
+            disagreements::write_players(evaluator, contenders, &comparison, dir, options.players)?;
         report::write_all(dir, &comparison, sheet.as_ref(), &players)?;
     }
     Ok(comparison)

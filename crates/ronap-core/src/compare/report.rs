@@ -685,21 +685,33 @@ struct Shown<'a> {
     players: &'a [u64],
 }
 
-/// The line above the links to the players of `players` (seeds).
-fn players_intro(players: &[u64]) -> String {
-    format!(
-        "Each policy's episode side by side on one timeline (play, step, scrub, follow a robot), \
-         for the {} where the policies disagree most{}:",
-        if players.len() == 1 {
+/// The line above the links to the players of `players` (seeds), of the seeds of `c` where one
+/// policy succeeded and another failed.
+fn players_intro(c: &Comparison, players: &[u64]) -> String {
+    let all = super::disagreements::success_disagreements(&c.policies, None).len();
+    let seeds = |n: usize| {
+        if n == 1 {
             "seed".to_string()
         } else {
-            format!("{} seeds", players.len())
-        },
-        if players.len() == super::disagreements::MAX_PLAYERS {
-            format!(" (at most {})", super::disagreements::MAX_PLAYERS)
-        } else {
-            String::new()
+            format!("{n} seeds")
         }
+    };
+    let which = if players.len() < all {
+        format!(
+            "the {} that disagree most of the {} where one policy succeeded and another failed \
+             (`--players all` for every one)",
+            seeds(players.len()),
+            seeds(all)
+        )
+    } else {
+        format!(
+            "the {} where one policy succeeded and another failed",
+            seeds(all)
+        )
+    };
+    format!(
+        "Each policy's episode side by side on one timeline (play, step, scrub, follow a robot), \
+         for {which}:"
     )
 }
 
@@ -730,7 +742,7 @@ fn markdown(c: &Comparison, shown: &Shown<'_>, config: &str) -> String {
         let _ = writeln!(
             md,
             "## Players\n\n{}\n{}\n",
-            players_intro(shown.players),
+            players_intro(c, shown.players),
             links.join(", ")
         );
     }
@@ -795,7 +807,7 @@ fn html(c: &Comparison, shown: &Shown<'_>, config: &str) -> String {
         let _ = write!(
             h,
             "<h2>Players</h2>\n<p>{}</p>\n<p class=\"players\">",
-            escape(&players_intro(shown.players))
+            escape(&players_intro(c, shown.players))
         );
         for s in shown.players {
             let _ = write!(h, " <a href=\"players/seed-{s:06}.html\">seed {s}</a>");
