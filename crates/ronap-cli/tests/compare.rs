@@ -375,18 +375,17 @@ fn a_team_scenario_is_compared_on_team_success_with_a_table_per_robot() {
 fn every_seed_one_policy_alone_succeeded_on_gets_a_player_unless_capped() {
     let dir = tempfile::tempdir().unwrap();
     let players = |out: &Path| std::fs::read_dir(out.join("players")).map_or(0, |d| d.count());
-    let all = dir.path().join("all");
-    ok(&ronap(&[
-        "compare",
-        "--policy",
-        "apf",
-        "--policy",
-        "geodesic",
-        "--seeds",
-        "12",
-        "--out",
-        all.to_str().unwrap(),
-    ]));
+    let compare = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec![
+            "compare", "--policy", "apf", "--policy", "geodesic", "--seeds", "12",
+        ];
+        args.extend_from_slice(extra);
+        args.extend_from_slice(&["--out", out.to_str().unwrap()]);
+        ok(&ronap(&args));
+        out
+    };
+    let all = compare("all", &[]);
     let table = rows(&all.join("seeds.csv"));
     let mixed = table[1..]
         .iter()
@@ -399,20 +398,7 @@ fn every_seed_one_policy_alone_succeeded_on_gets_a_player_unless_capped() {
         report.contains(&format!("the {mixed} seeds where one policy succeeded")),
         "{report}"
     );
-    let two = dir.path().join("two");
-    ok(&ronap(&[
-        "compare",
-        "--policy",
-        "apf",
-        "--policy",
-        "geodesic",
-        "--seeds",
-        "12",
-        "--players",
-        "2",
-        "--out",
-        two.to_str().unwrap(),
-    ]));
+    let two = compare("two", &["--players", "2"]);
     assert_eq!(players(&two), 2);
     assert_rejected(
         &["compare", "--policy", "apf", "--players", "lots"],

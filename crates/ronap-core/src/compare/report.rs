@@ -440,12 +440,7 @@ struct Picture {
 }
 
 fn png(image: &image::RgbImage) -> Result<Vec<u8>, image::ImageError> {
-    let mut bytes = Vec::new();
-    image.write_to(
-        &mut std::io::Cursor::new(&mut bytes),
-        image::ImageFormat::Png,
-    )?;
-    Ok(bytes)
+    crate::render::png_bytes(image)
 }
 
 /// The comparison's pictures.

@@ -9,7 +9,7 @@ use crate::io::run_dir::RunWriter;
 use crate::io::steplog::LoggedStep;
 use crate::job::replay::drive_team;
 use crate::job::{ReplayError, RobotLog};
-use crate::render::gif::{same_pose, AnimationError};
+use crate::render::gif::{check_logged_step, AnimationError};
 use crate::render::player::{player_page, Acted, PlayerPage, Recorder, Trace};
 use crate::sim::episode::Episode;
 use crate::sim::robot::{Action, Pose};
@@ -101,22 +101,7 @@ fn drive_lone(
     }
     let mut recorder = Recorder::new(&[&episode], episode.movers(), false);
     for (k, &action) in actions.iter().enumerate() {
-        if let Some(poses) = logged {
-            let model = episode.pose();
-            if !same_pose(poses[k], model) {
-                return Err(AnimationError::Diverged {
-                    step: k + 1,
-                    logged: poses[k],
-                    model,
-                });
-            }
-        }
-        if episode.status().is_done() {
-            return Err(AnimationError::EndedEarly {
-                step: k + 1,
-                status: episode.status().name(),
-            });
-        }
+        check_logged_step(&episode, logged, k)?;
         let r = episode.step(action);
         let acted = [Some(Acted {
             action,

@@ -175,22 +175,7 @@ pub fn animate(
     // Each frame is written when the next one is known, so the last can be held longer.
     let mut pending = first;
     for (k, &action) in actions.iter().enumerate() {
-        if let Some(poses) = logged {
-            let model = episode.pose();
-            if !same_pose(poses[k], model) {
-                return Err(AnimationError::Diverged {
-                    step: k + 1,
-                    logged: poses[k],
-                    model,
-                });
-            }
-        }
-        if episode.status().is_done() {
-            return Err(AnimationError::EndedEarly {
-                step: k + 1,
-                status: episode.status().name(),
-            });
-        }
+        check_logged_step(&episode, logged, k)?;
         let r = episode.step(action);
         if !r.collided {
             path.push(r.pose.position());
@@ -210,6 +195,32 @@ pub fn animate(
         steps: actions.len(),
         size: (width, height),
     })
+}
+
+/// Before replaying logged step `k` (from 0) on `episode`: the model's pose must be the logged
+/// one (`logged`, when the log has poses), and the episode must still be going.
+pub(crate) fn check_logged_step(
+    episode: &Episode,
+    logged: Option<&[Pose]>,
+    k: usize,
+) -> Result<(), AnimationError> {
+    if let Some(poses) = logged {
+        let model = episode.pose();
+        if !same_pose(poses[k], model) {
+            return Err(AnimationError::Diverged {
+                step: k + 1,
+                logged: poses[k],
+                model,
+            });
+        }
+    }
+    if episode.status().is_done() {
+        return Err(AnimationError::EndedEarly {
+            step: k + 1,
+            status: episode.status().name(),
+        });
+    }
+    Ok(())
 }
 
 /// Whether two poses agree to a log's precision (headings compared around the circle).

@@ -295,6 +295,16 @@ pub const PALETTE: [Rgb<u8>; 11] = [
     MOVER_TRACK,
 ];
 
+/// `image` encoded as a PNG file's bytes (for pages and reports that inline their pictures).
+pub fn png_bytes(image: &image::RgbImage) -> Result<Vec<u8>, image::ImageError> {
+    let mut bytes = Vec::new();
+    image.write_to(
+        &mut std::io::Cursor::new(&mut bytes),
+        image::ImageFormat::Png,
+    )?;
+    Ok(bytes)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -101,6 +101,13 @@ def load_scenario(scenario: ScenarioLike | _ronap.Scenario | None) -> _ronap.Sce
     raise ConfigError(f"scenario {scenario!r}: expected the path of a TOML scenario file or a dict nested like one")
 
 
+def init_arguments(arguments: dict[str, Any]) -> dict[str, Any]:
+    """A constructor's arguments as ``locals()`` holds them on its first line (``self`` left out,
+    ``**fields`` spread): what pickling needs to build the object again."""
+    kept = {k: v for k, v in arguments.items() if k not in ("self", "__class__", "fields")}
+    return {**kept, **arguments.get("fields", {})}
+
+
 def located(error: Exception, config: _ronap.Config) -> Exception:
     """``error`` with the scenario file and line of the ``[[moving]]`` / ``[[crowd]]`` field it
     names in front (a crowd pattern that leaves the scene is found only once the scene is built),

@@ -14,7 +14,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_path, checked_int, located, split_draw_limit, split_range, split_seed
+from .config import ScenarioLike, checked_config, checked_path, checked_int, init_arguments, located, split_draw_limit, split_range, split_seed
 
 
 class NavEnv(gym.Env[np.ndarray, Any]):
@@ -79,6 +79,8 @@ class NavEnv(gym.Env[np.ndarray, Any]):
         seed_step: int | None = None,
         **fields: Any,
     ) -> None:
+        # What pickling needs to build this object again (see __getstate__).
+        self._init_args = init_arguments(locals())
         if render_mode not in (None, "rgb_array"):
             raise _ronap.ConfigError(f"render_mode {render_mode!r}: expected None or 'rgb_array'")
         if render_view not in ("top", "first_person"):
@@ -91,20 +93,6 @@ class NavEnv(gym.Env[np.ndarray, Any]):
         checked = checked_config(config, fields, scenario)
         self._checked = checked
         self._env = _ronap.Env(checked, maze_seed, checked_path("map", map), continuous)
-        # What pickling needs to build this environment again (see __getstate__).
-        self._init_args = dict(
-            render_mode=render_mode,
-            scenario=scenario,
-            config=config,
-            continuous=continuous,
-            maze_seed=maze_seed,
-            map=map,
-            render_view=render_view,
-            render_scale=render_scale,
-            split=split,
-            seed_step=seed_step,
-            **fields,
-        )
         self._episode: tuple[int, list[Any]] | None = None
         self.config = json.loads(checked.json)
         self.render_mode = render_mode
@@ -271,6 +259,8 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         split: str | None = None,
         **fields: Any,
     ) -> None:
+        # What pickling needs to build this object again (see __getstate__).
+        self._init_args = init_arguments(locals())
         num_envs = checked_int("num_envs", num_envs, least=1, below=2**31)
         if split is not None:
             split_range(split)
@@ -315,24 +305,6 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         self._all = np.ones(num_envs, dtype=bool)
         self._rng = np.random.default_rng()
         self._started = False
-        # What pickling needs: the arguments, and the calls into Rust since the last reset of
-        # every environment (replayed by __setstate__; 8 bytes per environment and step).
-        self._init_args = dict(
-            num_envs=num_envs,
-            scenario=scenario,
-            config=config,
-            maze_seed=maze_seed,
-            map=map,
-            threads=threads,
-            continuous=continuous,
-            autoreset_mode=mode,
-            render_mode=render_mode,
-            render_view=render_view,
-            render_scale=render_scale,
-            max_episode_steps=None,
-            split=split,
-            **fields,
-        )
         self._calls: list[tuple[str, Any, Any]] = []
 
     def _infos(self, infos: dict[str, Any], mask: np.ndarray) -> dict[str, Any]:

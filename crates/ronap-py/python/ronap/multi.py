@@ -9,7 +9,7 @@ import numpy as np
 from gymnasium import spaces
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_path, checked_int, split_draw_limit, split_range, split_seed
+from .config import ScenarioLike, checked_config, checked_path, checked_int, init_arguments, split_draw_limit, split_range, split_seed
 from .env import discrete_actions
 
 if TYPE_CHECKING:
@@ -77,6 +77,8 @@ class MultiNavEnv(_Base):
         split: str | None = None,
         **fields: Any,
     ) -> None:
+        # What pickling needs to build this object again (see __getstate__).
+        self._init_args = init_arguments(locals())
         if render_mode not in (None, "rgb_array"):
             raise _ronap.ConfigError(f"render_mode {render_mode!r}: expected None or 'rgb_array'")
         if split is not None:
@@ -87,19 +89,6 @@ class MultiNavEnv(_Base):
         self._status: dict[str, str] = {}
         self._inbox: dict[str, list[dict[str, Any]]] = {}
         self._env = _ronap.MultiEnv(checked, maze_seed, checked_path("map", map), continuous)
-        # What pickling needs to build this environment again (see __getstate__).
-        self._init_args = dict(
-            render_mode=render_mode,
-            scenario=scenario,
-            config=config,
-            continuous=continuous,
-            maze_seed=maze_seed,
-            map=map,
-            render_scale=render_scale,
-            text_infos=text_infos,
-            split=split,
-            **fields,
-        )
         self._episode: tuple[int, list[tuple[list[Any], Any]]] | None = None
         self.config = json.loads(checked.json)
         self.render_mode = render_mode
@@ -341,6 +330,8 @@ class VecMultiNavEnv:
         split: str | None = None,
         **fields: Any,
     ) -> None:
+        # What pickling needs to build this object again (see __getstate__).
+        self._init_args = init_arguments(locals())
         num_envs = checked_int("num_envs", num_envs, least=1, below=2**31)
         threads = checked_int("threads", threads, below=2**16)
         if split is not None:
@@ -358,8 +349,6 @@ class VecMultiNavEnv:
         self.single_action_space = spaces.Discrete(3)
         self._started = False
         self.seed_used: int | None = None
-        # What pickling needs: the arguments and the calls since the last reset (see __getstate__).
-        self._init_args = dict(num_envs=num_envs, scenario=scenario, config=config, maze_seed=maze_seed, map=map, threads=threads, split=split, **fields)
         self._calls: list[tuple[Any, Any]] = []
 
     def reset(self, seed: int | None = None) -> tuple[np.ndarray, dict[str, np.ndarray]]:

@@ -338,10 +338,22 @@ impl RunWriter {
     /// Writes the animation of episode `seed`, which ended as `outcome` (`bytes`, a GIF, or why
     /// it could not be drawn); a failure is kept for the end, as [`RunWriter::episode`] does.
     pub fn animation(&self, seed: u64, outcome: Outcome, bytes: Result<&[u8], String>) {
+        self.episode_file(("gif", "gif"), seed, outcome, bytes);
+    }
+
+    /// Writes `folder/seed-SEED-OUTCOME.extension` (`bytes`, or why they could not be made),
+    /// keeping a failure for the end.
+    fn episode_file(
+        &self,
+        (folder, extension): (&str, &str),
+        seed: u64,
+        outcome: Outcome,
+        bytes: Result<&[u8], String>,
+    ) {
         let path = self
             .dir
-            .join("gif")
-            .join(format!("seed-{seed:06}-{}.gif", outcome.name()));
+            .join(folder)
+            .join(format!("seed-{seed:06}-{}.{extension}", outcome.name()));
         let written = match bytes {
             Ok(b) => self
                 .make_ready()
@@ -378,19 +390,7 @@ impl RunWriter {
     /// Writes the player of episode `seed`, which ended as `outcome` (`page`, its HTML, or why it
     /// could not be made); a failure is kept for the end, as [`RunWriter::episode`] does.
     pub fn player(&self, seed: u64, outcome: Outcome, page: Result<&[u8], String>) {
-        let path = self
-            .dir
-            .join("html")
-            .join(format!("seed-{seed:06}-{}.html", outcome.name()));
-        let written = match page {
-            Ok(b) => self
-                .make_ready()
-                .and_then(|()| write_atomic(&path, |w| w.write_all(b))),
-            Err(message) => Err(OutputError::Format { path, message }),
-        };
-        if let Err(e) = written {
-            self.note(e);
-        }
+        self.episode_file(("html", "html"), seed, outcome, page);
     }
 
     /// Records the front end's own options in the run's plan, for a later `--resume`.

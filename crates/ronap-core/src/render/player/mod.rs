@@ -134,13 +134,7 @@ fn background_png(trace: &Trace) -> Result<Vec<u8>, image::ImageError> {
     let scene = &trace.scene;
     let side = scene.width().max(scene.height()).max(1.0);
     let scale = (BACKGROUND_SIDE_PX / side).min(4.0);
-    let image = crate::render::Canvas::new(scene, scale).into_image();
-    let mut bytes = Vec::new();
-    image.write_to(
-        &mut std::io::Cursor::new(&mut bytes),
-        image::ImageFormat::Png,
-    )?;
-    Ok(bytes)
+    crate::render::png_bytes(&crate::render::Canvas::new(scene, scale).into_image())
 }
 
 /// The quantum of positions, distances and readings in a scene whose longer side is `side_px`:
