@@ -679,6 +679,7 @@ pub fn compare<'py>(
     let bins: usize = o.take("bins", 3)?;
     let resamples: usize = o.take("resamples", 10_000)?;
     let sheet: usize = o.take("sheet", 6)?;
+    let players: Option<usize> = o.take("players", None)?;
     let thread_safe: bool = o.take("thread_safe", false)?;
     let command: Option<String> = o.take("command", None)?;
     let force: bool = o.take("force", false)?;
@@ -728,7 +729,7 @@ pub fn compare<'py>(
         difficulty_bins: bins,
         resamples,
         sheet_rows: sheet,
-        players: None,
+        players,
         replace: force,
     };
     let info = CompareInfo {
@@ -780,7 +781,7 @@ fn warn_if_not_held_out(
                 py,
                 &category,
                 &std::ffi::CString::new(w).unwrap_or_default(),
-                1,
+                2,
             )
         }
         None => Ok(()),
@@ -893,7 +894,18 @@ impl PyBlockRun {
 
 /// Checks that `policy` can run under `config` (a known name, a weights file that fits the
 /// observation, or a callable) without running it; raises `ConfigError` naming what is wrong.
+/// Given the run's `seeds`, warns (`UserWarning`) when some are among those a trained network
+/// was trained or chosen on.
 #[pyfunction]
-pub fn check_policy(policy: &Bound<'_, PyAny>, config: &Config) -> PyResult<()> {
-    policy_factory(policy, config.valid(), false, false).map(|_| ())
+#[pyo3(signature = (policy, config, seeds = None))]
+pub fn check_policy(
+    policy: &Bound<'_, PyAny>,
+    config: &Config,
+    seeds: Option<Vec<u64>>,
+) -> PyResult<()> {
+    let (factory, name) = policy_factory(policy, config.valid(), false, false)?;
+    match seeds {
+        Some(seeds) => warn_if_not_held_out(policy.py(), &name, factory.as_ref(), &seeds),
+        None => Ok(()),
+    }
 }

@@ -225,3 +225,25 @@ def test_gymnasiums_own_vector_envs_play_vecnavenvs_episodes_with_seed_step():
         seeds_seen.update(int(s) for s in ia["seed"])
         assert list(ia["seed"]) == list(ib["seed"])
     assert len(seeds_seen) > 2 * n
+
+
+def test_copies_hold_their_own_actions_and_vector_seeds_stay_in_their_split():
+    vec = ronap.VecNavEnv(2, maze_cols=4, maze_rows=4)
+    vec.reset(seed=1)
+    buffer = np.zeros(2, np.int64)
+    for t in range(40):
+        buffer[:] = (t % 3, (t + 1) % 3)  # one buffer, rewritten each step, as loops do
+        vec.step(buffer)
+    twin = copy.deepcopy(vec)
+    buffer[:] = (1, 1)
+    np.testing.assert_array_equal(twin.step(buffer)[0], vec.step(buffer)[0])
+    near_end = ronap.VecNavEnv(2, split="validation", episode_max_steps=3)
+    near_end.reset(seed=499_998)
+    with pytest.raises(ronap.ConfigError, match="past the validation split"):
+        for _ in range(10):
+            near_end.step(np.ones(2, int))
+    # A copy keeps the spec gymnasium.make gave (its flags, not a default one).
+    import gymnasium as gym
+
+    made = pickle.loads(pickle.dumps(gym.make("ronap/Nav-v0", episode_max_steps=50, disable_env_checker=True).unwrapped))
+    assert made.spec.disable_env_checker is True and made.spec.max_episode_steps == 50

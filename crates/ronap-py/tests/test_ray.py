@@ -214,3 +214,12 @@ def test_a_team_scenario_is_refused_before_ray_starts(tmp_path):
     )
     assert r.returncode == 2 and "a team of 8" in r.stderr and not (tmp_path / "cli").exists()
     assert "Started a local Ray instance" not in r.stderr
+
+
+def test_splits_and_the_held_out_warning_as_evaluate(cluster, ronap_bin, tmp_path):
+    with pytest.warns(UserWarning, match="trained or chosen on"):
+        ronap.ray.evaluate(f"mlp:{ROOT / 'policies' / 'dqn.safetensors'}", range(3), split="validation", out=tmp_path / "ray", block=2)
+    ronap_run(ronap_bin, tmp_path / "one", "--policy", f"mlp:{ROOT / 'policies' / 'dqn.safetensors'}", "--seeds", "3", "--split", "validation")
+    assert (tmp_path / "ray" / "episodes.csv").read_bytes() == (tmp_path / "one" / "episodes.csv").read_bytes()
+    with pytest.raises(ronap.ConfigError, match="split"):
+        ronap.ray.evaluate("apf", range(3), split="dev")

@@ -141,6 +141,18 @@ pub struct TeamRecord {
     pub scene: Option<Arc<crate::Scene>>,
 }
 
+impl TeamRecord {
+    /// Why the team ended as it did, when a robot's record says: the first robot whose outcome
+    /// is the team's (an infeasible task names the robots and the passage, a planner that gave
+    /// up says why).
+    pub fn reason(&self) -> Option<&str> {
+        self.robots
+            .iter()
+            .filter(|x| x.outcome == self.outcome)
+            .find_map(|x| x.reason.as_deref())
+    }
+}
+
 /// `sum / n`, or 0 for none.
 fn over(sum: f64, n: usize) -> f64 {
     if n == 0 {

@@ -21,8 +21,7 @@ pub const TEAM_COLUMNS: [&str; 11] = [
     "reason",
 ];
 
-/// The team `episodes.csv` row of `r`. Its `reason` is the first robot's whose outcome is the
-/// team's (an infeasible task's names the robots and the passage), empty when none gives one.
+/// The team `episodes.csv` row of `r` (its `reason` empty when [`TeamRecord::reason`] has none).
 pub fn team_episode_row(r: &TeamRecord) -> Vec<String> {
     vec![
         r.seed.to_string(),
@@ -39,11 +38,7 @@ pub fn team_episode_row(r: &TeamRecord) -> Vec<String> {
         r.collisions.to_string(),
         r.robot_collisions.to_string(),
         r.deadlock.to_string(),
-        r.robots
-            .iter()
-            .filter(|x| x.outcome == r.outcome)
-            .find_map(|x| x.reason.clone())
-            .unwrap_or_default(),
+        r.reason().unwrap_or_default().to_string(),
     ]
 }
 

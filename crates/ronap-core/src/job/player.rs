@@ -189,6 +189,9 @@ pub(crate) fn team_record(
     if let Some(first) = trace.headline.first_mut() {
         first.1 = record.outcome.name().to_string();
     }
+    if let Some(reason) = record.reason() {
+        trace.headline.push(("why".into(), reason.to_string()));
+    }
     trace.title = format!("seed {}, {policy}", record.seed);
     Ok(trace)
 }

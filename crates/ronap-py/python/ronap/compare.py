@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any, Callable, Iterable, Mapping, Sequence
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_path, checked_seeds, refuse_sb3_thread_safe, split_seed
+from .config import ScenarioLike, checked_config, checked_int, checked_path, checked_seeds, refuse_sb3_thread_safe, split_seed
 
 
 def compare(
@@ -24,6 +24,7 @@ def compare(
     bins: int = 3,
     resamples: int = 10_000,
     sheet: int = 6,
+    players: int | None = None,
     thread_safe: bool = False,
     split: str | None = None,
     force: bool = False,
@@ -49,7 +50,9 @@ def compare(
     (``ronap run`` / ``evaluate(out=...)``) to reuse instead of running their policy again; each
     must record the same configuration, scenes and seeds. With ``out``, writes everything
     ``ronap compare --out`` writes: ``runs/<policy>/``, ``compare.png``, ``outcomes.png``,
-    ``disagreements.png``, ``seeds.csv``, ``compare.json``, ``report.md`` and ``report.html``.
+    ``disagreements.png``, ``seeds.csv``, ``compare.json``, ``report.md``, ``report.html`` and
+    ``players/``: a side-by-side HTML player of every seed where one policy succeeded and another
+    failed (about 90 KB a seed for two policies), or of the ``players`` that disagree most.
     ``out`` must be new or empty unless ``force=True`` (as ``ronap compare --force``). The
     configuration, ``split`` and ``thread_safe`` are given as for ``evaluate``.
     """
@@ -73,6 +76,7 @@ def compare(
         bins=bins,
         resamples=resamples,
         sheet=sheet,
+        players=None if players is None else checked_int("players", players),
         thread_safe=thread_safe,
         command=command,
         force=force,

@@ -202,6 +202,26 @@ def split_seed(split: str | None, seed: int, name: str = "seed") -> int:
     return first + seed
 
 
+COPY_LIMIT = 100_000
+"""Most steps since its last full reset a vector environment keeps to be copied by replaying
+them (``pickle``, ``copy.deepcopy``): 8 bytes an environment a step at most; a longer stretch is
+not kept and a copy is refused, naming why."""
+
+
+def check_split_seeds(split: str | None, seeds: Any) -> None:
+    """Refuses episode seeds that have left ``split`` (a vector environment's next seeds, ``s +
+    i + n``, run on past a split's end), naming the split and the first such seed."""
+    if split is None or split == "train":
+        return
+    first, last = split_range(split)
+    beyond = [int(s) for s in seeds if not first <= int(s) <= last]
+    if beyond:
+        raise ConfigError(
+            f"episode seed {beyond[0]}: the environments' next seeds have run past the {split} split "
+            f"({first}..={last}); reset() with a seed nearer its start, or fewer environments"
+        )
+
+
 def split_draw_limit(split: str | None, room: int = 1) -> int:
     """How far a random seed index may go in ``split`` leaving ``room`` seeds after it (2^63 with
     no split)."""

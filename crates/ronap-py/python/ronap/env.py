@@ -14,7 +14,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_path, checked_int, init_arguments, located, split_draw_limit, split_range, split_seed
+from .config import ScenarioLike, checked_config, checked_path, checked_int, init_arguments, located, split_draw_limit, split_range, split_seed, check_split_seeds, COPY_LIMIT
 
 
 class NavEnv(gym.Env[np.ndarray, Any]):
@@ -137,7 +137,8 @@ class NavEnv(gym.Env[np.ndarray, Any]):
             index = self._index + self.seed_step
         else:
             index = int(self.np_random.integers(0, split_draw_limit(self.split)))
-        episode_seed = split_seed(self.split, index)
+        name = "seed" if seed is not None else f"the next seed by seed_step ({self.seed_step}), index"
+        episode_seed = split_seed(self.split, index, name)
         self._index = index
         self._episode = (int(episode_seed), [])
         try:
@@ -162,12 +163,19 @@ class NavEnv(gym.Env[np.ndarray, Any]):
         """How to build this environment again and replay its episode so far: the model is
         deterministic, so the copy continues exactly where this one is (for Ray, multiprocessing
         and copy.deepcopy). A scenario given as a file is read again where the copy is made."""
-        return {"init": self._init_args, "episode": self._episode, "np_random": self._np_random, "index": self._index}
+        return {
+            "init": self._init_args,
+            "episode": self._episode,
+            "np_random": self._np_random,
+            "index": self._index,
+            "spec": self.__dict__.get("_spec"),
+        }
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__init__(**state["init"])  # type: ignore[misc]
         self._np_random = state["np_random"]
         self._index = state.get("index")
+        self.__dict__["_spec"] = state.get("spec")
         if state["episode"] is not None:
             seed, actions = state["episode"]
             self._env.reset(seed)
@@ -305,7 +313,16 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         self._all = np.ones(num_envs, dtype=bool)
         self._rng = np.random.default_rng()
         self._started = False
-        self._calls: list[tuple[str, Any, Any]] = []
+        self._calls: list[tuple[str, Any, Any]] | None = []
+
+    def _logged(self, call: tuple[str, Any, Any], full_reset: bool = False) -> None:
+        """Keeps `call` for copies, up to ``COPY_LIMIT`` steps since the last full reset."""
+        if full_reset:
+            self._calls = []
+        if self._calls is not None and len(self._calls) >= COPY_LIMIT:
+            self._calls = None
+        if self._calls is not None:
+            self._calls.append(call)
 
     def _infos(self, infos: dict[str, Any], mask: np.ndarray) -> dict[str, Any]:
         """Gymnasium's vector infos: every value an array over the environments, and beside each
@@ -365,9 +382,8 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
             obs, infos, _ = self._vec.reset(seeds, flags)
         except _ronap.SceneError as e:
             raise located(e, self._checked) from None
-        if flags is None:
-            self._calls.clear()
-        self._calls.append(("reset", seeds, flags))
+        self._logged(("reset", seeds, flags), full_reset=flags is None)
+        check_split_seeds(self.split, infos["seed"])
         self._started = True
         return obs, self._infos(infos, self._all if mask is None else mask.copy())
 
@@ -379,7 +395,8 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         else:
             a = discrete_actions(actions, (self.num_envs,))
         obs, rewards, terminated, truncated, infos, finals = self._vec.step(a)
-        self._calls.append(("step", a, None))
+        self._logged(("step", a.copy(), None))
+        check_split_seeds(self.split, infos["seed"])
         infos = self._infos(infos, self._all)
         if finals is not None:
             ended, last, final_infos = finals
@@ -395,7 +412,13 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
     def __getstate__(self) -> dict[str, Any]:
         """How to build this vector environment again and bring every environment to where it
         is: its arguments and the resets and actions since the last reset of them all (the
-        model is deterministic), for ``pickle`` and ``copy.deepcopy``."""
+        model is deterministic), for ``pickle`` and ``copy.deepcopy``; refused after more than
+        ``COPY_LIMIT`` steps since the last full reset (the record is not kept that long)."""
+        if self._calls is None:
+            raise _ronap.RonapError(
+                f"cannot copy a VecNavEnv more than {COPY_LIMIT} steps after its last reset() of every "
+                "environment: a copy replays them, and so many are not kept; reset() first"
+            )
         return {"init": self._init_args, "calls": self._calls, "rng": self._rng, "started": self._started}
 
     def __setstate__(self, state: dict[str, Any]) -> None:

@@ -9,7 +9,7 @@ import numpy as np
 from gymnasium import spaces
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_path, checked_int, init_arguments, split_draw_limit, split_range, split_seed
+from .config import ScenarioLike, checked_config, checked_path, checked_int, init_arguments, split_draw_limit, split_range, split_seed, check_split_seeds, COPY_LIMIT
 from .env import discrete_actions
 
 if TYPE_CHECKING:
@@ -349,7 +349,7 @@ class VecMultiNavEnv:
         self.single_action_space = spaces.Discrete(3)
         self._started = False
         self.seed_used: int | None = None
-        self._calls: list[tuple[Any, Any]] = []
+        self._calls: list[tuple[Any, Any]] | None = []
 
     def reset(self, seed: int | None = None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Restarts every environment: environment ``i`` plays seeds ``seed + i``, ``seed + i +
@@ -377,12 +377,24 @@ class VecMultiNavEnv:
             if m.shape != (*shape, self.message_size):
                 raise _ronap.ActionError(f"messages of shape {m.shape}: expected {(*shape, self.message_size)}")
             flat_messages = m.reshape(-1)
-        self._calls.append((a.reshape(-1), flat_messages))
-        return self._vec.step(a.reshape(-1), flat_messages)
+        if self._calls is not None:
+            kept = (a.reshape(-1).copy(), None if flat_messages is None else flat_messages.copy())
+            if len(self._calls) < COPY_LIMIT:
+                self._calls.append(kept)
+            else:
+                self._calls = None
+        stepped = self._vec.step(a.reshape(-1), flat_messages)
+        check_split_seeds(self.split, stepped[4]["seed"])
+        return stepped
 
     def __getstate__(self) -> dict[str, Any]:
         """Its arguments, seed and the actions since the last reset, replayed where the copy is
         made (``pickle``, ``copy.deepcopy``): the copy continues exactly where this one is."""
+        if self._calls is None:
+            raise _ronap.RonapError(
+                f"cannot copy a VecMultiNavEnv more than {COPY_LIMIT} steps after its reset(): a copy "
+                "replays them, and so many are not kept; reset() first"
+            )
         return {"init": self._init_args, "seed": self.seed_used if self._started else None, "calls": self._calls}
 
     def __setstate__(self, state: dict[str, Any]) -> None:

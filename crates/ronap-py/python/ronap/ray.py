@@ -40,7 +40,7 @@ from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_int, checked_seeds
+from .config import ScenarioLike, checked_config, checked_int, checked_seeds, split_seed
 
 __all__ = ["evaluate", "main"]
 
@@ -133,6 +133,7 @@ def evaluate(
     map: str | None = None,
     progress: bool = False,
     force: bool = False,
+    split: str | None = None,
     **fields: Any,
 ) -> dict[str, Any]:
     """Runs ``policy`` over ``seeds`` as Ray tasks of ``block`` seeds each (``cpus_per_task``
@@ -143,10 +144,11 @@ def evaluate(
     (``ConfigError``) before Ray starts. Returns ``{"summary": ..., "table": ..., "out": ...}``;
     the summary's wall time is the run's, Ray's start left out (``progress=True`` prints it, and
     the episodes done, on stderr). ``out`` must be new or empty unless ``force=True``, as for
-    ``ronap.evaluate``. The configuration keywords are ``ronap.evaluate``'s."""
+    ``ronap.evaluate``. The configuration keywords and ``split`` are ``ronap.evaluate``'s, and so is the
+    warning when the seeds meet a trained network's own."""
     import ray
 
-    seeds = checked_seeds(seeds)
+    seeds = [split_seed(split, s, f"seeds[{i}]") for i, s in enumerate(checked_seeds(seeds))]
     if not seeds:
         raise _ronap.ConfigError("seeds is empty: give at least one seed")
     block = checked_int("block", block, least=1, below=2**31)
@@ -155,7 +157,7 @@ def evaluate(
         raise _ronap.ConfigError(f"cpus_per_task = {cpus_per_task!r}: must be above 0")
     checked = checked_config(config, fields, scenario)
     _check_single_robot(checked)
-    _ronap.check_policy(policy, checked)
+    _ronap.check_policy(policy, checked, seeds)
     payload = _payload(policy)
     if not ray.is_initialized():
         started = time.perf_counter()
@@ -218,7 +220,8 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument("--policy", required=True, help="a built-in policy (apf, geodesic, random, ...) or mlp:FILE")
     p.add_argument("--seeds", type=int, default=1000, help="how many seeds")
-    p.add_argument("--seed-start", type=int, default=0, help="the first seed")
+    p.add_argument("--seed-start", type=int, default=0, help="the first seed (with --split, counted from the split's first)")
+    p.add_argument("--split", choices=("test", "validation", "train"), default=None, help="play a named split's seeds, as ronap run --split")
     p.add_argument("--out", required=True, help="the run directory to write")
     p.add_argument(
         "--address", default=None, help="the Ray cluster to join (auto: the one this machine is in); none: start a local one on 127.0.0.1"
@@ -246,6 +249,7 @@ def main(argv: list[str] | None = None) -> int:
             maze_seed=args.maze_seed,
             map=args.map,
             progress=True,
+            split=args.split,
         )
     except _ronap.RonapError as e:
         print(f"error: {e}", file=sys.stderr)

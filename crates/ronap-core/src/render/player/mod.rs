@@ -205,7 +205,13 @@ impl Column {
 /// The page data of `trace`: its JSON header and its deflated columns.
 fn encode(trace: &Trace) -> (serde_json::Value, Vec<u8>) {
     let scene = &trace.scene;
-    let q = position_quantum(scene.width().max(scene.height()));
+    // Readings reach as far as the laser does, which may be past the scene's side.
+    let reach = trace
+        .robots
+        .iter()
+        .map(|r| r.range_px)
+        .fold(scene.width().max(scene.height()), f64::max);
+    let q = position_quantum(reach);
     let names = [
         "x",
         "y",
