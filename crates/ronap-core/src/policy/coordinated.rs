@@ -850,29 +850,37 @@ impl TeamPolicy for Coordinated {
                     // Among moving obstacles, which no plan keeps clear, ORCA as the `orca`
                     // policy takes it: its horizon and margin.
                     mover_near = near.iter().any(|&j| j as usize >= robot_agents);
-                    let (horizon, margin) = if mover_near {
-                        (config.orca.time_horizon_steps, config.orca.safety_margin_px)
+                    if !mover_near && actions == PlannerActions::Discrete {
+                        // Among robots alone, the plan's cells (sized for a discrete step's
+                        // reach) keep them apart; ORCA would only shorten a velocity below
+                        // half a step, which a discrete robot answers by turning on the spot,
+                        // never reaching its cell.
+                        preferred
                     } else {
-                        (TIME_HORIZON_STEPS, 0.0)
-                    };
-                    self.avoider.velocity(
-                        me.scene(),
-                        &Avoid {
-                            agents: &self.agents,
-                            me: slot,
-                            preferred,
-                            horizon: Horizon {
-                                agents: horizon,
-                                obstacles: config.orca.obstacle_time_horizon_steps,
-                                max_speed: speed,
-                                time_step: 1.0,
+                        let (horizon, margin) = if mover_near {
+                            (config.orca.time_horizon_steps, config.orca.safety_margin_px)
+                        } else {
+                            (TIME_HORIZON_STEPS, 0.0)
+                        };
+                        self.avoider.velocity(
+                            me.scene(),
+                            &Avoid {
+                                agents: &self.agents,
+                                me: slot,
+                                preferred,
+                                horizon: Horizon {
+                                    agents: horizon,
+                                    obstacles: config.orca.obstacle_time_horizon_steps,
+                                    max_speed: speed,
+                                    time_step: 1.0,
+                                },
+                                neighbour_dist: range,
+                                max_neighbours: config.orca.max_neighbours as usize,
+                                margin,
+                                candidates: Some(near),
                             },
-                            neighbour_dist: range,
-                            max_neighbours: config.orca.max_neighbours as usize,
-                            margin,
-                            candidates: Some(near),
-                        },
-                    )
+                        )
+                    }
                 }
                 None => preferred,
             };
