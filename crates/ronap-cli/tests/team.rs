@@ -539,6 +539,41 @@ fn coordinated_brings_both_robots_through_the_corridor_with_a_bay() {
 }
 
 #[test]
+fn coordinated_brings_both_discrete_robots_through_the_corridor_with_a_bay() {
+    // The paper's actions: turns of 15 degrees on the spot and steps of 5 px. The robot
+    // planned first must wait in the corridor while the other gives way in the bay, which a
+    // priority order cannot plan; the two are planned together.
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = dir.path().join("corridor-bay-discrete.toml");
+    let text =
+        std::fs::read_to_string(repo_root().join("scenarios").join("corridor-bay.toml")).unwrap();
+    assert!(!text.contains("[orca]"), "the scenario has an [orca] table");
+    std::fs::write(
+        &scenario,
+        format!("{text}\n[orca]\nactions = \"discrete\"\n"),
+    )
+    .unwrap();
+    let out = dir.path().join("bay");
+    let table = ok(&ronap(&[
+        "run",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--policy",
+        "coordinated",
+        "--seeds",
+        "3",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    assert!(
+        table.contains("team success            100.0% (3 of 3"),
+        "{table}"
+    );
+    assert_eq!(row(&table, "robot collisions"), "0.00 per episode");
+    assert_eq!(row(&table, "wall collisions"), "0.00 per episode");
+}
+
+#[test]
 fn coordinated_brings_every_warehouse_team_home_with_no_deadlock() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("warehouse");

@@ -34,7 +34,7 @@ use crate::geometry::orca::{Agent, Horizon, V2};
 use crate::geometry::point_grid::PointGrid;
 use crate::geometry::{Point, Vector};
 use crate::plan::team::{
-    pair_feasible, plan_team, Limits, Pair, PlanFailure, PlanGrid, Schedule, Stop, Task,
+    pair_feasible, pair_plan, plan_team, Limits, Pair, PlanFailure, PlanGrid, Schedule, Stop, Task,
 };
 use crate::sim::avoid::{Avoid, Avoider};
 use crate::sim::episode::Episode;
@@ -65,6 +65,18 @@ fn reach_px(me: &Episode, actions: PlannerActions) -> f64 {
     match actions {
         PlannerActions::Continuous => 1.0,
         PlannerActions::Discrete => me.config().robot.move_speed_px / 2.0 + 0.5,
+    }
+}
+
+/// How far beyond a cell's free disc a robot may stand while it counts as on the cell or on
+/// its way between two, px: continuous actions keep to the line between centres (none); a
+/// discrete step may end anywhere within `reach` of a centre, so a cell is free only where
+/// the robot's disc fits that far off its centre (else its last step onto a cell beside a
+/// wall runs into the wall, again and again).
+fn overshoot_px(reach: f64, actions: PlannerActions) -> f64 {
+    match actions {
+        PlannerActions::Continuous => 0.0,
+        PlannerActions::Discrete => reach,
     }
 }
 
@@ -535,7 +547,7 @@ impl Coordinated {
         let anchors: Vec<Point> = team.robots().iter().map(|r| r.pose().position()).collect();
         let grid = PlanGrid::best(
             worlds[0].scene(),
-            max_radius + 0.5,
+            max_radius + 0.5 + overshoot_px(reach, actions),
             cell_px(max_radius, reach),
             &anchors,
         );
@@ -559,7 +571,16 @@ impl Coordinated {
                 }
             }
         }
-        self.follow(&grid, team, planned.and_then(Planned::found))?;
+        let planned = planned.and_then(|p| match p.plans {
+            // Two robots the priority orders could not plan (the one planned first would have
+            // had to wait for the other): the two planned together.
+            Err(_) if p.tasks.len() == 2 => {
+                let [a, b] = pair_plan(&grid, &p.tasks[0], &p.tasks[1])?;
+                Some((p.robots, vec![a, b]))
+            }
+            _ => p.found(),
+        });
+        self.follow(&grid, team, planned)?;
         self.grid = Some(grid);
         Ok(())
     }
@@ -829,29 +850,37 @@ impl TeamPolicy for Coordinated {
                     // Among moving obstacles, which no plan keeps clear, ORCA as the `orca`
                     // policy takes it: its horizon and margin.
                     mover_near = near.iter().any(|&j| j as usize >= robot_agents);
-                    let (horizon, margin) = if mover_near {
-                        (config.orca.time_horizon_steps, config.orca.safety_margin_px)
+                    if !mover_near && actions == PlannerActions::Discrete {
+                        // Among robots alone, the plan's cells (sized for a discrete step's
+                        // reach) keep them apart; ORCA would only shorten a velocity below
+                        // half a step, which a discrete robot answers by turning on the spot,
+                        // never reaching its cell.
+                        preferred
                     } else {
-                        (TIME_HORIZON_STEPS, 0.0)
-                    };
-                    self.avoider.velocity(
-                        me.scene(),
-                        &Avoid {
-                            agents: &self.agents,
-                            me: slot,
-                            preferred,
-                            horizon: Horizon {
-                                agents: horizon,
-                                obstacles: config.orca.obstacle_time_horizon_steps,
-                                max_speed: speed,
-                                time_step: 1.0,
+                        let (horizon, margin) = if mover_near {
+                            (config.orca.time_horizon_steps, config.orca.safety_margin_px)
+                        } else {
+                            (TIME_HORIZON_STEPS, 0.0)
+                        };
+                        self.avoider.velocity(
+                            me.scene(),
+                            &Avoid {
+                                agents: &self.agents,
+                                me: slot,
+                                preferred,
+                                horizon: Horizon {
+                                    agents: horizon,
+                                    obstacles: config.orca.obstacle_time_horizon_steps,
+                                    max_speed: speed,
+                                    time_step: 1.0,
+                                },
+                                neighbour_dist: range,
+                                max_neighbours: config.orca.max_neighbours as usize,
+                                margin,
+                                candidates: Some(near),
                             },
-                            neighbour_dist: range,
-                            max_neighbours: config.orca.max_neighbours as usize,
-                            margin,
-                            candidates: Some(near),
-                        },
-                    )
+                        )
+                    }
                 }
                 None => preferred,
             };

@@ -9,6 +9,6 @@ mod schedule;
 mod search;
 
 pub use grid::{PlanGrid, MOVES};
-pub use pair::{pair_feasible, Pair, MAX_STATES};
+pub use pair::{pair_feasible, pair_plan, Pair, MAX_STATES};
 pub use schedule::{Schedule, Wait};
 pub use search::{plan_team, Limits, PlanFailure, Stop, Task};

@@ -3,7 +3,7 @@
 //! reach their goals, no plan of the whole team can: the task is infeasible.
 
 use super::grid::PlanGrid;
-use super::search::Task;
+use super::search::{stops, Stop, Task};
 
 /// Largest number of joint states the search visits before it stops, undecided.
 pub const MAX_STATES: usize = 4_000_000;
@@ -72,4 +72,69 @@ pub fn pair_feasible(grid: &PlanGrid, a: &Task, b: &Task) -> Pair {
         }
     }
     Pair::Infeasible
+}
+
+/// A plan of robots `a` and `b` alone, one moving at a time (the shortest in joint moves), when
+/// both reach their goals and stay there: what prioritised planning may miss when the robot
+/// planned first must wait for the other (one giving way in a bay while the other passes).
+/// Each robot's stops, tick by tick as the joint moves go; `None` when there is none, a robot
+/// leaves the scene at its goal, or the joint states are too many to search.
+pub fn pair_plan(grid: &PlanGrid, a: &Task, b: &Task) -> Option<[Vec<Stop>; 2]> {
+    let (&ga, &gb) = (a.goals.last()?, b.goals.last()?);
+    if a.vanish || b.vanish || a.goals.len() != 1 || b.goals.len() != 1 {
+        return None;
+    }
+    let n = grid.len();
+    if n.saturating_mul(n) > MAX_STATES {
+        return None;
+    }
+    let index = |x: usize, y: usize| x * n + y;
+    // Each joint state's state before it and the move into it (robot `a` moved when below 8,
+    // robot `b` in direction `how - 8` otherwise).
+    let mut from: Vec<Option<(usize, u8)>> = vec![None; n * n];
+    let start = index(a.start, b.start);
+    from[start] = Some((start, u8::MAX));
+    let mut queue = std::collections::VecDeque::from([(a.start, b.start)]);
+    let mut found = false;
+    while let Some((x, y)) = queue.pop_front() {
+        if x == ga && y == gb {
+            found = true;
+            break;
+        }
+        let here = index(x, y);
+        for (d, x2) in grid.neighbours(x) {
+            let i = index(x2, y);
+            if x2 != y && from[i].is_none() {
+                from[i] = Some((here, d as u8));
+                queue.push_back((x2, y));
+            }
+        }
+        for (d, y2) in grid.neighbours(y) {
+            let i = index(x, y2);
+            if y2 != x && from[i].is_none() {
+                from[i] = Some((here, 8 + d as u8));
+                queue.push_back((x, y2));
+            }
+        }
+    }
+    if !found {
+        return None;
+    }
+    let mut moves = Vec::new();
+    let mut at = index(ga, gb);
+    while at != start {
+        let (before, how) = from[at]?;
+        moves.push((at, how));
+        at = before;
+    }
+    moves.reverse();
+    let mut ticks_a = vec![(a.start, 8u8)];
+    let mut ticks_b = vec![(b.start, 8u8)];
+    for (state, how) in moves {
+        let (x, y) = (state / n, state % n);
+        let (how_a, how_b) = if how < 8 { (how, 8) } else { (8, how - 8) };
+        ticks_a.push((x, how_a));
+        ticks_b.push((y, how_b));
+    }
+    Some([stops(grid, a, &ticks_a), stops(grid, b, &ticks_b)])
 }

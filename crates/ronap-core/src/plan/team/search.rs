@@ -290,7 +290,7 @@ impl Search<'_> {
 
 /// The stops of a robot's tick-by-tick plan (waits folded into the stop before), each goal
 /// marked at the first stop on its cell after the goal before.
-fn stops(grid: &PlanGrid, task: &Task, ticks: &[(usize, u8)]) -> Vec<Stop> {
+pub(super) fn stops(grid: &PlanGrid, task: &Task, ticks: &[(usize, u8)]) -> Vec<Stop> {
     let mut out: Vec<Stop> = Vec::new();
     for (t, &(cell, how)) in ticks.iter().enumerate() {
         let t = t as u32;
