@@ -25,3 +25,11 @@ def ronap_bin() -> str:
 def root() -> pathlib.Path:
     """The repository root (shipped policies and golden files are relative to it)."""
     return ROOT
+
+
+@pytest.fixture(autouse=True)
+def _sb3_logs_in_tmp_path(tmp_path, monkeypatch):
+    """Stable-Baselines3 makes a log folder for every `learn()` (the guides' and README's blocks
+    train), in the system's temporary folder unless $SB3_LOGDIR says otherwise: keep them in the
+    test's own folder, which pytest clears."""
+    monkeypatch.setenv("SB3_LOGDIR", str(tmp_path / "sb3-logs"))
