@@ -343,13 +343,10 @@ pub fn evaluate<'py>(
             evaluate_into(prepared.request(&cancel), factory.as_ref(), &|_| {}, &keep)
         })
         .map_err(|e| errors::PolicyError::new_err(e.to_string()))?;
-    if let Some(e) = &evaluation.write_error {
-        return Err(errors::output(e));
-    }
-    interrupt.raise()?;
-    if let Some(e) = &evaluation.result.error {
-        return Err(errors::run(e));
-    }
+    interrupt.finish(
+        evaluation.write_error.as_ref(),
+        evaluation.result.error.as_ref(),
+    )?;
     let d = PyDict::new(py);
     let summary = serde_json::to_value(&evaluation.summary).unwrap_or_default();
     d.set_item("summary", conv::json(py, &summary)?)?;
@@ -475,6 +472,20 @@ impl Interrupt {
             None => Ok(()),
         }
     }
+
+    /// How a finished run ends for Python, in order: its files could not be written, a signal
+    /// stopped it (once its files were written), an episode failed.
+    fn finish(
+        self,
+        write_error: Option<&ronap_core::io::atomic::OutputError>,
+        run_error: Option<&ronap_core::run::RunError>,
+    ) -> PyResult<()> {
+        if let Some(e) = write_error {
+            return Err(errors::output(e));
+        }
+        self.raise()?;
+        run_error.map_or(Ok(()), |e| Err(errors::run(e)))
+    }
 }
 
 /// The team policy `policy` names or is, with the name reports give it: `coordinated`, another
@@ -592,13 +603,10 @@ fn evaluate_team<'py>(
                 .map(|e| (e, rows.into_inner()))
         })
         .map_err(|e| errors::PolicyError::new_err(e.to_string()))?;
-    if let Some(e) = &evaluation.write_error {
-        return Err(errors::output(e));
-    }
-    interrupt.raise()?;
-    if let Some(e) = &evaluation.result.error {
-        return Err(errors::run(e));
-    }
+    interrupt.finish(
+        evaluation.write_error.as_ref(),
+        evaluation.result.error.as_ref(),
+    )?;
     let d = PyDict::new(py);
     let summary = serde_json::to_value(&evaluation.summary).unwrap_or_default();
     d.set_item("summary", conv::json(py, &summary)?)?;

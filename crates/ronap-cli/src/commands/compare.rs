@@ -11,7 +11,7 @@ use clap::{Args, ValueEnum};
 use ronap_core::compare::{
     compare, with_runs, CompareError, CompareInfo, CompareOptions, Contender, Progress,
 };
-use ronap_core::eval::Evaluator;
+use ronap_core::eval::{Evaluator, Seeds};
 use ronap_core::io::atomic::OutputError;
 use ronap_core::policy::{coordinated, TeamPolicyFactory};
 use std::io::Write as _;
@@ -111,7 +111,10 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
     let first = args.seeds.first()?;
     let seeds = seed_range(first, args.seeds.seeds)?;
     let end = first + args.seeds.seeds;
-    let range = args.seeds.range()?;
+    let range = Seeds::Range {
+        start: first,
+        count: args.seeds.seeds,
+    };
     for c in contenders.iter().filter(|c| c.reuse.is_none()) {
         warn_if_not_held_out(&c.name, c.factory.as_ref(), &range);
     }

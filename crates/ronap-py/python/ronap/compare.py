@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any, Callable, Iterable, Mapping, Sequence
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_int, checked_path, checked_seeds, refuse_sb3_thread_safe, split_seed
+from .config import ScenarioLike, checked_config, checked_int, checked_path, checked_seeds, refuse_sb3_thread_safe
 
 
 def compare(
@@ -56,7 +56,7 @@ def compare(
     ``out`` must be new or empty unless ``force=True`` (as ``ronap compare --force``). The
     configuration, ``split`` and ``thread_safe`` are given as for ``evaluate``.
     """
-    seeds = [split_seed(split, s, f"seeds[{i}]") for i, s in enumerate(checked_seeds(seeds))]
+    seeds = checked_seeds(seeds, split)
     for policy in policies:
         refuse_sb3_thread_safe(policy, thread_safe)
     command = _call(policies, seeds, scenario=scenario, config=config, maze_seed=maze_seed, map=map,

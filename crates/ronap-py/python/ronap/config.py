@@ -191,6 +191,13 @@ def split_range(split: str) -> tuple[int, int]:
     return int(first), int(last)
 
 
+def checked_split(split: str | None) -> str | None:
+    """``split`` itself when it is a split's name or None, else ``ConfigError``."""
+    if split is not None:
+        split_range(split)
+    return split
+
+
 def split_seed(split: str | None, seed: int, name: str = "seed") -> int:
     """Episode seed ``seed`` of ``split`` (counted from the split's first seed), or ``seed`` as
     given with no split; ``ConfigError`` when the split has no such seed."""
@@ -275,10 +282,11 @@ def checked_int(name: str, value: Any, least: int = 0, below: int = _U64) -> int
     return number
 
 
-def checked_seeds(seeds: Any) -> list[int]:
-    """Episode seeds as a list of ints in ``[0, 2^64)``; a ``ConfigError`` names the first bad one."""
+def checked_seeds(seeds: Any, split: str | None = None) -> list[int]:
+    """Episode seeds as a list of ints in ``[0, 2^64)``, counted from ``split``'s first seed when
+    one is named; a ``ConfigError`` names the first bad one."""
     try:
         items = list(seeds)
     except TypeError:
         raise ConfigError(f"seeds = {seeds!r}: expected an iterable of whole numbers (e.g. range(1000))") from None
-    return [checked_int(f"seeds[{i}]", s) for i, s in enumerate(items)]
+    return [split_seed(split, checked_int(f"seeds[{i}]", s), f"seeds[{i}]") for i, s in enumerate(items)]

@@ -14,7 +14,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_path, checked_int, init_arguments, located, split_draw_limit, split_range, split_seed, check_split_seeds, COPY_LIMIT
+from .config import ScenarioLike, checked_config, checked_path, checked_int, init_arguments, located, checked_split, split_draw_limit, split_seed, check_split_seeds, COPY_LIMIT
 
 
 class NavEnv(gym.Env[np.ndarray, Any]):
@@ -85,10 +85,8 @@ class NavEnv(gym.Env[np.ndarray, Any]):
             raise _ronap.ConfigError(f"render_mode {render_mode!r}: expected None or 'rgb_array'")
         if render_view not in ("top", "first_person"):
             raise _ronap.ConfigError(f"render_view {render_view!r}: expected 'top' or 'first_person'")
-        if split is not None:
-            split_range(split)
-        self.split = split
-        self.seed_step = None if seed_step is None else checked_int("seed_step", seed_step, least=1)
+        self.split: str | None = checked_split(split)
+        self.seed_step: int | None = None if seed_step is None else checked_int("seed_step", seed_step, least=1)
         self._index: int | None = None
         checked = checked_config(config, fields, scenario)
         self._checked = checked
@@ -270,9 +268,7 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         # What pickling needs to build this object again (see __getstate__).
         self._init_args = init_arguments(locals())
         num_envs = checked_int("num_envs", num_envs, least=1, below=2**31)
-        if split is not None:
-            split_range(split)
-        self.split = split
+        self.split: str | None = checked_split(split)
         threads = checked_int("threads", threads, below=2**16)
         mode = _autoreset_mode(autoreset_mode)
         if render_mode not in (None, "rgb_array"):

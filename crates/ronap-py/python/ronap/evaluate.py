@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any, Callable, Iterable, Mapping
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_path, checked_int, checked_seeds, located, refuse_sb3_thread_safe, split_seed
+from .config import ScenarioLike, checked_config, checked_path, checked_int, checked_seeds, located, refuse_sb3_thread_safe
 
 
 def evaluate(
@@ -83,7 +83,7 @@ def evaluate(
     A policy that raises or returns an invalid action or NaN raises ``PolicyError`` naming the seed
     and step.
     """
-    seeds = [split_seed(split, s, f"seeds[{i}]") for i, s in enumerate(checked_seeds(seeds))]
+    seeds = checked_seeds(seeds, split)
     refuse_sb3_thread_safe(policy, thread_safe)
     batch = checked_int("batch", batch, least=0, below=1 << 16)
     checked = checked_config(config, fields, scenario)

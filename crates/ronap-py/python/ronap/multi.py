@@ -9,7 +9,7 @@ import numpy as np
 from gymnasium import spaces
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_path, checked_int, init_arguments, split_draw_limit, split_range, split_seed, check_split_seeds, COPY_LIMIT
+from .config import ScenarioLike, checked_config, checked_path, checked_int, init_arguments, checked_split, split_draw_limit, split_seed, check_split_seeds, COPY_LIMIT
 from .env import discrete_actions
 
 if TYPE_CHECKING:
@@ -81,9 +81,7 @@ class MultiNavEnv(_Base):
         self._init_args = init_arguments(locals())
         if render_mode not in (None, "rgb_array"):
             raise _ronap.ConfigError(f"render_mode {render_mode!r}: expected None or 'rgb_array'")
-        if split is not None:
-            split_range(split)
-        self.split = split
+        self.split: str | None = checked_split(split)
         checked = checked_config(config, fields, scenario)
         self.text_infos: bool = bool(text_infos)
         self._status: dict[str, str] = {}
@@ -334,9 +332,7 @@ class VecMultiNavEnv:
         self._init_args = init_arguments(locals())
         num_envs = checked_int("num_envs", num_envs, least=1, below=2**31)
         threads = checked_int("threads", threads, below=2**16)
-        if split is not None:
-            split_range(split)
-        self.split = split
+        self.split: str | None = checked_split(split)
         checked = checked_config(config, fields, scenario)
         self._vec = _ronap.VecMultiEnv(int(num_envs), checked, maze_seed, checked_path("map", map), int(threads))
         self.config = json.loads(checked.json)

@@ -40,7 +40,7 @@ from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_int, checked_seeds, split_seed
+from .config import ScenarioLike, checked_config, checked_int, checked_seeds
 
 __all__ = ["evaluate", "main"]
 
@@ -148,7 +148,7 @@ def evaluate(
     warning when the seeds meet a trained network's own."""
     import ray
 
-    seeds = [split_seed(split, s, f"seeds[{i}]") for i, s in enumerate(checked_seeds(seeds))]
+    seeds = checked_seeds(seeds, split)
     if not seeds:
         raise _ronap.ConfigError("seeds is empty: give at least one seed")
     block = checked_int("block", block, least=1, below=2**31)
