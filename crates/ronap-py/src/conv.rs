@@ -7,7 +7,7 @@ use crate::errors;
 use numpy::{PyArray1, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use ronap_core::config::ConfigFile;
+use ronap_core::config::{ConfigFile, RobotConfig};
 use ronap_core::scene::map::MapSource;
 use ronap_core::sim::world::{SceneSpec, Scenes};
 use ronap_core::{Action, DiscreteAction, Episode, SimConfig, Status, ValidConfig};
@@ -239,17 +239,20 @@ pub fn scenes(
 /// What an action must be, for messages.
 const DISCRETE: &str = "expected 0 (LEFT), 1 (AHEAD) or 2 (RIGHT)";
 
-/// Reads an action: a discrete index (0 LEFT, 1 AHEAD, 2 RIGHT) or, when `continuous`, a pair
-/// `(v, w)` of finite numbers. The error says what was expected and is prefixed by the caller.
-pub fn action(value: &Bound<'_, PyAny>, continuous: bool) -> Result<Action, String> {
-    if continuous {
-        let pair: Vec<f64> = value
-            .extract()
-            .map_err(|_| "expected two numbers (v, w)".to_string())?;
-        return match pair[..] {
-            [v, w_deg] if v.is_finite() && w_deg.is_finite() => Ok(Action::Continuous { v, w_deg }),
-            _ => Err("expected two finite numbers (v, w)".into()),
-        };
+/// Reads an action: a discrete index (0 LEFT, 1 AHEAD, 2 RIGHT) or, given the robot of a
+/// `continuous` environment, its continuous command of finite numbers (`(v, w)`, or `(vx, vy,
+/// w)` and `(v, steer)` for omnidirectional and car-like robots). The error says what was
+/// expected and is prefixed by the caller.
+pub fn action(
+    value: &Bound<'_, PyAny>,
+    continuous: Option<&RobotConfig>,
+) -> Result<Action, String> {
+    if let Some(robot) = continuous {
+        let n = robot.action_scale().len();
+        let names = robot.continuous_names();
+        let what = || format!("expected {n} finite numbers {names}");
+        let values: Vec<f64> = value.extract().map_err(|_| what())?;
+        return ronap_core::sim::kinematics::continuous_action(robot, &values).ok_or_else(what);
     }
     if value.is_instance_of::<pyo3::types::PyBool>()
         || value
@@ -280,7 +283,10 @@ pub fn discrete(i: i64) -> Option<Action> {
 }
 
 /// The action a Python policy returned, or what is wrong with it (`returned X, expected ...`).
-pub fn policy_action(value: &Bound<'_, PyAny>, continuous: bool) -> Result<Action, String> {
+pub fn policy_action(
+    value: &Bound<'_, PyAny>,
+    continuous: Option<&RobotConfig>,
+) -> Result<Action, String> {
     action(value, continuous).map_err(|why| {
         let shown = match value.extract::<f64>() {
             Ok(x) if x.is_nan() => "NaN".to_string(),

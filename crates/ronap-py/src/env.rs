@@ -69,9 +69,18 @@ impl Env {
         Ok((obs, info))
     }
 
+    /// The full value of each dimension of a normalised continuous action: `[v_max px,
+    /// w_max deg]`, `[v_max, vy_max, w_max]` for an omnidirectional robot, `[v_max, steer_max
+    /// deg]` for a car-like one.
+    #[getter]
+    fn action_scale(&self) -> Vec<f64> {
+        self.worlds.config().robot.action_scale()
+    }
+
     /// Takes one step; returns (observation, reward, terminated, truncated, info).
     fn step<'py>(&mut self, py: Python<'py>, action: &Bound<'py, PyAny>) -> PyResult<Stepped<'py>> {
-        let action = conv::action(action, self.continuous)
+        let robot = &self.worlds.config().robot;
+        let action = conv::action(action, self.continuous.then_some(robot))
             .map_err(|why| ActionError::new_err(format!("action {action}: {why}")))?;
         let episode = self
             .episode

@@ -20,6 +20,7 @@ use ronap_core::policy::coordinated;
 use ronap_core::policy::{
     Decision, JointFactory, Policy, PolicyError, PolicyFactory, TeamPolicyFactory,
 };
+use ronap_core::sim::kinematics::continuous_action;
 use ronap_core::sim::world::Scenes;
 use ronap_core::{Action, Episode, ValidConfig, World};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -91,14 +92,17 @@ impl Policy for PyPolicy {
                 ))
             })?;
             let robot = &episode.config().robot;
-            conv::policy_action(value.bind(py), self.continuous)
+            conv::policy_action(value.bind(py), self.continuous.then_some(robot))
                 .map(|a| match a {
                     // Continuous policies answer in [-1, 1], as NavEnv's action space.
-                    Action::Continuous { v, w_deg } => Action::Continuous {
-                        v: v * robot.max_linear_speed_px,
-                        w_deg: w_deg * robot.max_angular_speed_deg,
-                    },
-                    other => other,
+                    Action::Discrete(_) => a,
+                    _ => {
+                        let full: Vec<f64> = (a.values().iter())
+                            .zip(robot.action_scale())
+                            .map(|(x, s)| x * s)
+                            .collect();
+                        continuous_action(robot, &full).unwrap_or(a)
+                    }
                 })
                 .map(Decision::Act)
                 .map_err(PolicyError::Failed)
@@ -129,15 +133,16 @@ impl PolicyFactory for PyPolicyFactory {
 }
 
 /// A Python callable that decides for many observations at once: an `(n, width)` float32 array
-/// in, `n` actions out (or `(n, 2)` normalised speeds when continuous).
+/// in, `n` actions out (or `(n, k)` normalised speeds when continuous, `k` the robot's
+/// continuous action size).
 struct PyBatchPolicy {
     callable: Py<PyAny>,
     continuous: bool,
     /// `ronap.env.discrete_actions` or `continuous_actions`: the returned actions as a checked
     /// array, or an `ActionError` naming what is wrong.
     check: Py<PyAny>,
-    /// Full speeds the normalised continuous actions scale to: px and degrees a step.
-    speeds: (f64, f64),
+    /// The robot, whose full speeds the normalised continuous actions scale to.
+    robot: ronap_core::config::RobotConfig,
 }
 
 impl PyBatchPolicy {
@@ -161,7 +166,7 @@ impl PyBatchPolicy {
             callable: callable.clone().unbind(),
             continuous,
             check,
-            speeds: (robot.max_linear_speed_px, robot.max_angular_speed_deg),
+            robot: robot.clone(),
         })
     }
 
@@ -202,16 +207,18 @@ impl PyBatchPolicy {
                 .map_err(|e| format!("returned {}: {}", shown(), e.value(py)))
         };
         if self.continuous {
-            let array = checked(&[rows, 2])?;
-            let pairs: Vec<f64> = array
+            let scale = self.robot.action_scale();
+            let array = checked(&[rows, scale.len()])?;
+            let values: Vec<f64> = array
                 .call_method0("ravel")
                 .and_then(|a| a.extract())
                 .map_err(|e| e.to_string())?;
-            let (v_max, w_max) = self.speeds;
-            actions.extend(pairs.chunks(2).map(|p| Action::Continuous {
-                v: p[0] * v_max,
-                w_deg: p[1] * w_max,
-            }));
+            for (row, v) in values.chunks(scale.len()).enumerate() {
+                let full: Vec<f64> = v.iter().zip(&scale).map(|(x, s)| x * s).collect();
+                actions.push(continuous_action(&self.robot, &full).ok_or_else(|| {
+                    format!("returned action {v:?} for row {row}: expected finite numbers")
+                })?);
+            }
         } else {
             let array = checked(&[rows])?;
             let indices: Vec<i64> = array.extract().map_err(|e| e.to_string())?;
@@ -540,7 +547,8 @@ fn team_factory(
             Box::new(PyBatchPolicy {
                 callable: decide.callable.clone_ref(py),
                 check: decide.check.clone_ref(py),
-                ..decide
+                continuous: decide.continuous,
+                robot: decide.robot.clone(),
             }) as Box<dyn BatchPolicy>
         }))
     };

@@ -149,6 +149,11 @@ impl MultiEnv {
     ) -> PyResult<TeamStepped<'py>> {
         let continuous = self.continuous;
         let n = self.rollout("step")?.team().robots().len();
+        // Each robot's own, for continuous actions (its kinematics say what they hold).
+        let robots: Vec<_> = (0..n)
+            .filter(|_| continuous)
+            .map(|k| self.worlds.config().team_robot(k).robot.clone())
+            .collect();
         if actions.len() != n {
             return Err(ActionError::new_err(format!(
                 "{} actions for {n} robots",
@@ -159,7 +164,7 @@ impl MultiEnv {
         for (k, a) in actions.iter().enumerate() {
             chosen.push(match a {
                 None => None,
-                Some(a) => Some(conv::action(a, continuous).map_err(|why| {
+                Some(a) => Some(conv::action(a, robots.get(k)).map_err(|why| {
                     ActionError::new_err(format!("robot_{k}'s action {a}: {why}"))
                 })?),
             });
@@ -252,6 +257,16 @@ impl MultiEnv {
                 let r = config.team_robot(k).robot.clone();
                 (r.max_linear_speed_px, r.max_angular_speed_deg)
             })
+            .collect()
+    }
+
+    /// Each robot's full value of each dimension of a normalised continuous action (see
+    /// `Env.action_scale`).
+    #[getter]
+    fn action_scales(&self) -> Vec<Vec<f64>> {
+        let config = self.worlds.config();
+        (0..config.team_size())
+            .map(|k| config.team_robot(k).robot.action_scale())
             .collect()
     }
 

@@ -11,6 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use ronap_core::run::batch::{Autoreset, Batch, BatchOptions, EnvStep, SeedOrder};
 use ronap_core::run::RunError;
+use ronap_core::sim::kinematics::continuous_action;
 use ronap_core::sim::world::Worlds;
 use ronap_core::{Action, Point, Status};
 
@@ -273,9 +274,16 @@ impl VecEnv {
         self.arrays(py)
     }
 
+    /// The full value of each dimension of a normalised continuous action (see
+    /// `Env.action_scale`).
+    #[getter]
+    fn action_scale(&self) -> Vec<f64> {
+        self.batch.worlds().config().robot.action_scale()
+    }
+
     /// Steps every environment with `actions`: one index per environment (0 LEFT, 1 AHEAD,
-    /// 2 RIGHT) as an int64 array, or for a continuous batch an (n, 2) float64 array of
-    /// (v px/step, w deg/step). Returns (observations, rewards, terminations, truncations,
+    /// 2 RIGHT) as an int64 array, or for a continuous batch an (n, k) float64 array of the
+    /// robot's continuous command (k = 2: (v px/step, w deg/step); see `action_scale`). Returns (observations, rewards, terminations, truncations,
     /// infos, finals): `finals` is None, or for the episodes same-step autoreset restarted
     /// (ended mask, their last observations, their final infos).
     fn step<'py>(
@@ -288,21 +296,28 @@ impl VecEnv {
         if self.continuous {
             let a: PyReadonlyArray2<'py, f64> = actions.extract()?;
             let a = a.as_array();
-            if a.dim() != (n, 2) {
+            let robot = &self.batch.worlds().config().robot;
+            let k = robot.action_size();
+            if a.dim() != (n, k) {
                 return Err(errors::ActionError::new_err(format!(
-                    "actions of shape {:?} for {n} environments: expected ({n}, 2)",
+                    "actions of shape {:?} for {n} environments: expected ({n}, {k})",
                     a.shape()
                 )));
             }
             for (i, r) in a.rows().into_iter().enumerate() {
-                match (r[0], r[1]) {
-                    (v, w_deg) if v.is_finite() && w_deg.is_finite() => {
-                        self.actions.push(Action::Continuous { v, w_deg });
-                    }
-                    (v, w) => {
+                let mut row = [0.0; 3];
+                for (to, x) in row.iter_mut().zip(r.iter()) {
+                    *to = *x;
+                }
+                let values = &row[..k];
+                match continuous_action(robot, values) {
+                    Some(action) => self.actions.push(action),
+                    None => {
+                        let shown: Vec<String> = values.iter().map(f64::to_string).collect();
                         return Err(errors::ActionError::new_err(format!(
-                            "action ({v}, {w}) for environment {i}: expected finite numbers"
-                        )))
+                            "action ({}) for environment {i}: expected finite numbers",
+                            shown.join(", ")
+                        )));
                     }
                 }
             }

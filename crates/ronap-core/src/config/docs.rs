@@ -32,10 +32,27 @@ const FIELD_DOCS: &[(&str, &str, &str, Option<&str>)] = &[
     ("robot", "max_linear_speed_px", "Continuous actions: largest |v|, px per step.", None),
     ("robot", "max_angular_speed_deg", "Continuous actions: largest |w|, degrees per step.", None),
     ("robot", "on_collision", "A step that would touch an obstacle: \"revert\" (stay, go on; the paper) or \"terminate\" (end the episode).", None),
+    ("robot", "shape", "Footprint: \"disc\" (radius_px; the default) or \"rectangle\" (length_px x width_px; radius_px becomes the circumscribed radius, which the free-space grid, placement, other robots and moving obstacles use).", Some("\"rectangle\"")),
+    ("robot", "length_px", "Rectangle footprint: length along the heading, px.", Some("20.0")),
+    ("robot", "width_px", "Rectangle footprint: width across the heading, px.", Some("10.0")),
+    ("robot", "offset_px", "Rectangle footprint: how far its centre lies ahead of the robot's position (the point it turns about), px. Unset: 0.", Some("0.0")),
+    ("robot", "kinematics", "How the body answers a command: \"discrete\" (the paper's; default), \"unicycle\" (the same body, for continuous (v, w)), \"diff_drive\" ((v, w) under acceleration and wheel limits), \"omni\" ((vx, vy, w)) or \"ackermann\" ((v, steer); cannot turn on the spot).", Some("\"diff_drive\"")),
+    ("robot", "accel_max_px", "diff_drive, omni, ackermann: largest change of the speed in one step, px per step per step. Unset: none.", Some("1.0")),
+    ("robot", "alpha_max_deg", "diff_drive, omni: largest change of the turn rate in one step, degrees per step per step. Unset: none.", Some("5.0")),
+    ("robot", "wheel_base_px", "diff_drive: distance between the wheels, each kept within max_linear_speed_px; ackermann (required): distance between the axles, px.", Some("8.0")),
+    ("robot", "max_lateral_speed_px", "omni: largest sideways speed |vy|, px per step. Unset: max_linear_speed_px.", Some("3.0")),
+    ("robot", "steer_max_deg", "ackermann: largest steering angle, degrees. Unset: 30.", Some("40.0")),
+    ("robot", "steer_rate_max_deg", "ackermann: largest change of the steering angle in one step, degrees. Unset: none.", Some("15.0")),
+    ("robot", "motion_noise_px", "Standard deviation of Gaussian noise on the executed speed (and sideways speed), px per step (0: none; its own random stream).", Some("0.1")),
+    ("robot", "motion_noise_deg", "Standard deviation of Gaussian noise on the executed turn rate, degrees per step (0: none).", Some("0.5")),
+    ("robot", "goal_noise_deg", "Standard deviation of Gaussian noise on the sensed goal bearing (the observation's goal direction), degrees (0: none; its own random stream).", Some("2.0")),
+    ("robot", "goal_noise_px", "Standard deviation of Gaussian noise on the sensed goal distance, px (0: none).", Some("5.0")),
     ("laser", "beams", "Number of laser beams m.", None),
     ("laser", "fov_deg", "Angle the beams cover, centred on the heading, degrees.", None),
     ("laser", "range_px", "Largest reading d_max, px.", None),
     ("laser", "noise_sigma_px", "Standard deviation of Gaussian reading noise, px (0: none).", None),
+    ("laser", "dropout", "Probability that a beam returns nothing in a scan (it reads range_px), 0 to 1 (its own random stream).", Some("0.05")),
+    ("laser", "angle_jitter_deg", "Standard deviation of Gaussian noise on each beam's angle, drawn afresh every scan, degrees (its own random stream).", Some("1.0")),
     ("episode", "goal_tolerance_px", "Success when the goal distance falls below this, px (epsilon).", None),
     ("episode", "max_steps", "Steps before a time-out.", None),
     ("episode", "reward_min", "End the episode when the summed reward falls to this (R_min). Unset: never.", Some("-50.0")),
@@ -519,6 +536,23 @@ mod documented_tests {
         c.social_force.sense_range_px = Some(50.0);
         c.social_force.speed_px = Some(4.0);
         c.dwa.sense_range_px = Some(50.0);
+        c.robot.shape = crate::config::Shape::Rectangle;
+        c.robot.length_px = Some(20.0);
+        c.robot.width_px = Some(10.0);
+        c.robot.offset_px = Some(1.0);
+        c.robot.kinematics = crate::config::KinematicsKind::Omni;
+        c.robot.accel_max_px = Some(1.0);
+        c.robot.alpha_max_deg = Some(5.0);
+        c.robot.wheel_base_px = Some(8.0);
+        c.robot.max_lateral_speed_px = Some(3.0);
+        c.robot.steer_max_deg = Some(40.0);
+        c.robot.steer_rate_max_deg = Some(15.0);
+        c.robot.motion_noise_px = 0.1;
+        c.robot.motion_noise_deg = 0.5;
+        c.robot.goal_noise_deg = 2.0;
+        c.robot.goal_noise_px = 5.0;
+        c.laser.dropout = 0.05;
+        c.laser.angle_jitter_deg = 1.0;
         let full = toml::Value::try_from(&c).unwrap();
         let mut count = 0;
         for (sec, table) in full.as_table().unwrap() {

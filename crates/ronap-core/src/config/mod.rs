@@ -40,7 +40,9 @@ pub use moving::{
     AgentOrca, Arrival, MotionKind, MovingConfig, MovingShape, Patrol, Pattern, MAX_MOVING,
 };
 pub use orca::{OrcaConfig, PlannerActions};
-pub use robot::{LaserConfig, OnCollision, RobotConfig, MAX_BEAMS};
+pub use robot::{
+    KinematicsKind, LaserConfig, OnCollision, RobotConfig, Shape, DEFAULT_STEER_MAX_DEG, MAX_BEAMS,
+};
 pub use scene::{
     is_convex_polygon, MapConfig, MazeConfig, ObstacleConfig, SceneConfig, SceneKind,
     WarehouseConfig,
@@ -395,7 +397,8 @@ impl SimConfig {
         self.orca.validate()?;
         self.social_force.validate()?;
         self.dwa.validate()?;
-        if self.crowd.is_empty() && !self.episode.collision_ends {
+        let rectangle = self.robot.shape == robot::Shape::Rectangle;
+        if self.crowd.is_empty() && !self.episode.collision_ends && !rectangle {
             moving::validate_total(&self.moving)?;
             return Ok(ValidConfig::plain(self));
         }
@@ -407,6 +410,10 @@ impl SimConfig {
         if effective.episode.collision_ends {
             effective.robot.on_collision = OnCollision::Terminate;
         }
+        // A rectangle is a disc that holds it wherever a disc is asked for (the free-space
+        // grid, placement, other robots, moving obstacles); the still scene's checks take it
+        // for the discs of `RobotConfig::cover`.
+        effective.robot.radius_px = effective.robot.circumscribed_px();
         Ok(ValidConfig {
             effective,
             written: Some(Box::new(self)),

@@ -255,8 +255,8 @@ impl Planner for DwaPlanner {
             }
         };
         self.last = match action {
-            Action::Continuous { v, w_deg } => (v, w_deg),
-            Action::Discrete(_) => (0.0, 0.0),
+            Action::Continuous { v, w_deg } | Action::Omni { vx: v, w_deg, .. } => (v, w_deg),
+            Action::Discrete(_) | Action::Steer { .. } => (0.0, 0.0),
         };
         Decision::Act(action)
     }

@@ -1,25 +1,39 @@
 //! Following a planned path with the discrete actions: turn towards a point a little way along
-//! the path, go ahead when facing it within half a turn step.
+//! the path, go ahead when facing it within half a turn step; or, for a car-like robot, which
+//! cannot turn on the spot, by pure pursuit: steer onto the circle through that point.
 //!
 //! The follower also watches its own progress: when the remaining path length has not shrunk for
 //! a while (pushing into a wall, turning back and forth) it reports itself stuck, so no episode
 //! waits for its time-out to fail.
 
+use crate::config::{KinematicsKind, RobotConfig, DEFAULT_STEER_MAX_DEG};
 use crate::geometry::{wrap_deg, Point};
 use crate::sim::episode::Episode;
-use crate::sim::robot::DiscreteAction;
+use crate::sim::robot::{Action, DiscreteAction};
 
 /// Steps without the remaining length shrinking by [`PROGRESS_PX`] before the follower gives up:
 /// two full turns and then some.
 const PATIENCE_STEPS: u32 = 60;
 /// Progress that counts, px.
 const PROGRESS_PX: f64 = 1.0;
+/// A car-like robot's patience: turning round in a narrow aisle takes several moves back and
+/// forth that shorten nothing.
+const CAR_PATIENCE_STEPS: u32 = 4 * PATIENCE_STEPS;
+/// Steps a car-like robot backs up after running into something.
+const BACK_UP_STEPS: u32 = 8;
 
 /// What the follower does next.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum FollowStep {
     /// Take this action.
     Act(DiscreteAction),
+    /// Drive a car-like robot at this speed and steering angle (pure pursuit).
+    Steer {
+        /// Speed, px per step (negative: backing up).
+        v: f64,
+        /// Steering angle, degrees.
+        steer_deg: f64,
+    },
     /// The end of the path is reached.
     Arrived,
     /// No progress for too long.
@@ -32,6 +46,9 @@ impl FollowStep {
     pub fn decision(self, end_reason: &str) -> super::Decision {
         match self {
             FollowStep::Act(a) => super::Decision::Act(a.into()),
+            FollowStep::Steer { v, steer_deg } => {
+                super::Decision::Act(Action::Steer { v, steer_deg })
+            }
             FollowStep::Arrived => super::Decision::GiveUp(end_reason.into()),
             FollowStep::Stuck => super::Decision::GiveUp("stuck following the path".into()),
         }
@@ -49,6 +66,10 @@ pub struct Follower {
     lookahead_px: f64,
     best_remaining: f64,
     since_progress: u32,
+    /// A car's steps still to back up, and the contacts its episode had counted at its last
+    /// command (a new one starts the backing up).
+    backing: u32,
+    contacts: u32,
 }
 
 impl Follower {
@@ -66,6 +87,8 @@ impl Follower {
             lookahead_px,
             best_remaining: f64::INFINITY,
             since_progress: 0,
+            backing: 0,
+            contacts: 0,
         }
     }
 
@@ -125,15 +148,63 @@ impl Follower {
         Some(self.point_at(along.0 + self.lookahead_px))
     }
 
-    /// The next action for `episode`'s robot.
+    /// The next command for `episode`'s robot: [`Follower::next`]'s discrete action, or for a
+    /// car-like robot ([`KinematicsKind::Ackermann`]) pure pursuit's speed and steering angle.
+    pub fn drive(&mut self, episode: &Episode) -> FollowStep {
+        let robot = &episode.config().robot;
+        if robot.kinematics != KinematicsKind::Ackermann {
+            return self.next(episode);
+        }
+        let contacts = episode.collisions() + episode.robot_collisions();
+        if contacts > self.contacts {
+            self.backing = BACK_UP_STEPS;
+        }
+        self.contacts = contacts;
+        match self.progress(episode) {
+            Ok((_, error)) if self.backing > 0 => {
+                // Ran into something: back up, the front swinging towards the aim.
+                self.backing -= 1;
+                let steer_max = robot.steer_max_deg.unwrap_or(DEFAULT_STEER_MAX_DEG);
+                FollowStep::Steer {
+                    v: -robot.max_linear_speed_px / 2.0,
+                    steer_deg: -steer_max * error.signum(),
+                }
+            }
+            Ok((aim, error)) => {
+                let p = episode.pose().position();
+                pursue(robot, (aim - p).norm(), error)
+            }
+            Err(step) => step,
+        }
+    }
+
+    /// The next discrete action for `episode`'s robot.
     pub fn next(&mut self, episode: &Episode) -> FollowStep {
+        let (_, error) = match self.progress(episode) {
+            Ok(aim) => aim,
+            Err(step) => return step,
+        };
+        let half_turn = episode.config().robot.turn_speed_deg / 2.0;
+        FollowStep::Act(if error > half_turn {
+            DiscreteAction::Left
+        } else if error < -half_turn {
+            DiscreteAction::Right
+        } else {
+            DiscreteAction::Ahead
+        })
+    }
+
+    /// Where `episode`'s robot is along the path: the point it aims at and the signed turn to
+    /// it from its heading (degrees in [-180, 180)), or what ends the following (the end
+    /// reached, or no progress for too long).
+    fn progress(&mut self, episode: &Episode) -> Result<(Point, f64), FollowStep> {
         let Some(&last) = self.path.last() else {
-            return FollowStep::Arrived;
+            return Err(FollowStep::Arrived);
         };
         let pose = episode.pose();
         let p = pose.position();
         if self.path.len() == 1 {
-            return FollowStep::Arrived;
+            return Err(FollowStep::Arrived);
         }
         let along = self.along(p);
         let total = self.length_to[self.length_to.len() - 1];
@@ -143,23 +214,44 @@ impl Follower {
             self.since_progress = 0;
         } else {
             self.since_progress += 1;
-            if self.since_progress > PATIENCE_STEPS {
-                return FollowStep::Stuck;
+            let patience = match episode.config().robot.kinematics {
+                KinematicsKind::Ackermann => CAR_PATIENCE_STEPS,
+                _ => PATIENCE_STEPS,
+            };
+            if self.since_progress > patience {
+                return Err(FollowStep::Stuck);
             }
         }
         if (last - p).norm() < self.lookahead_px / 4.0 {
-            return FollowStep::Arrived;
+            return Err(FollowStep::Arrived);
         }
         let aim = self.point_at(along.0 + self.lookahead_px);
         let bearing = (aim - p).y.atan2((aim - p).x).to_degrees();
-        let error = wrap_deg(bearing - pose.z_deg + 180.0) - 180.0;
-        let half_turn = episode.config().robot.turn_speed_deg / 2.0;
-        FollowStep::Act(if error > half_turn {
-            DiscreteAction::Left
-        } else if error < -half_turn {
-            DiscreteAction::Right
-        } else {
-            DiscreteAction::Ahead
-        })
+        Ok((aim, wrap_deg(bearing - pose.z_deg + 180.0) - 180.0))
+    }
+}
+
+/// Pure pursuit for a car-like `robot` whose aim lies `distance` px away, `error` degrees off
+/// its heading: the steering angle of the circle through the aim tangent to the heading
+/// (curvature `2 sin(error) / distance`), at full speed when the aim is ahead, slower the
+/// further it is off; an aim behind the robot is backed towards at half speed with the
+/// steering turned over, which turns the car round.
+fn pursue(robot: &RobotConfig, distance: f64, error: f64) -> FollowStep {
+    let wheel_base = robot.wheel_base_px.unwrap_or(2.0 * robot.radius_px);
+    let steer_max = robot.steer_max_deg.unwrap_or(DEFAULT_STEER_MAX_DEG);
+    let v_max = robot.max_linear_speed_px;
+    let e = error.to_radians();
+    if e.cos() < 0.0 {
+        // Behind: back up, the front swinging towards the aim.
+        return FollowStep::Steer {
+            v: -v_max / 2.0,
+            steer_deg: -steer_max * error.signum(),
+        };
+    }
+    let curvature = 2.0 * e.sin() / distance.max(1e-9);
+    let steer_deg = (curvature * wheel_base).atan().to_degrees();
+    FollowStep::Steer {
+        v: v_max * e.cos().max(0.3),
+        steer_deg: steer_deg.clamp(-steer_max, steer_max),
     }
 }

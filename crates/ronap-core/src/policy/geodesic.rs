@@ -112,7 +112,7 @@ impl Policy for Geodesic {
             return Ok(Decision::GiveUp("no path to the goal".into()));
         };
         Ok(follower
-            .next(episode)
+            .drive(episode)
             .decision("reached the end of the path short of the goal"))
     }
 }
@@ -151,7 +151,7 @@ impl Expert {
         let path = self.field.path(world.scene(), world.grid(), from, radius)?;
         match follow(world, path, Some(EXPERT_PATH_POINTS)).next(episode) {
             FollowStep::Act(a) => Some(a),
-            FollowStep::Arrived | FollowStep::Stuck => None,
+            FollowStep::Steer { .. } | FollowStep::Arrived | FollowStep::Stuck => None,
         }
     }
 }

@@ -236,6 +236,31 @@ impl Canvas {
         self.line(p, tip, 2.0, colour);
     }
 
+    /// Draws the robot `config` describes at `pose`, in `colour`: its footprint (a disc at
+    /// least `least` px across, or its rectangle) and a heading line.
+    pub fn body(
+        &mut self,
+        pose: Pose,
+        config: &crate::config::RobotConfig,
+        least: f64,
+        colour: Rgb<u8>,
+    ) {
+        match crate::sim::robot::Robot::corners(config, pose) {
+            Some(corners) => {
+                self.fill_polygon(&corners, colour);
+                let p = pose.position();
+                let reach = config.circumscribed_px().max(least);
+                self.line(
+                    p,
+                    p + crate::geometry::unit(pose.z_deg) * reach * 1.5,
+                    2.0,
+                    colour,
+                );
+            }
+            None => self.robot(pose, config.radius_px.max(least), colour),
+        }
+    }
+
     /// Draws a laser scan taken at `pose`: each ray to its reading, in its colour class.
     pub fn scan(&mut self, laser: &Laser, pose: Pose, readings: &[f64]) {
         for (i, &d) in readings.iter().enumerate() {
@@ -271,8 +296,8 @@ pub fn top_down(episode: &crate::sim::episode::Episode, path: &[Point], scale: f
         canvas.movers(movers);
     }
     canvas.scan(episode.laser(), episode.pose(), episode.readings());
-    canvas.robot(episode.start(), config.robot.radius_px.max(least), START);
-    canvas.robot(episode.pose(), config.robot.radius_px.max(least), PATH);
+    canvas.body(episode.start(), &config.robot, least, START);
+    canvas.body(episode.pose(), &config.robot, least, PATH);
     canvas.into_image()
 }
 

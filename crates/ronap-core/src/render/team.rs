@@ -62,8 +62,7 @@ pub fn team_frame(team: &Team, paths: &[Vec<Point>], scale: f64) -> RgbImage {
     }
     for (k, r) in team.robots().iter().enumerate() {
         if team.present(k) {
-            let radius = r.config().robot.radius_px.max(least);
-            canvas.robot(r.pose(), radius, policy_colour(k));
+            canvas.body(r.pose(), &r.config().robot, least, policy_colour(k));
         }
     }
     canvas.into_image()
@@ -90,8 +89,7 @@ pub fn team_setup(team: &Team, scale: f64) -> RgbImage {
         canvas.movers(movers);
     }
     for (k, r) in team.robots().iter().enumerate() {
-        let radius = r.config().robot.radius_px.max(least);
-        canvas.robot(r.start(), radius, policy_colour(k));
+        canvas.body(r.start(), &r.config().robot, least, policy_colour(k));
     }
     canvas.into_image()
 }

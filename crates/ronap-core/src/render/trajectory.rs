@@ -28,7 +28,7 @@ pub fn trajectory_image(record: &EpisodeRecord, scale: f64) -> Option<image::Rgb
     canvas.path(&points, 2.0, PATH);
     let laser = Laser::new(&config.laser);
     canvas.scan(&laser, record.end, &record.last_readings);
-    canvas.robot(record.start, config.robot.radius_px.max(least), START);
-    canvas.robot(record.end, config.robot.radius_px.max(least), PATH);
+    canvas.body(record.start, &config.robot, least, START);
+    canvas.body(record.end, &config.robot, least, PATH);
     Some(canvas.into_image())
 }

@@ -34,7 +34,9 @@ pub enum RunError {
         /// What went wrong.
         source: PolicyError,
     },
-    /// The policy returned an action that is not finite.
+    /// The policy returned an action that is not finite, or one the robot does not take (a
+    /// `(vx, vy, w)` command for a robot that is not omnidirectional, a `(v, steer)` one for a
+    /// robot that does not steer).
     #[error("seed {seed}, step {step}: policy returned an invalid action {action:?}")]
     InvalidAction {
         /// The episode seed.

@@ -113,14 +113,13 @@ impl Rollout {
                 return Ok(None);
             }
         };
-        if let Action::Continuous { v, w_deg } = action {
-            if !v.is_finite() || !w_deg.is_finite() {
-                return Err(RunError::InvalidAction {
-                    seed: self.episode.seed(),
-                    step: self.episode.steps() + 1,
-                    action,
-                });
-            }
+        let kind = self.episode.config().robot.kinematics;
+        if !action.is_finite() || !crate::sim::kinematics::accepts(kind, action) {
+            return Err(RunError::InvalidAction {
+                seed: self.episode.seed(),
+                step: self.episode.steps() + 1,
+                action,
+            });
         }
         Ok(Some(action))
     }

@@ -251,10 +251,9 @@ impl TeamRollout {
             }
             match decision {
                 Some(Decision::Act(action)) if self.team.running(k) => {
-                    if let Action::Continuous { v, w_deg } = action {
-                        if !v.is_finite() || !w_deg.is_finite() {
-                            return Err(RunError::InvalidAction { seed, step, action });
-                        }
+                    let kind = self.team.robot(k).config().robot.kinematics;
+                    if !action.is_finite() || !crate::sim::kinematics::accepts(kind, action) {
+                        return Err(RunError::InvalidAction { seed, step, action });
                     }
                     actions[k] = Some(action);
                     if !message.is_empty() {

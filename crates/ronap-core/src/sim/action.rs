@@ -1,5 +1,6 @@
 //! What a robot is told and where it is: its pose `[x px, y px, z deg]`, the paper's three
-//! discrete actions and the continuous `(v, w)` command, with the text logs write them as.
+//! discrete actions and the continuous commands (`(v, w)`, an omnidirectional robot's
+//! `(vx, vy, w)`, a car's `(v, steer)`), with the text logs write them as.
 
 use crate::geometry::{wrap_deg, Point};
 use serde::{Deserialize, Serialize};
@@ -97,6 +98,24 @@ pub enum Action {
         /// Angular speed, degrees per step.
         w_deg: f64,
     },
+    /// An omnidirectional robot's command: speeds along its heading `vx` and to its left `vy`,
+    /// px per step, and its turn rate `w_deg`, degrees per step, clipped to its limits.
+    Omni {
+        /// Speed along the heading, px per step.
+        vx: f64,
+        /// Speed to the left of the heading, px per step.
+        vy: f64,
+        /// Angular speed, degrees per step.
+        w_deg: f64,
+    },
+    /// A car-like robot's command: speed `v`, px per step, and steering angle `steer_deg`,
+    /// degrees (positive steers left), clipped to its limits.
+    Steer {
+        /// Linear speed, px per step.
+        v: f64,
+        /// Steering angle, degrees.
+        steer_deg: f64,
+    },
 }
 
 impl From<DiscreteAction> for Action {
@@ -110,17 +129,41 @@ impl Action {
     pub fn discrete(self) -> Option<DiscreteAction> {
         match self {
             Action::Discrete(a) => Some(a),
-            Action::Continuous { .. } => None,
+            _ => None,
+        }
+    }
+
+    /// Whether every number of the action is finite (a discrete action always is).
+    pub fn is_finite(self) -> bool {
+        match self {
+            Action::Discrete(_) => true,
+            Action::Continuous { v, w_deg } => v.is_finite() && w_deg.is_finite(),
+            Action::Omni { vx, vy, w_deg } => vx.is_finite() && vy.is_finite() && w_deg.is_finite(),
+            Action::Steer { v, steer_deg } => v.is_finite() && steer_deg.is_finite(),
+        }
+    }
+
+    /// The action's numbers (none for a discrete one): `[v, w]`, `[vx, vy, w]` or
+    /// `[v, steer]`.
+    pub fn values(self) -> Vec<f64> {
+        match self {
+            Action::Discrete(_) => Vec::new(),
+            Action::Continuous { v, w_deg } => vec![v, w_deg],
+            Action::Omni { vx, vy, w_deg } => vec![vx, vy, w_deg],
+            Action::Steer { v, steer_deg } => vec![v, steer_deg],
         }
     }
 }
 
-/// As logs write it: `LEFT`, `AHEAD`, `RIGHT`, or `v=SPEED;w=TURN` for a continuous action.
+/// As logs write it: `LEFT`, `AHEAD`, `RIGHT`, `v=SPEED;w=TURN` for a continuous action,
+/// `vx=SPEED;vy=SPEED;w=TURN` for an omnidirectional one, `v=SPEED;steer=ANGLE` for a car's.
 impl fmt::Display for Action {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Action::Discrete(a) => f.write_str(a.name()),
             Action::Continuous { v, w_deg } => write!(f, "v={v};w={w_deg}"),
+            Action::Omni { vx, vy, w_deg } => write!(f, "vx={vx};vy={vy};w={w_deg}"),
+            Action::Steer { v, steer_deg } => write!(f, "v={v};steer={steer_deg}"),
         }
     }
 }
@@ -129,21 +172,68 @@ impl fmt::Display for Action {
 impl FromStr for Action {
     type Err = String;
     fn from_str(text: &str) -> Result<Self, String> {
+        let number = |s: &str| {
+            s.parse::<f64>()
+                .ok()
+                .filter(|x| x.is_finite())
+                .ok_or_else(|| format!("{text:?}: {s:?} is not a finite number"))
+        };
+        if let Some(rest) = text.strip_prefix("vx=") {
+            let (vx, rest) = rest
+                .split_once(";vy=")
+                .and_then(|(vx, rest)| Some((vx, rest.split_once(";w=")?)))
+                .ok_or_else(|| format!("{text:?}: expected vx=SPEED;vy=SPEED;w=TURN"))?;
+            return Ok(Action::Omni {
+                vx: number(vx)?,
+                vy: number(rest.0)?,
+                w_deg: number(rest.1)?,
+            });
+        }
         if let Some(rest) = text.strip_prefix("v=") {
+            if let Some((v, steer)) = rest.split_once(";steer=") {
+                return Ok(Action::Steer {
+                    v: number(v)?,
+                    steer_deg: number(steer)?,
+                });
+            }
             let (v, w) = rest
                 .split_once(";w=")
                 .ok_or_else(|| format!("{text:?}: expected v=SPEED;w=TURN"))?;
-            let number = |s: &str| {
-                s.parse::<f64>()
-                    .ok()
-                    .filter(|x| x.is_finite())
-                    .ok_or_else(|| format!("{text:?}: {s:?} is not a finite number"))
-            };
             return Ok(Action::Continuous {
                 v: number(v)?,
                 w_deg: number(w)?,
             });
         }
         text.parse::<DiscreteAction>().map(Action::from)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_action_reads_back_what_it_writes() {
+        for a in [
+            Action::from(DiscreteAction::Left),
+            Action::Continuous {
+                v: 1.5,
+                w_deg: -3.25,
+            },
+            Action::Omni {
+                vx: 0.5,
+                vy: -2.0,
+                w_deg: 7.0,
+            },
+            Action::Steer {
+                v: 3.0,
+                steer_deg: -21.5,
+            },
+        ] {
+            assert_eq!(a.to_string().parse::<Action>(), Ok(a), "{a}");
+        }
+        for bad in ["vx=1;vy=2", "v=1;steer=x", "vx=1;vy=inf;w=0", "v=3"] {
+            assert!(bad.parse::<Action>().is_err(), "{bad}");
+        }
     }
 }

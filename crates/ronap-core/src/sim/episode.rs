@@ -7,10 +7,12 @@ use crate::config::{OnCollision, ValidConfig, ACTION_MEMORY};
 use crate::geometry::{wrap_deg, Point, Vector};
 use crate::scene::freespace::FreeGrid;
 use crate::scene::Scene;
+use crate::sim::kinematics::{travel, Velocity};
 use crate::sim::lidar::Laser;
 use crate::sim::moving::{Body, Disc, Movers};
+use crate::sim::noise::RobotNoise;
 use crate::sim::placement::{sample_placement, EpisodeError, Placement, PLACEMENT_TRIES};
-use crate::sim::rng::{stream, Rng, Stream};
+use crate::sim::rng::{robot_stream, stream, Rng, Stream};
 use crate::sim::robot::{Action, DiscreteAction, Motion, Pose, Robot};
 use rand::Rng as _;
 use std::sync::Arc;
@@ -118,8 +120,12 @@ pub struct Episode {
     seed: u64,
     start: Pose,
     pose: Pose,
+    /// The velocity held over the last step (zero at the start and after a blocked step).
+    velocity: Velocity,
     goal: Point,
     noise_rng: Rng,
+    /// Motion, goal-sensing and beam noise, when the configuration has any.
+    noise: Option<Box<RobotNoise>>,
     readings: Vec<f64>,
     /// The other robots near enough to see, gathered afresh each sensing (a kept buffer).
     near_discs: Vec<(Point, f64)>,
@@ -235,8 +241,10 @@ impl Episode {
             seed,
             start: placement.start,
             pose: placement.start,
+            velocity: Velocity::default(),
             goal: placement.goal,
             noise_rng: stream(seed, Stream::Noise),
+            noise: RobotNoise::new(&config.robot, &config.laser, seed, 0).map(Box::new),
             readings: vec![0.0; beams],
             near_discs: Vec::new(),
             facing: (f64::NAN, Vector::zeros()),
@@ -265,10 +273,11 @@ impl Episode {
         Ok(episode)
     }
 
-    /// Makes `rng` the laser noise's stream (a team's robot's own, fresh before its first
-    /// sensing among the team).
-    pub(crate) fn set_noise_stream(&mut self, rng: Rng) {
-        self.noise_rng = rng;
+    /// Makes the noise streams robot `k`'s of the episode with `seed` (a team's robot's own,
+    /// fresh before its first sensing among the team; robot 0's are a lone robot's).
+    pub(crate) fn set_noise_streams(&mut self, seed: u64, k: usize) {
+        self.noise_rng = robot_stream(seed, Stream::Noise, k);
+        self.noise = RobotNoise::new(&self.config.robot, &self.config.laser, seed, k).map(Box::new);
     }
 
     /// Reads the laser and goal sensors at the current pose and refreshes the observation.
@@ -285,6 +294,11 @@ impl Episode {
         let radius = self.config.robot.radius_px;
         let heading = crate::geometry::unit(self.pose.z_deg);
         self.facing = (self.pose.z_deg, heading);
+        if let Some(noise) = &mut self.noise {
+            if let Some(angles) = noise.jitter(self.readings.len()) {
+                self.laser.jitter(angles);
+            }
+        }
         self.laser
             .scan_toward(&self.scene, p, heading, &mut self.readings);
         if let Some(movers) = movers {
@@ -314,13 +328,39 @@ impl Episode {
         self.near_discs = near;
         self.laser
             .add_noise(&mut self.readings, &mut self.noise_rng);
-        self.distance_px = (self.goal - p).norm();
         let range = self.laser.range_px();
+        if let Some(noise) = &mut self.noise {
+            noise.drop_out(&mut self.readings, range);
+        }
+        self.distance_px = (self.goal - p).norm();
         for (o, r) in self.observation.iter_mut().zip(&self.readings) {
             *o = (r / range) as f32;
         }
+        self.observe_goal();
+    }
+
+    /// The observation's goal direction: the true one, or as sensed with goal-sensing noise.
+    fn observe_goal(&mut self) {
         let last = self.readings.len();
-        self.observation[last] = (self.direction_deg() / 360.0) as f32;
+        let direction = match &mut self.noise {
+            Some(noise) if noise.senses_goal() => {
+                let bearing = bearing_deg(self.pose.position(), self.goal);
+                let (bearing, _) = noise.sense_goal(bearing, self.distance_px);
+                wrap_deg(bearing - self.pose.z_deg)
+            }
+            _ => self.direction_deg(),
+        };
+        self.observation[last] = (direction / 360.0) as f32;
+    }
+
+    /// The goal's bearing (degrees in [0, 360)) and distance (px) as the robot last sensed
+    /// them: the true ones ([`Episode::bearing_deg`], [`Episode::distance_px`]) unless
+    /// `robot.goal_noise_deg` or `robot.goal_noise_px` is set.
+    pub fn sensed_goal(&self) -> (f64, f64) {
+        self.noise
+            .as_ref()
+            .and_then(|n| n.last_goal())
+            .unwrap_or((self.bearing_deg(), self.distance_px))
     }
 
     /// Records the gap to the nearest moving obstacle after a step, and to the still scene.
@@ -484,17 +524,35 @@ impl Episode {
     /// Recomputes the goal distance and the observation's goal direction for a new goal.
     fn refresh_goal(&mut self) {
         self.distance_px = (self.goal - self.pose.position()).norm();
-        let last = self.readings.len();
-        self.observation[last] = (self.direction_deg() / 360.0) as f32;
+        self.observe_goal();
     }
 
-    /// The first half of a step: where `action` would take the robot (no collision check).
-    pub(crate) fn motion(&self, action: Action) -> Motion {
+    /// The first half of a step: where `action` would take the robot (no collision check),
+    /// with motion noise on the velocity it executes when configured.
+    pub(crate) fn motion(&mut self, action: Action) -> Motion {
         // The unit heading of the last sensing, unless the pose was set since (re-posing in data
         // collection).
         let facing =
             (self.facing.0.to_bits() == self.pose.z_deg.to_bits()).then_some(self.facing.1);
-        self.robot.motion_facing(self.pose, facing, action)
+        match &mut self.noise {
+            None => self
+                .robot
+                .motion_from(self.pose, self.velocity, facing, action),
+            Some(noise) => {
+                let (velocity, turn_fraction) = self.robot.command(self.velocity, action);
+                let velocity = noise.executed(self.robot.kinematics(), velocity);
+                Motion {
+                    end: travel(self.pose, velocity, facing),
+                    turn_fraction,
+                    velocity,
+                }
+            }
+        }
+    }
+
+    /// The velocity held over the last step (zero at the start and after a blocked step).
+    pub fn velocity(&self) -> Velocity {
+        self.velocity
     }
 
     /// The robot.
@@ -526,6 +584,10 @@ impl Episode {
         if !(wall || moving || robot) {
             self.path_length_px += (motion.end.position() - self.pose.position()).norm();
             self.pose = motion.end;
+            self.velocity = motion.velocity;
+        } else {
+            // A blocked body stops.
+            self.velocity = Velocity::default();
         }
         self.steps += 1;
         collided

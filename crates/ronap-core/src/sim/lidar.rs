@@ -154,6 +154,14 @@ impl Laser {
         }
     }
 
+    /// Turns beam `i` by `jitter_deg[i]` from its place, for the scans that follow
+    /// (beam-angle jitter).
+    pub(crate) fn jitter(&mut self, jitter_deg: &[f64]) {
+        for (i, (o, j)) in self.offsets.iter_mut().zip(jitter_deg).enumerate() {
+            *o = unit(self.first_offset_deg + i as f64 * self.step_deg + j);
+        }
+    }
+
     /// Number of beams.
     pub fn beams(&self) -> usize {
         self.offsets.len()

@@ -10,6 +10,7 @@ pub mod episode;
 pub mod kinematics;
 pub mod lidar;
 pub mod moving;
+pub mod noise;
 pub mod placement;
 pub mod rng;
 pub mod robot;

@@ -30,6 +30,14 @@ pub enum Stream {
     Team = 7,
     /// The jitter of a `[[robots]]` entry's fixed start and goal.
     Jitter = 8,
+    /// Motion noise on the executed velocity.
+    Motion = 9,
+    /// Goal-sensing noise.
+    GoalSense = 10,
+    /// Laser beam dropout.
+    Dropout = 11,
+    /// Laser beam-angle jitter.
+    BeamJitter = 12,
 }
 
 /// The generator for `purpose` in the episode with `seed`.

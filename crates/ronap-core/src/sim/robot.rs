@@ -8,18 +8,20 @@ pub use crate::sim::kinematics::Motion;
 use crate::config::RobotConfig;
 use crate::geometry::{Point, Vector};
 use crate::scene::Scene;
-use crate::sim::kinematics::{self, Built, Kinematics};
+use crate::sim::kinematics::{self, Built, Kinematics, Velocity};
 use std::sync::Arc;
 
 /// The robot's shape and how it moves ([`Kinematics`]).
 #[derive(Clone, Debug)]
 pub struct Robot {
     radius_px: f64,
-    /// The built-in unicycle held as itself, any other kind behind the trait: a step's motion and
-    /// sweep then inline into the episode's step for the paper's robot, where three calls
-    /// through the trait (motion, sweep, and the sweep's test) cost 4% of `ronap bench
-    /// --threads 1`'s steps.
+    /// The built-in unicycle held as itself, any other kind behind the trait: a step's command
+    /// then inlines into the episode's step for the paper's robot, where calls through the
+    /// trait cost 4% of `ronap bench --threads 1`'s steps.
     kinematics: Built,
+    /// A footprint other than a disc as the discs that hold it (offset in the robot's frame,
+    /// radius); empty for a disc.
+    cover: Vec<(Vector, f64)>,
 }
 
 impl Robot {
@@ -28,6 +30,9 @@ impl Robot {
         Self {
             radius_px: config.radius_px,
             kinematics: kinematics::for_robot(config),
+            cover: (config.cover().into_iter())
+                .map(|([x, y], r)| (Vector::new(x, y), r))
+                .collect(),
         }
     }
 
@@ -36,6 +41,7 @@ impl Robot {
         Self {
             radius_px,
             kinematics: Built::Other(kinematics),
+            cover: Vec::new(),
         }
     }
 
@@ -52,18 +58,38 @@ impl Robot {
         }
     }
 
-    /// Where `action` takes the robot from `pose` in free space.
+    /// Where `action` takes the robot from `pose`, standing, in free space.
     pub fn motion(&self, pose: Pose, action: Action) -> Motion {
-        self.motion_facing(pose, None, action)
+        self.motion_from(pose, Velocity::default(), None, action)
     }
 
-    /// [`Robot::motion`], given `pose`'s unit heading (`unit(pose.z_deg)`) when the caller has it
-    /// already: a move straight ahead goes along it (the same bits: `unit` is the heading's cosine
-    /// and sine, as the move works them out without it).
-    pub fn motion_facing(&self, pose: Pose, facing: Option<Vector>, action: Action) -> Motion {
+    /// The velocity `action` commands from `velocity` (the last step's), within the robot's
+    /// limits, and how much of a full turn command it is.
+    #[inline]
+    pub fn command(&self, velocity: Velocity, action: Action) -> (Velocity, f64) {
         match &self.kinematics {
-            Built::Unicycle(u) => u.motion(pose, facing, action),
-            Built::Other(k) => k.motion(pose, facing, action),
+            Built::Unicycle(u) => u.command(velocity, action),
+            Built::Other(k) => k.command(velocity, action),
+        }
+    }
+
+    /// Where `action` takes the robot from `pose` with `velocity` held over the last step, in
+    /// free space; `facing` is `pose`'s unit heading (`unit(pose.z_deg)`) when the caller has it
+    /// already: a move straight ahead goes along it (the same bits: `unit` is the heading's
+    /// cosine and sine, as the move works them out without it).
+    #[inline]
+    pub fn motion_from(
+        &self,
+        pose: Pose,
+        velocity: Velocity,
+        facing: Option<Vector>,
+        action: Action,
+    ) -> Motion {
+        let (velocity, turn_fraction) = self.command(velocity, action);
+        Motion {
+            end: kinematics::travel(pose, velocity, facing),
+            turn_fraction,
+            velocity,
         }
     }
 
@@ -72,18 +98,61 @@ impl Robot {
         self.motion_clear_by(pose, motion, |a, b, r| scene.sweep_clear(a, b, r))
     }
 
-    /// Whether the disc can make `motion` from `pose` with every straight piece of its sweep
-    /// passing `sweep_clear(from, to, radius)`: the same check against any obstacles.
+    /// Whether the body can make `motion` from `pose` with every straight piece of its sweep
+    /// passing `sweep_clear(from, to, radius)`: the same check against any obstacles. A disc
+    /// sweeps its arc; a rectangle, each disc that holds a piece of it along that piece's own
+    /// arc (every point of a body turning at a constant rate moves on a circle).
+    #[inline]
     pub fn motion_clear_by(
         &self,
         pose: Pose,
         motion: &Motion,
         mut sweep_clear: impl FnMut(Point, Point, f64) -> bool,
     ) -> bool {
-        match &self.kinematics {
-            Built::Unicycle(u) => u.sweep_by(pose, motion, self.radius_px, &mut sweep_clear),
-            Built::Other(k) => k.sweep(pose, motion, self.radius_px, &mut sweep_clear),
+        if self.cover.is_empty() {
+            return kinematics::sweep_arc(
+                pose,
+                motion.velocity,
+                motion.end,
+                self.radius_px,
+                sweep_clear,
+            );
         }
+        let v = motion.velocity;
+        let w = v.w_deg.to_radians();
+        let heading = crate::geometry::unit(pose.z_deg);
+        let end_heading = crate::geometry::unit(motion.end.z_deg);
+        self.cover.iter().all(|&(o, r)| {
+            let at = |p: Pose, h: Vector| {
+                let q = p.position() + h * o.x + Vector::new(-h.y, h.x) * o.y;
+                Pose::new(q.x, q.y, p.z_deg)
+            };
+            // The piece's velocity in the robot's frame: the body's plus the turn's about the
+            // robot's position.
+            let piece = Velocity {
+                v: v.v - w * o.y,
+                vy: v.vy + w * o.x,
+                ..v
+            };
+            kinematics::sweep_arc(
+                at(pose, heading),
+                piece,
+                at(motion.end, end_heading),
+                r,
+                &mut sweep_clear,
+            )
+        })
+    }
+
+    /// The footprint's corners at `pose` (a rectangle's four, counter-clockwise), or `None`
+    /// for a disc.
+    pub fn corners(config: &RobotConfig, pose: Pose) -> Option<[Point; 4]> {
+        let (l, w, offset) = config.rectangle()?;
+        let h = crate::geometry::unit(pose.z_deg);
+        let left = Vector::new(-h.y, h.x);
+        let c = pose.position() + h * offset;
+        let (a, b) = (h * (l / 2.0), left * (w / 2.0));
+        Some([c - a - b, c + a - b, c + a + b, c - a + b])
     }
 }
 

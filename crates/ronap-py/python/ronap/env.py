@@ -24,7 +24,9 @@ class NavEnv(gym.Env[np.ndarray, Any]):
     direction over 360 (the model's 18 values by default, docs/model.md); with ``observation_history=k`` the last
     ``k`` of those frames, newest first, then the last ``k - 1`` actions as three values each
     (one-hot LEFT, AHEAD, RIGHT), all in [0, 1]. Actions: ``Discrete(3)`` (0 LEFT, 1 AHEAD,
-    2 RIGHT), or with ``continuous=True`` ``Box(-1, 1, (2,))``: ``(v / v_max, w / w_max)``.
+    2 RIGHT), or with ``continuous=True`` ``Box(-1, 1, (2,))``: ``(v / v_max, w / w_max)``
+    (``robot_kinematics="omni"``: ``Box(-1, 1, (3,))``, ``(vx / v_max, vy / vy_max, w / w_max)``;
+    ``"ackermann"``: ``(v / v_max, steer / steer_max)``; ``action_scale`` holds the full values).
     Rewards: the model's four terms; with ``reward_shaping="geodesic"`` the straight-line progress
     term becomes potential-based shaping along the geodesic distance (discount
     ``reward_shaping_gamma``, 0.99 by default: set it to your algorithm's).
@@ -99,11 +101,13 @@ class NavEnv(gym.Env[np.ndarray, Any]):
         n = self._env.observation_size
         self.observation_space = spaces.Box(0.0, 1.0, (n,), np.float32)
         self.continuous = continuous
+        #: The full value of each dimension of a continuous action: ``(v_max, w_max)``, or the
+        #: omnidirectional ``(v_max, vy_max, w_max)`` and car-like ``(v_max, steer_max)``.
+        self.action_scale: np.ndarray = np.array(self._env.action_scale, np.float64)
         if continuous:
             # Normalised, as learning libraries expect: (1, 1) is (v_max, w_max).
-            robot = self.config["robot"]
-            self._action_scale = np.array([robot["max_linear_speed_px"], robot["max_angular_speed_deg"]], np.float64)
-            self.action_space = spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
+            self._action_scale = self.action_scale
+            self.action_space = spaces.Box(-1.0, 1.0, self.action_scale.shape, dtype=np.float32)
         else:
             self.action_space = spaces.Discrete(3)
 
@@ -149,8 +153,9 @@ class NavEnv(gym.Env[np.ndarray, Any]):
             raise _ronap.ActionError(f"action {action!r}: expected 0 (LEFT), 1 (AHEAD) or 2 (RIGHT), not a bool")
         if self.continuous:
             scaled = np.asarray(action, dtype=np.float64)
-            if scaled.shape != (2,):
-                raise _ronap.ActionError(f"action {action!r}: expected two numbers in [-1, 1]")
+            if scaled.shape != self._action_scale.shape:
+                size = self._action_scale.shape[0]
+                raise _ronap.ActionError(f"action {action!r}: expected {'two' if size == 2 else size} numbers in [-1, 1]")
             action = (scaled * self._action_scale).tolist()
         result = self._env.step(action)
         if self._episode is not None:
@@ -298,10 +303,11 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         self.render_scale = render_scale
         n = self._vec.observation_size
         self.single_observation_space = spaces.Box(0.0, 1.0, (n,), np.float32)
+        #: The full value of each dimension of a continuous action (see ``NavEnv.action_scale``).
+        self.action_scale: np.ndarray = np.array(self._vec.action_scale, np.float64)
         if self.continuous:
-            robot = self.config["robot"]
-            self._action_scale = np.array([robot["max_linear_speed_px"], robot["max_angular_speed_deg"]], np.float64)
-            self.single_action_space = spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
+            self._action_scale = self.action_scale
+            self.single_action_space = spaces.Box(-1.0, 1.0, self.action_scale.shape, dtype=np.float32)
         else:
             self.single_action_space = spaces.Discrete(3)
         self.observation_space = batch_space(self.single_observation_space, num_envs)
@@ -387,7 +393,7 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         if not self._started:
             raise _ronap.RonapError("step() before reset(): call reset(seed=...) first")
         if self.continuous:
-            a = continuous_actions(actions, (self.num_envs, 2)) * self._action_scale
+            a = continuous_actions(actions, (self.num_envs, self._action_scale.shape[0])) * self._action_scale
         else:
             a = discrete_actions(actions, (self.num_envs,))
         obs, rewards, terminated, truncated, infos, finals = self._vec.step(a)

@@ -102,18 +102,18 @@ class MultiNavEnv(_Base):
             a: _observation_space(size - slots, slots)
             for a, size in zip(self.possible_agents, self._env.observation_sizes)
         }
-        self._action_spaces = {a: self._make_action_space() for a in self.possible_agents}
+        self._scales = [np.array(limits, np.float64) for limits in self._env.action_scales]
+        self._action_spaces = {a: self._make_action_space(k) for k, a in enumerate(self.possible_agents)}
         self._state_parts = [space.shape[0] for space in self._observation_spaces.values()]
         self.state_space: spaces.Box = spaces.Box(-np.inf, np.inf, (sum(self._state_parts),), np.float32)
         self._last_obs: list[np.ndarray] = [np.zeros(n, np.float32) for n in self._state_parts]
-        self._scales = [np.array(limits, np.float64) for limits in self._env.speed_limits]
         self._rng = np.random.default_rng()
         self.seed_used: int | None = None
 
-    def _make_action_space(self) -> spaces.Space[Any]:
+    def _make_action_space(self, k: int) -> spaces.Space[Any]:
         base: spaces.Space[Any]
         if self.continuous:
-            base = spaces.Box(-1.0, 1.0, (2,), dtype=np.float32)
+            base = spaces.Box(-1.0, 1.0, self._scales[k].shape, dtype=np.float32)
         else:
             base = spaces.Discrete(3)
         if self.message_size == 0:
@@ -258,8 +258,9 @@ class MultiNavEnv(_Base):
         if action is None:
             return None
         scaled = np.asarray(action, dtype=np.float64)
-        if scaled.shape != (2,):
-            raise _ronap.ActionError(f"robot_{k}'s action {action!r}: expected two numbers in [-1, 1]")
+        if scaled.shape != self._scales[k].shape:
+            size = self._scales[k].shape[0]
+            raise _ronap.ActionError(f"robot_{k}'s action {action!r}: expected {'two' if size == 2 else size} numbers in [-1, 1]")
         return (scaled * self._scales[k]).tolist()
 
     def render(self) -> np.ndarray | None:

@@ -210,7 +210,12 @@ impl Recorder {
                     // Discrete actions are a handful of names.
                     Some(Move::Named(index as u16))
                 }
-                Action::Continuous { v, w_deg } => Some(Move::Speeds(v as f32, w_deg as f32)),
+                // A player shows a speed and a turn: an omnidirectional robot's sideways
+                // speed is left out, a car's steering angle stands for the turn.
+                Action::Continuous { v, w_deg } | Action::Omni { vx: v, w_deg, .. } => {
+                    Some(Move::Speeds(v as f32, w_deg as f32))
+                }
+                Action::Steer { v, steer_deg } => Some(Move::Speeds(v as f32, steer_deg as f32)),
             };
             r.reward[last] = done.reward as f32;
             if done.collided {

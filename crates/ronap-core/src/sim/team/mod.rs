@@ -25,7 +25,7 @@ use crate::geometry::{point_segment_distance_squared, Point};
 use crate::sim::episode::{Episode, Status};
 use crate::sim::moving::{Disc, Movers};
 use crate::sim::placement::{needs_region_grid, sample_placement_with, EpisodeError};
-use crate::sim::rng::{robot_stream, stream, Stream};
+use crate::sim::rng::{stream, Stream};
 use crate::sim::world::World;
 use std::sync::Arc;
 
@@ -277,7 +277,7 @@ impl Team {
             r.set_among_movers(among);
             // Each robot's laser noise from its own stream, fresh for its first sensing among
             // the team below (its placement sensed alone): robot 0's is a lone robot's.
-            r.set_noise_stream(robot_stream(seed, Stream::Noise, k));
+            r.set_noise_streams(seed, k);
         }
         team.sense_all();
         Ok(team)

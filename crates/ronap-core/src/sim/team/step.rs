@@ -48,8 +48,8 @@ impl Team {
             let Some(action) = actions.get(k).copied().flatten().filter(|_| running[k]) else {
                 continue;
             };
+            let m = self.robots[k].motion(action);
             let r = &self.robots[k];
-            let m = r.motion(action);
             wall[k] = !r.robot().motion_clear(r.scene(), r.pose(), &m);
             moving[k] = match &self.movers {
                 Some(movers) => !r
