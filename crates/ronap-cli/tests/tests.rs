@@ -8,6 +8,7 @@ mod args;
 mod cli;
 mod compare;
 mod keep;
+mod kinematics;
 mod learn;
 mod limits;
 mod reference;

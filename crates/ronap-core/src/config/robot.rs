@@ -233,53 +233,44 @@ impl RobotConfig {
         non_negative("robot.max_angular_speed_deg", r.max_angular_speed_deg)?;
         let kind = r.kinematics;
         // Each model's own fields, refused for a model that has no use for them.
-        let only = |field: &str, given: bool, kinds: &[KinematicsKind]| {
-            check(
-                !given || kinds.contains(&kind),
+        use KinematicsKind::{Ackermann, DiffDrive, Omni};
+        let only = |field: &str, given: Option<f64>, kinds: &[KinematicsKind]| match given {
+            Some(v) if !kinds.contains(&kind) => check(
+                false,
                 field,
-                kind.name(),
+                format!("{v:?}"),
                 match kinds {
-                    [KinematicsKind::Ackermann] => "is only for kinematics = \"ackermann\"",
-                    [KinematicsKind::Omni] => "is only for kinematics = \"omni\"",
-                    [KinematicsKind::DiffDrive, KinematicsKind::Omni] => {
-                        "is only for kinematics = \"diff_drive\" or \"omni\""
-                    }
-                    [KinematicsKind::DiffDrive, KinematicsKind::Ackermann] => {
+                    [Ackermann] => "is only for kinematics = \"ackermann\"",
+                    [Omni] => "is only for kinematics = \"omni\"",
+                    [DiffDrive, Omni] => "is only for kinematics = \"diff_drive\" or \"omni\"",
+                    [DiffDrive, Ackermann] => {
                         "is only for kinematics = \"diff_drive\" or \"ackermann\""
                     }
                     _ => "is only for kinematics = \"diff_drive\", \"omni\" or \"ackermann\"",
                 },
-            )
+            ),
+            _ => Ok(()),
         };
-        use KinematicsKind::{Ackermann, DiffDrive, Omni};
         only(
             "robot.accel_max_px",
-            r.accel_max_px.is_some(),
+            r.accel_max_px,
             &[DiffDrive, Omni, Ackermann],
         )?;
-        only(
-            "robot.alpha_max_deg",
-            r.alpha_max_deg.is_some(),
-            &[DiffDrive, Omni],
-        )?;
+        only("robot.alpha_max_deg", r.alpha_max_deg, &[DiffDrive, Omni])?;
         only(
             "robot.wheel_base_px",
-            r.wheel_base_px.is_some(),
+            r.wheel_base_px,
             &[DiffDrive, Ackermann],
         )?;
         only(
             "robot.max_lateral_speed_px",
-            r.max_lateral_speed_px.is_some(),
+            r.max_lateral_speed_px,
             &[Omni],
         )?;
-        only(
-            "robot.steer_max_deg",
-            r.steer_max_deg.is_some(),
-            &[Ackermann],
-        )?;
+        only("robot.steer_max_deg", r.steer_max_deg, &[Ackermann])?;
         only(
             "robot.steer_rate_max_deg",
-            r.steer_rate_max_deg.is_some(),
+            r.steer_rate_max_deg,
             &[Ackermann],
         )?;
         for (field, v) in [
@@ -326,12 +317,14 @@ impl RobotConfig {
             ("robot.width_px", r.width_px),
             ("robot.offset_px", r.offset_px),
         ] {
-            check(
-                rectangle || v.is_none(),
-                field,
-                "disc",
-                "is only for shape = \"rectangle\"",
-            )?;
+            if let (false, Some(v)) = (rectangle, v) {
+                check(
+                    false,
+                    field,
+                    format!("{v:?}"),
+                    "is only for shape = \"rectangle\"",
+                )?;
+            }
         }
         if rectangle {
             for (field, v) in [

@@ -19,7 +19,7 @@
 use super::follow::Follower;
 use super::local::{Local, Planner, Senses};
 use super::Decision;
-use crate::config::PlannerActions;
+use crate::config::{KinematicsKind, PlannerActions};
 use crate::geometry::{unit, wrap_deg, Point};
 use crate::sim::episode::Episode;
 use crate::sim::robot::{Action, DiscreteAction, Pose, Robot};
@@ -78,6 +78,9 @@ impl DwaPlanner {
         let config = me.config();
         let r = config.robot.radius_px;
         let mut pose = me.pose();
+        // The body's own velocity carries over from step to step: a model with acceleration
+        // limits reaches a candidate's speed only as fast as they allow.
+        let mut velocity = me.velocity();
         let p0 = pose.position();
         // Each thing's threshold: the margin, or the gap already kept when that is smaller.
         let limit = |gap0: f64| margin.min(gap0 - 0.01);
@@ -86,7 +89,8 @@ impl DwaPlanner {
         let mut first_clear = true;
         for k in 0..horizon {
             let action = if k == 0 { first } else { then };
-            let motion = robot.motion(pose, action);
+            let motion = robot.motion_from(pose, velocity, None, action);
+            velocity = motion.velocity();
             if k == 0 {
                 first_clear = robot.motion_clear(me.scene(), pose, &motion);
             }
@@ -171,17 +175,29 @@ impl Planner for DwaPlanner {
                 .collect()
             }
             PlannerActions::Continuous => {
-                let (v0, w0) = self.last;
+                // The window round the last command, as wide as one step's change: the
+                // robot's own limits when its model has them (a diff-drive or omnidirectional
+                // base, a car), else the planner's.
+                let limited = !matches!(
+                    robot.kinematics,
+                    KinematicsKind::Discrete | KinematicsKind::Unicycle
+                );
+                let (v0, w0) = if limited {
+                    (me.velocity().v, me.velocity().w_deg)
+                } else {
+                    self.last
+                };
+                let accel = robot.accel_max_px.unwrap_or(dwa.linear_accel_px);
+                let alpha = match robot.kinematics {
+                    KinematicsKind::DiffDrive | KinematicsKind::Omni => {
+                        robot.alpha_max_deg.unwrap_or(dwa.angular_accel_deg)
+                    }
+                    _ => dwa.angular_accel_deg,
+                };
                 let v_max = robot.max_linear_speed_px;
                 let w_max = robot.max_angular_speed_deg;
-                let (v_lo, v_hi) = (
-                    (v0 - dwa.linear_accel_px).max(0.0),
-                    (v0 + dwa.linear_accel_px).min(v_max),
-                );
-                let (w_lo, w_hi) = (
-                    (w0 - dwa.angular_accel_deg).max(-w_max),
-                    (w0 + dwa.angular_accel_deg).min(w_max),
-                );
+                let (v_lo, v_hi) = ((v0 - accel).max(0.0), (v0 + accel).min(v_max));
+                let (w_lo, w_hi) = ((w0 - alpha).max(-w_max), (w0 + alpha).min(w_max));
                 let across = |lo: f64, hi: f64, n: u32, i: u32| {
                     lo + (hi - lo) * f64::from(i) / f64::from(n - 1)
                 };

@@ -1,0 +1,115 @@
+//! Robots as they are built: the shipped scenarios of each kinematic model run and replay from
+//! the command line, and a bad robot entry is one line naming the file, line, field and value.
+
+use crate::util::*;
+
+/// Successes of `policy` over seeds 0 to `seeds - 1` of shipped scenario `name`.
+fn successes(name: &str, policy: &str, seeds: &str, out: &std::path::Path) -> u64 {
+    let scenario = repo_root().join("scenarios").join(name);
+    ok(&ronap(&[
+        "run",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--policy",
+        policy,
+        "--seeds",
+        seeds,
+        "--threads",
+        "2",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    summary(out)["successes"].as_u64().unwrap()
+}
+
+#[test]
+fn each_models_scenario_runs_and_its_robot_reaches_goals() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, least) in [
+        ("diff-drive-maze.toml", 10),
+        ("omni-maze.toml", 10),
+        ("warehouse-forklift.toml", 9),
+    ] {
+        let out = dir.path().join(name);
+        let got = successes(name, "geodesic", "10", &out);
+        assert!(got >= least, "{name}: {got} of 10");
+    }
+    // dwa searches a diff-drive base's own window.
+    let out = dir.path().join("dwa");
+    assert!(successes("diff-drive-maze.toml", "dwa", "10", &out) >= 9);
+}
+
+#[test]
+fn a_cars_logged_episode_reads_back_its_steering_commands_and_replays() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("run");
+    let scenario = repo_root().join("scenarios/warehouse-forklift.toml");
+    ok(&ronap(&[
+        "run",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--policy",
+        "geodesic",
+        "--seeds",
+        "1",
+        "--log-steps",
+        "--out",
+        out.to_str().unwrap(),
+    ]));
+    let log = out.join("steps/seed-000000.csv");
+    let table = rows(&log);
+    let action = col(&table, "action");
+    assert!(
+        table[1..].iter().all(|r| r[action].contains(";steer=")),
+        "a car is logged with its steering commands"
+    );
+    let o = ronap(&["replay", log.to_str().unwrap(), "--stride", "20"]);
+    assert!(ok(&o).contains("seed 0"), "{}", stdout(&o));
+}
+
+#[test]
+fn a_bad_robot_entry_is_named_with_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    for (text, names) in [
+        (
+            "[robot]\nkinematics = \"diff_drive\"\nsteer_max_deg = 20.0\n",
+            &[":3:", "robot.steer_max_deg", "20", "ackermann"][..],
+        ),
+        (
+            "[robot]\nkinematics = \"hover\"\n",
+            &[":2:", "kinematics", "hover", "diff_drive"],
+        ),
+        (
+            "[robot]\nkinematics = \"ackermann\"\n",
+            &["robot.wheel_base_px", "ackermann"],
+        ),
+        (
+            "[robot]\nshape = \"rectangle\"\nlength_px = 10.0\n",
+            &["robot.width_px", "rectangle"],
+        ),
+        ("[laser]\ndropout = 1.5\n", &[":2:", "laser.dropout", "1.5"]),
+        (
+            "[robot]\nkinematics = \"omni\"\naccel_max_px = -1.0\n",
+            &[":3:", "robot.accel_max_px", "-1"],
+        ),
+    ] {
+        let file = dir.path().join("bad.toml");
+        std::fs::write(&file, text).unwrap();
+        let out = dir.path().join("out");
+        assert_rejected_leaving_nothing(
+            &[
+                "run",
+                "--policy",
+                "geodesic",
+                "--scenario",
+                file.to_str().unwrap(),
+                "--seeds",
+                "1",
+                "--out",
+                out.to_str().unwrap(),
+            ],
+            names,
+            &out,
+        );
+    }
+}
