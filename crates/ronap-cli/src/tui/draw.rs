@@ -379,6 +379,25 @@ fn first_person(area: Rect, episode: &Episode) -> Pen {
     pen
 }
 
+/// The robot's footprint at `pose`: its rectangle's outline, or a disc of `radius`.
+fn body(
+    pen: &mut Pen,
+    pose: ronap_core::Pose,
+    robot: &ronap_core::config::RobotConfig,
+    radius: f64,
+    colour: Color,
+) {
+    match ronap_core::sim::robot::Robot::corners(robot, pose) {
+        Some(c) => {
+            for i in 0..4 {
+                let (a, b) = (c[i], c[(i + 1) % 4]);
+                pen.line((a.x, a.y), (b.x, b.y), colour);
+            }
+        }
+        None => pen.disc((pose.x, pose.y), radius, colour),
+    }
+}
+
 /// The whole scene: walls, the path so far, the current rays, start, goal and the robot with a
 /// tick along its heading.
 fn whole_scene(area: Rect, episode: &Episode, path: &[Point]) -> Pen {
@@ -396,7 +415,7 @@ fn whole_scene(area: Rect, episode: &Episode, path: &[Point]) -> Pen {
     let goal = episode.goal();
     pen.disc((goal.x, goal.y), config.episode.goal_tolerance_px, GOAL);
     let radius = config.robot.radius_px.max(s);
-    pen.disc((pose.x, pose.y), radius, ROBOT);
+    body(&mut pen, pose, &config.robot, radius, ROBOT);
     let tip = pose.position() + unit(pose.z_deg) * radius * 2.5;
     pen.line((pose.x, pose.y), (tip.x, tip.y), ROBOT);
     pen
@@ -506,7 +525,7 @@ pub fn team_scene(
                 if team.present(k) {
                     let pose = r.pose();
                     let radius = r.config().robot.radius_px.max(s);
-                    pen.disc((pose.x, pose.y), radius, colour);
+                    body(&mut pen, pose, &r.config().robot, radius, colour);
                     if k == focus {
                         let tip = pose.position() + unit(pose.z_deg) * radius * 2.5;
                         pen.line((pose.x, pose.y), (tip.x, tip.y), colour);
