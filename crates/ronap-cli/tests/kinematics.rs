@@ -89,6 +89,14 @@ fn a_bad_robot_entry_is_named_with_its_line() {
         ),
         ("[laser]\ndropout = 1.5\n", &[":2:", "laser.dropout", "1.5"]),
         (
+            "[robot]\nshape = \"polygon\"\nvertices = [[0.0, 0.0], [5.0, 5.0], [5.0, 0.0], [0.0, 5.0]]\n",
+            &[":3:", "robot.vertices", "convex"],
+        ),
+        (
+            "[robot]\nshape = \"polygon\"\nvertices = [[10.0, 10.0], [20.0, 10.0], [15.0, 20.0]]\n",
+            &[":3:", "robot.vertices", "[0, 0]"],
+        ),
+        (
             "[robot]\nkinematics = \"omni\"\naccel_max_px = -1.0\n",
             &[":3:", "robot.accel_max_px", "-1"],
         ),

@@ -389,8 +389,8 @@ fn body(
 ) {
     match ronap_core::sim::robot::Robot::corners(robot, pose) {
         Some(c) => {
-            for i in 0..4 {
-                let (a, b) = (c[i], c[(i + 1) % 4]);
+            for i in 0..c.len() {
+                let (a, b) = (c[i], c[(i + 1) % c.len()]);
                 pen.line((a.x, a.y), (b.x, b.y), colour);
             }
         }

@@ -32,10 +32,11 @@ const FIELD_DOCS: &[(&str, &str, &str, Option<&str>)] = &[
     ("robot", "max_linear_speed_px", "Continuous actions: largest |v|, px per step.", None),
     ("robot", "max_angular_speed_deg", "Continuous actions: largest |w|, degrees per step.", None),
     ("robot", "on_collision", "A step that would touch an obstacle: \"revert\" (stay, go on; the paper) or \"terminate\" (end the episode).", None),
-    ("robot", "shape", "Footprint: \"disc\" (radius_px; the default) or \"rectangle\" (length_px x width_px; radius_px becomes the circumscribed radius, which the free-space grid, placement, other robots and moving obstacles use).", Some("\"rectangle\"")),
+    ("robot", "shape", "Footprint: \"disc\" (radius_px; the default), \"rectangle\" (length_px x width_px) or \"polygon\" (vertices); for the last two radius_px becomes the circumscribed radius, which the free-space grid, placement, other robots and moving obstacles use.", Some("\"rectangle\"")),
     ("robot", "length_px", "Rectangle footprint: length along the heading, px.", Some("20.0")),
     ("robot", "width_px", "Rectangle footprint: width across the heading, px.", Some("10.0")),
     ("robot", "offset_px", "Rectangle footprint: how far its centre lies ahead of the robot's position (the point it turns about), px. Unset: 0.", Some("0.0")),
+    ("robot", "vertices", "Polygon footprint: the corners of a convex polygon round the robot's position, [ahead px, left px], in order.", Some("[[10.0, 0.0], [-6.0, 6.0], [-6.0, -6.0]]")),
     ("robot", "kinematics", "How the body answers a command: \"discrete\" (the paper's; default), \"unicycle\" (the same body, for continuous (v, w)), \"diff_drive\" ((v, w) under acceleration and wheel limits), \"omni\" ((vx, vy, w)) or \"ackermann\" ((v, steer); cannot turn on the spot).", Some("\"diff_drive\"")),
     ("robot", "accel_max_px", "diff_drive, omni, ackermann: largest change of the speed in one step, px per step per step. Unset: none.", Some("1.0")),
     ("robot", "alpha_max_deg", "diff_drive, omni: largest change of the turn rate in one step, degrees per step per step. Unset: none.", Some("5.0")),
@@ -540,6 +541,7 @@ mod documented_tests {
         c.robot.length_px = Some(20.0);
         c.robot.width_px = Some(10.0);
         c.robot.offset_px = Some(1.0);
+        c.robot.vertices = vec![[10.0, 0.0], [-6.0, 6.0], [-6.0, -6.0]];
         c.robot.kinematics = crate::config::KinematicsKind::Omni;
         c.robot.accel_max_px = Some(1.0);
         c.robot.alpha_max_deg = Some(5.0);

@@ -397,8 +397,8 @@ impl SimConfig {
         self.orca.validate()?;
         self.social_force.validate()?;
         self.dwa.validate()?;
-        let rectangle = self.robot.shape == robot::Shape::Rectangle;
-        if self.crowd.is_empty() && !self.episode.collision_ends && !rectangle {
+        let disc = self.robot.shape == robot::Shape::Disc;
+        if self.crowd.is_empty() && !self.episode.collision_ends && disc {
             moving::validate_total(&self.moving)?;
             return Ok(ValidConfig::plain(self));
         }
@@ -410,7 +410,7 @@ impl SimConfig {
         if effective.episode.collision_ends {
             effective.robot.on_collision = OnCollision::Terminate;
         }
-        // A rectangle is a disc that holds it wherever a disc is asked for (the free-space
+        // A rectangle or polygon is a disc that holds it wherever a disc is asked for (the free-space
         // grid, placement, other robots, moving obstacles); the still scene's checks take it
         // for the discs of `RobotConfig::cover`.
         effective.robot.radius_px = effective.robot.circumscribed_px();

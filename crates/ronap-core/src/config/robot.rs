@@ -2,7 +2,9 @@
 //! and limits, what a collision does, its motion and goal-sensing noise, and the range finder,
 //! with their defaults and checks.
 
-use crate::config::{check, finite, fraction, is_zero, length, non_negative, ConfigError};
+use crate::config::{
+    check, finite, fraction, is_zero, length, non_negative, ConfigError, MAX_LENGTH_PX,
+};
 use serde::{Deserialize, Serialize};
 
 /// How the robot's body answers a command (docs/model.md "Kinematics").
@@ -91,6 +93,10 @@ pub struct RobotConfig {
     /// point it turns about; a car's rear axle), px. Unset: 0.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub offset_px: Option<f64>,
+    /// `polygon`: the corners of a convex polygon in the robot's frame, `[ahead px, left px]`,
+    /// in order round it.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub vertices: Vec<[f64; 2]>,
     /// How the body answers a command. Default `discrete`.
     #[serde(skip_serializing_if = "KinematicsKind::is_default")]
     pub kinematics: KinematicsKind,
@@ -143,6 +149,8 @@ pub enum Shape {
     /// A rectangle `length_px` along the heading by `width_px` across, its centre `offset_px`
     /// ahead of the robot's position (the point it turns about).
     Rectangle,
+    /// A convex polygon, its `vertices` in the robot's frame (`[ahead px, left px]`).
+    Polygon,
 }
 
 impl Shape {
@@ -170,6 +178,7 @@ impl Default for RobotConfig {
             length_px: None,
             width_px: None,
             offset_px: None,
+            vertices: Vec::new(),
             kinematics: KinematicsKind::Discrete,
             accel_max_px: None,
             alpha_max_deg: None,
@@ -326,6 +335,34 @@ impl RobotConfig {
                 )?;
             }
         }
+        let polygon = r.shape == Shape::Polygon;
+        if !polygon && !r.vertices.is_empty() {
+            check(
+                false,
+                "robot.vertices",
+                format!("{:?}", r.vertices),
+                "is only for shape = \"polygon\"",
+            )?;
+        }
+        if polygon {
+            let finite = r
+                .vertices
+                .iter()
+                .flatten()
+                .all(|v| v.abs() <= MAX_LENGTH_PX);
+            check(
+                finite && super::scene::is_convex_polygon(&r.vertices),
+                "robot.vertices",
+                format!("{:?}", r.vertices),
+                "must be at least three corners of a convex polygon, in order round it",
+            )?;
+            check(
+                super::scene::is_inside_convex(&r.vertices, [0.0, 0.0]),
+                "robot.vertices",
+                format!("{:?}", r.vertices),
+                "must hold the robot's position [0, 0] (the point it turns about)",
+            )?;
+        }
         if rectangle {
             for (field, v) in [
                 ("robot.length_px", r.length_px),
@@ -361,12 +398,32 @@ impl RobotConfig {
         }
     }
 
+    /// The footprint's corners in the robot's frame (`[ahead px, left px]`, counter-clockwise
+    /// for a rectangle): a rectangle's four or a polygon's vertices; empty for a disc.
+    pub fn outline(&self) -> Vec<[f64; 2]> {
+        if let Some((l, w, offset)) = self.rectangle() {
+            let (a, b) = (l / 2.0, w / 2.0);
+            return vec![
+                [offset - a, -b],
+                [offset + a, -b],
+                [offset + a, b],
+                [offset - a, b],
+            ];
+        }
+        match self.shape {
+            Shape::Polygon => self.vertices.clone(),
+            _ => Vec::new(),
+        }
+    }
+
     /// The radius of the disc about the robot's position that holds its footprint, px: what
     /// the free-space grid, placement, other robots and moving obstacles take the robot for.
     pub fn circumscribed_px(&self) -> f64 {
-        match self.rectangle() {
-            Some((l, w, offset)) => (offset.abs() + l / 2.0).hypot(w / 2.0),
-            None => self.radius_px,
+        match self.shape {
+            Shape::Disc => self.radius_px,
+            _ => (self.outline().iter())
+                .map(|[x, y]| x.hypot(*y))
+                .fold(0.0, f64::max),
         }
     }
 
@@ -375,6 +432,9 @@ impl RobotConfig {
     /// `length / n` by `width` piece, so they hold the whole rectangle and reach at most
     /// [`RobotConfig::cover_margin_px`] beyond it. Empty for a disc.
     pub fn cover(&self) -> Vec<([f64; 2], f64)> {
+        if self.shape == Shape::Polygon {
+            return self.edge_cover();
+        }
         let Some((l, w, offset)) = self.rectangle() else {
             return Vec::new();
         };
@@ -388,9 +448,36 @@ impl RobotConfig {
             .collect()
     }
 
-    /// How far at most the discs of [`RobotConfig::cover`] reach beyond the rectangle, px:
-    /// a step is blocked when an obstacle lies that close to the footprint (0 for a disc).
+    /// A polygon's discs: centred along its edges, each overlapping the next by half, so every
+    /// point of the outline lies in one of them (an obstacle cannot get inside without crossing
+    /// it, and every disc's sweep is checked); radius `max(1, perimeter / 96)` px.
+    fn edge_cover(&self) -> Vec<([f64; 2], f64)> {
+        let v = &self.vertices;
+        let n = v.len();
+        let edge = |i: usize| {
+            let ([x0, y0], [x1, y1]) = (v[i], v[(i + 1) % n]);
+            (x1 - x0).hypot(y1 - y0)
+        };
+        let perimeter: f64 = (0..n).map(edge).sum();
+        let r = (perimeter / 96.0).max(1.0);
+        let mut out = Vec::new();
+        for i in 0..n {
+            let ([x0, y0], [x1, y1]) = (v[i], v[(i + 1) % n]);
+            let k = ((edge(i) / (1.5 * r)).ceil() as usize).max(1);
+            for j in 0..k {
+                let t = j as f64 / k as f64;
+                out.push(([x0 + (x1 - x0) * t, y0 + (y1 - y0) * t], r));
+            }
+        }
+        out
+    }
+
+    /// How far at most the discs of [`RobotConfig::cover`] reach beyond the footprint, px:
+    /// a step is blocked when an obstacle lies that close to it (0 for a disc).
     pub fn cover_margin_px(&self) -> f64 {
+        if self.shape == Shape::Polygon {
+            return self.edge_cover().first().map_or(0.0, |&(_, r)| r);
+        }
         let Some((l, w, _)) = self.rectangle() else {
             return 0.0;
         };

@@ -320,6 +320,25 @@ pub(super) fn validate_obstacles(obstacles: &[ObstacleConfig]) -> Result<(), Con
     Ok(())
 }
 
+/// Whether `p` lies inside or on the convex polygon `points` (corners in order round it).
+pub(crate) fn is_inside_convex(points: &[[f64; 2]], p: [f64; 2]) -> bool {
+    let n = points.len();
+    let mut sign = 0.0f64;
+    for i in 0..n {
+        let [ax, ay] = points[i];
+        let [bx, by] = points[(i + 1) % n];
+        let cross = (bx - ax) * (p[1] - ay) - (by - ay) * (p[0] - ax);
+        if cross == 0.0 {
+            continue;
+        }
+        if sign * cross < 0.0 {
+            return false;
+        }
+        sign = cross.signum();
+    }
+    true
+}
+
 /// Whether `points` are the corners, in order either way round, of a convex polygon with an area.
 pub fn is_convex_polygon(points: &[[f64; 2]]) -> bool {
     let n = points.len();

@@ -144,15 +144,17 @@ impl Robot {
         })
     }
 
-    /// The footprint's corners at `pose` (a rectangle's four, counter-clockwise), or `None`
-    /// for a disc.
-    pub fn corners(config: &RobotConfig, pose: Pose) -> Option<[Point; 4]> {
-        let (l, w, offset) = config.rectangle()?;
+    /// The footprint's corners at `pose` (a rectangle's four, counter-clockwise, or a
+    /// polygon's), or `None` for a disc.
+    pub fn corners(config: &RobotConfig, pose: Pose) -> Option<Vec<Point>> {
+        let outline = config.outline();
+        if outline.is_empty() {
+            return None;
+        }
         let h = crate::geometry::unit(pose.z_deg);
         let left = Vector::new(-h.y, h.x);
-        let c = pose.position() + h * offset;
-        let (a, b) = (h * (l / 2.0), left * (w / 2.0));
-        Some([c - a - b, c + a - b, c + a + b, c - a + b])
+        let p = pose.position();
+        Some(outline.iter().map(|&[x, y]| p + h * x + left * y).collect())
     }
 }
 

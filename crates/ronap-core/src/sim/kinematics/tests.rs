@@ -323,7 +323,7 @@ fn continuous_actions_take_each_models_size() {
 
 /// Whether the convex polygon `corners` and the box overlap (separating axes: the box's two
 /// and the polygon's edge normals).
-fn overlaps(corners: &[Point; 4], b: &crate::geometry::Aabb) -> bool {
+fn overlaps(corners: &[Point], b: &crate::geometry::Aabb) -> bool {
     let box_corners = [
         b.min,
         Point::new(b.max.x, b.min.y),
@@ -331,8 +331,8 @@ fn overlaps(corners: &[Point; 4], b: &crate::geometry::Aabb) -> bool {
         Point::new(b.min.x, b.max.y),
     ];
     let mut axes = vec![Vector::new(1.0, 0.0), Vector::new(0.0, 1.0)];
-    for i in 0..4 {
-        let e = corners[(i + 1) % 4] - corners[i];
+    for i in 0..corners.len() {
+        let e = corners[(i + 1) % corners.len()] - corners[i];
         axes.push(Vector::new(-e.y, e.x));
     }
     axes.iter().all(|a| {
@@ -348,21 +348,38 @@ fn overlaps(corners: &[Point; 4], b: &crate::geometry::Aabb) -> bool {
     })
 }
 
-/// A rectangle robot of every kinematics, driven by random commands through random mazes,
-/// never ends a step overlapping a wall; and it does get close to them (the check is not
-/// vacuous).
+/// A rectangle or convex polygon robot of every kinematics, driven by random commands through
+/// random mazes, never ends a step overlapping a wall; and it does get close to them (the check
+/// is not vacuous).
 #[test]
-fn a_rectangle_never_ends_a_step_overlapping_an_obstacle() {
+fn a_rectangle_or_polygon_never_ends_a_step_overlapping_an_obstacle() {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
     let mut steps = 0;
     let mut blocked = 0;
     for (i, kind) in KinematicsKind::ALL.into_iter().cycle().take(40).enumerate() {
         let mut config = crate::SimConfig::default();
         config.robot.kinematics = kind;
-        config.robot.shape = crate::config::Shape::Rectangle;
-        config.robot.length_px = Some(rng.random_range(6.0..24.0));
-        config.robot.width_px = Some(rng.random_range(4.0..12.0));
-        config.robot.offset_px = Some(rng.random_range(-4.0..4.0));
+        if i % 2 == 0 {
+            config.robot.shape = crate::config::Shape::Rectangle;
+            config.robot.length_px = Some(rng.random_range(6.0..24.0));
+            config.robot.width_px = Some(rng.random_range(4.0..12.0));
+            config.robot.offset_px = Some(rng.random_range(-4.0..4.0));
+        } else {
+            // A convex polygon of 3 to 7 corners round the robot's position, uneven radii.
+            config.robot.shape = crate::config::Shape::Polygon;
+            let n = rng.random_range(3..8);
+            let turn = rng.random_range(0.0..360.0);
+            config.robot.vertices = (0..n)
+                .map(|k| {
+                    let a = (turn + 360.0 * f64::from(k) / f64::from(n)).to_radians();
+                    let r = rng.random_range(4.0..12.0);
+                    [r * a.cos(), r * a.sin()]
+                })
+                .collect();
+            if !crate::config::is_convex_polygon(&config.robot.vertices) {
+                continue;
+            }
+        }
         config.robot.max_linear_speed_px = 8.0;
         config.robot.max_angular_speed_deg = 45.0;
         if kind == KinematicsKind::Ackermann {
@@ -397,7 +414,7 @@ fn a_rectangle_never_ends_a_step_overlapping_an_obstacle() {
             let (collided, pose, done) = (r.collided, r.pose, r.status.is_done());
             blocked += usize::from(collided);
             steps += 1;
-            let corners = Robot::corners(&robot, pose).expect("a rectangle");
+            let corners = Robot::corners(&robot, pose).expect("a footprint");
             for b in episode.scene().boxes() {
                 assert!(
                     !overlaps(&corners, b),
