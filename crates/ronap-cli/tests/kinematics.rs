@@ -121,3 +121,33 @@ fn a_bad_robot_entry_is_named_with_its_line() {
         );
     }
 }
+
+#[test]
+fn coordinated_says_it_cannot_drive_a_car() {
+    let dir = tempfile::tempdir().unwrap();
+    let team = std::fs::read_to_string(repo_root().join("scenarios/corridor-bay.toml")).unwrap();
+    let file = dir.path().join("cars.toml");
+    std::fs::write(
+        &file,
+        format!("{team}\n[robot]\nkinematics = \"ackermann\"\nwheel_base_px = 8.0\n"),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let o = ronap(&[
+        "run",
+        "--policy",
+        "coordinated",
+        "--scenario",
+        file.to_str().unwrap(),
+        "--seeds",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_ne!(o.status.code(), Some(0));
+    let err = stderr(&o);
+    assert!(
+        err.contains("coordinated cannot drive a car-like robot") && !err.contains("panicked"),
+        "{err}"
+    );
+}

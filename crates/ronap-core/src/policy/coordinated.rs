@@ -758,6 +758,19 @@ fn goal_stops(grid: &PlanGrid, team: &Team, k: usize, stops: &[Stop]) -> Vec<Opt
 
 impl TeamPolicy for Coordinated {
     fn reset(&mut self, team: &Team, worlds: &[Arc<World>]) -> Result<(), RobotError> {
+        // Its plans turn robots on the spot between waypoints, which a car cannot.
+        if let Some(k) = (0..team.robots().len()).find(|&k| {
+            team.robot(k).config().robot.kinematics == crate::config::KinematicsKind::Ackermann
+        }) {
+            return Err((
+                k,
+                PolicyError::Failed(
+                    "coordinated cannot drive a car-like robot (kinematics = \"ackermann\"): \
+                     its plans turn robots on the spot; use geodesic or dwa"
+                        .into(),
+                ),
+            ));
+        }
         self.last.clear();
         self.plan(team, worlds)
     }
