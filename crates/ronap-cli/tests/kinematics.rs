@@ -3,22 +3,26 @@
 
 use crate::util::*;
 
+/// `ronap run` of `policy` over seeds 0 to `seeds - 1` of `scenario` into `out`.
+fn run<'a>(policy: &'a str, scenario: &'a str, seeds: &'a str, out: &'a str) -> [&'a str; 9] {
+    [
+        "run",
+        "--policy",
+        policy,
+        "--scenario",
+        scenario,
+        "--seeds",
+        seeds,
+        "--out",
+        out,
+    ]
+}
+
 /// Successes of `policy` over seeds 0 to `seeds - 1` of shipped scenario `name`.
 fn successes(name: &str, policy: &str, seeds: &str, out: &std::path::Path) -> u64 {
     let scenario = repo_root().join("scenarios").join(name);
-    ok(&ronap(&[
-        "run",
-        "--scenario",
-        scenario.to_str().unwrap(),
-        "--policy",
-        policy,
-        "--seeds",
-        seeds,
-        "--threads",
-        "2",
-        "--out",
-        out.to_str().unwrap(),
-    ]));
+    let (scenario, out_text) = (scenario.to_str().unwrap(), out.to_str().unwrap());
+    ok(&ronap(&run(policy, scenario, seeds, out_text)));
     summary(out)["successes"].as_u64().unwrap()
 }
 
@@ -44,18 +48,13 @@ fn a_cars_logged_episode_reads_back_its_steering_commands_and_replays() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
     let scenario = repo_root().join("scenarios/warehouse-forklift.toml");
-    ok(&ronap(&[
-        "run",
-        "--scenario",
-        scenario.to_str().unwrap(),
-        "--policy",
+    let args = run(
         "geodesic",
-        "--seeds",
+        scenario.to_str().unwrap(),
         "1",
-        "--log-steps",
-        "--out",
         out.to_str().unwrap(),
-    ]));
+    );
+    ok(&ronap(&[&args[..], &["--log-steps"]].concat()));
     let log = out.join("steps/seed-000000.csv");
     let table = rows(&log);
     let action = col(&table, "action");
@@ -104,21 +103,8 @@ fn a_bad_robot_entry_is_named_with_its_line() {
         let file = dir.path().join("bad.toml");
         std::fs::write(&file, text).unwrap();
         let out = dir.path().join("out");
-        assert_rejected_leaving_nothing(
-            &[
-                "run",
-                "--policy",
-                "geodesic",
-                "--scenario",
-                file.to_str().unwrap(),
-                "--seeds",
-                "1",
-                "--out",
-                out.to_str().unwrap(),
-            ],
-            names,
-            &out,
-        );
+        let args = run("geodesic", file.to_str().unwrap(), "1", out.to_str().unwrap());
+        assert_rejected_leaving_nothing(&args, names, &out);
     }
 }
 
@@ -133,17 +119,12 @@ fn coordinated_says_it_cannot_drive_a_car() {
     )
     .unwrap();
     let out = dir.path().join("out");
-    let o = ronap(&[
-        "run",
-        "--policy",
+    let o = ronap(&run(
         "coordinated",
-        "--scenario",
         file.to_str().unwrap(),
-        "--seeds",
         "1",
-        "--out",
         out.to_str().unwrap(),
-    ]);
+    ));
     assert_ne!(o.status.code(), Some(0));
     let err = stderr(&o);
     assert!(

@@ -8,7 +8,7 @@
 
 use crate::config::{RobotConfig, ACTION_MEMORY, DEFAULT_STEER_MAX_DEG};
 use crate::sim::action::{Action, DiscreteAction};
-use crate::sim::kinematics::{finite_or_zero, remembered_as, Kinematics, Velocity};
+use crate::sim::kinematics::{finite_or_zero, one_hot, remembered_as, Kinematics, Velocity};
 
 /// A car-like robot's speeds and limits (docs/model.md "Kinematics").
 #[derive(Clone, Debug, PartialEq)]
@@ -113,11 +113,7 @@ impl Kinematics for Ackermann {
     fn remembered(&self, action: Action) -> [f32; ACTION_MEMORY] {
         let m = self.steer_max_deg;
         match action {
-            Action::Discrete(d) => {
-                let mut v = [0.0; ACTION_MEMORY];
-                v[d as usize] = 1.0;
-                v
-            }
+            Action::Discrete(d) => one_hot(d),
             Action::Steer { v, steer_deg } => remembered_as(v, self.v_max, steer_deg, m),
             Action::Continuous { v, w_deg } => {
                 remembered_as(v, self.v_max, self.steer_for(v, w_deg, 0.0), m)

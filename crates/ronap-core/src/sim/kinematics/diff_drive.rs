@@ -6,7 +6,9 @@
 
 use crate::config::{RobotConfig, ACTION_MEMORY};
 use crate::sim::action::{Action, DiscreteAction};
-use crate::sim::kinematics::{approach, finite_or_zero, remembered_as, Kinematics, Velocity};
+use crate::sim::kinematics::{
+    approach, finite_or_zero, remembered_twist, turn_fraction, Kinematics, Velocity,
+};
 
 /// A differential-drive base's speeds and limits (docs/model.md "Kinematics").
 #[derive(Clone, Debug, PartialEq)]
@@ -70,18 +72,13 @@ impl Kinematics for DiffDrive {
             self.accel_max_px,
             self.alpha_max_deg,
         );
-        let frac = if self.w_max > 0.0 {
-            (w.abs() / self.w_max).min(1.0)
-        } else {
-            0.0
-        };
         (
             Velocity {
                 v,
                 w_deg: w,
                 ..Velocity::default()
             },
-            frac,
+            turn_fraction(w, self.w_max),
         )
     }
 
@@ -95,15 +92,6 @@ impl Kinematics for DiffDrive {
     }
 
     fn remembered(&self, action: Action) -> [f32; ACTION_MEMORY] {
-        match action {
-            Action::Discrete(d) => {
-                let mut v = [0.0; ACTION_MEMORY];
-                v[d as usize] = 1.0;
-                v
-            }
-            Action::Continuous { v, w_deg } => remembered_as(v, self.v_max, w_deg, self.w_max),
-            Action::Omni { vx, w_deg, .. } => remembered_as(vx, self.v_max, w_deg, self.w_max),
-            Action::Steer { v, .. } => remembered_as(v, self.v_max, 0.0, self.w_max),
-        }
+        remembered_twist(action, self.v_max, self.w_max)
     }
 }

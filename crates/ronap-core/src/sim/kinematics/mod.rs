@@ -19,7 +19,7 @@ pub use unicycle::Unicycle;
 
 use crate::config::{KinematicsKind, RobotConfig, ACTION_MEMORY};
 use crate::geometry::{Point, Vector};
-use crate::sim::action::{Action, Pose};
+use crate::sim::action::{Action, DiscreteAction, Pose};
 use std::fmt::Debug;
 use std::sync::Arc;
 
@@ -280,6 +280,35 @@ fn finite_or_zero(x: f64) -> f64 {
         0.0
     } else {
         x
+    }
+}
+
+/// The action memory of one of the paper's actions: one-hot LEFT, AHEAD, RIGHT.
+fn one_hot(action: DiscreteAction) -> [f32; ACTION_MEMORY] {
+    let mut v = [0.0; ACTION_MEMORY];
+    v[action as usize] = 1.0;
+    v
+}
+
+/// The action memory of a body commanded in `(v, w)` with limits `v_max`, `w_max`: one-hot for
+/// the paper's actions, else [`remembered_as`] (a sideways speed is not remembered; a steering
+/// command, which such a body does not take, as going straight).
+fn remembered_twist(action: Action, v_max: f64, w_max: f64) -> [f32; ACTION_MEMORY] {
+    match action {
+        Action::Discrete(d) => one_hot(d),
+        Action::Continuous { v, w_deg } | Action::Omni { vx: v, w_deg, .. } => {
+            remembered_as(v, v_max, w_deg, w_max)
+        }
+        Action::Steer { v, .. } => remembered_as(v, v_max, 0.0, w_max),
+    }
+}
+
+/// How much of a full turn `w` is of the largest `w_max`, in [0, 1].
+fn turn_fraction(w: f64, w_max: f64) -> f64 {
+    if w_max > 0.0 {
+        (w.abs() / w_max).min(1.0)
+    } else {
+        0.0
     }
 }
 

@@ -6,7 +6,9 @@
 
 use crate::config::{RobotConfig, ACTION_MEMORY};
 use crate::sim::action::{Action, DiscreteAction};
-use crate::sim::kinematics::{approach, finite_or_zero, remembered_as, Kinematics, Velocity};
+use crate::sim::kinematics::{
+    approach, finite_or_zero, remembered_twist, turn_fraction, Kinematics, Velocity,
+};
 
 /// An omnidirectional base's speeds and limits (docs/model.md "Kinematics").
 #[derive(Clone, Debug, PartialEq)]
@@ -59,11 +61,6 @@ impl Kinematics for Omni {
             self.accel_max_px,
             self.alpha_max_deg,
         );
-        let frac = if self.w_max > 0.0 {
-            (w_deg.abs() / self.w_max).min(1.0)
-        } else {
-            0.0
-        };
         (
             Velocity {
                 v,
@@ -71,7 +68,7 @@ impl Kinematics for Omni {
                 w_deg,
                 steer_deg: 0.0,
             },
-            frac,
+            turn_fraction(w_deg, self.w_max),
         )
     }
 
@@ -87,15 +84,6 @@ impl Kinematics for Omni {
 
     /// As the unicycle's: the sideways speed is not remembered.
     fn remembered(&self, action: Action) -> [f32; ACTION_MEMORY] {
-        match action {
-            Action::Discrete(d) => {
-                let mut v = [0.0; ACTION_MEMORY];
-                v[d as usize] = 1.0;
-                v
-            }
-            Action::Continuous { v, w_deg } => remembered_as(v, self.v_max, w_deg, self.w_max),
-            Action::Omni { vx, w_deg, .. } => remembered_as(vx, self.v_max, w_deg, self.w_max),
-            Action::Steer { v, .. } => remembered_as(v, self.v_max, 0.0, self.w_max),
-        }
+        remembered_twist(action, self.v_max, self.w_max)
     }
 }
