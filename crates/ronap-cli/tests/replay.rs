@@ -144,6 +144,56 @@ fn run_gif_writes_the_chosen_seeds_episode() {
 }
 
 #[test]
+fn a_run_of_another_model_version_is_refused_naming_both() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = logged_run(dir.path(), "apf");
+    let log = run.join("steps").join("seed-000006.csv");
+    let summary = run.join("summary.json");
+    let mut manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&summary).unwrap()).unwrap();
+    let ours = ronap_core::MODEL_VERSION;
+    assert_eq!(manifest["model_version"], serde_json::json!(ours));
+    let out = dir.path().join("x.gif");
+    let args = |summary: &Path| {
+        [
+            "replay",
+            log.to_str().unwrap(),
+            "--summary",
+            summary.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]
+        .map(String::from)
+    };
+    // A run of an older model, and one written before summaries recorded it (model 1).
+    let older = dir.path().join("older.json");
+    manifest["model_version"] = serde_json::json!(ours - 1);
+    std::fs::write(&older, manifest.to_string()).unwrap();
+    let unrecorded = dir.path().join("unrecorded.json");
+    manifest.as_object_mut().unwrap().remove("model_version");
+    std::fs::write(&unrecorded, manifest.to_string()).unwrap();
+    for (file, theirs) in [(&older, ours - 1), (&unrecorded, 1)] {
+        let args = args(file);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        assert_rejected(
+            &args,
+            &[
+                file.to_str().unwrap(),
+                &format!("model version {theirs}"),
+                &format!("model version {ours}"),
+            ],
+        );
+    }
+    assert!(!out.exists());
+    // The run's own summary replays.
+    let args = args(&summary);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let o = ronap(&args);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(out.exists());
+}
+
+#[test]
 fn bad_replays_are_named_and_write_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let run = logged_run(dir.path(), "apf");

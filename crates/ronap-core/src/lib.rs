@@ -42,8 +42,13 @@ pub mod sim;
 
 /// The version of the simulation model: the scenes, sensors, kinematics, random streams and
 /// metrics that make an episode out of a seed. Runs recorded under another model version do not
-/// replay the same (`ronap --version` prints it).
-pub const MODEL_VERSION: u32 = 1;
+/// replay the same (`ronap --version` prints it, `summary.json` records it and `ronap replay`
+/// refuses a run of another).
+///
+/// - 1: the first.
+/// - 2: a `random_walk` obstacle turns by a near-normal draw (the sum of eight random bytes) of
+///   its own SplitMix64 stream, not by a normal draw of the shared moving-obstacle stream.
+pub const MODEL_VERSION: u32 = 2;
 
 pub use config::{ConfigError, SimConfig, ValidConfig};
 pub use geometry::{Aabb, Point, Vector};

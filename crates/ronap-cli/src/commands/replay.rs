@@ -98,8 +98,19 @@ pub fn run(args: ReplayArgs) -> Result<ExitCode> {
             run_dir.join("summary.json")
         }
     };
-    let (config, scenes) = RunManifest::read(&summary)
-        .and_then(|m| m.setting(&summary))
+    let manifest = RunManifest::read(&summary)
+        .context("replay needs the run's configuration (pass --summary FILE)")?;
+    if manifest.model_version != ronap_core::MODEL_VERSION {
+        bail!(
+            "{}: the run was recorded under model version {}, this ronap runs model version {}: \
+             its episodes do not replay the same (run it again with this ronap)",
+            summary.display(),
+            manifest.model_version,
+            ronap_core::MODEL_VERSION
+        );
+    }
+    let (config, scenes) = manifest
+        .setting(&summary)
         .context("replay needs the run's configuration (pass --summary FILE)")?;
     if let Some(html) = &args.html {
         if html.extension().and_then(|e| e.to_str()) != Some("html") {

@@ -20,6 +20,11 @@ pub struct RunManifest {
     pub schema_version: u32,
     /// The ronap version that wrote the run.
     pub ronap_version: String,
+    /// The simulation model the run's episodes were made under ([`crate::MODEL_VERSION`]);
+    /// a run recorded before the manifest carried it was model 1. Another model makes other
+    /// episodes of the same seeds, so `ronap replay` refuses it.
+    #[serde(default = "first_model")]
+    pub model_version: u32,
     /// The policy, as named to the front end (`apf`, `mlp:FILE`, a Python function's name...).
     pub policy: String,
     /// The first seed.
@@ -43,6 +48,12 @@ pub struct RunManifest {
     pub team: Option<crate::eval::TeamSummary>,
     /// The whole configuration.
     pub config: SimConfig,
+}
+
+/// The model version of a manifest that does not record one: written before the field was, under
+/// model 1.
+fn first_model() -> u32 {
+    1
 }
 
 /// A manifest that cannot be read.
@@ -181,6 +192,9 @@ pub struct RunPlan {
     pub schema_version: u32,
     /// The ronap version that wrote the run; another version may run episodes differently.
     pub ronap_version: String,
+    /// The simulation model of the run's episodes ([`RunManifest::model_version`]).
+    #[serde(default = "first_model")]
+    pub model_version: u32,
     /// The policy, as named to the front end.
     pub policy: String,
     /// The first seed.
@@ -209,7 +223,7 @@ pub struct RunPlan {
 }
 
 impl RunPlan {
-    /// Reads `path`, refusing a plan of another schema or ronap version by name.
+    /// Reads `path`, refusing a plan of another schema, ronap or model version by name.
     pub fn read(path: &Path) -> Result<Self, ManifestError> {
         let plan: Self = read_versioned(path, PLAN_SCHEMA_VERSION)?;
         let ours = env!("CARGO_PKG_VERSION");
@@ -220,6 +234,17 @@ impl RunPlan {
                     "written by ronap {}; this is ronap {ours}, whose episodes may differ: \
                      finish the run with ronap {}",
                     plan.ronap_version, plan.ronap_version
+                ),
+            });
+        }
+        if plan.model_version != crate::MODEL_VERSION {
+            return Err(ManifestError::Format {
+                path: path.to_path_buf(),
+                message: format!(
+                    "begun under model version {}; this ronap runs model version {}, whose \
+                     episodes differ: finish the run with the ronap that began it",
+                    plan.model_version,
+                    crate::MODEL_VERSION
                 ),
             });
         }

@@ -197,6 +197,7 @@ pub(crate) fn manifest(
     RunManifest {
         schema_version: SCHEMA_VERSION,
         ronap_version: env!("CARGO_PKG_VERSION").to_string(),
+        model_version: crate::MODEL_VERSION,
         policy: info.policy.clone(),
         seed_start: options.seeds.first().unwrap_or(0),
         seeds_requested: options.seeds.len() as u64,

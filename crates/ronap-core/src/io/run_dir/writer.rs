@@ -476,6 +476,7 @@ impl RunWriter {
         RunPlan {
             schema_version: PLAN_SCHEMA_VERSION,
             ronap_version: env!("CARGO_PKG_VERSION").to_string(),
+            model_version: crate::MODEL_VERSION,
             policy: info.policy.clone(),
             seed_start: first,
             seeds_requested: count,

@@ -5,6 +5,7 @@
 
 use crate::geometry::{Aabb, Point, Vector};
 use crate::sim::moving::Entry;
+use crate::sim::rng::{split_mix, SPLIT_MIX_GAMMA};
 
 /// Where the obstacles are and where they head, one array per quantity, so that the turns, the
 /// moves and the fast clearance test of every obstacle run as one vectorised pass.
@@ -31,8 +32,11 @@ pub(super) struct State {
     pub(super) walks: Vec<bool>,
     /// The standard deviation of its turns, rad (0 when absent or not turning; the same).
     pub(super) sigma: Vec<f64>,
+    /// Its turn stream: a SplitMix64 state, advanced every step whether it turns or not
+    /// ([`State::draw_turns`]).
+    stream: Vec<u64>,
     /// This step's turn, rad (0 for the obstacles not turning), and its sine and cosine.
-    pub(super) turn: Vec<f64>,
+    turn: Vec<f64>,
     sin: Vec<f64>,
     cos: Vec<f64>,
     /// This step's intended centre, and whether it lies in the free box.
@@ -41,8 +45,6 @@ pub(super) struct State {
     pub(super) fits: Vec<bool>,
     /// Whether the pass has moved it (a walk in its free box and far from the robot).
     pub(super) moved: Vec<bool>,
-    /// This step's turns beyond 1 rad, as `(obstacle, sin, cos)`, applied after the pass.
-    pub(super) wide: Vec<(usize, f64, f64)>,
     /// The obstacles by band of [`BAND_PX`] in y, then by x, as of the end of the last step, and
     /// where each band starts in that order (`band_start`, one past the last band at the end): a
     /// scan looks only at the obstacles of the bands within its reach whose x is within its reach
@@ -99,6 +101,9 @@ impl pulp::WithSimd for Pass<'_> {
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, _: S) {
+        if self.state.draw_turns() {
+            self.state.turn_wide();
+        }
         self.state.pass(self.robots);
     }
 }
@@ -108,6 +113,8 @@ impl pulp::WithSimd for Pass<'_> {
 const FIT_MARGIN: f64 = 1e-9;
 
 impl State {
+    /// Adds an obstacle of `entry` at `position` heading along `dir` at `speed` px a step,
+    /// checked against a robot within `near_robot` px, turning from the turn stream at `stream`.
     pub(super) fn push(
         &mut self,
         entry: &Entry,
@@ -115,7 +122,9 @@ impl State {
         dir: Vector,
         speed: f64,
         near_robot: f64,
+        stream: u64,
     ) {
+        self.stream.push(stream);
         self.drift = self.drift.max(speed * (1.0 + 1e-9));
         self.bound.push(entry.body.bounding_radius());
         self.near_robot2.push(near_robot * near_robot);
@@ -209,21 +218,53 @@ impl State {
         }
     }
 
-    /// Turns every heading by this step's turn and moves it `speed` ahead into `ahead`, marking
-    /// in `fits` those whose move stays in their free box; moves there, and marks `moved`, the
-    /// walks that fit and are not near any robot at `robots`. Turns beyond 1 rad are applied one
-    /// by one first; the rest is plain arithmetic over the arrays in loops with no branch, which
-    /// vectorise (compiled for the processor's widest instruction set, the same bits on each).
+    /// Draws this step's turns, turns every heading by its turn and moves it `speed` ahead into
+    /// `ahead`, marking in `fits` those whose move stays in their free box; moves there, and
+    /// marks `moved`, the walks that fit and are not near any robot at `robots`. Turns beyond
+    /// 1 rad (rare) are applied one by one; the rest is plain integer and floating-point
+    /// arithmetic over the arrays in loops with no branch, which vectorise (compiled for the
+    /// processor's widest instruction set, the same bits on each).
     pub(super) fn turn_and_look_ahead(&mut self, robots: &[Point]) {
-        for &(i, s, c) in &self.wide {
-            let (dx, dy) = (self.dx[i], self.dy[i]);
-            self.dx[i] = dx * c - dy * s;
-            self.dy[i] = dx * s + dy * c;
-        }
         crate::geometry::ARCH.dispatch(Pass {
             state: self,
             robots,
         });
+    }
+
+    /// Draws every obstacle's turn for this step from its own stream: `sigma` times a draw of
+    /// [`standard_turn`]. Returns whether a turn is beyond 1 rad ([`State::turn_wide`]).
+    #[inline(always)]
+    fn draw_turns(&mut self) -> bool {
+        let n = self.stream.len();
+        let (stream, sigma, turn) = (&mut self.stream[..n], &self.sigma[..n], &mut self.turn[..n]);
+        let mut wide = false;
+        for i in 0..n {
+            let state = stream[i].wrapping_add(SPLIT_MIX_GAMMA);
+            stream[i] = state;
+            let a = sigma[i] * standard_turn(split_mix(state));
+            // An obstacle that does not turn turns by +0 exactly (a `linear` one's heading is
+            // then rotated by cos 1, sin +0: unchanged to the bit).
+            let a = if sigma[i] > 0.0 { a } else { 0.0 };
+            turn[i] = a;
+            wide |= a.abs() > 1.0;
+        }
+        wide
+    }
+
+    /// Turns the headings whose turn is beyond 1 rad by it at once (halving the angle for the
+    /// series), and sets their turn to 0 so that the pass only renormalises them.
+    #[inline(always)]
+    fn turn_wide(&mut self) {
+        for i in 0..self.turn.len() {
+            let a = self.turn[i];
+            if a.abs() > 1.0 {
+                let (s, c) = sin_cos(a);
+                let (dx, dy) = (self.dx[i], self.dy[i]);
+                self.dx[i] = dx * c - dy * s;
+                self.dy[i] = dx * s + dy * c;
+                self.turn[i] = 0.0;
+            }
+        }
     }
 
     /// The vectorised part of [`State::turn_and_look_ahead`].
@@ -281,19 +322,6 @@ impl State {
         }
     }
 
-    /// Sets this step's turn of obstacle `i` to `a` rad.
-    #[inline]
-    pub(super) fn set_turn(&mut self, i: usize, a: f64) {
-        if a.abs() <= 1.0 {
-            self.turn[i] = a;
-        } else {
-            // Turned before the vectorised pass, which then only renormalises it.
-            self.turn[i] = 0.0;
-            let (s, c) = sin_cos(a);
-            self.wide.push((i, s, c));
-        }
-    }
-
     /// Sets obstacle `i`'s free box to `free` shrunk by `half` (the body's half extents).
     pub(super) fn set_free(&mut self, i: usize, free: Aabb, half: Vector) {
         self.lo_x[i] = free.min.x + half.x + FIT_MARGIN;
@@ -306,6 +334,28 @@ impl State {
     pub(super) fn in_free(&self, i: usize, p: Point) -> bool {
         p.x > self.lo_x[i] && p.x < self.hi_x[i] && p.y > self.lo_y[i] && p.y < self.hi_y[i]
     }
+}
+
+/// One over the standard deviation of the sum of eight bytes drawn uniformly from 0..=255:
+/// `1 / sqrt(8 (256^2 - 1) / 12) = 1 / sqrt(43690)`.
+const BYTE_SUM_INV_SD: f64 = 0.004_784_196_154_532_612;
+
+/// A turn of standard deviation 1 from one 64-bit draw `z`: the sum of its eight bytes, less
+/// their mean (1020), over their standard deviation. The sum of eight uniforms (Irwin and Hall)
+/// is near normal: symmetric, standard deviation 1, within 4.88 of 0, kurtosis 2.85 (a
+/// normal's: 3), in steps of 0.0048. Integer operations and one exact conversion, so the same
+/// bits on every processor, and it vectorises.
+#[inline(always)]
+fn standard_turn(z: u64) -> f64 {
+    const BYTES: u64 = 0x00ff_00ff_00ff_00ff;
+    const PAIRS: u64 = 0x0000_ffff_0000_ffff;
+    let sum = (z & BYTES) + ((z >> 8) & BYTES);
+    let sum = (sum & PAIRS) + ((sum >> 16) & PAIRS);
+    let sum = (sum & 0xffff_ffff) + (sum >> 32);
+    // Exact for any integer below 2^52: its bits as the fraction of 2^52, less 2^52.
+    const TWO_52: f64 = 4_503_599_627_370_496.0;
+    let sum = f64::from_bits(sum | TWO_52.to_bits()) - TWO_52;
+    (sum - 1020.0) * BYTE_SUM_INV_SD
 }
 
 /// `(sin a, cos a)` for |a| <= 1 by Taylor series (to a^17 and a^18: the first term left out is
@@ -365,6 +415,33 @@ fn sin_cos(a: f64) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn standard_turns_have_mean_0_and_standard_deviation_1() {
+        // Every byte pattern's extremes, then a SplitMix64 stream's draws.
+        assert_eq!(standard_turn(0), -1020.0 * BYTE_SUM_INV_SD);
+        assert_eq!(standard_turn(u64::MAX), 1020.0 * BYTE_SUM_INV_SD);
+        assert_eq!(standard_turn(0x8080_8080_8080_807c), 0.0);
+        let mut state = 7u64;
+        let draws: Vec<f64> = (0..200_000)
+            .map(|_| {
+                state = state.wrapping_add(SPLIT_MIX_GAMMA);
+                standard_turn(split_mix(state))
+            })
+            .collect();
+        let n = draws.len() as f64;
+        let mean = draws.iter().sum::<f64>() / n;
+        let var = draws.iter().map(|g| (g - mean).powi(2)).sum::<f64>() / n;
+        let kurtosis = draws.iter().map(|g| (g - mean).powi(4)).sum::<f64>() / n / (var * var);
+        assert!(mean.abs() < 0.01, "mean {mean}");
+        assert!(
+            (var.sqrt() - 1.0).abs() < 0.01,
+            "standard deviation {}",
+            var.sqrt()
+        );
+        assert!((kurtosis - 2.85).abs() < 0.03, "kurtosis {kurtosis}");
+        assert!(draws.iter().all(|g| g.abs() <= 4.88));
+    }
 
     #[test]
     fn sin_cos_matches_the_library() {

@@ -1,6 +1,7 @@
 //! Moving and appearing obstacles (docs/model.md "Moving obstacles"): discs and boxes that move before the
 //! robot in every step, as `linear`, `waypoints`, `random_walk` or `appear` say, all drawn from the
-//! episode seed's own moving-obstacle stream, so adding one never changes the maze, the start or
+//! episode seed's own moving-obstacle streams (the random walks' turns from one SplitMix64 stream
+//! per obstacle, keyed by the walk stream), so adding one never changes the maze, the start or
 //! the goal.
 //!
 //! Contact works both ways and is swept, so no speed carries one through the other: an obstacle
@@ -26,10 +27,10 @@ pub use waypoints::Waypoints;
 use crate::config::{MotionKind, MovingConfig, MovingShape, ValidConfig};
 use crate::geometry::{point_segment_distance_squared, unit, Point, Vector};
 use crate::scene::Scene;
+use crate::sim::rng::{split_mix, SPLIT_MIX_GAMMA};
 use crate::sim::rng::{stream, Rng, Stream};
 use heading::{State, RESORT_EVERY};
 use rand::Rng as _;
-use rand_distr::{Distribution, StandardNormal};
 
 /// Attempts at finding a free spot for an obstacle.
 const SPOT_TRIES: usize = 1000;
@@ -38,7 +39,8 @@ const SPOT_TRIES: usize = 1000;
 #[derive(Clone, Copy, Debug)]
 enum Motion {
     Still,
-    /// `linear` (no turning) or `random_walk` (turning by N(0, sigma^2) rad each step), moved
+    /// `linear` (no turning) or `random_walk` (turning each step by a near-normal draw of
+    /// standard deviation `sigma_rad`, rad: `heading::standard_turn`), moved
     /// with every other heading in one pass.
     Heading {
         sigma_rad: f64,
@@ -234,6 +236,13 @@ impl Movers {
         // Pattern pedestrians placed so far: starts and goals, with their radii.
         let mut taken: Vec<(Point, f64)> = Vec::new();
         let mut state = State::default();
+        // Each obstacle turns by draws of its own SplitMix64 stream, obstacle k's starting at
+        // the k-th number of the one keyed by the episode's walk stream: the turns are drawn
+        // side by side, and take nothing from the moving-obstacle stream.
+        let walk_key: u64 = stream(seed, Stream::Walk).random();
+        let turn_stream = |k: usize| {
+            split_mix(walk_key.wrapping_add((k as u64 + 1).wrapping_mul(SPLIT_MIX_GAMMA)))
+        };
         let mut reach: f64 = 0.0;
         for (entry, m) in config.moving.iter().enumerate() {
             // Entries past the file's own `[[moving]]` ones are its crowds.
@@ -289,7 +298,7 @@ impl Movers {
                     Self::make(m, body, scene, robots, goals, &mut rng).map_err(err)?
                 };
                 let near = speed + body.bounding_radius() + robot_radius;
-                state.push(&e, position, dir, speed, near);
+                state.push(&e, position, dir, speed, near, turn_stream(entries.len()));
                 entries.push(e);
                 behaviours.push(behaviour);
             }
@@ -432,10 +441,10 @@ impl Movers {
     /// Moves every obstacle one step (step `step` of the episode, from 1), with the robot (a disc
     /// of the configured radius) standing at `robot`.
     ///
-    /// In three passes: appearances and releases, then this step's turns from the random stream
-    /// in obstacle order, then the turns and moves of all headings at once (vectorised, with a
-    /// free box per obstacle answering most clearance questions); what the free box cannot
-    /// answer, waypoints and the contact with the robot are settled one by one.
+    /// In three passes: appearances and releases, then the turns (each obstacle's from its own
+    /// stream) and moves of all headings at once (vectorised, with a free box per obstacle
+    /// answering most clearance questions); what the free box cannot answer, waypoints and the
+    /// contact with the robot are settled one by one.
     pub fn advance(&mut self, step: u32, scene: &Scene, robot: Point) -> Advance {
         let robot = [Disc::new(robot, self.robot_radius)];
         let mut touched = Vec::new();
@@ -507,16 +516,6 @@ impl Movers {
                 scene,
                 &mut self.rng,
             );
-        }
-        state.wide.clear();
-        for i in 0..state.sigma.len() {
-            let sigma = state.sigma[i];
-            if sigma > 0.0 {
-                let z: f64 = StandardNormal.sample(&mut self.rng);
-                state.set_turn(i, sigma * z);
-            } else {
-                state.turn[i] = 0.0;
-            }
         }
         state.turn_and_look_ahead(&self.centres);
         for (i, e) in self.entries.iter().enumerate() {
