@@ -244,6 +244,7 @@ fn encode(trace: &Trace) -> (serde_json::Value, Vec<u8>) {
                 None => (u16::MAX, 0.0, 0.0),
                 Some(Move::Named(i)) => (*i, 0.0, 0.0),
                 Some(Move::Speeds(v, w)) => (u16::MAX - 1, *v, *w),
+                Some(Move::Steer(v, steer)) => (u16::MAX - 2, *v, *steer),
             };
             action.bytes.extend_from_slice(&code.to_le_bytes());
             speed.bytes.extend_from_slice(&v.to_le_bytes());
@@ -310,14 +311,23 @@ fn encode(trace: &Trace) -> (serde_json::Value, Vec<u8>) {
         .iter()
         .map(|r| {
             let [red, green, blue] = r.colour;
-            serde_json::json!({
+            let mut robot = serde_json::json!({
                 "colour": format!("#{red:02x}{green:02x}{blue:02x}"),
                 "radius": round(r.radius_px),
                 "tolerance": round(r.goal_tolerance_px),
                 "goals": r.goals.iter().map(|g| [round(g.x), round(g.y)]).collect::<Vec<_>>(),
                 "beams": r.beam_offsets_deg.iter().map(|&d| round(d)).collect::<Vec<_>>(),
                 "range": round(r.range_px),
-            })
+            });
+            // A footprint other than a disc: its corners, ahead and left of the robot.
+            if !r.outline.is_empty() {
+                robot["outline"] = serde_json::json!(r
+                    .outline
+                    .iter()
+                    .map(|&[x, y]| [round(x), round(y)])
+                    .collect::<Vec<_>>());
+            }
+            robot
         })
         .collect();
     let movers: Vec<serde_json::Value> = trace

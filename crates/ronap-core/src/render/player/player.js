@@ -285,7 +285,20 @@
         ctx.moveTo(x, y);
         ctx.lineTo(x + Math.cos(a) * radius * 2, y - Math.sin(a) * radius * 2);
         ctx.stroke();
-        disc(x, y, radius, colour);
+        if (r.outline) {
+          // A rectangle or polygon footprint: its corners turned by the heading.
+          const c = Math.cos(a), n = Math.sin(a);
+          ctx.fillStyle = colour;
+          ctx.beginPath();
+          r.outline.forEach(([ahead, left], i) => {
+            const vx = x + (c * ahead - n * left) * s, vy = y - (n * ahead + c * left) * s;
+            if (i === 0) ctx.moveTo(vx, vy); else ctx.lineTo(vx, vy);
+          });
+          ctx.closePath();
+          ctx.fill();
+        } else {
+          disc(x, y, radius, colour);
+        }
         if (k === state.robot && m.robots.length > 1) {
           ctx.strokeStyle = "#000";
           ctx.lineWidth = least;
@@ -310,7 +323,9 @@
         ? last ? "none: the episode ended" : "none: it no longer acts"
         : code === 0xfffe
           ? `v=${+this.speed[i].toFixed(4)};w=${+this.turn[i].toFixed(4)}`
-          : m.actions[code] ?? "?";
+          : code === 0xfffd
+            ? `v=${+this.speed[i].toFixed(4)};steer=${+this.turn[i].toFixed(4)}`
+            : m.actions[code] ?? "?";
       const state = (flags & 1) === 0 ? "not in the scene" : (flags & 2) !== 0 ? "running" : "stopped";
       const readings = r.beams.map((_, b) => fmt(this.readings[this.readingsAt[k] + b * F + f], 1));
       const g = Math.min(this.goal[i], r.goals.length - 1);

@@ -30,6 +30,8 @@ pub(super) enum Move {
     Named(u16),
     /// A continuous action: linear speed, px per step, and angular speed, degrees per step.
     Speeds(f32, f32),
+    /// A car's action: speed, px per step, and steering angle, degrees.
+    Steer(f32, f32),
 }
 
 /// One robot of a trace: what stays and its state at every frame.
@@ -37,6 +39,8 @@ pub(super) enum Move {
 pub(super) struct RobotTrace {
     pub(super) colour: [u8; 3],
     pub(super) radius_px: f64,
+    /// A footprint other than a disc: its corners in the robot's frame (empty for a disc).
+    pub(super) outline: Vec<[f64; 2]>,
     pub(super) goal_tolerance_px: f64,
     /// Its goals in visiting order.
     pub(super) goals: Vec<Point>,
@@ -133,6 +137,7 @@ impl Recorder {
                 RobotTrace {
                     colour,
                     radius_px: r.config().robot.radius_px,
+                    outline: r.config().robot.outline(),
                     goal_tolerance_px: r.config().episode.goal_tolerance_px,
                     goals,
                     beam_offsets_deg: (0..laser.beams())
@@ -210,12 +215,12 @@ impl Recorder {
                     // Discrete actions are a handful of names.
                     Some(Move::Named(index as u16))
                 }
-                // A player shows a speed and a turn: an omnidirectional robot's sideways
-                // speed is left out, a car's steering angle stands for the turn.
+                // A player shows two numbers: an omnidirectional robot's sideways speed is left
+                // out.
                 Action::Continuous { v, w_deg } | Action::Omni { vx: v, w_deg, .. } => {
                     Some(Move::Speeds(v as f32, w_deg as f32))
                 }
-                Action::Steer { v, steer_deg } => Some(Move::Speeds(v as f32, steer_deg as f32)),
+                Action::Steer { v, steer_deg } => Some(Move::Steer(v as f32, steer_deg as f32)),
             };
             r.reward[last] = done.reward as f32;
             if done.collided {
