@@ -127,8 +127,10 @@ pub struct Episode {
     /// Motion, goal-sensing and beam noise, when the configuration has any.
     noise: Option<Box<RobotNoise>>,
     readings: Vec<f64>,
-    /// The other robots near enough to see, gathered afresh each sensing (a kept buffer).
+    /// The other robots near enough to see, gathered afresh each sensing (a kept buffer), and
+    /// their headings.
     near_discs: Vec<(Point, f64)>,
+    near_headings: Vec<f64>,
     /// The heading the last sensing faced, degrees, and its unit vector (`unit(z_deg)`): a step
     /// ahead from that heading moves along it without working out its sine and cosine again.
     facing: (f64, Vector),
@@ -247,6 +249,7 @@ impl Episode {
             noise: RobotNoise::new(&config.robot, &config.laser, seed, 0).map(Box::new),
             readings: vec![0.0; beams],
             near_discs: Vec::new(),
+            near_headings: Vec::new(),
             facing: (f64::NAN, Vector::zeros()),
             observation: vec![0.0; config.observation_size()],
             distance_px: 0.0,
@@ -307,25 +310,39 @@ impl Episode {
         }
         let reach = self.laser.range_px() + radius;
         let mut near = std::mem::take(&mut self.near_discs);
+        let mut headings = std::mem::take(&mut self.near_headings);
         near.clear();
+        headings.clear();
         // Squared distances, without a square root: a disc near the edge of `reach` (which is
         // the range plus the robot's radius) is beyond every beam's range either way.
-        near.extend(
-            others
-                .iter()
-                .filter(|d| (d.at - p).norm_squared() <= (reach + d.radius) * (reach + d.radius))
-                .map(|d| (d.at, d.radius)),
-        );
+        for d in others {
+            if (d.at - p).norm_squared() <= (reach + d.radius) * (reach + d.radius) {
+                near.push((d.at, d.radius));
+                headings.push(d.z_deg);
+            }
+        }
         if !near.is_empty() {
+            // The team's robots share this robot's footprint: a disc, or an outline the beams
+            // meet within its circumscribed disc.
+            let outline = self.config.robot.outline();
+            let mut corners = Vec::with_capacity(outline.len());
             self.laser.refine_round_toward(
                 p,
                 heading,
                 &mut self.readings,
                 &near,
-                |j, origin, dir, best| Body::Disc(near[j].1).ray(near[j].0, origin, dir, best),
+                |j, origin, dir, best| {
+                    if outline.is_empty() {
+                        return Body::Disc(near[j].1).ray(near[j].0, origin, dir, best);
+                    }
+                    let pose = Pose::new(near[j].0.x, near[j].0.y, headings[j]);
+                    Robot::place(&outline, pose, &mut corners);
+                    crate::sim::robot::ray_convex(&corners, origin, dir, best)
+                },
             );
         }
         self.near_discs = near;
+        self.near_headings = headings;
         self.laser
             .add_noise(&mut self.readings, &mut self.noise_rng);
         let range = self.laser.range_px();
@@ -406,6 +423,8 @@ impl Episode {
                 0.03 * rand_distr::Distribution::<f64>::sample(&rand_distr::StandardNormal, rng);
             let z = wrap_deg(bearing_deg(p, self.goal) + 360.0 * lambda3);
             self.pose = Pose::new(p.x, p.y, z);
+            // A body put down elsewhere stands still.
+            self.velocity = Velocity::default();
             self.sense();
             return Some(self.pose);
         }

@@ -126,6 +126,9 @@ pub struct Laser {
     first_offset_deg: f64,
     step_deg: f64,
     noise: Option<Normal<f64>>,
+    /// How far at most a beam is turned from its place by the last jitter, degrees (0 without
+    /// jitter): the beam windows of [`Laser::refine_round`] widen by it.
+    spread_deg: f64,
 }
 
 impl Laser {
@@ -151,14 +154,17 @@ impl Laser {
             first_offset_deg,
             step_deg,
             noise,
+            spread_deg: 0.0,
         }
     }
 
     /// Turns beam `i` by `jitter_deg[i]` from its place, for the scans that follow
     /// (beam-angle jitter).
     pub(crate) fn jitter(&mut self, jitter_deg: &[f64]) {
+        self.spread_deg = 0.0;
         for (i, (o, j)) in self.offsets.iter_mut().zip(jitter_deg).enumerate() {
             *o = unit(self.first_offset_deg + i as f64 * self.step_deg + j);
+            self.spread_deg = self.spread_deg.max(j.abs());
         }
     }
 
@@ -389,6 +395,12 @@ impl Laser {
                 // window at least as wide as the target's, so every beam that can touch it is
                 // asked (the others miss it). Not used when every beam is asked.
                 let half = (radius / (d2 - r2).sqrt()).to_degrees() + WINDOW_MARGIN_DEG;
+                // Jittered beams may stand off their places by up to the spread.
+                let half = if self.spread_deg > 0.0 {
+                    half + self.spread_deg
+                } else {
+                    half
+                };
                 *w = (from_first, half, all);
             }
             for (k, &(from_first, half, all)) in windows[..chunk.len()].iter().enumerate() {
@@ -663,12 +675,20 @@ mod tests {
         for case in 0..2000 {
             let beams = [1, 2, 17, 64, 360, 1081][case % 6];
             let fov = [180.0, 360.0, 90.0, 270.0][case % 4];
-            let l = Laser::new(&LaserConfig {
+            let mut l = Laser::new(&LaserConfig {
                 beams,
                 fov_deg: fov,
                 range_px: 200.0,
                 ..LaserConfig::default()
             });
+            // Every third case with its beams jittered, some by many beam steps.
+            if case % 3 == 1 {
+                let sigma = [0.5, 3.0, 20.0][case % 9 / 3];
+                let jitter: Vec<f64> = (0..beams)
+                    .map(|_| sigma * rng.random_range(-2.0..2.0))
+                    .collect();
+                l.jitter(&jitter);
+            }
             let p = Point::new(rng.random_range(0.0..500.0), rng.random_range(0.0..500.0));
             // Headings as a robot turns them, and far beyond a turn or two.
             let heading = match case % 10 {

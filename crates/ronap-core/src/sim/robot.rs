@@ -151,11 +151,58 @@ impl Robot {
         if outline.is_empty() {
             return None;
         }
+        let mut out = Vec::with_capacity(outline.len());
+        Self::place(&outline, pose, &mut out);
+        Some(out)
+    }
+
+    /// The corners of `outline` (in the robot's frame, `[ahead px, left px]`) at `pose`, into
+    /// `out`.
+    pub(crate) fn place(outline: &[[f64; 2]], pose: Pose, out: &mut Vec<Point>) {
         let h = crate::geometry::unit(pose.z_deg);
         let left = Vector::new(-h.y, h.x);
         let p = pose.position();
-        Some(outline.iter().map(|&[x, y]| p + h * x + left * y).collect())
+        out.clear();
+        out.extend(outline.iter().map(|&[x, y]| p + h * x + left * y));
     }
+}
+
+/// How far along the unit `dir` from `origin` the convex polygon `corners` (in order round it,
+/// either way) lies, if within `max`: 0 from inside it.
+pub(crate) fn ray_convex(corners: &[Point], origin: Point, dir: Vector, max: f64) -> Option<f64> {
+    let n = corners.len();
+    let twice_area: f64 = (0..n)
+        .map(|i| {
+            let (a, b) = (corners[i], corners[(i + 1) % n]);
+            a.x * b.y - b.x * a.y
+        })
+        .sum();
+    let turn = twice_area.signum();
+    // Clip the ray to each edge's inner half-plane (its outward normal `outward`).
+    let (mut enter, mut leave) = (0.0f64, max);
+    for i in 0..n {
+        let (a, b) = (corners[i], corners[(i + 1) % n]);
+        let e = b - a;
+        let outward = Vector::new(e.y, -e.x) * turn;
+        let room = outward.dot(&(a - origin));
+        let along = outward.dot(&dir);
+        if along == 0.0 {
+            if room < 0.0 {
+                return None;
+            }
+            continue;
+        }
+        let t = room / along;
+        if along < 0.0 {
+            enter = enter.max(t);
+        } else {
+            leave = leave.min(t);
+        }
+        if enter > leave {
+            return None;
+        }
+    }
+    Some(enter)
 }
 
 #[cfg(test)]
@@ -205,5 +252,33 @@ mod tests {
         assert!((m.end.x - r * 15f64.to_radians().sin()).abs() < 1e-9);
         assert!((m.end.y - r * (1.0 - 15f64.to_radians().cos())).abs() < 1e-9);
         assert_eq!(m.turn_fraction, 1.0);
+    }
+}
+
+#[cfg(test)]
+mod ray_tests {
+    use super::*;
+
+    #[test]
+    fn a_ray_meets_a_convex_polygon_where_its_edges_say() {
+        // The square [0, 10] x [0, 10], counter-clockwise and clockwise.
+        let square = [
+            Point::new(0.0, 0.0),
+            Point::new(10.0, 0.0),
+            Point::new(10.0, 10.0),
+            Point::new(0.0, 10.0),
+        ];
+        let reversed: Vec<Point> = square.iter().rev().copied().collect();
+        for c in [&square[..], &reversed[..]] {
+            let east = Vector::new(1.0, 0.0);
+            assert_eq!(ray_convex(c, Point::new(-5.0, 5.0), east, 50.0), Some(5.0));
+            assert_eq!(ray_convex(c, Point::new(5.0, 5.0), east, 50.0), Some(0.0));
+            assert_eq!(ray_convex(c, Point::new(-5.0, 15.0), east, 50.0), None);
+            assert_eq!(ray_convex(c, Point::new(-5.0, 5.0), east, 4.0), None);
+            assert_eq!(ray_convex(c, Point::new(15.0, 5.0), east, 50.0), None);
+            let d = Vector::new(1.0, 1.0).normalize();
+            let t = ray_convex(c, Point::new(-3.0, -3.0), d, 50.0).expect("a hit");
+            assert!((t - 3.0 * 2f64.sqrt()).abs() < 1e-12);
+        }
     }
 }

@@ -173,19 +173,27 @@ pub struct Movers {
     waiting: usize,
 }
 
-/// A robot as moving obstacles see it: a disc.
+/// A robot as moving obstacles see it: a disc (and its heading, which turns a footprint other
+/// than a disc for the lasers of a team's other robots).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Disc {
     /// Its centre.
     pub at: Point,
     /// Its radius, px.
     pub radius: f64,
+    /// Its heading, degrees.
+    pub z_deg: f64,
 }
 
 impl Disc {
     /// The disc of `radius` at `at`.
     pub fn new(at: Point, radius: f64) -> Self {
-        Self { at, radius }
+        Self::facing(at, radius, 0.0)
+    }
+
+    /// The disc of `radius` at `at`, heading `z_deg`.
+    pub fn facing(at: Point, radius: f64, z_deg: f64) -> Self {
+        Self { at, radius, z_deg }
     }
 }
 

@@ -384,7 +384,11 @@ fn places_of(robots: impl Iterator<Item = usize>, n: usize) -> Vec<Option<u32>> 
 
 /// Robot `r` as a disc.
 fn disc(r: &Episode) -> Disc {
-    Disc::new(r.pose().position(), r.config().robot.radius_px)
+    Disc::facing(
+        r.pose().position(),
+        r.config().robot.radius_px,
+        r.pose().z_deg,
+    )
 }
 
 #[cfg(test)]
@@ -448,6 +452,35 @@ mod tests {
                 Arc::new(World::new(config.team_robot(k), scene.clone()))
             })
             .collect()
+    }
+
+    /// A team's robots see each other's footprint: a rectangle's side, not its circumscribed
+    /// disc.
+    #[test]
+    fn a_robot_reads_another_robots_rectangle() {
+        let at = |x: f64| TeamRobotConfig {
+            count: 1,
+            start: Some([x, 150.0, 0.0]),
+            goal: Some([x, 850.0]),
+            ..Default::default()
+        };
+        let mut c = crate::SimConfig {
+            robots: vec![at(150.0), at(190.0)],
+            ..Default::default()
+        };
+        c.scene.seed = Some(0);
+        c.maze.cols = 1;
+        c.maze.rows = 1;
+        c.maze.cell_px = 1000.0;
+        c.robot.shape = crate::config::Shape::Rectangle;
+        c.robot.length_px = Some(20.0);
+        c.robot.width_px = Some(10.0);
+        let config = c.validate().expect("valid");
+        let team = Team::new(&config, &worlds(&config, 0), 0).expect("placed");
+        // Robot 0's middle beam (of 17, straight ahead) meets robot 1's rear side at 40 - 10
+        // px; its circumscribed disc would read 40 - 11.18.
+        let middle = team.robot(0).readings()[8];
+        assert!((middle - 30.0).abs() < 1e-9, "{middle}");
     }
 
     #[test]
