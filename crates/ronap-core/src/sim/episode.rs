@@ -357,6 +357,7 @@ impl Episode {
     }
 
     /// The observation's goal direction: the true one, or as sensed with goal-sensing noise.
+    #[inline]
     fn observe_goal(&mut self) {
         let last = self.readings.len();
         let direction = match &mut self.noise {
@@ -548,6 +549,7 @@ impl Episode {
 
     /// The first half of a step: where `action` would take the robot (no collision check),
     /// with motion noise on the velocity it executes when configured.
+    #[inline]
     pub(crate) fn motion(&mut self, action: Action) -> Motion {
         // The unit heading of the last sensing, unless the pose was set since (re-posing in data
         // collection).

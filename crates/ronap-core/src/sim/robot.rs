@@ -94,6 +94,7 @@ impl Robot {
     }
 
     /// Whether the disc can make `motion` from `pose` without touching an obstacle.
+    #[inline]
     pub fn motion_clear(&self, scene: &Scene, pose: Pose, motion: &Motion) -> bool {
         self.motion_clear_by(pose, motion, |a, b, r| scene.sweep_clear(a, b, r))
     }

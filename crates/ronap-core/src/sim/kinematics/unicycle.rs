@@ -33,7 +33,7 @@ impl Unicycle {
 
     /// The speed, turn and turn fraction `action` commands: a discrete action as the paper's,
     /// a continuous one clipped to the limits (a NaN is 0).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn target(&self, action: Action) -> (f64, f64, f64) {
         let continuous = |v: f64, w_deg: f64| {
             let (v_max, w_max) = (self.max_linear_speed_px, self.max_angular_speed_deg);
