@@ -201,13 +201,30 @@ impl Planner for DwaPlanner {
                 let across = |lo: f64, hi: f64, n: u32, i: u32| {
                     lo + (hi - lo) * f64::from(i) / f64::from(n - 1)
                 };
+                // An omnidirectional base's sideways speeds too: the ends of its window and
+                // the speed nearest none.
+                let sideways: Vec<f64> = if robot.kinematics == KinematicsKind::Omni {
+                    let (vy0, vy_max) = (me.velocity().vy, robot.lateral_speed_px());
+                    let (lo, hi) = ((vy0 - accel).max(-vy_max), (vy0 + accel).min(vy_max));
+                    let mut s = vec![lo, 0.0f64.clamp(lo, hi), hi];
+                    s.dedup();
+                    s
+                } else {
+                    Vec::new()
+                };
                 let mut out = Vec::new();
                 for i in 0..dwa.speed_samples {
                     let v = across(v_lo, v_hi, dwa.speed_samples, i);
                     for j in 0..dwa.turn_samples {
                         let w_deg = across(w_lo, w_hi, dwa.turn_samples, j);
-                        let a = Action::Continuous { v, w_deg };
-                        out.push((a, a, v));
+                        if sideways.is_empty() {
+                            let a = Action::Continuous { v, w_deg };
+                            out.push((a, a, v));
+                        }
+                        for &vy in &sideways {
+                            let a = Action::Omni { vx: v, vy, w_deg };
+                            out.push((a, a, v.hypot(vy)));
+                        }
                     }
                 }
                 out
