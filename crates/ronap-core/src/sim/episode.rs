@@ -360,15 +360,23 @@ impl Episode {
     #[inline]
     fn observe_goal(&mut self) {
         let last = self.readings.len();
-        let direction = match &mut self.noise {
-            Some(noise) if noise.senses_goal() => {
-                let bearing = bearing_deg(self.pose.position(), self.goal);
-                let (bearing, _) = noise.sense_goal(bearing, self.distance_px);
-                wrap_deg(bearing - self.pose.z_deg)
-            }
+        let direction = match &self.noise {
+            Some(noise) if noise.senses_goal() => self.sensed_direction_deg(),
             _ => self.direction_deg(),
         };
         self.observation[last] = (direction / 360.0) as f32;
+    }
+
+    /// The goal's direction from the heading as sensed with goal-sensing noise, degrees.
+    #[cold]
+    #[inline(never)]
+    fn sensed_direction_deg(&mut self) -> f64 {
+        let bearing = bearing_deg(self.pose.position(), self.goal);
+        let (z, distance) = (self.pose.z_deg, self.distance_px);
+        match &mut self.noise {
+            Some(noise) => wrap_deg(noise.sense_goal(bearing, distance).0 - z),
+            None => self.direction_deg(),
+        }
     }
 
     /// The goal's bearing (degrees in [0, 360)) and distance (px) as the robot last sensed
@@ -555,19 +563,27 @@ impl Episode {
         // collection).
         let facing =
             (self.facing.0.to_bits() == self.pose.z_deg.to_bits()).then_some(self.facing.1);
-        match &mut self.noise {
-            None => self
-                .robot
-                .motion_from(self.pose, self.velocity, facing, action),
-            Some(noise) => {
-                let (velocity, turn_fraction) = self.robot.command(self.velocity, action);
-                let velocity = noise.executed(self.robot.kinematics(), velocity);
-                Motion {
-                    end: travel(self.pose, velocity, facing),
-                    turn_fraction,
-                    velocity,
-                }
-            }
+        if self.noise.is_some() {
+            return self.noisy_motion(facing, action);
+        }
+        self.robot
+            .motion_from(self.pose, self.velocity, facing, action)
+    }
+
+    /// [`Episode::motion`] with motion noise on the executed velocity (out of the step's way:
+    /// the noiseless step inlines without it).
+    #[cold]
+    #[inline(never)]
+    fn noisy_motion(&mut self, facing: Option<Vector>, action: Action) -> Motion {
+        let (velocity, turn_fraction) = self.robot.command(self.velocity, action);
+        let velocity = match &mut self.noise {
+            Some(noise) => noise.executed(self.robot.kinematics(), velocity),
+            None => velocity,
+        };
+        Motion {
+            end: travel(self.pose, velocity, facing),
+            turn_fraction,
+            velocity,
         }
     }
 

@@ -119,6 +119,17 @@ impl Robot {
                 sweep_clear,
             );
         }
+        self.cover_clear(pose, motion, &mut sweep_clear)
+    }
+
+    /// [`Robot::motion_clear_by`] for a footprint other than a disc (out of the disc's way).
+    #[inline(never)]
+    fn cover_clear(
+        &self,
+        pose: Pose,
+        motion: &Motion,
+        sweep_clear: &mut dyn FnMut(Point, Point, f64) -> bool,
+    ) -> bool {
         let v = motion.velocity;
         let w = v.w_deg.to_radians();
         let heading = crate::geometry::unit(pose.z_deg);
@@ -140,7 +151,7 @@ impl Robot {
                 piece,
                 at(motion.end, end_heading),
                 r,
-                &mut sweep_clear,
+                &mut *sweep_clear,
             )
         })
     }
