@@ -369,6 +369,33 @@ fn bench_times_a_team_step_of_every_robot() {
 }
 
 #[test]
+fn bench_times_a_team_policys_planning_and_steps() {
+    let scenario = repo_root().join("scenarios/corridor-bay.toml");
+    let text = ok(&ronap(&[
+        "bench",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--policy",
+        "coordinated",
+        "--seconds",
+        "0.2",
+    ]));
+    let figure = |name: &str| -> f64 {
+        let line = text.lines().find(|l| l.contains(name)).unwrap();
+        line.split_whitespace().nth(1).unwrap().parse().unwrap()
+    };
+    assert!(figure("planning") > 0.0, "{text}");
+    assert!(text.contains("ms per team (coordinated, mean of"), "{text}");
+    let one = text.lines().find(|l| l.contains("one thread")).unwrap();
+    assert!(one.contains("decisions included"), "{one}");
+    // A lone robot has no team policy to time: one line says so.
+    assert_rejected(
+        &["bench", "--policy", "geodesic", "--seconds", "0.1"],
+        &["--policy", "team"],
+    );
+}
+
+#[test]
 fn log_steps_writes_a_log_per_robot_and_replay_plays_the_team_again() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("team");

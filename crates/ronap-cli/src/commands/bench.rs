@@ -54,6 +54,11 @@ pub struct BenchArgs {
     /// range of 50, 200 and 1000 px, instead of the usual figures.
     #[arg(long, conflicts_with_all = ["beams", "range", "threads"])]
     sweep: bool,
+    /// Team scenarios: time this team policy (coordinated, or any policy `ronap run` takes) on
+    /// one thread, its planning of each team and its steps with their decisions, instead of the
+    /// action pattern.
+    #[arg(long, value_name = "NAME", conflicts_with = "sweep")]
+    policy: Option<String>,
     #[command(flatten)]
     sim: SimArgs,
 }
@@ -173,6 +178,55 @@ impl Bench {
         Ok(std::process::ExitCode::SUCCESS)
     }
 
+    /// The figures of team policy `name` on a team scenario, on one thread: its planning of each
+    /// team (resetting it for a new episode) and a team step with every robot's decision, over
+    /// team episodes from seed 0 on for about `duration`.
+    fn team_policy(
+        &self,
+        name: &str,
+        duration: Duration,
+        out: &mut impl Write,
+    ) -> Result<std::process::ExitCode> {
+        let policies = crate::args::TeamPolicies::new(&self.config, name)?;
+        let worlds = Worlds::new(
+            self.config.clone(),
+            ronap_core::Scenes::Fixed(self.scene.clone()),
+        );
+        let robots = self.config.team_size();
+        let (mut steps, mut stepping, mut teams, mut planning) = (0u64, 0.0, 0u32, 0.0);
+        let begin = Instant::now();
+        let mut seed = 0;
+        while steps == 0 || begin.elapsed() < duration {
+            let mut policy = policies.start()?;
+            let clock = Instant::now();
+            let mut rollout =
+                TeamRollout::start(&self.config, worlds.team(seed), seed, policy.as_mut())
+                    .with_context(|| format!("starting the team of seed {seed}"))?;
+            planning += clock.elapsed().as_secs_f64();
+            teams += 1;
+            let clock = Instant::now();
+            while (steps == 0 || begin.elapsed() < duration) && rollout.advance(policy.as_mut())? {
+                steps += 1;
+            }
+            stepping += clock.elapsed().as_secs_f64();
+            seed += 1;
+        }
+        let per_step = stepping / steps.max(1) as f64;
+        writeln!(
+            out,
+            "  planning         {:>14.3} ms per team ({name}, mean of {teams})",
+            planning / f64::from(teams) * 1e3
+        )?;
+        writeln!(
+            out,
+            "  one thread       {:>14.3} ms per step of all {robots} robots, decisions included \
+             ({} robot-steps/s)",
+            per_step * 1e3,
+            group(robots as f64 / per_step)
+        )?;
+        Ok(std::process::ExitCode::SUCCESS)
+    }
+
     /// Steps team episodes from `first_seed` on for about `duration`, each robot driving the
     /// action pattern at its own phase; returns the team steps and the seconds they took
     /// (placing a new team when one ends is not counted).
@@ -268,6 +322,12 @@ pub fn run(args: BenchArgs) -> Result<std::process::ExitCode> {
         || std::thread::available_parallelism().map_or(1, |n| n.get()),
         |n| n as usize,
     );
+    if args.policy.is_some() && bench.config.team_size() == 0 {
+        anyhow::bail!(
+            "--policy times a team scenario's policy; this configuration has one robot, whose \
+             figures are the action pattern's (a team: [[robots]] entries)"
+        );
+    }
     let seconds = args.seconds.unwrap_or(SECONDS);
     let duration = Duration::from_secs_f64(seconds);
     let laser = &bench.config.laser;
@@ -285,9 +345,13 @@ pub fn run(args: BenchArgs) -> Result<std::process::ExitCode> {
         laser.range_px,
         seconds
     )?;
+    if let (Some(name), true) = (&args.policy, bench.config.team_size() > 0) {
+        return bench.team_policy(name, duration, &mut out);
+    }
     if bench.config.team_size() > 0 {
         return bench.team(threads, duration, &mut out);
     }
+
     let single = bench.steps_per_second(1, duration)?;
     writeln!(out, "  one thread       {:>14} steps/s", group(single))?;
     // On one thread the all-threads figure would measure the same again.
