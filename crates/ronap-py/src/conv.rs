@@ -248,7 +248,7 @@ pub fn action(
     continuous: Option<&RobotConfig>,
 ) -> Result<Action, String> {
     if let Some(robot) = continuous {
-        let n = robot.action_scale().len();
+        let n = robot.action_size();
         let names = robot.continuous_names();
         let what = || format!("expected {n} finite numbers {names}");
         let values: Vec<f64> = value.extract().map_err(|_| what())?;

@@ -93,17 +93,8 @@ impl Policy for PyPolicy {
             })?;
             let robot = &episode.config().robot;
             conv::policy_action(value.bind(py), self.continuous.then_some(robot))
-                .map(|a| match a {
-                    // Continuous policies answer in [-1, 1], as NavEnv's action space.
-                    Action::Discrete(_) => a,
-                    _ => {
-                        let full: Vec<f64> = (a.values().iter())
-                            .zip(robot.action_scale())
-                            .map(|(x, s)| x * s)
-                            .collect();
-                        continuous_action(robot, &full).unwrap_or(a)
-                    }
-                })
+                // Continuous policies answer in [-1, 1], as NavEnv's action space.
+                .map(|a| a.scaled(&robot.action_scale()))
                 .map(Decision::Act)
                 .map_err(PolicyError::Failed)
         })
@@ -214,10 +205,10 @@ impl PyBatchPolicy {
                 .and_then(|a| a.extract())
                 .map_err(|e| e.to_string())?;
             for (row, v) in values.chunks(scale.len()).enumerate() {
-                let full: Vec<f64> = v.iter().zip(&scale).map(|(x, s)| x * s).collect();
-                actions.push(continuous_action(&self.robot, &full).ok_or_else(|| {
+                let action = continuous_action(&self.robot, v).ok_or_else(|| {
                     format!("returned action {v:?} for row {row}: expected finite numbers")
-                })?);
+                })?;
+                actions.push(action.scaled(&scale));
             }
         } else {
             let array = checked(&[rows])?;

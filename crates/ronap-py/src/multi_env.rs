@@ -247,19 +247,6 @@ impl MultiEnv {
             .collect()
     }
 
-    /// Each robot's (max linear speed px/step, max angular speed deg/step), for continuous
-    /// actions.
-    #[getter]
-    fn speed_limits(&self) -> Vec<(f64, f64)> {
-        let config = self.worlds.config();
-        (0..config.team_size())
-            .map(|k| {
-                let r = config.team_robot(k).robot.clone();
-                (r.max_linear_speed_px, r.max_angular_speed_deg)
-            })
-            .collect()
-    }
-
     /// Each robot's full value of each dimension of a normalised continuous action (see
     /// `Env.action_scale`).
     #[getter]

@@ -429,8 +429,9 @@ impl RobotConfig {
 
     /// The discs, in the robot's frame (`[ahead px, left px]`, radius px), that the collision
     /// checks take a rectangle footprint for: a row of them along it, each holding a
-    /// `length / n` by `width` piece, so they hold the whole rectangle and reach at most
-    /// [`RobotConfig::cover_margin_px`] beyond it. Empty for a disc.
+    /// `length / n` by `width` piece, so they hold the whole rectangle and reach beyond it by
+    /// at most their radius less half a piece (docs/model.md "Footprints"); a polygon's along
+    /// its edges. Empty for a disc.
     pub fn cover(&self) -> Vec<([f64; 2], f64)> {
         if self.shape == Shape::Polygon {
             return self.edge_cover();
@@ -472,22 +473,15 @@ impl RobotConfig {
         out
     }
 
-    /// How far at most the discs of [`RobotConfig::cover`] reach beyond the footprint, px:
-    /// a step is blocked when an obstacle lies that close to it (0 for a disc).
-    pub fn cover_margin_px(&self) -> f64 {
-        if self.shape == Shape::Polygon {
-            return self.edge_cover().first().map_or(0.0, |&(_, r)| r);
-        }
-        let Some((l, w, _)) = self.rectangle() else {
-            return 0.0;
-        };
-        match self.cover().first() {
-            Some(&(_, r)) => {
-                let piece = l / self.cover().len() as f64;
-                (r - piece / 2.0).max(r - w / 2.0)
-            }
-            None => 0.0,
-        }
+    /// A car's largest steering angle, degrees: `steer_max_deg`, unset 30.
+    pub fn steer_limit_deg(&self) -> f64 {
+        self.steer_max_deg.unwrap_or(DEFAULT_STEER_MAX_DEG)
+    }
+
+    /// A car's distance between its axles, px: `wheel_base_px` (which a validated `ackermann`
+    /// robot gives), else the robot's diameter.
+    pub fn axle_base_px(&self) -> f64 {
+        self.wheel_base_px.unwrap_or(2.0 * self.radius_px)
     }
 
     /// The largest sideways speed, px per step: `max_lateral_speed_px` for an omnidirectional
@@ -517,7 +511,7 @@ impl RobotConfig {
         match self.kinematics {
             KinematicsKind::Omni => vec![v, self.lateral_speed_px(), w],
             KinematicsKind::Ackermann => {
-                vec![v, self.steer_max_deg.unwrap_or(DEFAULT_STEER_MAX_DEG)]
+                vec![v, self.steer_limit_deg()]
             }
             _ => vec![v, w],
         }

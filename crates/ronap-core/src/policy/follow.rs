@@ -6,7 +6,7 @@
 //! a while (pushing into a wall, turning back and forth) it reports itself stuck, so no episode
 //! waits for its time-out to fail.
 
-use crate::config::{KinematicsKind, RobotConfig, DEFAULT_STEER_MAX_DEG};
+use crate::config::{KinematicsKind, RobotConfig};
 use crate::geometry::{wrap_deg, Point};
 use crate::sim::episode::Episode;
 use crate::sim::robot::{Action, DiscreteAction};
@@ -162,13 +162,9 @@ impl Follower {
         self.contacts = contacts;
         match self.progress(episode) {
             Ok((_, error)) if self.backing > 0 => {
-                // Ran into something: back up, the front swinging towards the aim.
+                // Ran into something: back up.
                 self.backing -= 1;
-                let steer_max = robot.steer_max_deg.unwrap_or(DEFAULT_STEER_MAX_DEG);
-                FollowStep::Steer {
-                    v: -robot.max_linear_speed_px / 2.0,
-                    steer_deg: -steer_max * error.signum(),
-                }
+                back_up(robot, error)
             }
             Ok((aim, error)) => {
                 let p = episode.pose().position();
@@ -237,21 +233,24 @@ impl Follower {
 /// further it is off; an aim behind the robot is backed towards at half speed with the
 /// steering turned over, which turns the car round.
 fn pursue(robot: &RobotConfig, distance: f64, error: f64) -> FollowStep {
-    let wheel_base = robot.wheel_base_px.unwrap_or(2.0 * robot.radius_px);
-    let steer_max = robot.steer_max_deg.unwrap_or(DEFAULT_STEER_MAX_DEG);
-    let v_max = robot.max_linear_speed_px;
     let e = error.to_radians();
     if e.cos() < 0.0 {
-        // Behind: back up, the front swinging towards the aim.
-        return FollowStep::Steer {
-            v: -v_max / 2.0,
-            steer_deg: -steer_max * error.signum(),
-        };
+        return back_up(robot, error);
     }
     let curvature = 2.0 * e.sin() / distance.max(1e-9);
-    let steer_deg = (curvature * wheel_base).atan().to_degrees();
+    let steer_deg = (curvature * robot.axle_base_px()).atan().to_degrees();
+    let steer_max = robot.steer_limit_deg();
     FollowStep::Steer {
-        v: v_max * e.cos().max(0.3),
+        v: robot.max_linear_speed_px * e.cos().max(0.3),
         steer_deg: steer_deg.clamp(-steer_max, steer_max),
+    }
+}
+
+/// A car-like `robot` backing up at half speed, the steering turned over so that its front
+/// swings towards an aim `error` degrees off its heading.
+fn back_up(robot: &RobotConfig, error: f64) -> FollowStep {
+    FollowStep::Steer {
+        v: -robot.max_linear_speed_px / 2.0,
+        steer_deg: -robot.steer_limit_deg() * error.signum(),
     }
 }

@@ -143,14 +143,26 @@ impl Action {
         }
     }
 
-    /// The action's numbers (none for a discrete one): `[v, w]`, `[vx, vy, w]` or
-    /// `[v, steer]`.
-    pub fn values(self) -> Vec<f64> {
+    /// The action with each number times its dimension's `scale` (a normalised continuous
+    /// action made full: `RobotConfig::action_scale`); a discrete action, or a number without
+    /// a scale, as it is.
+    pub fn scaled(self, scale: &[f64]) -> Self {
+        let s = |i: usize| scale.get(i).copied().unwrap_or(1.0);
         match self {
-            Action::Discrete(_) => Vec::new(),
-            Action::Continuous { v, w_deg } => vec![v, w_deg],
-            Action::Omni { vx, vy, w_deg } => vec![vx, vy, w_deg],
-            Action::Steer { v, steer_deg } => vec![v, steer_deg],
+            Action::Discrete(_) => self,
+            Action::Continuous { v, w_deg } => Action::Continuous {
+                v: v * s(0),
+                w_deg: w_deg * s(1),
+            },
+            Action::Omni { vx, vy, w_deg } => Action::Omni {
+                vx: vx * s(0),
+                vy: vy * s(1),
+                w_deg: w_deg * s(2),
+            },
+            Action::Steer { v, steer_deg } => Action::Steer {
+                v: v * s(0),
+                steer_deg: steer_deg * s(1),
+            },
         }
     }
 }

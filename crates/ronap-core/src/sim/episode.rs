@@ -7,7 +7,7 @@ use crate::config::{OnCollision, ValidConfig, ACTION_MEMORY};
 use crate::geometry::{wrap_deg, Point, Vector};
 use crate::scene::freespace::FreeGrid;
 use crate::scene::Scene;
-use crate::sim::kinematics::{travel, Velocity};
+use crate::sim::kinematics::Velocity;
 use crate::sim::lidar::Laser;
 use crate::sim::moving::{Body, Disc, Movers};
 use crate::sim::noise::RobotNoise;
@@ -324,7 +324,7 @@ impl Episode {
         if !near.is_empty() {
             // The team's robots share this robot's footprint: a disc, or an outline the beams
             // meet within its circumscribed disc.
-            let outline = self.config.robot.outline();
+            let outline = self.robot.outline();
             let mut corners = Vec::with_capacity(outline.len());
             self.laser.refine_round_toward(
                 p,
@@ -336,7 +336,7 @@ impl Episode {
                         return Body::Disc(near[j].1).ray(near[j].0, origin, dir, best);
                     }
                     let pose = Pose::new(near[j].0.x, near[j].0.y, headings[j]);
-                    Robot::place(&outline, pose, &mut corners);
+                    Robot::place(outline, pose, &mut corners);
                     crate::sim::robot::ray_convex(&corners, origin, dir, best)
                 },
             );
@@ -575,16 +575,17 @@ impl Episode {
     #[cold]
     #[inline(never)]
     fn noisy_motion(&mut self, facing: Option<Vector>, action: Action) -> Motion {
-        let (velocity, turn_fraction) = self.robot.command(self.velocity, action);
-        let velocity = match &mut self.noise {
-            Some(noise) => noise.executed(self.robot.kinematics(), velocity),
-            None => velocity,
-        };
-        Motion {
-            end: travel(self.pose, velocity, facing),
-            turn_fraction,
-            velocity,
-        }
+        let noise = &mut self.noise;
+        self.robot.motion_executed(
+            self.pose,
+            self.velocity,
+            facing,
+            action,
+            |k, v| match noise {
+                Some(noise) => noise.executed(k, v),
+                None => v,
+            },
+        )
     }
 
     /// The velocity held over the last step (zero at the start and after a blocked step).

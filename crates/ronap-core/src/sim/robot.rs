@@ -22,6 +22,9 @@ pub struct Robot {
     /// A footprint other than a disc as the discs that hold it (offset in the robot's frame,
     /// radius); empty for a disc.
     cover: Vec<(Vector, f64)>,
+    /// The footprint's corners in the robot's frame ([`RobotConfig::outline`]); empty for a
+    /// disc.
+    outline: Vec<[f64; 2]>,
 }
 
 impl Robot {
@@ -33,6 +36,7 @@ impl Robot {
             cover: (config.cover().into_iter())
                 .map(|([x, y], r)| (Vector::new(x, y), r))
                 .collect(),
+            outline: config.outline(),
         }
     }
 
@@ -42,12 +46,18 @@ impl Robot {
             radius_px,
             kinematics: Built::Other(kinematics),
             cover: Vec::new(),
+            outline: Vec::new(),
         }
     }
 
     /// Disc radius, px.
     pub fn radius_px(&self) -> f64 {
         self.radius_px
+    }
+
+    /// The footprint's corners in the robot's frame, `[ahead px, left px]`; empty for a disc.
+    pub fn outline(&self) -> &[[f64; 2]] {
+        &self.outline
     }
 
     /// How the robot moves.
@@ -85,7 +95,22 @@ impl Robot {
         facing: Option<Vector>,
         action: Action,
     ) -> Motion {
-        let (velocity, turn_fraction) = self.command(velocity, action);
+        self.motion_executed(pose, velocity, facing, action, |_, v| v)
+    }
+
+    /// [`Robot::motion_from`] with the commanded velocity turned into the one the body
+    /// executes by `executed` (given the kinematics; motion noise).
+    #[inline]
+    pub fn motion_executed(
+        &self,
+        pose: Pose,
+        velocity: Velocity,
+        facing: Option<Vector>,
+        action: Action,
+        executed: impl FnOnce(&dyn Kinematics, Velocity) -> Velocity,
+    ) -> Motion {
+        let (commanded, turn_fraction) = self.command(velocity, action);
+        let velocity = executed(self.kinematics(), commanded);
         Motion {
             end: kinematics::travel(pose, velocity, facing),
             turn_fraction,

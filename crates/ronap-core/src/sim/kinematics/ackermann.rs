@@ -6,7 +6,7 @@
 //! discrete actions drive at `move_speed_px` steering fully left (LEFT), straight (AHEAD) or
 //! fully right (RIGHT).
 
-use crate::config::{RobotConfig, ACTION_MEMORY, DEFAULT_STEER_MAX_DEG};
+use crate::config::{RobotConfig, ACTION_MEMORY};
 use crate::sim::action::{Action, DiscreteAction};
 use crate::sim::kinematics::{finite_or_zero, one_hot, remembered_as, Kinematics, Velocity};
 
@@ -27,8 +27,8 @@ impl Ackermann {
         Self {
             move_speed_px: config.move_speed_px,
             v_max: config.max_linear_speed_px,
-            wheel_base_px: config.wheel_base_px.unwrap_or(2.0 * config.radius_px),
-            steer_max_deg: config.steer_max_deg.unwrap_or(DEFAULT_STEER_MAX_DEG),
+            wheel_base_px: config.axle_base_px(),
+            steer_max_deg: config.steer_limit_deg(),
             steer_rate_max_deg: config.steer_rate_max_deg,
             accel_max_px: config.accel_max_px,
         }

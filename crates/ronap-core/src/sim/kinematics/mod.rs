@@ -54,15 +54,6 @@ pub struct Motion {
 }
 
 impl Motion {
-    /// The motion of a step at `velocity` from `pose`, `turn_fraction` of a full turn command.
-    pub fn new(pose: Pose, velocity: Velocity, turn_fraction: f64) -> Self {
-        Self {
-            end: travel(pose, velocity, None),
-            turn_fraction,
-            velocity,
-        }
-    }
-
     /// The velocity held over the step.
     pub fn velocity(&self) -> Velocity {
         self.velocity

@@ -5,7 +5,9 @@
 
 use crate::config::{RobotConfig, ACTION_MEMORY};
 use crate::sim::action::{Action, DiscreteAction};
-use crate::sim::kinematics::{Kinematics, Velocity};
+use crate::sim::kinematics::{
+    finite_or_zero, remembered_twist, turn_fraction, Kinematics, Velocity,
+};
 
 /// A unicycle's speeds and limits (docs/model.md "Robot").
 #[derive(Clone, Debug, PartialEq)]
@@ -37,12 +39,9 @@ impl Unicycle {
     pub(crate) fn target(&self, action: Action) -> (f64, f64, f64) {
         let continuous = |v: f64, w_deg: f64| {
             let (v_max, w_max) = (self.max_linear_speed_px, self.max_angular_speed_deg);
-            let v = if v.is_nan() { 0.0 } else { v };
-            let w = if w_deg.is_nan() { 0.0 } else { w_deg };
-            let v = v.clamp(-v_max, v_max);
-            let w = w.clamp(-w_max, w_max);
-            let frac = if w_max > 0.0 { w.abs() / w_max } else { 0.0 };
-            (v, w, frac)
+            let v = finite_or_zero(v).clamp(-v_max, v_max);
+            let w = finite_or_zero(w_deg).clamp(-w_max, w_max);
+            (v, w, turn_fraction(w, w_max))
         };
         match action {
             Action::Discrete(DiscreteAction::Left) => (0.0, self.turn_speed_deg, 1.0),
@@ -82,24 +81,6 @@ impl Kinematics for Unicycle {
 
     /// One-hot LEFT, AHEAD, RIGHT; a continuous action as `w+ / w_max, v / v_max, w- / w_max`.
     fn remembered(&self, action: Action) -> [f32; ACTION_MEMORY] {
-        let (v_max, w_max) = (self.max_linear_speed_px, self.max_angular_speed_deg);
-        let of = |v: f64, w_deg: f64| {
-            let w = (w_deg / w_max).clamp(-1.0, 1.0);
-            [
-                w.max(0.0) as f32,
-                (v / v_max).clamp(0.0, 1.0) as f32,
-                (-w).max(0.0) as f32,
-            ]
-        };
-        match action {
-            Action::Discrete(d) => {
-                let mut v = [0.0; ACTION_MEMORY];
-                v[d as usize] = 1.0;
-                v
-            }
-            Action::Continuous { v, w_deg } => of(v, w_deg),
-            Action::Omni { vx, w_deg, .. } => of(vx, w_deg),
-            Action::Steer { v, .. } => of(v, 0.0),
-        }
+        remembered_twist(action, self.max_linear_speed_px, self.max_angular_speed_deg)
     }
 }
