@@ -366,6 +366,10 @@ pub struct Coordinated {
     robot_agents: usize,
     /// The place of each robot in `agents`.
     slot: Vec<Option<usize>>,
+    /// Each robot's velocity chosen at the last decision: its own velocity in ORCA, as in RVO2,
+    /// so a unicycle that turned on the spot last step (and moved nowhere) asks ORCA the same
+    /// question again rather than flipping between two answers.
+    chosen: Vec<Vector>,
     avoider: Avoider,
 }
 
@@ -687,6 +691,7 @@ impl Coordinated {
         let n = team.robots().len();
         let movers = team.movers().map_or(0, |m| m.items().len());
         self.last.resize(n + movers, None);
+        self.chosen.resize(n, Vector::zeros());
         self.agents.clear();
         self.slot.clear();
         let mut seen = |slot: usize, at: Option<Point>, radius: f64, agents: &mut Vec<_>| {
@@ -875,7 +880,9 @@ impl TeamPolicy for Coordinated {
                         } else {
                             (TIME_HORIZON_STEPS, 0.0)
                         };
-                        self.avoider.velocity(
+                        let seen = self.agents[slot].velocity;
+                        self.agents[slot].velocity = V2::from(self.chosen[k]);
+                        let v = self.avoider.velocity(
                             me.scene(),
                             &Avoid {
                                 agents: &self.agents,
@@ -892,7 +899,9 @@ impl TeamPolicy for Coordinated {
                                 margin,
                                 candidates: Some(near),
                             },
-                        )
+                        );
+                        self.agents[slot].velocity = seen;
+                        v
                     }
                 }
                 None => preferred,
@@ -904,6 +913,7 @@ impl TeamPolicy for Coordinated {
             } else {
                 v
             };
+            self.chosen[k] = v;
             // Dodging what moves, it tracks its velocity as the `orca` policy does, arcs and all.
             *d = Some(Decision::Act(if mover_near {
                 action(me, v, to, actions)
