@@ -144,41 +144,22 @@ fn bad_input_is_named_with_exit_code_2_and_no_output() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("m.png");
     let o = out.to_str().unwrap();
-    assert_rejected_in_empty_dir(
-        &["maze", "--cols", "0", "--out", o],
-        &["--cols", "0"],
-        Some(&out),
-    );
-    assert_rejected_in_empty_dir(
-        &["maze", "--rows", "-2", "--out", o],
-        &["--rows", "-2"],
-        Some(&out),
-    );
-    assert_rejected_in_empty_dir(
-        &["maze", "--cell", "-5", "--out", o],
-        &["--cell", "-5"],
-        Some(&out),
-    );
-    assert_rejected_in_empty_dir(
-        &["maze", "--wall-thickness", "0", "--out", o],
-        &["--wall-thickness", "0"],
-        Some(&out),
-    );
-    assert_rejected_in_empty_dir(
-        &["maze", "--loops", "1.5", "--out", o],
-        &["--loops", "1.5"],
-        Some(&out),
-    );
-    assert_rejected_in_empty_dir(
-        &["maze", "--loops", "-0.1", "--out", o],
-        &["--loops", "-0.1"],
-        Some(&out),
-    );
-    assert_rejected_in_empty_dir(
-        &["maze", "--scale", "nan", "--out", o],
-        &["--scale", "nan"],
-        Some(&out),
-    );
+    // Each flag with a value it refuses: the error names both.
+    for (flag, value) in [
+        ("--cols", "0"),
+        ("--rows", "-2"),
+        ("--cell", "-5"),
+        ("--wall-thickness", "0"),
+        ("--loops", "1.5"),
+        ("--loops", "-0.1"),
+        ("--scale", "nan"),
+    ] {
+        assert_rejected_in_empty_dir(
+            &["maze", flag, value, "--out", o],
+            &[flag, value],
+            Some(&out),
+        );
+    }
     assert_rejected_in_empty_dir(
         &["maze", "--out", "/nonexistent-dir/m.png"],
         &["/nonexistent-dir/m.png"],

@@ -1,7 +1,9 @@
 //! The learning loop from the command line: collect, train, run; weights-file errors; the shipped
 //! policies against their reported figures.
 
-use crate::util::{assert_rejected, ok, repo_root, ronap, summary, text};
+use crate::util::{
+    assert_rejected, assert_rejected_leaving_nothing, ok, repo_root, ronap, summary, text,
+};
 
 #[test]
 fn collect_train_run_loop() {
@@ -284,23 +286,21 @@ fn bad_weights_and_data_are_named() {
     let dir = tempfile::tempdir().unwrap();
     let junk = dir.path().join("junk.safetensors");
     std::fs::write(&junk, b"not weights").unwrap();
+    let out = dir.path().join("r");
     let policy = format!("mlp:{}", junk.display());
-    let o = ronap(&[
-        "run",
-        "--policy",
-        &policy,
-        "--seeds",
-        "1",
-        "--out",
-        dir.path().join("r").to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    let e = text(&o.stderr);
-    assert!(
-        e.contains("junk.safetensors") && e.contains("not a safetensors file"),
-        "{e}"
+    assert_rejected_leaving_nothing(
+        &[
+            "run",
+            "--policy",
+            &policy,
+            "--seeds",
+            "1",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &["junk.safetensors", "not a safetensors file"],
+        &out,
     );
-    assert!(!dir.path().join("r").exists());
 
     // A network for another observation size.
     let wide = dir.path().join("wide.safetensors");
@@ -315,27 +315,14 @@ fn bad_weights_and_data_are_named() {
     )
     .unwrap();
     std::fs::write(&wide, mlp.to_bytes().unwrap()).unwrap();
-    let o = ronap(&[
-        "run",
-        "--policy",
-        &format!("mlp:{}", wide.display()),
-        "--seeds",
-        "1",
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    let e = text(&o.stderr);
-    assert!(
-        e.contains("takes 25 inputs") && e.contains("observation has 18"),
-        "{e}"
+    let policy = format!("mlp:{}", wide.display());
+    let names = ["takes 25 inputs", "observation has 18"];
+    assert_rejected(&["run", "--policy", &policy, "--seeds", "1"], &names);
+    let policy = format!("{policy}@hottest");
+    assert_rejected(
+        &["run", "--policy", &policy],
+        &["\"hottest\" is not a decision rule"],
     );
-
-    let o = ronap(&[
-        "run",
-        "--policy",
-        &format!("mlp:{}@hottest", wide.display()),
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(text(&o.stderr).contains("\"hottest\" is not a decision rule"));
 
     let bad = dir.path().join("bad.csv");
     std::fs::write(
@@ -343,21 +330,19 @@ fn bad_weights_and_data_are_named() {
         "laser_0,heading,bearing,action\n1,2,3,AHEAD\n4,5,x,LEFT\n",
     )
     .unwrap();
-    let o = ronap(&[
-        "train",
-        "bc",
-        "--data",
-        bad.to_str().unwrap(),
-        "--out",
-        dir.path().join("b.safetensors").to_str().unwrap(),
-    ]);
-    assert_eq!(o.status.code(), Some(2));
-    let e = text(&o.stderr);
-    assert!(
-        e.contains("bad.csv:3") && e.contains("bearing = \"x\""),
-        "{e}"
+    let out = dir.path().join("b.safetensors");
+    assert_rejected_leaving_nothing(
+        &[
+            "train",
+            "bc",
+            "--data",
+            bad.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &["bad.csv:3", "bearing = \"x\""],
+        &out,
     );
-    assert!(!dir.path().join("b.safetensors").exists());
 }
 
 #[test]

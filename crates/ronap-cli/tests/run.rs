@@ -166,120 +166,52 @@ fn bad_input_is_named_and_leaves_no_output() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("never");
     let o = out.to_str().unwrap();
-    assert_rejected_leaving_nothing(
-        &["run", "--policy", "teleport", "--out", o],
-        &["teleport", "apf"],
-        &out,
-    );
-    assert_rejected_leaving_nothing(
-        &["run", "--policy", "apf", "--seeds", "0", "--out", o],
-        &["--seeds", "0"],
-        &out,
-    );
-    assert_rejected_leaving_nothing(
-        &[
-            "run",
-            "--policy",
-            "random",
-            "--seed-start",
-            "1",
-            "--seeds",
-            "18446744073709551615",
-            "--out",
-            o,
-        ],
-        &["--seeds 18446744073709551615", "--seed-start"],
-        &out,
-    );
-    assert_rejected_leaving_nothing(
-        &[
-            "run",
-            "--policy",
-            "apf",
-            "--map",
-            "/no/such/map.png",
-            "--out",
-            o,
-        ],
-        &["/no/such/map.png"],
-        &out,
-    );
-    let corrupt = dir.path().join("corrupt.png");
-    std::fs::write(&corrupt, b"\x89PNG not really").unwrap();
-    assert_rejected_leaving_nothing(
-        &[
-            "run",
-            "--policy",
-            "apf",
-            "--map",
-            corrupt.to_str().unwrap(),
-            "--out",
-            o,
-        ],
-        &["corrupt.png"],
-        &out,
-    );
-    let yaml = dir.path().join("bad.yaml");
-    std::fs::write(&yaml, "image: x.pgm\nresolution: fast\n").unwrap();
-    assert_rejected_leaving_nothing(
-        &[
-            "run",
-            "--policy",
-            "apf",
-            "--map",
-            yaml.to_str().unwrap(),
-            "--out",
-            o,
-        ],
-        &["bad.yaml", "line 2", "fast"],
-        &out,
-    );
-    let cfg = dir.path().join("c.toml");
-    std::fs::write(&cfg, "[robot]\nradius_px = -3\n").unwrap();
-    assert_rejected_leaving_nothing(
-        &[
-            "run",
-            "--policy",
-            "apf",
-            "--config",
-            cfg.to_str().unwrap(),
-            "--out",
-            o,
-        ],
-        &["c.toml", "robot.radius_px", "-3"],
-        &out,
-    );
-    std::fs::write(&cfg, "[laser]\nbeams = 17\nbeam = 3\n").unwrap();
-    assert_rejected_leaving_nothing(
-        &[
-            "run",
-            "--policy",
-            "apf",
-            "--config",
-            cfg.to_str().unwrap(),
-            "--out",
-            o,
-        ],
-        &["c.toml", "c.toml:3:", "beam"],
-        &out,
-    );
+    let file = |name: &str, text: &[u8]| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        path.to_str().unwrap().to_owned()
+    };
+    let corrupt = file("corrupt.png", b"\x89PNG not really");
+    let yaml = file("bad.yaml", b"image: x.pgm\nresolution: fast\n");
+    let radius = file("c.toml", b"[robot]\nradius_px = -3\n");
+    let beam = file("d.toml", b"[laser]\nbeams = 17\nbeam = 3\n");
+    // Each case: the arguments between `run` and `--out`, and what the error must name.
+    let cases: [(String, &[&str]); 8] = [
+        ("--policy teleport".into(), &["teleport", "apf"]),
+        ("--policy apf --seeds 0".into(), &["--seeds", "0"]),
+        (
+            "--policy random --seed-start 1 --seeds 18446744073709551615".into(),
+            &["--seeds 18446744073709551615", "--seed-start"],
+        ),
+        (
+            "--policy apf --map /no/such/map.png".into(),
+            &["/no/such/map.png"],
+        ),
+        (format!("--policy apf --map {corrupt}"), &["corrupt.png"]),
+        (
+            format!("--policy apf --map {yaml}"),
+            &["bad.yaml", "line 2", "fast"],
+        ),
+        (
+            format!("--policy apf --config {radius}"),
+            &["c.toml", "robot.radius_px", "-3"],
+        ),
+        (
+            format!("--policy apf --config {beam}"),
+            &["d.toml", "d.toml:3:", "beam"],
+        ),
+    ];
+    for (args, names) in cases {
+        let mut args: Vec<&str> = args.split_whitespace().collect();
+        args.splice(0..0, ["run"]);
+        args.extend(["--out", o]);
+        assert_rejected_leaving_nothing(&args, names, &out);
+    }
     // An output directory under a regular file cannot be created.
-    let file = dir.path().join("file");
-    std::fs::write(&file, "x").unwrap();
-    let under = file.join("out");
-    assert_rejected_leaving_nothing(
-        &[
-            "run",
-            "--policy",
-            "apf",
-            "--seeds",
-            "2",
-            "--out",
-            under.to_str().unwrap(),
-        ],
-        &["file/out"],
-        &under,
-    );
+    let under = Path::new(&file("file", b"x")).join("out");
+    let args = format!("run --policy apf --seeds 2 --out {}", under.display());
+    let args: Vec<&str> = args.split_whitespace().collect();
+    assert_rejected_leaving_nothing(&args, &["file/out"], &under);
 }
 
 fn save_map(path: &Path, walls: &[(u32, u32, u32, u32)]) {
@@ -307,6 +239,22 @@ fn fixed(dir: &Path, start: [f64; 3], goal: [f64; 2]) -> PathBuf {
     cfg
 }
 
+/// The rows of `episodes.csv` of `ronap run` of `policy` for `seeds` seeds on `map` with
+/// configuration `cfg`, into `out`.
+fn on_map(policy: &str, seeds: &str, map: &Path, cfg: &Path, out: &Path) -> Vec<Vec<String>> {
+    let (map, cfg, o) = (
+        map.to_str().unwrap(),
+        cfg.to_str().unwrap(),
+        out.to_str().unwrap(),
+    );
+    let args = [
+        "run", "--policy", policy, "--seeds", seeds, "--map", map, "--config", cfg,
+    ];
+    let o = ronap(&[&args[..], &["--out", o]].concat());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    rows(&out.join("episodes.csv"))
+}
+
 #[test]
 fn apf_fails_promptly_in_a_local_minimum_and_succeeds_in_the_open() {
     let dir = tempfile::tempdir().unwrap();
@@ -318,21 +266,7 @@ fn apf_fails_promptly_in_a_local_minimum_and_succeeds_in_the_open() {
     );
     let cfg = fixed(dir.path(), [110.0, 100.0, 0.0], [260.0, 100.0]);
     let out = dir.path().join("cup-run");
-    let o = ronap(&[
-        "run",
-        "--policy",
-        "apf",
-        "--seeds",
-        "3",
-        "--map",
-        cup.to_str().unwrap(),
-        "--config",
-        cfg.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    let episodes = rows(&out.join("episodes.csv"));
+    let episodes = on_map("apf", "3", &cup, &cfg, &out);
     for r in &episodes[1..] {
         assert_eq!(r[col(&episodes, "outcome")], "stuck");
         assert!(r[col(&episodes, "reason")].contains("local minimum"));
@@ -343,41 +277,13 @@ fn apf_fails_promptly_in_a_local_minimum_and_succeeds_in_the_open() {
     let open = dir.path().join("open.png");
     save_map(&open, &[]);
     let out = dir.path().join("open-run");
-    let o = ronap(&[
-        "run",
-        "--policy",
-        "apf",
-        "--seeds",
-        "3",
-        "--map",
-        open.to_str().unwrap(),
-        "--config",
-        cfg.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    let episodes = rows(&out.join("episodes.csv"));
+    let episodes = on_map("apf", "3", &open, &cfg, &out);
     assert!(episodes[1..]
         .iter()
         .all(|r| r[col(&episodes, "outcome")] == "success"));
     // The geodesic planner walks out of the cup.
     let out = dir.path().join("cup-geodesic");
-    let o = ronap(&[
-        "run",
-        "--policy",
-        "geodesic",
-        "--seeds",
-        "1",
-        "--map",
-        cup.to_str().unwrap(),
-        "--config",
-        cfg.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", text(&o.stderr));
-    let episodes = rows(&out.join("episodes.csv"));
+    let episodes = on_map("geodesic", "1", &cup, &cfg, &out);
     assert_eq!(episodes[1][col(&episodes, "outcome")], "success");
 }
 

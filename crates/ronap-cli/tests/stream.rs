@@ -130,19 +130,25 @@ fn a_team_run_killed_with_sigkill_is_resumed_to_the_same_bytes() {
     // second (a team episode's rows do not fill a write buffer sooner), well before the end.
     let scenario = repo_root().join("scenarios/warehouse-team.toml");
     kill_and_resume(
-        &[
-            "run",
-            "--scenario",
-            scenario.to_str().unwrap(),
-            "--policy",
-            "random",
-            "--seeds",
-            "120",
-            "--threads",
-            "2",
-        ],
+        &on_two_threads(&scenario, "random", "120"),
         &["episodes.csv", "robots.csv"],
     );
+}
+
+/// `ronap run` of `policy` on `scenario` for `seeds` seeds on two threads.
+fn on_two_threads<'a>(scenario: &'a Path, policy: &'a str, seeds: &'a str) -> [&'a str; 9] {
+    let scenario = scenario.to_str().unwrap();
+    [
+        "run",
+        "--scenario",
+        scenario,
+        "--policy",
+        policy,
+        "--seeds",
+        seeds,
+        "--threads",
+        "2",
+    ]
 }
 
 /// A shipped scenario with the crowd metrics asked for, written into `dir`.
@@ -160,33 +166,13 @@ fn runs_measuring_crowd_metrics_are_resumed_to_the_same_bytes() {
     // A lone robot among pedestrians: about 2000 episodes a second on two cores here.
     let scenario = measuring_crowds(dir.path(), "maze-pedestrians.toml");
     kill_and_resume(
-        &[
-            "run",
-            "--scenario",
-            scenario.to_str().unwrap(),
-            "--policy",
-            "geodesic-wait",
-            "--seeds",
-            "8000",
-            "--threads",
-            "2",
-        ],
+        &on_two_threads(&scenario, "geodesic-wait", "8000"),
         &["episodes.csv"],
     );
     // A team: each robot's metrics in robots.csv.
     let scenario = measuring_crowds(dir.path(), "warehouse-team.toml");
     kill_and_resume(
-        &[
-            "run",
-            "--scenario",
-            scenario.to_str().unwrap(),
-            "--policy",
-            "random",
-            "--seeds",
-            "120",
-            "--threads",
-            "2",
-        ],
+        &on_two_threads(&scenario, "random", "120"),
         &["episodes.csv", "robots.csv"],
     );
 }

@@ -3,7 +3,7 @@
 //! threads, and bad entries named.
 
 use crate::util::{assert_rejected, col, ok, repo_root, ronap, rows, summary};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 fn run_team(scenario: &Path, out: &Path, extra: &[&str]) -> String {
     let mut args = vec![
@@ -500,29 +500,37 @@ fn a_team_of_one_runs_as_the_lone_robot_column_for_column() {
 }
 
 /// `ronap run --scenario FILE --policy coordinated --seeds N` into `out`: its table.
-fn coordinated(scenario: &str, out: &Path, seeds: &str) -> String {
-    ok(&ronap(&[
-        "run",
-        "--scenario",
-        repo_root()
-            .join("scenarios")
-            .join(scenario)
-            .to_str()
-            .unwrap(),
-        "--policy",
+fn coordinated(scenario: &Path, out: &Path, seeds: &str, more: &[&str]) -> String {
+    let mut args = vec!["run", "--scenario", scenario.to_str().unwrap(), "--policy"];
+    args.extend([
         "coordinated",
         "--seeds",
         seeds,
         "--out",
         out.to_str().unwrap(),
-    ]))
+    ]);
+    args.extend(more);
+    ok(&ronap(&args))
+}
+
+/// A shipped scenario's file.
+fn shipped(name: &str) -> PathBuf {
+    repo_root().join("scenarios").join(name)
+}
+
+/// Every team of the run's `seeds` episodes came home without touching a robot or a wall.
+fn assert_all_home_untouched(table: &str, seeds: u32) {
+    let want = format!("team success            100.0% ({seeds} of {seeds}");
+    assert!(table.contains(&want), "{table}");
+    assert_eq!(row(table, "robot collisions"), "0.00 per episode");
+    assert_eq!(row(table, "wall collisions"), "0.00 per episode");
 }
 
 #[test]
 fn coordinated_names_the_corridor_swap_infeasible_before_its_first_step() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("swap");
-    let table = coordinated("corridor-swap.toml", &out, "3");
+    let table = coordinated(&shipped("corridor-swap.toml"), &out, "3", &[]);
     assert_eq!(
         row(&table, "infeasible"),
         "3 (each one's reason in robots.csv)"
@@ -556,13 +564,8 @@ fn coordinated_names_the_corridor_swap_infeasible_before_its_first_step() {
 fn coordinated_brings_both_robots_through_the_corridor_with_a_bay() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("bay");
-    let table = coordinated("corridor-bay.toml", &out, "3");
-    assert!(
-        table.contains("team success            100.0% (3 of 3"),
-        "{table}"
-    );
-    assert_eq!(row(&table, "robot collisions"), "0.00 per episode");
-    assert_eq!(row(&table, "wall collisions"), "0.00 per episode");
+    let table = coordinated(&shipped("corridor-bay.toml"), &out, "3", &[]);
+    assert_all_home_untouched(&table, 3);
 }
 
 #[test]
@@ -572,39 +575,20 @@ fn coordinated_brings_both_discrete_robots_through_the_corridor_with_a_bay() {
     // priority order cannot plan; the two are planned together.
     let dir = tempfile::tempdir().unwrap();
     let scenario = dir.path().join("corridor-bay-discrete.toml");
-    let text =
-        std::fs::read_to_string(repo_root().join("scenarios").join("corridor-bay.toml")).unwrap();
+    let text = std::fs::read_to_string(shipped("corridor-bay.toml")).unwrap();
     assert!(!text.contains("[orca]"), "the scenario has an [orca] table");
-    std::fs::write(
-        &scenario,
-        format!("{text}\n[orca]\nactions = \"discrete\"\n"),
-    )
-    .unwrap();
-    let out = dir.path().join("bay");
-    let table = ok(&ronap(&[
-        "run",
-        "--scenario",
-        scenario.to_str().unwrap(),
-        "--policy",
-        "coordinated",
-        "--seeds",
-        "3",
-        "--out",
-        out.to_str().unwrap(),
-    ]));
-    assert!(
-        table.contains("team success            100.0% (3 of 3"),
-        "{table}"
-    );
-    assert_eq!(row(&table, "robot collisions"), "0.00 per episode");
-    assert_eq!(row(&table, "wall collisions"), "0.00 per episode");
+    let text = format!("{text}\n[orca]\nactions = \"discrete\"\n");
+    std::fs::write(&scenario, text).unwrap();
+    let table = coordinated(&scenario, &dir.path().join("bay"), "3", &[]);
+    assert_all_home_untouched(&table, 3);
 }
 
 #[test]
 fn coordinated_brings_every_warehouse_team_home_with_no_deadlock() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("warehouse");
-    let table = coordinated("warehouse-team.toml", &out, "10");
+    let warehouse = shipped("warehouse-team.toml");
+    let table = coordinated(&warehouse, &out, "10", &[]);
     assert!(
         table.contains("team success            100.0% (10 of 10"),
         "{table}"
@@ -612,22 +596,7 @@ fn coordinated_brings_every_warehouse_team_home_with_no_deadlock() {
     assert_eq!(row(&table, "deadlocks"), "0");
     // The same bytes again, and on one thread.
     let again = dir.path().join("again");
-    ok(&ronap(&[
-        "run",
-        "--scenario",
-        repo_root()
-            .join("scenarios/warehouse-team.toml")
-            .to_str()
-            .unwrap(),
-        "--policy",
-        "coordinated",
-        "--seeds",
-        "10",
-        "--threads",
-        "1",
-        "--out",
-        again.to_str().unwrap(),
-    ]));
+    coordinated(&warehouse, &again, "10", &["--threads", "1"]);
     for f in ["episodes.csv", "robots.csv"] {
         assert_eq!(
             std::fs::read(out.join(f)).unwrap(),
