@@ -218,7 +218,13 @@ def test_a_forced_run_failing_at_once_leaves_the_old_run(tmp_path):
 def test_ctrl_c_stops_the_run_keeping_its_files_then_raises(tmp_path):
     import _thread
 
+    # The Ctrl-C comes a second after the run's first decision (a fixed second after the call
+    # could come before the run starts, on a loaded machine, with nothing yet to keep).
+    timer = threading.Timer(1.0, _thread.interrupt_main)
+
     def slow(obs):
+        if not timer.is_alive() and not timer.finished.is_set():
+            timer.start()
         time.sleep(0.002)
         return 1
 
@@ -226,8 +232,6 @@ def test_ctrl_c_stops_the_run_keeping_its_files_then_raises(tmp_path):
     # A shell that starts the tests in the background leaves SIGINT ignored, and Python then
     # never installs its handler: interrupt_main would do nothing and the run go on for ever.
     handler = signal.signal(signal.SIGINT, signal.default_int_handler)
-    timer = threading.Timer(1.0, _thread.interrupt_main)
-    timer.start()
     try:
         with pytest.raises(KeyboardInterrupt):
             ronap.evaluate(slow, range(1_000_000), out=str(out), threads=1)

@@ -285,6 +285,14 @@ def checked_int(name: str, value: Any, least: int = 0, below: int = _U64) -> int
 def checked_seeds(seeds: Any, split: str | None = None) -> list[int]:
     """Episode seeds as a list of ints in ``[0, 2^64)``, counted from ``split``'s first seed when
     one is named; a ``ConfigError`` names the first bad one."""
+    if isinstance(seeds, range) and len(seeds) > 0:
+        # A range's seeds lie between its ends: when both are good, so is every seed (one by
+        # one, a million seeds took a second). Else the loop below names the first bad one.
+        ends = (seeds[0], seeds[-1])
+        high = _U64 - 1 if split is None else split_range(split)[1] - split_range(split)[0]
+        if all(0 <= s <= high for s in ends):
+            offset = 0 if split is None else split_range(split)[0]
+            return list(range(seeds.start + offset, seeds.stop + offset, seeds.step))
     try:
         items = list(seeds)
     except TypeError:
