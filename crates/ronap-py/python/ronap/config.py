@@ -288,11 +288,9 @@ def checked_seeds(seeds: Any, split: str | None = None) -> list[int]:
     if isinstance(seeds, range) and len(seeds) > 0:
         # A range's seeds lie between its ends: when both are good, so is every seed (one by
         # one, a million seeds took a second). Else the loop below names the first bad one.
-        ends = (seeds[0], seeds[-1])
-        high = _U64 - 1 if split is None else split_range(split)[1] - split_range(split)[0]
-        if all(0 <= s <= high for s in ends):
-            offset = 0 if split is None else split_range(split)[0]
-            return list(range(seeds.start + offset, seeds.stop + offset, seeds.step))
+        first, last = (0, _U64 - 1) if split is None else split_range(split)
+        if all(0 <= s <= last - first for s in (seeds[0], seeds[-1])):
+            return list(range(seeds.start + first, seeds.stop + first, seeds.step))
     try:
         items = list(seeds)
     except TypeError:
