@@ -312,7 +312,7 @@ impl Policy for PyProcess {
         Ok(())
     }
 
-    fn hear(&mut self, inbox: ronap_core::sim::team::Inbox<'_>) {
+    fn hear(&mut self, inbox: ronap_core::sim::Inbox<'_>) {
         let size = inbox.get(0).map_or(0, |b| b.message.len());
         let mut text = format!("{} {size}", inbox.len());
         for b in inbox {

@@ -10,7 +10,7 @@ use ronap_core::config::{OnArrival, SimConfig, TeamRobotConfig};
 use ronap_core::policy::coordinated::Coordinated;
 use ronap_core::policy::TeamPolicy;
 use ronap_core::run::team::TeamRollout;
-use ronap_core::sim::world::{Scenes, Worlds};
+use ronap_core::sim::{Scenes, Worlds};
 use ronap_core::ValidConfig;
 use std::time::{Duration, Instant};
 

@@ -8,11 +8,11 @@
 //! scan among 500 discs (`scan/360_beams_200px_500_discs`) within 4x of one among 100.
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
-use ronap_core::geometry::reference::ParryScene;
 use ronap_core::geometry::unit;
+use ronap_core::geometry::ParryScene;
 use ronap_core::policy::{Decision, Policy};
-use ronap_core::scene::freespace::FreeGrid;
-use ronap_core::sim::world::maze_scene;
+use ronap_core::scene::FreeGrid;
+use ronap_core::sim::maze_scene;
 use ronap_core::{Action, DiscreteAction, Episode, Laser, ValidConfig};
 use std::hint::black_box;
 use std::sync::Arc;
@@ -463,7 +463,7 @@ fn mlp(c: &mut Criterion) {
 /// is per step of all 1024; divide 1024 by it for env-steps/s.
 fn batch(c: &mut Criterion) {
     use ronap_core::run::batch::{Autoreset, Batch, BatchOptions, SeedOrder};
-    use ronap_core::sim::world::{Scenes, Worlds};
+    use ronap_core::sim::{Scenes, Worlds};
     let mut group = c.benchmark_group("batch");
     group.throughput(Throughput::Elements(1024));
     for (name, threads) in [("step_1024_one_thread", 1), ("step_1024_all_threads", 0)] {

@@ -164,7 +164,7 @@ pub fn train(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ronap_core::sim::robot::DiscreteAction;
+    use ronap_core::sim::DiscreteAction;
 
     /// A rule an MLP can learn: turn towards the goal unless it is ahead.
     fn rule_data(n: usize, seed: u64) -> DataSet {

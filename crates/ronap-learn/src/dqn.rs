@@ -519,7 +519,7 @@ pub fn train(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ronap_core::sim::world::Scenes;
+    use ronap_core::sim::Scenes;
     use ronap_core::SimConfig;
 
     /// A small open room where the goal is always in reach: DQN must learn to head for it.

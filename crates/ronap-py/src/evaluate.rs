@@ -20,8 +20,8 @@ use ronap_core::policy::coordinated;
 use ronap_core::policy::{
     Decision, JointFactory, Policy, PolicyError, PolicyFactory, TeamPolicyFactory,
 };
-use ronap_core::sim::kinematics::continuous_action;
-use ronap_core::sim::world::Scenes;
+use ronap_core::sim::continuous_action;
+use ronap_core::sim::Scenes;
 use ronap_core::{Action, Episode, ValidConfig, World};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};

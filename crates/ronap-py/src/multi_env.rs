@@ -8,9 +8,9 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use ronap_core::run::team::TeamRollout;
 use ronap_core::run::team_batch::{RobotStep, TeamBatch};
-use ronap_core::sim::robot::Action;
-use ronap_core::sim::team::Team;
-use ronap_core::sim::world::Worlds;
+use ronap_core::sim::Action;
+use ronap_core::sim::Team;
+use ronap_core::sim::Worlds;
 use ronap_core::Point;
 
 /// Several robots in one scene, an episode at a time.

@@ -121,7 +121,7 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
     let evaluator = Evaluator::new(config.clone(), scenes);
     if team {
         // A team that cannot be placed fails the same way for every seed: say so now.
-        ronap_core::sim::team::Team::new(&config, &evaluator.worlds().team(first), first)
+        ronap_core::sim::Team::new(&config, &evaluator.worlds().team(first), first)
             .with_context(|| format!("cannot start team episodes in this scene (seed {first})"))?;
     } else {
         evaluator

@@ -13,8 +13,8 @@ use ronap_core::io::manifest::PLAN_FILE;
 use ronap_core::io::run_dir::{Pictures, ResumeError, RunFiles, RunInfo, RunWriter};
 use ronap_core::job::{evaluate_into, evaluate_team_into, RunRequest};
 use ronap_core::policy::PolicyFactory;
-use ronap_core::scene::map::MapSource;
-use ronap_core::sim::world::SceneSpec;
+use ronap_core::scene::MapSource;
+use ronap_core::sim::SceneSpec;
 use ronap_core::{Scenes, ValidConfig};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -459,7 +459,7 @@ fn run_team(
     let (first, last) = job.span();
     let evaluator = Evaluator::new(config.clone(), scenes);
     // A team that cannot be placed fails the same way for every seed: say so before writing.
-    ronap_core::sim::team::Team::new(&config, &evaluator.worlds().team(first), first)
+    ronap_core::sim::Team::new(&config, &evaluator.worlds().team(first), first)
         .with_context(|| format!("cannot start team episodes in this scene (seed {first})"))?;
     let (writer, cancel, bar) = job.begin(
         writer,

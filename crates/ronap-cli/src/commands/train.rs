@@ -11,7 +11,7 @@ use ronap_core::io::atomic::{save_network, OutputError};
 use ronap_core::io::datalog;
 use ronap_core::io::training::{Curves, TrainingLog};
 use ronap_core::policy::mlp::{observation_layout, DecisionRule, Mlp};
-use ronap_core::sim::split::{SeedRanges, Split};
+use ronap_core::sim::{SeedRanges, Split};
 use ronap_learn::bc::{self, BcOptions};
 use ronap_learn::dqn::{self, DqnOptions, Loss, Priorities, Validation};
 use ronap_learn::net::TrainActivation;

@@ -319,7 +319,7 @@ mod tests {
     use ratatui::backend::TestBackend;
     use ratatui::crossterm::event::KeyModifiers;
     use ratatui::Terminal;
-    use ronap_core::sim::world::Scenes;
+    use ronap_core::sim::Scenes;
     use ronap_core::ValidConfig;
 
     fn screen(view: &HumanView) -> String {

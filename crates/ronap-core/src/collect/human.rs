@@ -11,10 +11,10 @@
 use crate::eval::Evaluator;
 use crate::io::datalog::Sample;
 use crate::run::RunError;
-use crate::sim::episode::{Episode, Status};
-use crate::sim::rng::{stream, Rng, Stream};
-use crate::sim::robot::{DiscreteAction, Pose};
-use crate::sim::world::World;
+use crate::sim::World;
+use crate::sim::{stream, Rng, Stream};
+use crate::sim::{DiscreteAction, Pose};
+use crate::sim::{Episode, Status};
 use std::sync::Arc;
 
 /// What the latest recorded action did, for the person to see.
@@ -166,7 +166,7 @@ mod tests {
     use super::*;
     use crate::config::ValidConfig;
     use crate::geometry::wrap_deg;
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
 
     fn evaluator() -> Evaluator {
         Evaluator::new(ValidConfig::default(), Scenes::MazePerSeed)

@@ -21,7 +21,7 @@ use crate::io::run_dir::{RunFiles, RunInfo, RunWriter};
 use crate::job::{evaluate_into, evaluate_team_into, RunRequest};
 use crate::policy::{PolicyError, PolicyFactory, TeamPolicyFactory};
 use crate::scene::map::MapSource;
-use crate::sim::world::SceneSpec;
+use crate::sim::SceneSpec;
 use difficulty::{Difficulty, Figure};
 use disagreements::disagreement_sheet;
 pub use disagreements::disagreements;

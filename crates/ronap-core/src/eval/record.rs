@@ -2,10 +2,10 @@
 //! trajectory and steps.
 
 use crate::geometry::Point;
-use crate::sim::episode::{DynamicMetrics, Status};
-use crate::sim::moving::Track;
-use crate::sim::robot::{Action, Pose};
-use crate::sim::world::World;
+use crate::sim::Track;
+use crate::sim::World;
+use crate::sim::{Action, Pose};
+use crate::sim::{DynamicMetrics, Status};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -106,7 +106,7 @@ pub(crate) struct Before {
 
 impl Before {
     /// What `robot` senses now, before it steps.
-    pub(crate) fn of(robot: &crate::sim::episode::Episode) -> Self {
+    pub(crate) fn of(robot: &crate::sim::Episode) -> Self {
         Self {
             pose: robot.pose(),
             readings: robot.readings().to_vec(),

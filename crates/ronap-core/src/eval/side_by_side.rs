@@ -10,7 +10,7 @@ use crate::eval::{
 use crate::policy::{Policy, PolicyError, PolicyFactory};
 use crate::run::rollout::Rollout;
 use crate::run::RunError;
-use crate::sim::episode::Episode;
+use crate::sim::Episode;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
@@ -249,8 +249,8 @@ mod tests {
     use crate::config::SimConfig;
     use crate::policy::mlp::MlpFactory;
     use crate::policy::Decision;
-    use crate::sim::robot::DiscreteAction;
-    use crate::sim::world::{Scenes, World};
+    use crate::sim::DiscreteAction;
+    use crate::sim::{Scenes, World};
     use std::path::Path;
     use std::sync::atomic::Ordering;
 

@@ -5,7 +5,7 @@
 
 use crate::eval::metric::Kind;
 use crate::eval::{Figures, Outcome, RobotFigures, TeamFigures};
-use crate::sim::episode::DynamicMetrics;
+use crate::sim::DynamicMetrics;
 
 /// The file's name inside a run directory (it only ever exists as a partial file).
 pub const FIGURES_FILE: &str = "figures.csv";

@@ -5,7 +5,7 @@
 use crate::config::{SimConfig, ValidConfig};
 use crate::eval::Summary;
 use crate::scene::map::{MapError, MapSource};
-use crate::sim::world::{SceneSpec, Scenes};
+use crate::sim::{SceneSpec, Scenes};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 

@@ -2,7 +2,7 @@
 //! the episode ends and read back by `ronap replay`.
 
 use crate::eval::{EpisodeRecord, StepLog};
-use crate::sim::robot::{Action, Pose};
+use crate::sim::{Action, Pose};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -181,7 +181,7 @@ mod tests {
     use super::*;
     use crate::eval::{Evaluator, Recording};
     use crate::policy::{Builtin, PolicyFactory};
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
 
     #[test]
     fn step_logs_read_back_as_written() {

@@ -150,7 +150,7 @@ mod tests {
     use crate::eval::{EvalOptions, Evaluator};
     use crate::io::run_dir::{RunFiles, RunInfo, RunWriter};
     use crate::policy::{Decision, Policy};
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
     use crate::{Episode, World};
     use std::sync::atomic::AtomicBool;
 
@@ -214,7 +214,7 @@ mod tests {
         };
         let info = RunInfo {
             policy: "random".into(),
-            scenes: crate::sim::world::SceneSpec::MazePerSeed,
+            scenes: crate::sim::SceneSpec::MazePerSeed,
             map: None,
         };
         let cancel = AtomicBool::new(false);

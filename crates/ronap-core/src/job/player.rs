@@ -11,8 +11,8 @@ use crate::job::replay::drive_team;
 use crate::job::{ReplayError, RobotLog};
 use crate::render::gif::{check_logged_step, AnimationError};
 use crate::render::player::{player_page, Acted, PlayerPage, Recorder, Trace};
-use crate::sim::episode::Episode;
-use crate::sim::robot::{Action, Pose};
+use crate::sim::Episode;
+use crate::sim::{Action, Pose};
 
 /// The trace of lone `episode` (as placed) replayed from its logged `steps`, each logged pose
 /// held to the model's.
@@ -229,7 +229,7 @@ mod tests {
     use super::*;
     use crate::eval::Recording;
     use crate::policy::{Builtin, PolicyFactory};
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
 
     const STEPS: Recording = Recording {
         trajectory: false,

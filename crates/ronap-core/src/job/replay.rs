@@ -9,8 +9,8 @@ use crate::render::gif::{same_pose, Animation, AnimationError, GifOptions, GifWr
 use crate::render::team::{team_frame, team_gif_writer};
 use crate::run::team::TeamRollout;
 use crate::run::RunError;
-use crate::sim::robot::{Action, Pose};
-use crate::sim::team::Team;
+use crate::sim::Team;
+use crate::sim::{Action, Pose};
 use image::RgbImage;
 
 impl RobotLog {
@@ -278,7 +278,7 @@ mod tests {
     use crate::config::TeamRobotConfig;
     use crate::eval::{Outcome, Recording};
     use crate::policy::{factory, PerRobotFactory, TeamPolicyFactory};
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
 
     fn logs_of(record: &crate::eval::TeamRecord) -> Vec<RobotLog> {
         RobotLog::of_record(record)

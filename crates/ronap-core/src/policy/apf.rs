@@ -16,9 +16,9 @@ use super::{Decision, Policy, PolicyError};
 use crate::config::ApfConfig;
 use crate::geometry::{Point, Vector};
 use crate::scene::Scene;
-use crate::sim::episode::Episode;
-use crate::sim::robot::DiscreteAction;
-use crate::sim::world::World;
+use crate::sim::DiscreteAction;
+use crate::sim::Episode;
+use crate::sim::World;
 use std::collections::HashSet;
 
 /// The result of the descent.

@@ -8,8 +8,8 @@
 
 use crate::config::{KinematicsKind, RobotConfig};
 use crate::geometry::{wrap_deg, Point};
-use crate::sim::episode::Episode;
-use crate::sim::robot::{Action, DiscreteAction};
+use crate::sim::Episode;
+use crate::sim::{Action, DiscreteAction};
 
 /// Steps without the remaining length shrinking by [`PROGRESS_PX`] before the follower gives up:
 /// two full turns and then some.

@@ -8,9 +8,9 @@ use super::follow::{FollowStep, Follower};
 use super::{Decision, Policy, PolicyError};
 use crate::geometry::Point;
 use crate::plan::{grid_path, smooth, DistanceField};
-use crate::sim::episode::Episode;
-use crate::sim::robot::DiscreteAction;
-use crate::sim::world::World;
+use crate::sim::DiscreteAction;
+use crate::sim::Episode;
+use crate::sim::World;
 
 /// Cost factor of grid steps within a radius of touching a wall.
 const CLOSE_COST: f64 = 4.0;

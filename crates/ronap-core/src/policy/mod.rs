@@ -22,9 +22,9 @@ pub use team::{
     Joint, JointFactory, PerRobot, PerRobotFactory, RobotError, TeamPolicy, TeamPolicyFactory,
 };
 
-use crate::sim::episode::Episode;
-use crate::sim::robot::Action;
-use crate::sim::world::World;
+use crate::sim::Action;
+use crate::sim::Episode;
+use crate::sim::World;
 
 /// A policy that could not decide.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
@@ -55,11 +55,7 @@ pub trait Policy: Send {
     /// The decision for robot `k` of `team` when it is driven by this policy alone among the
     /// team's ([`team::PerRobot`]): by default [`Policy::act`] on the robot's own episode; a
     /// policy that avoids the other robots and the team's moving obstacles sees them here.
-    fn act_in_team(
-        &mut self,
-        team: &crate::sim::team::Team,
-        k: usize,
-    ) -> Result<Decision, PolicyError> {
+    fn act_in_team(&mut self, team: &crate::sim::Team, k: usize) -> Result<Decision, PolicyError> {
         self.act(team.robot(k))
     }
 
@@ -72,7 +68,7 @@ pub trait Policy: Send {
     /// What a robot of a team received at the last step (the broadcasts of the robots within
     /// `team.comm_range_px`, nearest first), told before each [`Policy::act`]; the built-in
     /// policies do not listen.
-    fn hear(&mut self, inbox: crate::sim::team::Inbox<'_>) {
+    fn hear(&mut self, inbox: crate::sim::Inbox<'_>) {
         let _ = inbox;
     }
 
@@ -127,7 +123,7 @@ pub trait PolicyFactory: Sync {
     /// The episode seeds the policy was trained or chosen on, where it records them (a trained
     /// network's `training_seeds` and `validation_seeds`): a run over any of them is warned
     /// about ([`crate::eval::held_out_warning`]).
-    fn seeds_seen(&self) -> crate::sim::split::SeedRanges {
-        crate::sim::split::SeedRanges::default()
+    fn seeds_seen(&self) -> crate::sim::SeedRanges {
+        crate::sim::SeedRanges::default()
     }
 }

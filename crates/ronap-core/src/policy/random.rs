@@ -1,10 +1,10 @@
 //! The random policy: LEFT, AHEAD or RIGHT with equal probability, from the episode's policy stream.
 
 use super::{Decision, Policy, PolicyError};
-use crate::sim::episode::Episode;
-use crate::sim::rng::{stream, Rng, Stream};
-use crate::sim::robot::DiscreteAction;
-use crate::sim::world::World;
+use crate::sim::DiscreteAction;
+use crate::sim::Episode;
+use crate::sim::World;
+use crate::sim::{stream, Rng, Stream};
 use rand::Rng as _;
 
 /// Uniformly random discrete actions.

@@ -12,8 +12,8 @@
 
 use crate::geometry::Point;
 use crate::render;
-use crate::sim::episode::Episode;
-use crate::sim::robot::{Action, Pose};
+use crate::sim::Episode;
+use crate::sim::{Action, Pose};
 use image::RgbImage;
 use std::io::Write;
 
@@ -373,8 +373,8 @@ fn changed_rect(a: &[u8], b: &[u8], width: usize) -> Option<(usize, usize, usize
 mod tests {
     use super::*;
     use crate::config::ValidConfig;
-    use crate::sim::robot::DiscreteAction;
-    use crate::sim::world::maze_scene;
+    use crate::sim::maze_scene;
+    use crate::sim::DiscreteAction;
     use std::sync::Arc;
 
     fn episode(seed: u64) -> Episode {

@@ -18,8 +18,8 @@ pub use first_person::{first_person, HeadingUp, FIRST_PERSON_HALF_SPAN};
 
 use crate::geometry::{Aabb, Point};
 use crate::scene::Scene;
-use crate::sim::lidar::{Laser, RayClass};
-use crate::sim::robot::Pose;
+use crate::sim::Pose;
+use crate::sim::{Laser, RayClass};
 use image::{Rgb, RgbImage};
 
 /// Floor colour.
@@ -110,22 +110,22 @@ impl Canvas {
     }
 
     /// Draws the present moving obstacles where they are.
-    pub fn movers(&mut self, movers: &crate::sim::moving::Movers) {
+    pub fn movers(&mut self, movers: &crate::sim::Movers) {
         for m in movers.items().filter(|m| m.present()) {
             self.mover(m.body(), m.position(), MOVER);
         }
     }
 
     /// Draws a moving obstacle's `body` at `center`.
-    pub fn mover(&mut self, body: crate::sim::moving::Body, center: Point, colour: Rgb<u8>) {
+    pub fn mover(&mut self, body: crate::sim::Body, center: Point, colour: Rgb<u8>) {
         match body {
-            crate::sim::moving::Body::Disc(r) => self.fill_disc(center, r, colour),
-            crate::sim::moving::Body::Box(_) => self.fill_box(&body.aabb(center), colour),
+            crate::sim::Body::Disc(r) => self.fill_disc(center, r, colour),
+            crate::sim::Body::Box(_) => self.fill_box(&body.aabb(center), colour),
         }
     }
 
     /// Draws moving obstacles' tracks faded: each a polyline of its positions while present.
-    pub fn tracks(&mut self, tracks: &[crate::sim::moving::Track]) {
+    pub fn tracks(&mut self, tracks: &[crate::sim::Track]) {
         for track in tracks {
             for pair in track.points.windows(2) {
                 if let [Some(a), Some(b)] = pair {
@@ -245,7 +245,7 @@ impl Canvas {
         least: f64,
         colour: Rgb<u8>,
     ) {
-        match crate::sim::robot::Robot::corners(config, pose) {
+        match crate::sim::Robot::corners(config, pose) {
             Some(corners) => {
                 self.fill_polygon(&corners, colour);
                 let p = pose.position();
@@ -282,7 +282,7 @@ impl Canvas {
 
 /// The whole scene with an episode drawn on it: `path` in blue, start red, goal green, the robot
 /// and its current laser scan.
-pub fn top_down(episode: &crate::sim::episode::Episode, path: &[Point], scale: f64) -> RgbImage {
+pub fn top_down(episode: &crate::sim::Episode, path: &[Point], scale: f64) -> RgbImage {
     let config = episode.config();
     let mut canvas = Canvas::new(episode.scene(), scale);
     let least = 4.0 / scale;

@@ -9,10 +9,10 @@
 use crate::geometry::Point;
 use crate::run::shaping::Shaper;
 use crate::run::RunError;
-use crate::sim::episode::{Episode, Status, PREFETCH_STAGES};
-use crate::sim::rng::{stream, Rng, Stream};
-use crate::sim::robot::{Action, Pose};
-use crate::sim::world::Worlds;
+use crate::sim::Worlds;
+use crate::sim::{stream, Rng, Stream};
+use crate::sim::{Action, Pose};
+use crate::sim::{Episode, Status, PREFETCH_STAGES};
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
@@ -638,8 +638,8 @@ impl Lanes {
 mod tests {
     use super::*;
     use crate::config::SimConfig;
-    use crate::sim::robot::DiscreteAction;
-    use crate::sim::world::Scenes;
+    use crate::sim::DiscreteAction;
+    use crate::sim::Scenes;
 
     fn batch(envs: usize, threads: usize, autoreset: Autoreset) -> Batch {
         let mut c = SimConfig::default();

@@ -10,8 +10,8 @@ pub mod team;
 pub mod team_batch;
 
 use crate::policy::PolicyError;
-use crate::sim::placement::EpisodeError;
-use crate::sim::robot::Action;
+use crate::sim::Action;
+use crate::sim::EpisodeError;
 
 /// An episode that could not start, or a policy that failed while driving one.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]

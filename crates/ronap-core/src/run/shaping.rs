@@ -13,8 +13,8 @@
 
 use crate::config::Shaping;
 use crate::plan::LazyField;
-use crate::sim::episode::Episode;
-use crate::sim::world::World;
+use crate::sim::Episode;
+use crate::sim::World;
 use std::sync::Arc;
 
 /// The shaping of one episode: its field towards the current goal and the current potential.
@@ -103,7 +103,7 @@ mod tests {
     use super::*;
     use crate::policy::geodesic::Geodesic;
     use crate::policy::{Decision, Policy};
-    use crate::sim::robot::{Action, DiscreteAction};
+    use crate::sim::{Action, DiscreteAction};
     use crate::SimConfig;
 
     /// The default maze of seed 3 with geodesic shaping at `gamma`.
@@ -187,7 +187,7 @@ mod tests {
         let w = world(1.0);
         let mut episode = w.episode(11).unwrap();
         let mut shaper = Shaper::start(w.clone(), &episode).unwrap();
-        let mut rng = crate::sim::rng::stream(5, crate::sim::rng::Stream::Policy);
+        let mut rng = crate::sim::stream(5, crate::sim::Stream::Policy);
         let mut seen = 0;
         for _ in 0..2000 {
             if episode.status().is_done() {

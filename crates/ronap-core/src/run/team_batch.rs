@@ -11,9 +11,9 @@
 use crate::config::ValidConfig;
 use crate::run::team::TeamRollout;
 use crate::run::RunError;
-use crate::sim::episode::Status;
-use crate::sim::robot::Action;
-use crate::sim::world::Worlds;
+use crate::sim::Action;
+use crate::sim::Status;
+use crate::sim::Worlds;
 use rayon::prelude::*;
 
 /// Environments per parallel task.
@@ -290,8 +290,8 @@ impl Ctx<'_> {
 mod tests {
     use super::*;
     use crate::config::{SimConfig, TeamRobotConfig};
-    use crate::sim::robot::DiscreteAction;
-    use crate::sim::world::Scenes;
+    use crate::sim::DiscreteAction;
+    use crate::sim::Scenes;
 
     fn worlds(count: u32) -> Worlds {
         let mut c = SimConfig {

@@ -20,7 +20,7 @@ use crate::io::figures::{self, FIGURES_FILE};
 use crate::io::manifest::{ManifestError, RunManifest, RunPlan, SCHEMA_VERSION};
 use crate::io::partial::partial_path;
 use crate::scene::map::MapSource;
-use crate::sim::world::SceneSpec;
+use crate::sim::SceneSpec;
 pub(crate) use rows::start_goal_cells;
 pub use rows::{
     episode_header, episode_row, metric_cells, timing_row, write_episodes, write_timing, Layout,
@@ -218,7 +218,7 @@ mod tests {
     use crate::eval::{Evaluator, Seeds};
     use crate::io::manifest::PLAN_FILE;
     use crate::policy::Builtin;
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
     use std::sync::atomic::AtomicBool;
 
     fn setting() -> (ValidConfig, Evaluator, RunInfo) {

@@ -5,7 +5,7 @@ use crate::config::ValidConfig;
 use crate::eval::metric;
 use crate::eval::EpisodeRecord;
 use crate::geometry::Point;
-use crate::sim::robot::Pose;
+use crate::sim::Pose;
 use std::io::Write;
 
 /// Columns of `episodes.csv`.

@@ -28,10 +28,10 @@ pub use network::{
 };
 
 use crate::policy::{Decision, Policy, PolicyError, PolicyFactory};
-use crate::sim::episode::Episode;
-use crate::sim::robot::DiscreteAction;
-use crate::sim::split::SeedRanges;
-use crate::sim::world::World;
+use crate::sim::DiscreteAction;
+use crate::sim::Episode;
+use crate::sim::SeedRanges;
+use crate::sim::World;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -46,10 +46,10 @@ pub const SIDE_BY_SIDE: usize = 16;
 pub struct MlpPolicy {
     mlp: Arc<Mlp>,
     rule: DecisionRule,
-    rng: crate::sim::rng::Rng,
+    rng: crate::sim::Rng,
     scratch: Scratch,
     /// Each lane's policy stream, when episodes run side by side.
-    lane_rngs: Vec<crate::sim::rng::Rng>,
+    lane_rngs: Vec<crate::sim::Rng>,
     /// The lanes' observations, a row each.
     rows: Vec<f32>,
 }
@@ -61,7 +61,7 @@ impl MlpPolicy {
         Self {
             mlp,
             rule,
-            rng: crate::sim::rng::stream(0, crate::sim::rng::Stream::Policy),
+            rng: crate::sim::stream(0, crate::sim::Stream::Policy),
             scratch: Scratch::default(),
             lane_rngs: Vec::new(),
             rows: Vec::new(),
@@ -83,7 +83,7 @@ impl MlpPolicy {
 }
 
 /// The action `rule` picks from the network's `outputs`, drawing from `rng` when it samples.
-fn choose(rule: DecisionRule, outputs: &[f32], rng: &mut crate::sim::rng::Rng) -> DiscreteAction {
+fn choose(rule: DecisionRule, outputs: &[f32], rng: &mut crate::sim::Rng) -> DiscreteAction {
     match rule {
         DecisionRule::Argmax => DiscreteAction::ALL[network::argmax(outputs)],
         DecisionRule::Sample { temperature } => {
@@ -110,7 +110,7 @@ fn choose(rule: DecisionRule, outputs: &[f32], rng: &mut crate::sim::rng::Rng) -
 impl Policy for MlpPolicy {
     fn reset(&mut self, _world: &World, episode: &Episode) -> Result<(), PolicyError> {
         self.check(episode)?;
-        self.rng = crate::sim::rng::stream(episode.seed(), crate::sim::rng::Stream::Policy);
+        self.rng = crate::sim::stream(episode.seed(), crate::sim::Stream::Policy);
         Ok(())
     }
 
@@ -132,11 +132,10 @@ impl Policy for MlpPolicy {
         self.check(episode)?;
         if self.lane_rngs.len() <= lane {
             self.lane_rngs.resize_with(lane + 1, || {
-                crate::sim::rng::stream(0, crate::sim::rng::Stream::Policy)
+                crate::sim::stream(0, crate::sim::Stream::Policy)
             });
         }
-        self.lane_rngs[lane] =
-            crate::sim::rng::stream(episode.seed(), crate::sim::rng::Stream::Policy);
+        self.lane_rngs[lane] = crate::sim::stream(episode.seed(), crate::sim::Stream::Policy);
         Ok(())
     }
 
