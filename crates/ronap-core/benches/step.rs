@@ -230,7 +230,7 @@ fn setup(c: &mut Criterion) {
             next += 1;
             let world = Arc::new(ronap_core::World::maze(shaped.clone(), seed));
             let episode = world.episode(seed).expect("placement");
-            let shaper = ronap_core::run::shaping::Shaper::start(world, &episode);
+            let shaper = ronap_core::run::Shaper::start(world, &episode);
             shaper.map(|s| s.potential())
         })
     });
@@ -383,11 +383,11 @@ fn movers(c: &mut Criterion) {
 /// runs it: without allocation (`mlp/forward_into`), and through the allocating `forward`.
 fn mlp(c: &mut Criterion) {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../policies/bc.safetensors");
-    let net = ronap_core::policy::mlp::Mlp::load(std::path::Path::new(path)).expect("shipped");
+    let net = ronap_core::policy::Mlp::load(std::path::Path::new(path)).expect("shipped");
     let config = ValidConfig::default();
     let episode = Episode::new(&config, Arc::new(maze_scene(&config, 0)), 0).expect("places");
     let observation = episode.observation().to_vec();
-    let mut scratch = ronap_core::policy::mlp::Scratch::default();
+    let mut scratch = ronap_core::policy::Scratch::default();
     let mut group = c.benchmark_group("mlp");
     group.throughput(Throughput::Elements(1));
     group.bench_function("forward_into", |b| {
@@ -426,8 +426,8 @@ fn mlp(c: &mut Criterion) {
     // The same steps as the evaluator takes them for a network's policy: sixteen episodes side
     // by side on one thread, the policy deciding for all sixteen at once (`Policy::act_lanes`),
     // then each episode stepping; per episode step.
-    let lanes = ronap_core::policy::mlp::SIDE_BY_SIDE;
-    let mut policy = ronap_core::policy::mlp::MlpPolicy::new(Arc::new(net.clone()));
+    let lanes = ronap_core::policy::SIDE_BY_SIDE;
+    let mut policy = ronap_core::policy::MlpPolicy::new(Arc::new(net.clone()));
     let world = ronap_core::World::maze(config.clone(), 0);
     let mut episodes: Vec<Episode> = (0..lanes as u64)
         .map(|s| Episode::new(&config, scene.clone(), s).expect("default scene"))
@@ -462,7 +462,7 @@ fn mlp(c: &mut Criterion) {
 /// stepped side by side with a fixed action pattern, on one thread and on every core. The figure
 /// is per step of all 1024; divide 1024 by it for env-steps/s.
 fn batch(c: &mut Criterion) {
-    use ronap_core::run::batch::{Autoreset, Batch, BatchOptions, SeedOrder};
+    use ronap_core::run::{Autoreset, Batch, BatchOptions, SeedOrder};
     use ronap_core::sim::{Scenes, Worlds};
     let mut group = c.benchmark_group("batch");
     group.throughput(Throughput::Elements(1024));

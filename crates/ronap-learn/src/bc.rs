@@ -9,7 +9,7 @@ use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use ronap_core::io::datalog::DataSet;
-use ronap_core::policy::mlp::Mlp;
+use ronap_core::policy::Mlp;
 use std::collections::HashMap;
 
 /// Training settings. The defaults are the original's network and optimiser, with more data per

@@ -15,8 +15,8 @@ use ronap_core::io::run_dir::{
 use ronap_core::io::team_rows::{robot_columns, robot_rows, team_episode_row, TEAM_COLUMNS};
 use ronap_core::job::evaluate_team_into;
 use ronap_core::job::{evaluate_into, RunRequest};
-use ronap_core::policy::batched::{BatchPolicy, Batched};
-use ronap_core::policy::coordinated;
+use ronap_core::policy::{coordinated_drives, CoordinatedFactory};
+use ronap_core::policy::{BatchPolicy, Batched};
 use ronap_core::policy::{
     Decision, JointFactory, Policy, PolicyError, PolicyFactory, TeamPolicyFactory,
 };
@@ -497,8 +497,8 @@ fn team_factory(
 ) -> PyResult<(Box<dyn TeamPolicyFactory>, String)> {
     let n = config.team_size();
     if let Ok(name) = policy.extract::<String>() {
-        if coordinated::drives(config, &name).map_err(errors::ConfigError::new_err)? {
-            return Ok((Box::new(coordinated::CoordinatedFactory::new(n)), name));
+        if coordinated_drives(config, &name).map_err(errors::ConfigError::new_err)? {
+            return Ok((Box::new(CoordinatedFactory::new(n)), name));
         }
         let mut factories: Vec<Box<dyn PolicyFactory>> = Vec::new();
         let mut names = Vec::new();

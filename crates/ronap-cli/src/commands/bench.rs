@@ -7,7 +7,7 @@ use crate::args::{positive, SimArgs};
 use anyhow::{Context, Result};
 use clap::Args;
 use ronap_core::config::MAX_BEAMS;
-use ronap_core::run::team::TeamRollout;
+use ronap_core::run::TeamRollout;
 use ronap_core::scene::FreeGrid;
 use ronap_core::sim::{free_grid, needs_region_grid, sample_placement};
 use ronap_core::sim::{SceneSpec, Worlds};

@@ -13,7 +13,7 @@ use ronap_core::compare::{
 };
 use ronap_core::eval::{Evaluator, Seeds};
 use ronap_core::io::atomic::OutputError;
-use ronap_core::policy::{coordinated, TeamPolicyFactory};
+use ronap_core::policy::{CoordinatedFactory, TeamPolicyFactory, COORDINATED_NAME};
 use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -96,8 +96,8 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
         } else {
             None
         };
-        let factory = if team.is_some() && name == coordinated::NAME {
-            Box::new(coordinated::CoordinatedFactory::new(config.team_size()))
+        let factory = if team.is_some() && name == COORDINATED_NAME {
+            Box::new(CoordinatedFactory::new(config.team_size()))
         } else {
             policy_factory(&name, &config.team_robot(0))?
         };

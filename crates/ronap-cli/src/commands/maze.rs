@@ -5,7 +5,7 @@ use crate::args::{positive, seed, SimArgs};
 use anyhow::{Context, Result};
 use clap::Args;
 use ronap_core::render::{Canvas, GOAL, MOVER, START};
-use ronap_core::run::team::TeamRollout;
+use ronap_core::run::TeamRollout;
 use ronap_core::sim::{needs_region_grid, sample_placement};
 use ronap_core::sim::{SceneSpec, Worlds};
 use ronap_core::ValidConfig;

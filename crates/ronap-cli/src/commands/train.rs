@@ -10,7 +10,7 @@ use ronap_core::eval::Seeds;
 use ronap_core::io::atomic::{save_network, OutputError};
 use ronap_core::io::datalog;
 use ronap_core::io::training::{Curves, TrainingLog};
-use ronap_core::policy::mlp::{observation_layout, DecisionRule, Mlp};
+use ronap_core::policy::{observation_layout, DecisionRule, Mlp};
 use ronap_core::sim::{SeedRanges, Split};
 use ronap_learn::bc::{self, BcOptions};
 use ronap_learn::dqn::{self, DqnOptions, Loss, Priorities, Validation};

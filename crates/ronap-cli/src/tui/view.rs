@@ -17,7 +17,7 @@ use ratatui::Frame;
 use ronap_core::eval::Evaluator;
 use ronap_core::geometry::Point;
 use ronap_core::policy::Policy;
-use ronap_core::run::rollout::Rollout;
+use ronap_core::run::Rollout;
 use ronap_core::run::RunError;
 use ronap_core::{Episode, Status};
 use std::process::ExitCode;

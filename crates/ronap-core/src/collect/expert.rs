@@ -8,9 +8,9 @@
 
 use crate::eval::Evaluator;
 use crate::io::datalog::Sample;
-use crate::policy::geodesic::Expert;
+use crate::policy::Expert;
 use crate::policy::{Policy, PolicyError, PolicyFactory};
-use crate::run::rollout::Rollout;
+use crate::run::Rollout;
 use crate::run::RunError;
 use crate::sim::{stream, Stream};
 use rayon::prelude::*;

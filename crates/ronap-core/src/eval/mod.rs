@@ -21,7 +21,7 @@ pub use team::{
 use crate::config::ValidConfig;
 use crate::plan::shortest_path_px;
 use crate::policy::{Policy, PolicyError, PolicyFactory};
-use crate::run::rollout::Rollout;
+use crate::run::Rollout;
 use crate::run::RunError;
 use crate::sim::Episode;
 use crate::sim::SeedRanges;

@@ -8,7 +8,7 @@ use crate::eval::{
     worker_pool, EpisodeRecord, EvalOptions, Evaluator, Failure, Recorder, Recording, RunEnd,
 };
 use crate::policy::{Policy, PolicyError, PolicyFactory};
-use crate::run::rollout::Rollout;
+use crate::run::Rollout;
 use crate::run::RunError;
 use crate::sim::Episode;
 use std::sync::atomic::AtomicBool;
@@ -247,8 +247,8 @@ impl Evaluator {
 mod tests {
     use super::*;
     use crate::config::SimConfig;
-    use crate::policy::mlp::MlpFactory;
     use crate::policy::Decision;
+    use crate::policy::MlpFactory;
     use crate::sim::DiscreteAction;
     use crate::sim::{Scenes, World};
     use std::path::Path;

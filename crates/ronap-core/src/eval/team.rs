@@ -10,8 +10,8 @@ use crate::eval::{
 use crate::geometry::Point;
 use crate::plan::shortest_path_px;
 use crate::policy::{PolicyError, TeamPolicy, TeamPolicyFactory};
-use crate::run::team::TeamRollout;
 use crate::run::RunError;
+use crate::run::TeamRollout;
 use crate::sim::Pose;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::AtomicBool;
@@ -49,7 +49,7 @@ pub struct RobotRecord {
     /// Goals it reached.
     pub goals_reached: u32,
     /// A goal list's tour lengths (the driven order's and the optimal one), px.
-    pub tour: Option<crate::run::team::TourLengths>,
+    pub tour: Option<crate::run::TourLengths>,
     /// Its shortest path from start to within epsilon of the goal (on success; through every
     /// goal of a list, the optimal tour less the tolerance at each end of each leg), px.
     pub shortest_px: Option<f64>,

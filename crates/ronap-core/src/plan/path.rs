@@ -4,8 +4,7 @@
 
 use crate::geometry::{unit, Point, Vector};
 use crate::plan::field::grid_path;
-use crate::scene::FreeGrid;
-use crate::scene::Scene;
+use crate::scene::{FreeGrid, Scene};
 use crate::sim::World;
 
 /// Step sizes, px, of [`smooth`]'s corner tightening, coarse to fine.

@@ -10,9 +10,7 @@
 //! episodes are the same as unbatched, bit for bit, for any policy that decides each row by itself.
 
 use crate::policy::{Decision, Policy, PolicyError, PolicyFactory};
-use crate::sim::Action;
-use crate::sim::Episode;
-use crate::sim::World;
+use crate::sim::{Action, Episode, World};
 use std::collections::HashMap;
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};

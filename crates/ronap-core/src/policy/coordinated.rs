@@ -30,18 +30,11 @@ use super::orca::Orca;
 use super::team::{PerRobot, RobotError, TeamPolicy, TeamPolicyFactory};
 use super::{Decision, Policy, PolicyError};
 use crate::config::{OnArrival, PlannerActions};
-use crate::geometry::PointGrid;
-use crate::geometry::{Agent, Horizon, V2};
-use crate::geometry::{Point, Vector};
-use crate::plan::team::{
+use crate::geometry::{Agent, Horizon, Point, PointGrid, Vector, V2};
+use crate::plan::{
     pair_feasible, pair_plan, plan_team, Limits, Pair, PlanFailure, PlanGrid, Schedule, Stop, Task,
 };
-use crate::sim::Action;
-use crate::sim::Episode;
-use crate::sim::Team;
-use crate::sim::World;
-use crate::sim::{stream, Stream};
-use crate::sim::{Avoid, Avoider};
+use crate::sim::{stream, Action, Avoid, Avoider, Episode, Stream, Team, World};
 use std::collections::HashSet;
 use std::sync::Arc;
 

@@ -8,13 +8,8 @@ use super::follow::Follower;
 use super::geodesic::planned;
 use super::{Decision, Policy, PolicyError};
 use crate::config::PlannerActions;
-use crate::geometry::{wrap_deg, Point, Vector};
-use crate::geometry::{Agent, V2};
-use crate::sim::Episode;
-use crate::sim::Movers;
-use crate::sim::Team;
-use crate::sim::World;
-use crate::sim::{Action, DiscreteAction};
+use crate::geometry::{wrap_deg, Agent, Point, Vector, V2};
+use crate::sim::{Action, DiscreteAction, Episode, Movers, Team, World};
 use std::f64::consts::TAU;
 
 /// How sharply a unicycle's speed falls with the angle between its chord and the velocity it

@@ -1,30 +1,45 @@
 //! Policies, above `plan`: what decides each step's action, one file per policy. Every policy
 //! implements [`Policy`], so the episode loop and the evaluator never know which one they run.
 //! Uses `config`, `geometry`, `scene`, `sim` and `plan`.
+//!
+//! The files are private: what other crates use is re-exported here (`pub use`), and what the
+//! layers above use beside it, `pub(crate) use`, so a file can move without breaking anyone.
 
-pub mod apf;
-pub mod batched;
-pub mod coordinated;
-pub mod dodge;
-pub mod dwa;
-pub mod follow;
-pub mod geodesic;
+mod apf;
+mod batched;
+mod coordinated;
+mod dodge;
+mod dwa;
+mod follow;
+mod geodesic;
 mod local;
-pub mod mlp;
-pub mod name;
-pub mod orca;
-pub mod random;
-pub mod social_force;
-pub mod team;
+mod mlp;
+mod name;
+mod orca;
+mod random;
+mod social_force;
+mod team;
 
+// The built-in policies by name, and policies deciding for many robots or environments at once.
+pub use batched::{BatchPolicy, Batched};
 pub use name::{factory, Builtin, PolicyNameError};
 pub use team::{
     Joint, JointFactory, PerRobot, PerRobotFactory, RobotError, TeamPolicy, TeamPolicyFactory,
 };
+// The team planner; its name and `drives` are aliased here, as the policy layer holds many names.
+pub use coordinated::{
+    drives as coordinated_drives, Coordinated, CoordinatedFactory, NAME as COORDINATED_NAME,
+};
+// Trained networks.
+pub use mlp::{
+    observation_layout, Activation, DecisionRule, Layer, Mlp, MlpError, MlpFactory, MlpPolicy,
+    Scratch, RRELU_SLOPE, SIDE_BY_SIDE,
+};
 
-use crate::sim::Action;
-use crate::sim::Episode;
-use crate::sim::World;
+// For the layers above only.
+pub(crate) use geodesic::Expert;
+
+use crate::sim::{Action, Episode, World};
 
 /// A policy that could not decide.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]

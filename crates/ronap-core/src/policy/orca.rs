@@ -11,8 +11,7 @@ use super::follow::Follower;
 use super::local::{self, Local, Planner, Senses};
 use super::Decision;
 use crate::geometry::Horizon;
-use crate::sim::Episode;
-use crate::sim::{Avoid, Avoider};
+use crate::sim::{Avoid, Avoider, Episode};
 
 /// The `orca` policy: ORCA towards the geodesic path's lookahead point.
 pub type Orca = Local<OrcaPlanner>;

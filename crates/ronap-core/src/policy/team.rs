@@ -5,9 +5,7 @@
 
 use crate::policy::batched::BatchPolicy;
 use crate::policy::{Decision, Policy, PolicyError, PolicyFactory};
-use crate::sim::Episode;
-use crate::sim::Team;
-use crate::sim::World;
+use crate::sim::{Episode, Team, World};
 use std::sync::Arc;
 
 /// A policy's failure for one robot of a team: the robot, and what went wrong.
@@ -313,10 +311,8 @@ impl TeamPolicyFactory for JointFactory {
 mod tests {
     use super::*;
     use crate::config::TeamRobotConfig;
-    use crate::run::team::TeamRollout;
-    use crate::run::RunError;
-    use crate::sim::DiscreteAction;
-    use crate::sim::Worlds;
+    use crate::run::{RunError, TeamRollout};
+    use crate::sim::{DiscreteAction, Worlds};
 
     /// Robot 0 drives ahead and says its step; robot 1 gives up at once; robot 2's policy
     /// fails at the third step.

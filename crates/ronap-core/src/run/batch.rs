@@ -9,10 +9,7 @@
 use crate::geometry::Point;
 use crate::run::shaping::Shaper;
 use crate::run::RunError;
-use crate::sim::Worlds;
-use crate::sim::{stream, Rng, Stream};
-use crate::sim::{Action, Pose};
-use crate::sim::{Episode, Status, PREFETCH_STAGES};
+use crate::sim::{stream, Action, Episode, Pose, Rng, Status, Stream, Worlds, PREFETCH_STAGES};
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
@@ -638,8 +635,7 @@ impl Lanes {
 mod tests {
     use super::*;
     use crate::config::SimConfig;
-    use crate::sim::DiscreteAction;
-    use crate::sim::Scenes;
+    use crate::sim::{DiscreteAction, Scenes};
 
     fn batch(envs: usize, threads: usize, autoreset: Autoreset) -> Batch {
         let mut c = SimConfig::default();

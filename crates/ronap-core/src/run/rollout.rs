@@ -5,9 +5,7 @@
 
 use crate::policy::{Decision, Policy, PolicyError};
 use crate::run::RunError;
-use crate::sim::Episode;
-use crate::sim::World;
-use crate::sim::{Action, Pose};
+use crate::sim::{Action, Episode, Pose, World};
 use std::sync::Arc;
 
 /// What one step of a rollout did.

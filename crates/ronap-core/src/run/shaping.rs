@@ -13,8 +13,7 @@
 
 use crate::config::Shaping;
 use crate::plan::LazyField;
-use crate::sim::Episode;
-use crate::sim::World;
+use crate::sim::{Episode, World};
 use std::sync::Arc;
 
 /// The shaping of one episode: its field towards the current goal and the current potential.
@@ -101,8 +100,7 @@ fn field(world: &World, episode: &Episode) -> LazyField {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::policy::geodesic::Geodesic;
-    use crate::policy::{Decision, Policy};
+    use crate::policy::{Builtin, Decision, PolicyFactory};
     use crate::sim::{Action, DiscreteAction};
     use crate::SimConfig;
 
@@ -123,7 +121,7 @@ mod tests {
         let mut episode = world.episode(3).unwrap();
         let mut shaper = Shaper::start(world.clone(), &episode).unwrap();
         let phi0 = shaper.potential();
-        let mut policy = Geodesic::default();
+        let mut policy = Builtin::Geodesic.make().unwrap();
         policy.reset(world, &episode).unwrap();
         let (mut shaped, mut sparse, mut discount) = (0.0, 0.0, 1.0);
         let mut t = 0;

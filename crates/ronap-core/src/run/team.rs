@@ -4,14 +4,10 @@
 //! robot out of the running; it stays where it is, an obstacle to the others.
 
 use crate::geometry::Point;
-use crate::plan::tour::{self, CostMatrix, Order};
-use crate::plan::{path_length, smooth, DistanceField};
-use crate::policy::team::TeamPolicy;
-use crate::policy::Decision;
+use crate::plan::{path_length, smooth, CostMatrix, DistanceField, Order};
+use crate::policy::{Decision, TeamPolicy};
 use crate::run::RunError;
-use crate::sim::Action;
-use crate::sim::Team;
-use crate::sim::World;
+use crate::sim::{Action, Team, World};
 use std::sync::Arc;
 
 /// One team episode in progress with its robots' policies' reasons for giving up.
@@ -83,7 +79,7 @@ fn plan_tour(
             })
     };
     let tours = CostMatrix::from_fn(nodes.len(), leg).map(|costs| {
-        [Order::Given, Order::Nearest, Order::Optimal].map(|o| tour::order(&costs, o))
+        [Order::Given, Order::Nearest, Order::Optimal].map(|o| crate::plan::order(&costs, o))
     });
     match tours {
         Ok([given, nearest, optimal]) => {

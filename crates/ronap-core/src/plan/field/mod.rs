@@ -4,8 +4,7 @@
 //! `geodesic` policy descends and the yardstick for SPL.
 
 use crate::geometry::Point;
-use crate::scene::FreeGrid;
-use crate::scene::Scene;
+use crate::scene::{FreeGrid, Scene};
 use search::*;
 
 mod search;

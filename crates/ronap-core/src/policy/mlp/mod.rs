@@ -13,25 +13,20 @@
 //! - `format`: `ronap-mlp/1`;
 //! - `activation`: `relu`, `tanh`, `leaky_relu:SLOPE`, or `rrelu` (the paper's RReLU; at inference
 //!   it is a leaky ReLU of slope `(1/8 + 1/3) / 2`, PyTorch's evaluation mode);
-//! - `observation`: the observation layout, [`OBSERVATION_LAYOUT`] for the 18 values of docs/model.md "Observation";
+//! - `observation`: the observation layout, [`network::OBSERVATION_LAYOUT`] for the 18 values of
+//!   docs/model.md "Observation";
 //! - `observation_size`: the number of inputs;
 //! - optional, for people: `output` (`q_values` or `logits`), `command` (what trained it),
 //!   `trained` (a description of the training data or run).
 
-pub mod file;
-pub mod network;
+mod file;
+mod network;
 
 pub use file::MlpError;
-pub use network::{
-    observation_layout, Activation, DecisionRule, Layer, Mlp, Scratch, FORMAT, OBSERVATION_LAYOUT,
-    RRELU_SLOPE,
-};
+pub use network::{observation_layout, Activation, DecisionRule, Layer, Mlp, Scratch, RRELU_SLOPE};
 
 use crate::policy::{Decision, Policy, PolicyError, PolicyFactory};
-use crate::sim::DiscreteAction;
-use crate::sim::Episode;
-use crate::sim::SeedRanges;
-use crate::sim::World;
+use crate::sim::{DiscreteAction, Episode, SeedRanges, World};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -238,6 +233,7 @@ impl PolicyFactory for MlpFactory {
 
 #[cfg(test)]
 mod tests {
+    use super::network::OBSERVATION_LAYOUT;
     use super::*;
     use nalgebra::{DMatrix, DVector};
     use safetensors::tensor::TensorView;
