@@ -4,7 +4,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use ronap_core::eval::Evaluator;
-use ronap_core::render::gif::{animate, GifOptions};
+use ronap_core::render::{animate, GifOptions};
 use ronap_core::{Scenes, SimConfig};
 use std::path::Path;
 

@@ -386,7 +386,7 @@ pub fn json(py: Python<'_>, v: &serde_json::Value) -> PyResult<PyObject> {
 pub fn record<'py>(
     py: Python<'py>,
     r: &ronap_core::eval::EpisodeRecord,
-    metrics: &[ronap_core::eval::metric::Kind],
+    metrics: &[ronap_core::eval::MetricKind],
 ) -> PyResult<Bound<'py, PyDict>> {
     let row = PyDict::new(py);
     row.set_item("seed", r.seed)?;

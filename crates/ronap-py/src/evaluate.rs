@@ -349,7 +349,7 @@ pub fn evaluate<'py>(
     let summary = serde_json::to_value(&evaluation.summary).unwrap_or_default();
     d.set_item("summary", conv::json(py, &summary)?)?;
     let episodes = PyList::empty(py);
-    let metrics = ronap_core::eval::metric::kinds(config);
+    let metrics = ronap_core::eval::metric_kinds(config);
     for r in &evaluation.result.records {
         episodes.append(conv::record(py, r, metrics)?)?;
     }

@@ -226,10 +226,7 @@ impl MultiEnv {
             )));
         }
         let team = self.rollout("render")?.team();
-        conv::image(
-            py,
-            ronap_core::render::team::team_frame(team, &self.paths, scale),
-        )
+        conv::image(py, ronap_core::render::team_frame(team, &self.paths, scale))
     }
 
     /// Robots in the team.

@@ -138,7 +138,7 @@ fn team_picture(
         .context("cannot place the team's robots")?;
     let team = rollout.team();
     check_size(team.robot(0).scene(), args.scale)?;
-    let image = ronap_core::render::team::team_setup(team, args.scale);
+    let image = ronap_core::render::team_setup(team, args.scale);
     ronap_core::io::atomic::save_image(path, &image)?;
     Ok(ExitCode::SUCCESS)
 }

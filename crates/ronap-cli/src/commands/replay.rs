@@ -3,7 +3,7 @@
 //!
 //! The log gives the actions; the run's `summary.json` gives the configuration and the scenes;
 //! the model steps the actions again from the episode's start and every logged pose is checked
-//! against it ([`ronap_core::render::gif`] says why this beats drawing the logged numbers or
+//! against it ([`ronap_core::render::animate`] says why this beats drawing the logged numbers or
 //! re-running the policy).
 
 use crate::args::{count, positive};
@@ -13,7 +13,7 @@ use ronap_core::eval::Evaluator;
 use ronap_core::io::manifest::RunManifest;
 use ronap_core::io::steplog::read_steps;
 use ronap_core::job::{play_lone, play_team, replay_team, single_page, RobotLog};
-use ronap_core::render::gif::{animate, GifOptions, View};
+use ronap_core::render::{animate, GifOptions, View};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;

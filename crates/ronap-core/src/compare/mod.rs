@@ -889,9 +889,7 @@ fn breakdown(
                     result.bin.members.iter().map(|&i| &p.seeds[i]).collect();
                 let k = rows.iter().filter(|r| r.success()).count();
                 result.success_rate.push(k as f64 / n.max(1) as f64);
-                result
-                    .success_ci95
-                    .push(crate::eval::summary::wilson95(k, n));
+                result.success_ci95.push(crate::eval::wilson95(k, n));
                 result
                     .spl
                     .push(rows.iter().map(|r| r.spl).sum::<f64>() / n.max(1) as f64);

@@ -2,10 +2,7 @@
 //! trajectory and steps.
 
 use crate::geometry::Point;
-use crate::sim::Track;
-use crate::sim::World;
-use crate::sim::{Action, Pose};
-use crate::sim::{DynamicMetrics, Status};
+use crate::sim::{Action, DynamicMetrics, Pose, Status, Track, World};
 use serde::Serialize;
 use std::sync::Arc;
 

@@ -8,8 +8,7 @@ use crate::eval::{
     worker_pool, EpisodeRecord, EvalOptions, Evaluator, Failure, Recorder, Recording, RunEnd,
 };
 use crate::policy::{Policy, PolicyError, PolicyFactory};
-use crate::run::Rollout;
-use crate::run::RunError;
+use crate::run::{Rollout, RunError};
 use crate::sim::Episode;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
@@ -247,10 +246,8 @@ impl Evaluator {
 mod tests {
     use super::*;
     use crate::config::SimConfig;
-    use crate::policy::Decision;
-    use crate::policy::MlpFactory;
-    use crate::sim::DiscreteAction;
-    use crate::sim::{Scenes, World};
+    use crate::policy::{Decision, MlpFactory};
+    use crate::sim::{DiscreteAction, Scenes, World};
     use std::path::Path;
     use std::sync::atomic::Ordering;
 

@@ -10,8 +10,7 @@ use crate::eval::{
 use crate::geometry::Point;
 use crate::plan::shortest_path_px;
 use crate::policy::{PolicyError, TeamPolicy, TeamPolicyFactory};
-use crate::run::RunError;
-use crate::run::TeamRollout;
+use crate::run::{RunError, TeamRollout};
 use crate::sim::Pose;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::AtomicBool;

@@ -265,7 +265,7 @@ pub fn parse_team(
         path_length_px: f.bits()?,
         collisions: f.parse()?,
         robot_collisions: f.parse()?,
-        flow: crate::eval::team::Flow {
+        flow: crate::eval::Flow {
             sum_of_costs: f.optional()?,
             makespan_lower_bound: f.optional()?,
             sum_of_costs_lower_bound: f.optional()?,
@@ -345,7 +345,7 @@ mod tests {
             path_length_px: 12.5,
             collisions: 1,
             robot_collisions: 4,
-            flow: crate::eval::team::Flow {
+            flow: crate::eval::Flow {
                 sum_of_costs: Some(40),
                 makespan_lower_bound: None,
                 sum_of_costs_lower_bound: Some(7),

@@ -3,14 +3,14 @@
 //! the steps a run recorded, or a step log read back, every logged pose held to the model's),
 //! recorded frame by frame into a [`Trace`] that [`crate::render::player`] packs into a page.
 
-use crate::eval::team::team_outcome;
+use crate::eval::team_outcome;
 use crate::eval::{EpisodeRecord, Evaluator, Outcome, TeamRecord};
 use crate::io::run_dir::RunWriter;
 use crate::io::steplog::LoggedStep;
 use crate::job::replay::drive_team;
 use crate::job::{ReplayError, RobotLog};
-use crate::render::gif::{check_logged_step, AnimationError};
-use crate::render::player::{player_page, Acted, PlayerPage, Recorder, Trace};
+use crate::render::{check_logged_step, AnimationError};
+use crate::render::{player_page, Acted, PlayerPage, Recorder, Trace};
 use crate::sim::Episode;
 use crate::sim::{Action, Pose};
 

@@ -5,8 +5,8 @@
 use crate::eval::Evaluator;
 use crate::geometry::Point;
 use crate::io::steplog::LoggedStep;
-use crate::render::gif::{same_pose, Animation, AnimationError, GifOptions, GifWriter};
-use crate::render::team::{team_frame, team_gif_writer};
+use crate::render::{same_pose, Animation, AnimationError, GifOptions, GifWriter};
+use crate::render::{team_frame, team_gif_writer};
 use crate::run::RunError;
 use crate::run::TeamRollout;
 use crate::sim::Team;

@@ -1,25 +1,39 @@
 //! Pictures, above `eval`: the canvas, the top view, the first-person view, trajectory pictures of
-//! finished episodes, animated GIFs and the charts that compare policies ([`chart`]). Uses every
-//! layer below it.
+//! finished episodes, animated GIFs and the charts that compare policies ([`compare_chart`] and
+//! the others of `chart`). Uses every layer below it.
 //!
 //! Drawing scenes to images: white floor, black walls, y flipped so up is up.
 //!
 //! A [`Canvas`] maps scene px to image pixels at `scale` pixels per px. Markers and paths are drawn
 //! in scene coordinates, so callers never deal with the flip.
+//!
+//! The files are private: what other crates use is re-exported here (`pub use`), and what the
+//! layers above use beside it, `pub(crate) use`, so a file can move without breaking anyone.
 
-pub mod chart;
-pub mod first_person;
-pub mod gif;
-pub mod player;
-pub mod team;
-pub mod trajectory;
+pub(crate) mod chart;
+mod first_person;
+mod gif;
+mod player;
+mod team;
+mod trajectory;
 
+// The charts that compare policies.
+pub use chart::{
+    compare_chart, contact_sheet, grouped_bars, outcome_strip, PolicyBars, Series, SheetRow,
+};
 pub use first_person::{first_person, HeadingUp, FIRST_PERSON_HALF_SPAN};
+pub use gif::{animate, AnimationError, GifOptions, View};
+pub use team::{team_frame, team_setup};
+
+// For the layers above only.
+pub(crate) use gif::{check_logged_step, same_pose, Animation, GifWriter};
+pub(crate) use player::{player_page, Acted, PlayerPage, Recorder, Trace};
+pub(crate) use team::{team_gif_writer, team_image};
+pub(crate) use trajectory::trajectory_image;
 
 use crate::geometry::{Aabb, Point};
 use crate::scene::Scene;
-use crate::sim::Pose;
-use crate::sim::{Laser, RayClass};
+use crate::sim::{Laser, Pose, RayClass};
 use image::{Rgb, RgbImage};
 
 /// Floor colour.
@@ -305,7 +319,7 @@ pub fn top_down(episode: &crate::sim::Episode, path: &[Point], scale: f64) -> Rg
 pub const RANGE_CIRCLE: Rgb<u8> = Rgb([150, 150, 150]);
 
 /// Every colour the pictures of this module use: floor, walls, markers, path, rays and the range
-/// circle. An animation encodes with exactly these ([`crate::render::gif`]).
+/// circle. An animation encodes with exactly these ([`animate`]).
 pub const PALETTE: [Rgb<u8>; 11] = [
     FLOOR,
     WALL,

@@ -4,9 +4,7 @@
 use crate::config::ValidConfig;
 use crate::eval::metric::{kinds, End, Metric, Other, View};
 use crate::geometry::{Point, Vector};
-use crate::sim::Episode;
-use crate::sim::Team;
-use crate::sim::{Body, Movers};
+use crate::sim::{Body, Episode, Movers, Team};
 
 /// The metrics of one robot, and where it was when they last saw it.
 struct Robot {
