@@ -9,7 +9,7 @@ use ronap_core::{Scenes, SimConfig};
 use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(steps) = ronap_core::io::steplog::parse_steps(data, Path::new("/fuzz/steps.csv")) else {
+    let Ok(steps) = ronap_core::io::parse_steps(data, Path::new("/fuzz/steps.csv")) else {
         return;
     };
     let Some(seed) = steps.first().map(|s| s.seed) else {

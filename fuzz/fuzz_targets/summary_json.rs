@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use ronap_core::io::manifest::RunManifest;
+use ronap_core::io::RunManifest;
 use ronap_core::sim::SceneSpec;
 use std::path::Path;
 

@@ -325,7 +325,7 @@ fn setup(c: &mut Criterion) {
 /// expert driving, or re-posed after each action), the episode's whole field included, over the
 /// seeds of 16 episodes in turn.
 fn label(c: &mut Criterion) {
-    use ronap_core::collect::expert::{collect_episode, Posing};
+    use ronap_core::collect::{collect_episode, Posing};
     let config = ValidConfig::default();
     let evaluator = ronap_core::eval::Evaluator::new(config, ronap_core::Scenes::MazePerSeed);
     let mut group = c.benchmark_group("label");

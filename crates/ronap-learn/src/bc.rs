@@ -8,7 +8,7 @@ use candle_nn::optim::Optimizer;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use ronap_core::io::datalog::DataSet;
+use ronap_core::io::DataSet;
 use ronap_core::policy::Mlp;
 use std::collections::HashMap;
 
@@ -216,7 +216,7 @@ mod tests {
 #[cfg(test)]
 mod expert_data {
     use super::*;
-    use ronap_core::collect::expert::{collect, Collection, Posing};
+    use ronap_core::collect::{collect, Collection, Posing};
     use ronap_core::eval::Evaluator;
     use ronap_core::{Scenes, SimConfig};
     use std::sync::atomic::AtomicBool;

@@ -9,10 +9,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use ronap_core::eval::TeamRecord;
 use ronap_core::eval::{EvalOptions, Evaluator};
-use ronap_core::io::run_dir::{
-    BlockRun, EpisodeRows, Layout, Pictures, RunFiles, RunInfo, RunWriter,
-};
-use ronap_core::io::team_rows::{robot_columns, robot_rows, team_episode_row, TEAM_COLUMNS};
+use ronap_core::io::{robot_columns, robot_rows, team_episode_row, TEAM_COLUMNS};
+use ronap_core::io::{BlockRun, EpisodeRows, Layout, Pictures, RunFiles, RunInfo, RunWriter};
 use ronap_core::job::evaluate_team_into;
 use ronap_core::job::{evaluate_into, RunRequest};
 use ronap_core::policy::{coordinated_drives, CoordinatedFactory};
@@ -475,7 +473,7 @@ impl Interrupt {
     /// stopped it (once its files were written), an episode failed.
     fn finish(
         self,
-        write_error: Option<&ronap_core::io::atomic::OutputError>,
+        write_error: Option<&ronap_core::io::OutputError>,
         run_error: Option<&ronap_core::run::RunError>,
     ) -> PyResult<()> {
         if let Some(e) = write_error {

@@ -12,7 +12,7 @@ use ronap_core::compare::{
     compare, with_runs, CompareError, CompareInfo, CompareOptions, Contender, Progress,
 };
 use ronap_core::eval::{Evaluator, Seeds};
-use ronap_core::io::atomic::OutputError;
+use ronap_core::io::OutputError;
 use ronap_core::policy::{CoordinatedFactory, TeamPolicyFactory, COORDINATED_NAME};
 use std::io::Write as _;
 use std::path::PathBuf;

@@ -89,7 +89,7 @@ pub fn run(args: MazeArgs) -> Result<ExitCode> {
                 canvas.fill_disc(p.goal, config.episode.goal_tolerance_px.max(least), GOAL);
                 canvas.robot(p.start, config.robot.radius_px.max(least), START);
             }
-            ronap_core::io::atomic::save_image(path, &canvas.into_image())?;
+            ronap_core::io::save_image(path, &canvas.into_image())?;
         }
         None => {
             let (maze, cell) = scene
@@ -139,6 +139,6 @@ fn team_picture(
     let team = rollout.team();
     check_size(team.robot(0).scene(), args.scale)?;
     let image = ronap_core::render::team_setup(team, args.scale);
-    ronap_core::io::atomic::save_image(path, &image)?;
+    ronap_core::io::save_image(path, &image)?;
     Ok(ExitCode::SUCCESS)
 }

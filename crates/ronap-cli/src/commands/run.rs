@@ -8,9 +8,9 @@ use crate::output::cancel_on_ctrl_c;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use ronap_core::eval::{EvalOptions, Evaluator, Recording, Seeds};
-use ronap_core::io::atomic::OutputError;
-use ronap_core::io::manifest::PLAN_FILE;
-use ronap_core::io::run_dir::{Pictures, ResumeError, RunFiles, RunInfo, RunWriter};
+use ronap_core::io::OutputError;
+use ronap_core::io::PLAN_FILE;
+use ronap_core::io::{Pictures, ResumeError, RunFiles, RunInfo, RunWriter};
 use ronap_core::job::{evaluate_into, evaluate_team_into, RunRequest};
 use ronap_core::policy::PolicyFactory;
 use ronap_core::scene::MapSource;
@@ -504,8 +504,8 @@ fn run_team(
 
 /// The error of a run whose files could not be written (a full disk, a read-only directory):
 /// what is kept, and how to go on (space to free only when the disk is full).
-fn stopped_writing(e: ronap_core::io::atomic::OutputError, dir: &Path) -> anyhow::Error {
-    use ronap_core::io::atomic::OutputError;
+fn stopped_writing(e: ronap_core::io::OutputError, dir: &Path) -> anyhow::Error {
+    use ronap_core::io::OutputError;
     let full = matches!(&e, OutputError::Io { source, .. }
         if source.kind() == std::io::ErrorKind::StorageFull);
     let fix = if full {
@@ -521,7 +521,7 @@ fn stopped_writing(e: ronap_core::io::atomic::OutputError, dir: &Path) -> anyhow
             dir.display()
         ));
     }
-    let plan = dir.join(ronap_core::io::manifest::PLAN_FILE);
+    let plan = dir.join(ronap_core::io::PLAN_FILE);
     let next = if plan.exists() {
         format!(
             "the finished episodes are kept in {}; {fix}, then ronap run --resume {}",

@@ -7,11 +7,9 @@
 //! being improved, as in DAgger) chooses where it goes while the expert labels every state.
 
 use crate::eval::Evaluator;
-use crate::io::datalog::Sample;
-use crate::policy::Expert;
-use crate::policy::{Policy, PolicyError, PolicyFactory};
-use crate::run::Rollout;
-use crate::run::RunError;
+use crate::io::Sample;
+use crate::policy::{Expert, Policy, PolicyError, PolicyFactory};
+use crate::run::{Rollout, RunError};
 use crate::sim::{stream, Stream};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};

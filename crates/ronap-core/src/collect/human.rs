@@ -9,12 +9,9 @@
 //! [`HumanCollector::act`] and [`HumanCollector::rearm`].
 
 use crate::eval::Evaluator;
-use crate::io::datalog::Sample;
+use crate::io::Sample;
 use crate::run::RunError;
-use crate::sim::World;
-use crate::sim::{stream, Rng, Stream};
-use crate::sim::{DiscreteAction, Pose};
-use crate::sim::{Episode, Status};
+use crate::sim::{stream, DiscreteAction, Episode, Pose, Rng, Status, Stream, World};
 use std::sync::Arc;
 
 /// What the latest recorded action did, for the person to see.

@@ -4,7 +4,7 @@
 
 use super::{CompareError, Comparison, Contender, PolicyResult};
 use crate::eval::{Evaluator, Recording};
-use crate::io::atomic::{write_atomic, OutputError};
+use crate::io::{write_atomic, OutputError};
 use crate::render::chart;
 use crate::render::{player_page, PlayerPage, Trace};
 use std::path::Path;

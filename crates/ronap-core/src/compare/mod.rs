@@ -6,18 +6,19 @@
 //! `ronap run` writes, so each can be replayed or reused; a run given for reuse must have been made
 //! with the same configuration, scenes and seeds. The figures are deterministic: the bootstrap
 //! draws from a fixed seed.
+//!
+//! The files are private: what other crates use is re-exported here, so a file can move without
+//! breaking anyone.
 
-pub mod difficulty;
+mod difficulty;
 mod disagreements;
-pub mod report;
-pub mod result;
-pub mod stats;
+mod report;
+mod result;
+mod stats;
 
 use crate::config::{OnCollision, ValidConfig};
 use crate::eval::{EvalOptions, Evaluator, Recording};
-use crate::io::atomic::OutputError;
-use crate::io::manifest::{ManifestError, RunManifest};
-use crate::io::run_dir::{RunFiles, RunInfo, RunWriter};
+use crate::io::{ManifestError, OutputError, RunFiles, RunInfo, RunManifest, RunWriter};
 use crate::job::{evaluate_into, evaluate_team_into, RunRequest};
 use crate::policy::{PolicyError, PolicyFactory, TeamPolicyFactory};
 use crate::scene::map::MapSource;

@@ -77,7 +77,7 @@ pub struct StepsError {
     pub message: String,
 }
 
-/// Reads a step log ([`write_steps`]; the heading may also be a `heading` column, as in data
+/// Reads a step log (`write_steps`; the heading may also be a `heading` column, as in data
 /// logs): one episode's consecutive steps, numbered from 1. Extra columns are ignored.
 pub fn read_steps(path: &Path) -> Result<Vec<LoggedStep>, StepsError> {
     let file = crate::bounded::open_lines(path).map_err(|e| StepsError {

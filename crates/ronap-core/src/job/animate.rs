@@ -4,7 +4,7 @@
 //! row in `episodes.csv` describes.
 
 use crate::eval::{EpisodeRecord, Evaluator, Outcome, TeamRecord};
-use crate::io::run_dir::RunWriter;
+use crate::io::RunWriter;
 use crate::job::{replay_team, RobotLog};
 use crate::render::{animate, Animation, GifOptions};
 

@@ -4,10 +4,10 @@
 use super::into::{run_into, Episodes, FileRows, Ran, Tallies};
 use crate::eval::Tally;
 use crate::eval::{EpisodeRecord, EvalOptions, Evaluator, Figures, RunEnd, RunResult, Summary};
-use crate::io::atomic::OutputError;
 use crate::io::figures;
-use crate::io::manifest::RunManifest;
-use crate::io::run_dir::{finish, lone_headers, manifest, EpisodeRows, Layout, RunWriter};
+use crate::io::OutputError;
+use crate::io::RunManifest;
+use crate::io::{finish, lone_headers, manifest, EpisodeRows, Layout, RunWriter};
 use crate::job::{animate, player, RunRequest};
 use crate::policy::{PolicyError, PolicyFactory};
 use std::sync::atomic::AtomicBool;
@@ -148,7 +148,7 @@ impl Tallies<EpisodeRecord> for Lone<'_> {
 mod tests {
     use super::*;
     use crate::eval::{EvalOptions, Evaluator};
-    use crate::io::run_dir::{RunFiles, RunInfo, RunWriter};
+    use crate::io::{RunFiles, RunInfo, RunWriter};
     use crate::policy::{Decision, Policy};
     use crate::sim::Scenes;
     use crate::{Episode, World};

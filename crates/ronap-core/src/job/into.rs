@@ -7,8 +7,8 @@
 
 use crate::eval::Outcome;
 use crate::eval::{EvalOptions, RunEnd, RunResult};
-use crate::io::atomic::OutputError;
-use crate::io::run_dir::{restore, Pictures, RunWriter, Streams};
+use crate::io::OutputError;
+use crate::io::{restore, Pictures, RunWriter, Streams};
 use crate::job::RunRequest;
 use crate::policy::PolicyError;
 use std::sync::atomic::AtomicBool;

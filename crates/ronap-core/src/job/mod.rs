@@ -21,7 +21,7 @@ pub use replay::{replay_team, ReplayError, RobotLog};
 pub use team::{evaluate_team_into, TeamEvaluation};
 
 use crate::eval::{EvalOptions, Evaluator};
-use crate::io::run_dir::{RunInfo, RunWriter};
+use crate::io::{RunInfo, RunWriter};
 use std::sync::atomic::AtomicBool;
 
 /// An evaluation to run and where its results go.

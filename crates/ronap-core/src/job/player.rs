@@ -5,8 +5,8 @@
 
 use crate::eval::team_outcome;
 use crate::eval::{EpisodeRecord, Evaluator, Outcome, TeamRecord};
-use crate::io::run_dir::RunWriter;
-use crate::io::steplog::LoggedStep;
+use crate::io::LoggedStep;
+use crate::io::RunWriter;
 use crate::job::replay::drive_team;
 use crate::job::{ReplayError, RobotLog};
 use crate::render::{check_logged_step, AnimationError};

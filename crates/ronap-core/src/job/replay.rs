@@ -4,7 +4,7 @@
 
 use crate::eval::Evaluator;
 use crate::geometry::Point;
-use crate::io::steplog::LoggedStep;
+use crate::io::LoggedStep;
 use crate::render::{same_pose, Animation, AnimationError, GifOptions, GifWriter};
 use crate::render::{team_frame, team_gif_writer};
 use crate::run::RunError;

@@ -22,10 +22,7 @@ use crate::io::partial::partial_path;
 use crate::scene::map::MapSource;
 use crate::sim::SceneSpec;
 pub(crate) use rows::start_goal_cells;
-pub use rows::{
-    episode_header, episode_row, metric_cells, timing_row, write_episodes, write_timing, Layout,
-    DYNAMIC_COLUMNS, EPISODE_COLUMNS, TIMING_COLUMNS,
-};
+pub use rows::{episode_header, episode_row, metric_cells, timing_row, Layout, TIMING_COLUMNS};
 use std::path::{Path, PathBuf};
 pub use writer::RunWriter;
 pub(crate) use writer::{finish, Streams};
