@@ -16,8 +16,7 @@
 //! the observation and the team's inbox (a list of dicts: `from`, `pose`, `goal`, `message`,
 //! nearest sender first; empty for a lone robot) and returns an action or `(action, message)`.
 
-use ronap_core::policy::{BatchPolicy, Batched};
-use ronap_core::policy::{Decision, Policy, PolicyError, PolicyFactory};
+use ronap_core::policy::{BatchPolicy, Batched, Decision, Policy, PolicyError, PolicyFactory};
 use ronap_core::{Action, DiscreteAction, Episode, World};
 use std::io::{BufRead, BufReader, Write};
 use std::path::PathBuf;

@@ -7,8 +7,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use ronap_core::config::{OnArrival, SimConfig, TeamRobotConfig};
-use ronap_core::policy::Coordinated;
-use ronap_core::policy::TeamPolicy;
+use ronap_core::policy::{Coordinated, TeamPolicy};
 use ronap_core::run::TeamRollout;
 use ronap_core::sim::{Scenes, Worlds};
 use ronap_core::ValidConfig;

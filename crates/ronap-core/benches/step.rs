@@ -8,8 +8,7 @@
 //! scan among 500 discs (`scan/360_beams_200px_500_discs`) within 4x of one among 100.
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
-use ronap_core::geometry::unit;
-use ronap_core::geometry::ParryScene;
+use ronap_core::geometry::{unit, ParryScene};
 use ronap_core::policy::{Decision, Policy};
 use ronap_core::scene::FreeGrid;
 use ronap_core::sim::maze_scene;

@@ -8,8 +8,7 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use ronap_core::config::{SimConfig, TeamRobotConfig};
 use ronap_core::run::TeamRollout;
-use ronap_core::sim::{Action, DiscreteAction};
-use ronap_core::sim::{Scenes, Worlds};
+use ronap_core::sim::{Action, DiscreteAction, Scenes, Worlds};
 use std::time::Duration;
 
 /// The action pattern `ronap bench` uses: mostly ahead, some turns.

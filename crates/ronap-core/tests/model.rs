@@ -6,8 +6,7 @@
 
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
-use ronap_core::geometry::unit;
-use ronap_core::geometry::ParryScene;
+use ronap_core::geometry::{unit, ParryScene};
 use ronap_core::render::Canvas;
 use ronap_core::sim::maze_scene;
 use ronap_core::{DiscreteAction, Episode, Laser, Point, Scene, SimConfig, ValidConfig};

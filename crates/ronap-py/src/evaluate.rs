@@ -7,19 +7,17 @@ use crate::kwargs::Options;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use ronap_core::eval::TeamRecord;
-use ronap_core::eval::{EvalOptions, Evaluator};
-use ronap_core::io::{robot_columns, robot_rows, team_episode_row, TEAM_COLUMNS};
-use ronap_core::io::{BlockRun, EpisodeRows, Layout, Pictures, RunFiles, RunInfo, RunWriter};
-use ronap_core::job::evaluate_team_into;
-use ronap_core::job::{evaluate_into, RunRequest};
-use ronap_core::policy::{coordinated_drives, CoordinatedFactory};
-use ronap_core::policy::{BatchPolicy, Batched};
-use ronap_core::policy::{
-    Decision, JointFactory, Policy, PolicyError, PolicyFactory, TeamPolicyFactory,
+use ronap_core::eval::{EvalOptions, Evaluator, TeamRecord};
+use ronap_core::io::{
+    robot_columns, robot_rows, team_episode_row, BlockRun, EpisodeRows, Layout, Pictures, RunFiles,
+    RunInfo, RunWriter, TEAM_COLUMNS,
 };
-use ronap_core::sim::continuous_action;
-use ronap_core::sim::Scenes;
+use ronap_core::job::{evaluate_into, evaluate_team_into, RunRequest};
+use ronap_core::policy::{
+    coordinated_drives, BatchPolicy, Batched, CoordinatedFactory, Decision, JointFactory, Policy,
+    PolicyError, PolicyFactory, TeamPolicyFactory,
+};
+use ronap_core::sim::{continuous_action, Scenes};
 use ronap_core::{Action, Episode, ValidConfig, World};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};

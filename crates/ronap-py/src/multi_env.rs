@@ -6,11 +6,8 @@ use crate::errors::{self, ActionError};
 use numpy::{PyArray1, PyArray3, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use ronap_core::run::TeamRollout;
-use ronap_core::run::{RobotStep, TeamBatch};
-use ronap_core::sim::Action;
-use ronap_core::sim::Team;
-use ronap_core::sim::Worlds;
+use ronap_core::run::{RobotStep, TeamBatch, TeamRollout};
+use ronap_core::sim::{Action, Team, Worlds};
 use ronap_core::Point;
 
 /// Several robots in one scene, an episode at a time.

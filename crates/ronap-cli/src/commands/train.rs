@@ -5,11 +5,10 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use indicatif::ProgressBar;
 use ronap_core::config::Shaping;
-use ronap_core::eval::Evaluator;
-use ronap_core::eval::Seeds;
-use ronap_core::io::{read_data_log, DataLogFormat, DataSet};
-use ronap_core::io::{save_network, OutputError};
-use ronap_core::io::{Curves, TrainingLog};
+use ronap_core::eval::{Evaluator, Seeds};
+use ronap_core::io::{
+    read_data_log, save_network, Curves, DataLogFormat, DataSet, OutputError, TrainingLog,
+};
 use ronap_core::policy::{observation_layout, DecisionRule, Mlp};
 use ronap_core::sim::{SeedRanges, Split};
 use ronap_learn::bc::{self, BcOptions};

@@ -18,9 +18,7 @@ use ratatui::widgets::{Block, Paragraph};
 use ratatui::Frame;
 use ronap_core::geometry::{unit, Point};
 use ronap_core::render::{HeadingUp, FIRST_PERSON_HALF_SPAN};
-use ronap_core::sim::RayClass;
-use ronap_core::sim::Team;
-use ronap_core::sim::{Body, Movers};
+use ronap_core::sim::{Body, Movers, RayClass, Team};
 use ronap_core::Episode;
 
 /// Walls within the laser's range (first-person) and everywhere (whole scene).

@@ -18,8 +18,7 @@ use ratatui::Frame;
 use ronap_core::eval::Evaluator;
 use ronap_core::geometry::Point;
 use ronap_core::policy::TeamPolicy;
-use ronap_core::run::RunError;
-use ronap_core::run::TeamRollout;
+use ronap_core::run::{RunError, TeamRollout};
 use ronap_core::sim::Team;
 use ronap_core::{Episode, Status};
 

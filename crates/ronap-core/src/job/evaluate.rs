@@ -2,12 +2,12 @@
 //! Python's `ronap.evaluate` share.
 
 use super::into::{run_into, Episodes, FileRows, Ran, Tallies};
-use crate::eval::Tally;
-use crate::eval::{EpisodeRecord, EvalOptions, Evaluator, Figures, RunEnd, RunResult, Summary};
+use crate::eval::{
+    EpisodeRecord, EvalOptions, Evaluator, Figures, RunEnd, RunResult, Summary, Tally,
+};
 use crate::io::figures;
-use crate::io::OutputError;
-use crate::io::RunManifest;
 use crate::io::{finish, lone_headers, manifest, EpisodeRows, Layout, RunWriter};
+use crate::io::{OutputError, RunManifest};
 use crate::job::{animate, player, RunRequest};
 use crate::policy::{PolicyError, PolicyFactory};
 use std::sync::atomic::AtomicBool;

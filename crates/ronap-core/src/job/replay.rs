@@ -5,12 +5,11 @@
 use crate::eval::Evaluator;
 use crate::geometry::Point;
 use crate::io::LoggedStep;
-use crate::render::{same_pose, Animation, AnimationError, GifOptions, GifWriter};
-use crate::render::{team_frame, team_gif_writer};
-use crate::run::RunError;
-use crate::run::TeamRollout;
-use crate::sim::Team;
-use crate::sim::{Action, Pose};
+use crate::render::{
+    same_pose, team_frame, team_gif_writer, Animation, AnimationError, GifOptions, GifWriter,
+};
+use crate::run::{RunError, TeamRollout};
+use crate::sim::{Action, Pose, Team};
 use image::RgbImage;
 
 impl RobotLog {

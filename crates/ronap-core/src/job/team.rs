@@ -7,9 +7,8 @@ use crate::eval::{
     TeamRunResult, TeamSummary, TeamTally,
 };
 use crate::io::figures;
-use crate::io::OutputError;
 use crate::io::{finish, manifest, timing_row, RunWriter, TIMING_COLUMNS};
-use crate::io::{robot_columns, robot_rows, team_episode_row, TEAM_COLUMNS};
+use crate::io::{robot_columns, robot_rows, team_episode_row, OutputError, TEAM_COLUMNS};
 use crate::job::{animate, player, RunRequest};
 use crate::policy::{PolicyError, TeamPolicyFactory};
 use std::sync::atomic::AtomicBool;
