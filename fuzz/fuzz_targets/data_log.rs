@@ -8,5 +8,5 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    let _ = ronap_core::io::datalog::parse(text, Path::new("/fuzz/data.csv"), 50.0);
+    let _ = ronap_core::io::parse_data_log(text, Path::new("/fuzz/data.csv"), 50.0);
 });

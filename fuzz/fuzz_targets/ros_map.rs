@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use ronap_core::scene::map::RosMap;
+use ronap_core::scene::RosMap;
 use ronap_core::{Scenes, SimConfig};
 use std::path::Path;
 use std::sync::Arc;

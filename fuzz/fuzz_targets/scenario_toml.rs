@@ -4,7 +4,7 @@
 
 use libfuzzer_sys::fuzz_target;
 use ronap_core::config::ConfigFile;
-use ronap_core::sim::world::SceneSpec;
+use ronap_core::sim::SceneSpec;
 use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {

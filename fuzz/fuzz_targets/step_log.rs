@@ -4,12 +4,12 @@
 
 use libfuzzer_sys::fuzz_target;
 use ronap_core::eval::Evaluator;
-use ronap_core::render::gif::{animate, GifOptions};
+use ronap_core::render::{animate, GifOptions};
 use ronap_core::{Scenes, SimConfig};
 use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
-    let Ok(steps) = ronap_core::io::steplog::parse_steps(data, Path::new("/fuzz/steps.csv")) else {
+    let Ok(steps) = ronap_core::io::parse_steps(data, Path::new("/fuzz/steps.csv")) else {
         return;
     };
     let Some(seed) = steps.first().map(|s| s.seed) else {

@@ -3,8 +3,8 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use ronap_core::io::manifest::RunManifest;
-use ronap_core::sim::world::SceneSpec;
+use ronap_core::io::RunManifest;
+use ronap_core::sim::SceneSpec;
 use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {

@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use ronap_core::policy::mlp::Mlp;
+use ronap_core::policy::Mlp;
 
 fuzz_target!(|data: &[u8]| {
     let Ok(mlp) = Mlp::from_bytes(data) else {

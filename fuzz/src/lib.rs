@@ -4,8 +4,7 @@
 //! look for panics, hangs and runaway memory, not for slow configurations.
 
 use ronap_core::eval::{Evaluator, Recording};
-use ronap_core::policy::name::Builtin;
-use ronap_core::policy::{PerRobot, Policy, PolicyFactory};
+use ronap_core::policy::{Builtin, PerRobot, Policy, PolicyFactory};
 use ronap_core::{Scenes, SimConfig, ValidConfig};
 
 /// Steps each fuzzed episode runs at most.

@@ -1,5 +1,5 @@
 //! Output helpers of the binary: progress bars, closed pipes, Ctrl-C, clock time for file names;
-//! atomic writing itself lives in `ronap_core::io::atomic`.
+//! atomic writing itself lives in `ronap_core::io` ([`ronap_core::io::write_atomic`]).
 
 use std::io::Write as _;
 use std::sync::atomic::{AtomicBool, Ordering};

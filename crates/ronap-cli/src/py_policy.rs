@@ -16,8 +16,7 @@
 //! the observation and the team's inbox (a list of dicts: `from`, `pose`, `goal`, `message`,
 //! nearest sender first; empty for a lone robot) and returns an action or `(action, message)`.
 
-use ronap_core::policy::batched::{BatchPolicy, Batched};
-use ronap_core::policy::{Decision, Policy, PolicyError, PolicyFactory};
+use ronap_core::policy::{BatchPolicy, Batched, Decision, Policy, PolicyError, PolicyFactory};
 use ronap_core::{Action, DiscreteAction, Episode, World};
 use std::io::{BufRead, BufReader, Write};
 use std::path::PathBuf;
@@ -312,7 +311,7 @@ impl Policy for PyProcess {
         Ok(())
     }
 
-    fn hear(&mut self, inbox: ronap_core::sim::team::Inbox<'_>) {
+    fn hear(&mut self, inbox: ronap_core::sim::Inbox<'_>) {
         let size = inbox.get(0).map_or(0, |b| b.message.len());
         let mut text = format!("{} {size}", inbox.len());
         for b in inbox {

@@ -77,7 +77,7 @@ fn collect_train_run_loop() {
         "{out}"
     );
     let bytes = std::fs::read(&weights).unwrap();
-    let mlp = ronap_core::policy::mlp::Mlp::from_bytes(&bytes).unwrap();
+    let mlp = ronap_core::policy::Mlp::from_bytes(&bytes).unwrap();
     assert_eq!(mlp.inputs(), 18);
     assert!(mlp.metadata["command"].contains("train bc"));
 
@@ -127,7 +127,7 @@ fn dqn_trains_and_writes_weights() {
         out.contains("mean return") && out.contains("success") && out.contains("validation"),
         "{out}"
     );
-    let mlp = ronap_core::policy::mlp::Mlp::load(&weights).unwrap();
+    let mlp = ronap_core::policy::Mlp::load(&weights).unwrap();
     assert_eq!(mlp.metadata["output"], "q_values");
     assert_eq!(mlp.metadata["decision"], "sample:0.3");
     // The curves beside the weights: a row per report, validation from the first.
@@ -179,9 +179,7 @@ fn bc_writes_its_accuracy_curves_beside_the_weights() {
     assert_eq!(log.lines().count(), 4);
     assert!(image::open(dir.path().join("bc-training.png")).is_ok());
     assert_eq!(
-        ronap_core::policy::mlp::Mlp::load(&weights)
-            .unwrap()
-            .metadata["decision"],
+        ronap_core::policy::Mlp::load(&weights).unwrap().metadata["decision"],
         "sample:2"
     );
 }
@@ -210,7 +208,7 @@ fn a_network_trained_with_history_runs_with_it_and_is_refused_without() {
         "--out",
         weights.to_str().unwrap(),
     ]));
-    let mlp = ronap_core::policy::mlp::Mlp::load(&weights).unwrap();
+    let mlp = ronap_core::policy::Mlp::load(&weights).unwrap();
     assert_eq!(mlp.inputs(), 3 * 18 + 2 * 3);
     assert!(
         mlp.metadata["observation"].contains("observation.history = 3"),
@@ -304,13 +302,13 @@ fn bad_weights_and_data_are_named() {
 
     // A network for another observation size.
     let wide = dir.path().join("wide.safetensors");
-    let layer = |o, i| ronap_core::policy::mlp::Layer {
+    let layer = |o, i| ronap_core::policy::Layer {
         weight: nalgebra::DMatrix::zeros(o, i),
         bias: nalgebra::DVector::zeros(o),
     };
-    let mlp = ronap_core::policy::mlp::Mlp::new(
+    let mlp = ronap_core::policy::Mlp::new(
         vec![layer(4, 25), layer(3, 4)],
-        ronap_core::policy::mlp::Activation::Relu,
+        ronap_core::policy::Activation::Relu,
         Default::default(),
     )
     .unwrap();

@@ -7,10 +7,9 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use ronap_core::config::{OnArrival, SimConfig, TeamRobotConfig};
-use ronap_core::policy::coordinated::Coordinated;
-use ronap_core::policy::TeamPolicy;
-use ronap_core::run::team::TeamRollout;
-use ronap_core::sim::world::{Scenes, Worlds};
+use ronap_core::policy::{Coordinated, TeamPolicy};
+use ronap_core::run::TeamRollout;
+use ronap_core::sim::{Scenes, Worlds};
 use ronap_core::ValidConfig;
 use std::time::{Duration, Instant};
 

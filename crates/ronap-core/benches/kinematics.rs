@@ -7,7 +7,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use ronap_core::config::{KinematicsKind, Shape};
-use ronap_core::sim::world::maze_scene;
+use ronap_core::sim::maze_scene;
 use ronap_core::{Action, Episode, SimConfig};
 use std::sync::Arc;
 

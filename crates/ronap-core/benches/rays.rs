@@ -11,7 +11,7 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use rand::{Rng, SeedableRng};
 use ronap_core::render::Canvas;
-use ronap_core::sim::world::maze_scene;
+use ronap_core::sim::maze_scene;
 use ronap_core::{Laser, Point, Scene, SimConfig, ValidConfig};
 use std::hint::black_box;
 

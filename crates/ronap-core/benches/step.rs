@@ -8,11 +8,10 @@
 //! scan among 500 discs (`scan/360_beams_200px_500_discs`) within 4x of one among 100.
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
-use ronap_core::geometry::reference::ParryScene;
-use ronap_core::geometry::unit;
+use ronap_core::geometry::{unit, ParryScene};
 use ronap_core::policy::{Decision, Policy};
-use ronap_core::scene::freespace::FreeGrid;
-use ronap_core::sim::world::maze_scene;
+use ronap_core::scene::FreeGrid;
+use ronap_core::sim::maze_scene;
 use ronap_core::{Action, DiscreteAction, Episode, Laser, ValidConfig};
 use std::hint::black_box;
 use std::sync::Arc;
@@ -230,7 +229,7 @@ fn setup(c: &mut Criterion) {
             next += 1;
             let world = Arc::new(ronap_core::World::maze(shaped.clone(), seed));
             let episode = world.episode(seed).expect("placement");
-            let shaper = ronap_core::run::shaping::Shaper::start(world, &episode);
+            let shaper = ronap_core::run::Shaper::start(world, &episode);
             shaper.map(|s| s.potential())
         })
     });
@@ -325,7 +324,7 @@ fn setup(c: &mut Criterion) {
 /// expert driving, or re-posed after each action), the episode's whole field included, over the
 /// seeds of 16 episodes in turn.
 fn label(c: &mut Criterion) {
-    use ronap_core::collect::expert::{collect_episode, Posing};
+    use ronap_core::collect::{collect_episode, Posing};
     let config = ValidConfig::default();
     let evaluator = ronap_core::eval::Evaluator::new(config, ronap_core::Scenes::MazePerSeed);
     let mut group = c.benchmark_group("label");
@@ -383,11 +382,11 @@ fn movers(c: &mut Criterion) {
 /// runs it: without allocation (`mlp/forward_into`), and through the allocating `forward`.
 fn mlp(c: &mut Criterion) {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../policies/bc.safetensors");
-    let net = ronap_core::policy::mlp::Mlp::load(std::path::Path::new(path)).expect("shipped");
+    let net = ronap_core::policy::Mlp::load(std::path::Path::new(path)).expect("shipped");
     let config = ValidConfig::default();
     let episode = Episode::new(&config, Arc::new(maze_scene(&config, 0)), 0).expect("places");
     let observation = episode.observation().to_vec();
-    let mut scratch = ronap_core::policy::mlp::Scratch::default();
+    let mut scratch = ronap_core::policy::Scratch::default();
     let mut group = c.benchmark_group("mlp");
     group.throughput(Throughput::Elements(1));
     group.bench_function("forward_into", |b| {
@@ -426,8 +425,8 @@ fn mlp(c: &mut Criterion) {
     // The same steps as the evaluator takes them for a network's policy: sixteen episodes side
     // by side on one thread, the policy deciding for all sixteen at once (`Policy::act_lanes`),
     // then each episode stepping; per episode step.
-    let lanes = ronap_core::policy::mlp::SIDE_BY_SIDE;
-    let mut policy = ronap_core::policy::mlp::MlpPolicy::new(Arc::new(net.clone()));
+    let lanes = ronap_core::policy::SIDE_BY_SIDE;
+    let mut policy = ronap_core::policy::MlpPolicy::new(Arc::new(net.clone()));
     let world = ronap_core::World::maze(config.clone(), 0);
     let mut episodes: Vec<Episode> = (0..lanes as u64)
         .map(|s| Episode::new(&config, scene.clone(), s).expect("default scene"))
@@ -462,8 +461,8 @@ fn mlp(c: &mut Criterion) {
 /// stepped side by side with a fixed action pattern, on one thread and on every core. The figure
 /// is per step of all 1024; divide 1024 by it for env-steps/s.
 fn batch(c: &mut Criterion) {
-    use ronap_core::run::batch::{Autoreset, Batch, BatchOptions, SeedOrder};
-    use ronap_core::sim::world::{Scenes, Worlds};
+    use ronap_core::run::{Autoreset, Batch, BatchOptions, SeedOrder};
+    use ronap_core::sim::{Scenes, Worlds};
     let mut group = c.benchmark_group("batch");
     group.throughput(Throughput::Elements(1024));
     for (name, threads) in [("step_1024_one_thread", 1), ("step_1024_all_threads", 0)] {

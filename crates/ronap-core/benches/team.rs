@@ -7,9 +7,8 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use ronap_core::config::{SimConfig, TeamRobotConfig};
-use ronap_core::run::team::TeamRollout;
-use ronap_core::sim::robot::{Action, DiscreteAction};
-use ronap_core::sim::world::{Scenes, Worlds};
+use ronap_core::run::TeamRollout;
+use ronap_core::sim::{Action, DiscreteAction, Scenes, Worlds};
 use std::time::Duration;
 
 /// The action pattern `ronap bench` uses: mostly ahead, some turns.

@@ -1,13 +1,13 @@
-//! Renders every chart of `ronap_core::render::chart` with made-up data to `/tmp/charts/*.png`,
+//! Renders every comparison chart of `ronap_core::render` with made-up data to `/tmp/charts/*.png`,
 //! to look at them: `cargo run --release -p ronap-core --example charts`.
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use ronap_core::eval::Outcome;
-use ronap_core::render::chart::{
-    compare_chart, contact_sheet, grouped_bars, outcome_strip, PolicyBars, Series, SheetRow,
+use ronap_core::render::{
+    compare_chart, contact_sheet, grouped_bars, outcome_strip, Canvas, PolicyBars, Series,
+    SheetRow, GOAL, PATH, START,
 };
-use ronap_core::render::{Canvas, GOAL, PATH, START};
 use ronap_core::{Aabb, Point, Scene};
 use std::error::Error;
 use std::path::Path;

@@ -52,10 +52,8 @@ pub const MODEL_VERSION: u32 = 2;
 
 pub use config::{ConfigError, SimConfig, ValidConfig};
 pub use geometry::{Aabb, Point, Vector};
-pub use scene::maze::Maze;
-pub use scene::{Scene, SceneError};
-pub use sim::episode::{Episode, Status, StepResult};
-pub use sim::lidar::Laser;
-pub use sim::placement::{EpisodeError, Placement};
-pub use sim::robot::{Action, DiscreteAction, Pose, Robot};
-pub use sim::world::{Scenes, World};
+pub use scene::{Maze, Scene, SceneError};
+pub use sim::{
+    Action, DiscreteAction, Episode, EpisodeError, Laser, Placement, Pose, Robot, Scenes, Status,
+    StepResult, World,
+};

@@ -6,10 +6,9 @@
 
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
-use ronap_core::geometry::reference::ParryScene;
-use ronap_core::geometry::unit;
+use ronap_core::geometry::{unit, ParryScene};
 use ronap_core::render::Canvas;
-use ronap_core::sim::world::maze_scene;
+use ronap_core::sim::maze_scene;
 use ronap_core::{DiscreteAction, Episode, Laser, Point, Scene, SimConfig, ValidConfig};
 use std::sync::Arc;
 
@@ -170,7 +169,7 @@ fn laser_readings_are_the_least_box_hit_to_the_bit() {
             maze_scene(&config, 2),
             image_of_maze(&config, 3),
             with_box,
-            ronap_core::sim::world::warehouse_scene(&config, 5),
+            ronap_core::sim::warehouse_scene(&config, 5),
         ];
         for scene in &scenes {
             for k in 0..25 {

@@ -10,8 +10,7 @@ use parry2d_f64::shape::{Ball, Compound, ConvexPolygon, Cuboid, SharedShape};
 use proptest::prelude::*;
 use ronap_core::config::{LaserConfig, MotionKind, MovingConfig, MovingShape, ObstacleConfig};
 use ronap_core::geometry::unit;
-use ronap_core::sim::moving::Body;
-use ronap_core::sim::world::maze_scene;
+use ronap_core::sim::{maze_scene, Body};
 use ronap_core::{Action, Episode, Point, Scene, SimConfig, ValidConfig};
 use std::sync::Arc;
 

@@ -7,7 +7,7 @@
 // Test code may panic on setup failures: that is a failed test, as intended.
 #![allow(clippy::unwrap_used)]
 
-use ronap_core::geometry::orca::{
+use ronap_core::geometry::{
     agent_neighbours, crowd_step, new_velocity, Agent, CrowdAgent, CrowdSettings, Horizon,
     Obstacles, Real, Surroundings, V2,
 };

@@ -8,8 +8,8 @@ use candle_nn::optim::Optimizer;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use ronap_core::io::datalog::DataSet;
-use ronap_core::policy::mlp::Mlp;
+use ronap_core::io::DataSet;
+use ronap_core::policy::Mlp;
 use std::collections::HashMap;
 
 /// Training settings. The defaults are the original's network and optimiser, with more data per
@@ -164,7 +164,7 @@ pub fn train(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ronap_core::sim::robot::DiscreteAction;
+    use ronap_core::sim::DiscreteAction;
 
     /// A rule an MLP can learn: turn towards the goal unless it is ahead.
     fn rule_data(n: usize, seed: u64) -> DataSet {
@@ -216,7 +216,7 @@ mod tests {
 #[cfg(test)]
 mod expert_data {
     use super::*;
-    use ronap_core::collect::expert::{collect, Collection, Posing};
+    use ronap_core::collect::{collect, Collection, Posing};
     use ronap_core::eval::Evaluator;
     use ronap_core::{Scenes, SimConfig};
     use std::sync::atomic::AtomicBool;

@@ -26,8 +26,8 @@ use candle_nn::optim::Optimizer;
 use rand::{Rng as _, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use ronap_core::eval::{EvalOptions, Evaluator, Outcome, Recording, Seeds};
-use ronap_core::policy::mlp::{DecisionRule, Mlp, MlpFactory};
-use ronap_core::run::batch::{Autoreset, Batch, BatchOptions, SeedOrder};
+use ronap_core::policy::{DecisionRule, Mlp, MlpFactory};
+use ronap_core::run::{Autoreset, Batch, BatchOptions, SeedOrder};
 use ronap_core::{Action, DiscreteAction, Status};
 use std::collections::{HashMap, VecDeque};
 use std::sync::atomic::AtomicBool;
@@ -519,7 +519,7 @@ pub fn train(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use ronap_core::sim::world::Scenes;
+    use ronap_core::sim::Scenes;
     use ronap_core::SimConfig;
 
     /// A small open room where the goal is always in reach: DQN must learn to head for it.

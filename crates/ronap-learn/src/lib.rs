@@ -2,7 +2,7 @@
 //!
 //! Behaviour cloning ([`bc`], the paper's Algorithm 2) fits a classifier to expert or human rows;
 //! DQN ([`dqn`], Algorithm 1) learns Q-values from the model's reward while episodes run on every
-//! core. Both produce the core's [`ronap_core::policy::mlp::Mlp`], saved as a safetensors file
+//! core. Both produce the core's [`ronap_core::policy::Mlp`], saved as a safetensors file
 //! that `ronap run --policy mlp:FILE` runs without any ML framework.
 
 pub mod bc;

@@ -7,7 +7,7 @@ use candle_nn::optim::{AdamW, Optimizer, ParamsAdamW};
 use nalgebra::{DMatrix, DVector};
 use rand::Rng as _;
 use rand_chacha::ChaCha8Rng;
-use ronap_core::policy::mlp::{Activation, Layer, Mlp};
+use ronap_core::policy::{Activation, Layer, Mlp};
 use std::collections::HashMap;
 
 /// Bounds of RReLU's random negative slope in training (PyTorch's defaults).
@@ -47,7 +47,7 @@ impl TrainActivation {
             Self::Relu => Activation::Relu,
             Self::Tanh => Activation::Tanh,
             Self::LeakyRelu(a) => Activation::LeakyRelu(a),
-            Self::Rrelu => Activation::LeakyRelu(ronap_core::policy::mlp::RRELU_SLOPE),
+            Self::Rrelu => Activation::LeakyRelu(ronap_core::policy::RRELU_SLOPE),
         }
     }
 }

@@ -8,8 +8,8 @@ use numpy::{PyArray1, PyArray3, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use ronap_core::config::{ConfigFile, RobotConfig};
-use ronap_core::scene::map::MapSource;
-use ronap_core::sim::world::{SceneSpec, Scenes};
+use ronap_core::scene::MapSource;
+use ronap_core::sim::{SceneSpec, Scenes};
 use ronap_core::{Action, DiscreteAction, Episode, SimConfig, Status, ValidConfig};
 use serde_json::{Map, Value};
 use std::path::{Path, PathBuf};
@@ -252,7 +252,7 @@ pub fn action(
         let names = robot.continuous_names();
         let what = || format!("expected {n} finite numbers {names}");
         let values: Vec<f64> = value.extract().map_err(|_| what())?;
-        return ronap_core::sim::kinematics::continuous_action(robot, &values).ok_or_else(what);
+        return ronap_core::sim::continuous_action(robot, &values).ok_or_else(what);
     }
     if value.is_instance_of::<pyo3::types::PyBool>()
         || value
@@ -386,7 +386,7 @@ pub fn json(py: Python<'_>, v: &serde_json::Value) -> PyResult<PyObject> {
 pub fn record<'py>(
     py: Python<'py>,
     r: &ronap_core::eval::EpisodeRecord,
-    metrics: &[ronap_core::eval::metric::Kind],
+    metrics: &[ronap_core::eval::MetricKind],
 ) -> PyResult<Bound<'py, PyDict>> {
     let row = PyDict::new(py);
     row.set_item("seed", r.seed)?;

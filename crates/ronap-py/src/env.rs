@@ -5,8 +5,8 @@ use crate::errors::{self, ActionError};
 use numpy::{PyArray1, PyArray3};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use ronap_core::run::shaping::Shaper;
-use ronap_core::sim::world::Worlds;
+use ronap_core::run::Shaper;
+use ronap_core::sim::Worlds;
 use ronap_core::{Episode, Point};
 
 /// One RoNAP environment.

@@ -81,8 +81,8 @@ pub fn output(e: impl std::fmt::Display) -> PyErr {
 
 /// An output directory that cannot be written as an `OutputError`, with the ways on when it was
 /// refused for what it holds.
-pub fn out_dir(e: ronap_core::io::atomic::OutputError) -> PyErr {
-    use ronap_core::io::atomic::OutputError as E;
+pub fn out_dir(e: ronap_core::io::OutputError) -> PyErr {
+    use ronap_core::io::OutputError as E;
     let hint = match &e {
         E::StoppedShort { dir, .. } => format!(
             ": `ronap run --resume {}` finishes it, force=True replaces it, or choose another out",

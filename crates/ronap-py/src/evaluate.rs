@@ -7,21 +7,17 @@ use crate::kwargs::Options;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use ronap_core::eval::TeamRecord;
-use ronap_core::eval::{EvalOptions, Evaluator};
-use ronap_core::io::run_dir::{
-    BlockRun, EpisodeRows, Layout, Pictures, RunFiles, RunInfo, RunWriter,
+use ronap_core::eval::{EvalOptions, Evaluator, TeamRecord};
+use ronap_core::io::{
+    robot_columns, robot_rows, team_episode_row, BlockRun, EpisodeRows, Layout, Pictures, RunFiles,
+    RunInfo, RunWriter, TEAM_COLUMNS,
 };
-use ronap_core::io::team_rows::{robot_columns, robot_rows, team_episode_row, TEAM_COLUMNS};
-use ronap_core::job::evaluate_team_into;
-use ronap_core::job::{evaluate_into, RunRequest};
-use ronap_core::policy::batched::{BatchPolicy, Batched};
-use ronap_core::policy::coordinated;
+use ronap_core::job::{evaluate_into, evaluate_team_into, RunRequest};
 use ronap_core::policy::{
-    Decision, JointFactory, Policy, PolicyError, PolicyFactory, TeamPolicyFactory,
+    coordinated_drives, BatchPolicy, Batched, CoordinatedFactory, Decision, JointFactory, Policy,
+    PolicyError, PolicyFactory, TeamPolicyFactory,
 };
-use ronap_core::sim::kinematics::continuous_action;
-use ronap_core::sim::world::Scenes;
+use ronap_core::sim::{continuous_action, Scenes};
 use ronap_core::{Action, Episode, ValidConfig, World};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
@@ -349,7 +345,7 @@ pub fn evaluate<'py>(
     let summary = serde_json::to_value(&evaluation.summary).unwrap_or_default();
     d.set_item("summary", conv::json(py, &summary)?)?;
     let episodes = PyList::empty(py);
-    let metrics = ronap_core::eval::metric::kinds(config);
+    let metrics = ronap_core::eval::metric_kinds(config);
     for r in &evaluation.result.records {
         episodes.append(conv::record(py, r, metrics)?)?;
     }
@@ -475,7 +471,7 @@ impl Interrupt {
     /// stopped it (once its files were written), an episode failed.
     fn finish(
         self,
-        write_error: Option<&ronap_core::io::atomic::OutputError>,
+        write_error: Option<&ronap_core::io::OutputError>,
         run_error: Option<&ronap_core::run::RunError>,
     ) -> PyResult<()> {
         if let Some(e) = write_error {
@@ -497,8 +493,8 @@ fn team_factory(
 ) -> PyResult<(Box<dyn TeamPolicyFactory>, String)> {
     let n = config.team_size();
     if let Ok(name) = policy.extract::<String>() {
-        if coordinated::drives(config, &name).map_err(errors::ConfigError::new_err)? {
-            return Ok((Box::new(coordinated::CoordinatedFactory::new(n)), name));
+        if coordinated_drives(config, &name).map_err(errors::ConfigError::new_err)? {
+            return Ok((Box::new(CoordinatedFactory::new(n)), name));
         }
         let mut factories: Vec<Box<dyn PolicyFactory>> = Vec::new();
         let mut names = Vec::new();

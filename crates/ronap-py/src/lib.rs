@@ -64,14 +64,14 @@ fn maze_picture(seed: u64, config: &Config, scale: f64) -> PyResult<image::RgbIm
             "scale = {scale}: must be between 0 and 16"
         )));
     }
-    let scene = ronap_core::sim::world::maze_scene(config.valid(), seed);
+    let scene = ronap_core::sim::maze_scene(config.valid(), seed);
     Ok(ronap_core::render::Canvas::new(&scene, scale).into_image())
 }
 
 /// The first and last seed of a named split (`test`, `validation`, `train`).
 #[pyfunction]
 fn split_range(name: &str) -> PyResult<(u64, u64)> {
-    let split = ronap_core::sim::split::Split::parse(name).map_err(errors::ConfigError::new_err)?;
+    let split = ronap_core::sim::Split::parse(name).map_err(errors::ConfigError::new_err)?;
     Ok((*split.range().start(), *split.range().end()))
 }
 

@@ -5,8 +5,8 @@
 use crate::errors;
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
-use ronap_core::io::atomic::save_network;
-use ronap_core::policy::mlp::{Activation, Layer, Mlp, Scratch};
+use ronap_core::io::save_network;
+use ronap_core::policy::{Activation, Layer, Mlp, Scratch};
 use std::collections::HashMap;
 use std::path::PathBuf;
 

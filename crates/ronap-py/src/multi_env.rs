@@ -6,11 +6,8 @@ use crate::errors::{self, ActionError};
 use numpy::{PyArray1, PyArray3, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use ronap_core::run::team::TeamRollout;
-use ronap_core::run::team_batch::{RobotStep, TeamBatch};
-use ronap_core::sim::robot::Action;
-use ronap_core::sim::team::Team;
-use ronap_core::sim::world::Worlds;
+use ronap_core::run::{RobotStep, TeamBatch, TeamRollout};
+use ronap_core::sim::{Action, Team, Worlds};
 use ronap_core::Point;
 
 /// Several robots in one scene, an episode at a time.
@@ -226,10 +223,7 @@ impl MultiEnv {
             )));
         }
         let team = self.rollout("render")?.team();
-        conv::image(
-            py,
-            ronap_core::render::team::team_frame(team, &self.paths, scale),
-        )
+        conv::image(py, ronap_core::render::team_frame(team, &self.paths, scale))
     }
 
     /// Robots in the team.

@@ -3,7 +3,7 @@
 
 use crate::errors::ConfigError;
 use pyo3::prelude::*;
-use ronap_core::geometry::orca::{crowd_step, Agent, CrowdAgent, CrowdSettings, Real, V2};
+use ronap_core::geometry::{crowd_step, Agent, CrowdAgent, CrowdSettings, Real, V2};
 
 /// Each agent's new velocity, agent neighbours and obstacle neighbours.
 type Step = (Vec<[f64; 2]>, Vec<Vec<usize>>, Vec<Vec<usize>>);

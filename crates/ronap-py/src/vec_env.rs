@@ -9,10 +9,8 @@ use numpy::{PyArray1, PyArrayMethods, PyFixedUnicode, PyReadonlyArray1, PyReadon
 use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use ronap_core::run::batch::{Autoreset, Batch, BatchOptions, EnvStep, SeedOrder};
-use ronap_core::run::RunError;
-use ronap_core::sim::kinematics::continuous_action;
-use ronap_core::sim::world::Worlds;
+use ronap_core::run::{Autoreset, Batch, BatchOptions, EnvStep, RunError, SeedOrder};
+use ronap_core::sim::{continuous_action, Worlds};
 use ronap_core::{Action, Point, Status};
 
 /// Many RoNAP environments stepped together.

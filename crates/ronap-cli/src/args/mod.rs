@@ -13,7 +13,7 @@ pub use sim::{EpisodeArgs, SceneArgs, SimArgs};
 use clap::Args;
 use ronap_core::eval::{held_out_warning, Seeds};
 use ronap_core::policy::PolicyFactory;
-use ronap_core::sim::split::Split;
+use ronap_core::sim::Split;
 
 /// Parses a positive, finite number of px.
 pub fn positive(s: &str) -> Result<f64, String> {

@@ -2,8 +2,8 @@
 
 use anyhow::Result;
 use ronap_core::policy::{
-    coordinated, Builtin, PerRobot, PolicyError, PolicyFactory, PolicyNameError, TeamPolicy,
-    TeamPolicyFactory,
+    coordinated_drives, Builtin, Coordinated, PerRobot, PolicyError, PolicyFactory,
+    PolicyNameError, TeamPolicy, TeamPolicyFactory, COORDINATED_NAME,
 };
 use ronap_core::ValidConfig;
 
@@ -20,7 +20,7 @@ pub fn named_policy(
     config: &ValidConfig,
 ) -> Result<Box<dyn PolicyFactory>> {
     let flag = label;
-    if name == coordinated::NAME {
+    if name == COORDINATED_NAME {
         anyhow::bail!(
             "{flag} coordinated: a team planner, for scenarios with [[robots]]; one robot alone \
              has no one to coordinate with (orca is what it would run)"
@@ -78,8 +78,8 @@ impl TeamPolicies {
             batched: Vec::new(),
             coordinated: false,
         };
-        if coordinated::drives(config, default).map_err(anyhow::Error::msg)? {
-            team.names = vec![coordinated::NAME.to_string(); config.team_size()];
+        if coordinated_drives(config, default).map_err(anyhow::Error::msg)? {
+            team.names = vec![COORDINATED_NAME.to_string(); config.team_size()];
             team.coordinated = true;
             return Ok(team);
         }
@@ -122,7 +122,7 @@ impl TeamPolicies {
     /// policy that could not start.
     pub fn start(&self) -> Result<Box<dyn TeamPolicy>> {
         if self.coordinated {
-            return Ok(Box::<coordinated::Coordinated>::default());
+            return Ok(Box::<Coordinated>::default());
         }
         let policies = self
             .of_robot
@@ -142,7 +142,7 @@ impl TeamPolicies {
 impl TeamPolicyFactory for TeamPolicies {
     fn make(&self) -> Result<Box<dyn TeamPolicy>, PolicyError> {
         if self.coordinated {
-            return Ok(Box::<coordinated::Coordinated>::default());
+            return Ok(Box::<Coordinated>::default());
         }
         if let Some((py, pool)) = &self.batch {
             let others = self

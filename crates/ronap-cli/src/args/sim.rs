@@ -5,8 +5,8 @@ use crate::args::{fraction, positive, seed};
 use anyhow::{Context, Result};
 use clap::Args;
 use ronap_core::config::ConfigFile;
-use ronap_core::scene::map::MapSource;
-use ronap_core::sim::world::{SceneSpec, Scenes};
+use ronap_core::scene::MapSource;
+use ronap_core::sim::{SceneSpec, Scenes};
 use ronap_core::{ConfigError, SimConfig, ValidConfig};
 use std::path::PathBuf;
 

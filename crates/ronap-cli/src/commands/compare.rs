@@ -12,8 +12,8 @@ use ronap_core::compare::{
     compare, with_runs, CompareError, CompareInfo, CompareOptions, Contender, Progress,
 };
 use ronap_core::eval::{Evaluator, Seeds};
-use ronap_core::io::atomic::OutputError;
-use ronap_core::policy::{coordinated, TeamPolicyFactory};
+use ronap_core::io::OutputError;
+use ronap_core::policy::{CoordinatedFactory, TeamPolicyFactory, COORDINATED_NAME};
 use std::io::Write as _;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -96,8 +96,8 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
         } else {
             None
         };
-        let factory = if team.is_some() && name == coordinated::NAME {
-            Box::new(coordinated::CoordinatedFactory::new(config.team_size()))
+        let factory = if team.is_some() && name == COORDINATED_NAME {
+            Box::new(CoordinatedFactory::new(config.team_size()))
         } else {
             policy_factory(&name, &config.team_robot(0))?
         };
@@ -121,7 +121,7 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
     let evaluator = Evaluator::new(config.clone(), scenes);
     if team {
         // A team that cannot be placed fails the same way for every seed: say so now.
-        ronap_core::sim::team::Team::new(&config, &evaluator.worlds().team(first), first)
+        ronap_core::sim::Team::new(&config, &evaluator.worlds().team(first), first)
             .with_context(|| format!("cannot start team episodes in this scene (seed {first})"))?;
     } else {
         evaluator

@@ -5,9 +5,8 @@ use crate::args::{positive, seed, SimArgs};
 use anyhow::{Context, Result};
 use clap::Args;
 use ronap_core::render::{Canvas, GOAL, MOVER, START};
-use ronap_core::run::team::TeamRollout;
-use ronap_core::sim::placement::{needs_region_grid, sample_placement};
-use ronap_core::sim::world::{SceneSpec, Worlds};
+use ronap_core::run::TeamRollout;
+use ronap_core::sim::{needs_region_grid, sample_placement, SceneSpec, Worlds};
 use ronap_core::ValidConfig;
 use std::io::Write;
 use std::path::PathBuf;
@@ -89,7 +88,7 @@ pub fn run(args: MazeArgs) -> Result<ExitCode> {
                 canvas.fill_disc(p.goal, config.episode.goal_tolerance_px.max(least), GOAL);
                 canvas.robot(p.start, config.robot.radius_px.max(least), START);
             }
-            ronap_core::io::atomic::save_image(path, &canvas.into_image())?;
+            ronap_core::io::save_image(path, &canvas.into_image())?;
         }
         None => {
             let (maze, cell) = scene
@@ -138,7 +137,7 @@ fn team_picture(
         .context("cannot place the team's robots")?;
     let team = rollout.team();
     check_size(team.robot(0).scene(), args.scale)?;
-    let image = ronap_core::render::team::team_setup(team, args.scale);
-    ronap_core::io::atomic::save_image(path, &image)?;
+    let image = ronap_core::render::team_setup(team, args.scale);
+    ronap_core::io::save_image(path, &image)?;
     Ok(ExitCode::SUCCESS)
 }

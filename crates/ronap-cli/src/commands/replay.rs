@@ -3,17 +3,16 @@
 //!
 //! The log gives the actions; the run's `summary.json` gives the configuration and the scenes;
 //! the model steps the actions again from the episode's start and every logged pose is checked
-//! against it ([`ronap_core::render::gif`] says why this beats drawing the logged numbers or
+//! against it ([`ronap_core::render::animate`] says why this beats drawing the logged numbers or
 //! re-running the policy).
 
 use crate::args::{count, positive};
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use ronap_core::eval::Evaluator;
-use ronap_core::io::manifest::RunManifest;
-use ronap_core::io::steplog::read_steps;
+use ronap_core::io::{read_steps, RunManifest};
 use ronap_core::job::{play_lone, play_team, replay_team, single_page, RobotLog};
-use ronap_core::render::gif::{animate, GifOptions, View};
+use ronap_core::render::{animate, GifOptions, View};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -159,7 +158,7 @@ pub fn run(args: ReplayArgs) -> Result<ExitCode> {
         let logs = team_logs(&args.steps, seed)?;
         let animation = replay_team(&evaluator, seed, &logs, &options)
             .with_context(|| format!("cannot replay {}", args.steps.display()))?;
-        ronap_core::io::atomic::write_atomic(&out, |w| w.write_all(&animation.bytes))?;
+        ronap_core::io::write_atomic(&out, |w| w.write_all(&animation.bytes))?;
         writeln!(
             std::io::stdout().lock(),
             "{}: seed {seed}, {} robots, {} steps, {} frames of {} x {} (stride {}), {:.0} KB",
@@ -182,7 +181,7 @@ pub fn run(args: ReplayArgs) -> Result<ExitCode> {
     let poses: Vec<_> = steps.iter().map(|s| s.pose).collect();
     let animation = animate(episode, &actions, Some(&poses), &options)
         .with_context(|| format!("cannot replay {}", args.steps.display()))?;
-    ronap_core::io::atomic::write_atomic(&out, |w| w.write_all(&animation.bytes))?;
+    ronap_core::io::write_atomic(&out, |w| w.write_all(&animation.bytes))?;
     let mut stdout = std::io::stdout().lock();
     writeln!(
         stdout,
@@ -204,7 +203,7 @@ pub fn run(args: ReplayArgs) -> Result<ExitCode> {
 fn write_player(
     evaluator: &Evaluator,
     log: &Path,
-    steps: &[ronap_core::io::steplog::LoggedStep],
+    steps: &[ronap_core::io::LoggedStep],
     seed: u64,
     html: &Path,
 ) -> Result<ExitCode> {
@@ -221,7 +220,7 @@ fn write_player(
     };
     let (robots, frames) = (trace.robots(), trace.frames());
     let page = single_page(trace).map_err(anyhow::Error::msg)?;
-    ronap_core::io::atomic::write_atomic(html, |w| w.write_all(&page))
+    ronap_core::io::write_atomic(html, |w| w.write_all(&page))
         .with_context(|| format!("cannot write the player to {}", html.display()))?;
     writeln!(
         std::io::stdout().lock(),

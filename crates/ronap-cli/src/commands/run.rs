@@ -8,13 +8,11 @@ use crate::output::cancel_on_ctrl_c;
 use anyhow::{bail, Context, Result};
 use clap::Args;
 use ronap_core::eval::{EvalOptions, Evaluator, Recording, Seeds};
-use ronap_core::io::atomic::OutputError;
-use ronap_core::io::manifest::PLAN_FILE;
-use ronap_core::io::run_dir::{Pictures, ResumeError, RunFiles, RunInfo, RunWriter};
+use ronap_core::io::{OutputError, Pictures, ResumeError, RunFiles, RunInfo, RunWriter, PLAN_FILE};
 use ronap_core::job::{evaluate_into, evaluate_team_into, RunRequest};
 use ronap_core::policy::PolicyFactory;
-use ronap_core::scene::map::MapSource;
-use ronap_core::sim::world::SceneSpec;
+use ronap_core::scene::MapSource;
+use ronap_core::sim::SceneSpec;
 use ronap_core::{Scenes, ValidConfig};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
@@ -459,7 +457,7 @@ fn run_team(
     let (first, last) = job.span();
     let evaluator = Evaluator::new(config.clone(), scenes);
     // A team that cannot be placed fails the same way for every seed: say so before writing.
-    ronap_core::sim::team::Team::new(&config, &evaluator.worlds().team(first), first)
+    ronap_core::sim::Team::new(&config, &evaluator.worlds().team(first), first)
         .with_context(|| format!("cannot start team episodes in this scene (seed {first})"))?;
     let (writer, cancel, bar) = job.begin(
         writer,
@@ -504,8 +502,8 @@ fn run_team(
 
 /// The error of a run whose files could not be written (a full disk, a read-only directory):
 /// what is kept, and how to go on (space to free only when the disk is full).
-fn stopped_writing(e: ronap_core::io::atomic::OutputError, dir: &Path) -> anyhow::Error {
-    use ronap_core::io::atomic::OutputError;
+fn stopped_writing(e: ronap_core::io::OutputError, dir: &Path) -> anyhow::Error {
+    use ronap_core::io::OutputError;
     let full = matches!(&e, OutputError::Io { source, .. }
         if source.kind() == std::io::ErrorKind::StorageFull);
     let fix = if full {
@@ -521,7 +519,7 @@ fn stopped_writing(e: ronap_core::io::atomic::OutputError, dir: &Path) -> anyhow
             dir.display()
         ));
     }
-    let plan = dir.join(ronap_core::io::manifest::PLAN_FILE);
+    let plan = dir.join(ronap_core::io::PLAN_FILE);
     let next = if plan.exists() {
         format!(
             "the finished episodes are kept in {}; {fix}, then ronap run --resume {}",

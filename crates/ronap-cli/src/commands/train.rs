@@ -5,13 +5,12 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use indicatif::ProgressBar;
 use ronap_core::config::Shaping;
-use ronap_core::eval::Evaluator;
-use ronap_core::eval::Seeds;
-use ronap_core::io::atomic::{save_network, OutputError};
-use ronap_core::io::datalog;
-use ronap_core::io::training::{Curves, TrainingLog};
-use ronap_core::policy::mlp::{observation_layout, DecisionRule, Mlp};
-use ronap_core::sim::split::{SeedRanges, Split};
+use ronap_core::eval::{Evaluator, Seeds};
+use ronap_core::io::{
+    read_data_log, save_network, Curves, DataLogFormat, DataSet, OutputError, TrainingLog,
+};
+use ronap_core::policy::{observation_layout, DecisionRule, Mlp};
+use ronap_core::sim::{SeedRanges, Split};
 use ronap_learn::bc::{self, BcOptions};
 use ronap_learn::dqn::{self, DqnOptions, Loss, Priorities, Validation};
 use ronap_learn::net::TrainActivation;
@@ -331,7 +330,7 @@ fn check_out(path: &Path) -> Result<()> {
         );
     }
     // The weights and the curves are written through temporary files in that directory: try one.
-    if let Err(e) = ronap_core::io::atomic::check_writable(dir) {
+    if let Err(e) = ronap_core::io::check_writable(dir) {
         bail!("--out {}: {e}", path.display());
     }
     Ok(())
@@ -379,18 +378,18 @@ impl Finished<'_> {
 fn train_bc(args: BcArgs) -> Result<ExitCode> {
     check_out(&args.net.out)?;
     let range = args.laser_range;
-    let mut data: Option<datalog::DataSet> = None;
+    let mut data: Option<DataSet> = None;
     let mut described = Vec::new();
     for path in &args.data {
         let (d, format) =
-            datalog::read(path, range).with_context(|| format!("--data {}", path.display()))?;
+            read_data_log(path, range).with_context(|| format!("--data {}", path.display()))?;
         described.push(format!(
             "{} ({} rows, {} format, {} skipped)",
             path.display(),
             d.len(),
             match format {
-                datalog::Format::Ronap => "ronap",
-                datalog::Format::Original => "original RoNAP",
+                DataLogFormat::Ronap => "ronap",
+                DataLogFormat::Original => "original RoNAP",
             },
             d.skipped
         ));

@@ -8,7 +8,7 @@ use crate::tui::view::{start_episode, Ending, Lone, ViewApp, ViewState};
 use anyhow::{Context, Result};
 use clap::Args;
 use ronap_core::eval::Evaluator;
-use ronap_core::sim::world::Scenes;
+use ronap_core::sim::Scenes;
 use ronap_core::ValidConfig;
 use std::process::ExitCode;
 

@@ -1,7 +1,7 @@
 //! `ronap collect --human`: the paper's Collect Data screen in the terminal. The first-person view
 //! (`M` for the whole scene), the left / up / right arrows for LEFT / AHEAD / RIGHT, the down
 //! arrow to re-arm them after each action (anti-mispress), the robot re-posed after every
-//! recorded action ([`ronap_core::collect::human`]).
+//! recorded action ([`ronap_core::collect::HumanCollector`]).
 //!
 //! Every row goes to the data log (the core's [`DataLogWriter`], the format `--expert` writes)
 //! and is flushed as it is taken, so quitting, Ctrl-C or a crash loses no row already taken.
@@ -14,9 +14,9 @@ use ratatui::crossterm::event::{KeyCode, KeyEvent};
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::{Line, Span};
 use ratatui::Frame;
-use ronap_core::collect::human::HumanCollector;
+use ronap_core::collect::HumanCollector;
 use ronap_core::eval::Evaluator;
-use ronap_core::io::datalog::DataLogWriter;
+use ronap_core::io::DataLogWriter;
 use ronap_core::DiscreteAction;
 use std::io::Write;
 use std::path::PathBuf;
@@ -319,7 +319,7 @@ mod tests {
     use ratatui::backend::TestBackend;
     use ratatui::crossterm::event::KeyModifiers;
     use ratatui::Terminal;
-    use ronap_core::sim::world::Scenes;
+    use ronap_core::sim::Scenes;
     use ronap_core::ValidConfig;
 
     fn screen(view: &HumanView) -> String {

@@ -18,9 +18,7 @@ use ratatui::widgets::{Block, Paragraph};
 use ratatui::Frame;
 use ronap_core::geometry::{unit, Point};
 use ronap_core::render::{HeadingUp, FIRST_PERSON_HALF_SPAN};
-use ronap_core::sim::lidar::RayClass;
-use ronap_core::sim::moving::{Body, Movers};
-use ronap_core::sim::team::Team;
+use ronap_core::sim::{Body, Movers, RayClass, Team};
 use ronap_core::Episode;
 
 /// Walls within the laser's range (first-person) and everywhere (whole scene).
@@ -387,7 +385,7 @@ fn body(
     radius: f64,
     colour: Color,
 ) {
-    match ronap_core::sim::robot::Robot::corners(robot, pose) {
+    match ronap_core::sim::Robot::corners(robot, pose) {
         Some(c) => {
             for i in 0..c.len() {
                 let (a, b) = (c[i], c[(i + 1) % c.len()]);

@@ -18,9 +18,8 @@ use ratatui::Frame;
 use ronap_core::eval::Evaluator;
 use ronap_core::geometry::Point;
 use ronap_core::policy::TeamPolicy;
-use ronap_core::run::team::TeamRollout;
-use ronap_core::run::RunError;
-use ronap_core::sim::team::Team;
+use ronap_core::run::{RunError, TeamRollout};
+use ronap_core::sim::Team;
 use ronap_core::{Episode, Status};
 
 /// Everything the team view shows.

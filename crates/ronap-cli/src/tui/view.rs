@@ -17,8 +17,7 @@ use ratatui::Frame;
 use ronap_core::eval::Evaluator;
 use ronap_core::geometry::Point;
 use ronap_core::policy::Policy;
-use ronap_core::run::rollout::Rollout;
-use ronap_core::run::RunError;
+use ronap_core::run::{Rollout, RunError};
 use ronap_core::{Episode, Status};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
@@ -467,10 +466,8 @@ mod tests {
 
     /// Seed 7 under `policy`, stepped until `stop` says so (or the episode ends).
     fn state_of(policy: Builtin, stop: impl Fn(&ViewState) -> bool) -> ViewState {
-        let evaluator = Evaluator::new(
-            ValidConfig::default(),
-            ronap_core::sim::world::Scenes::MazePerSeed,
-        );
+        let evaluator =
+            Evaluator::new(ValidConfig::default(), ronap_core::sim::Scenes::MazePerSeed);
         let mut p = policy.make().unwrap();
         let rollout = start_episode(&evaluator, p.as_mut(), 7).unwrap();
         let mut state = ViewState::new(rollout, policy.name(), 20);
@@ -651,7 +648,7 @@ mod tests {
         };
         let evaluator = Evaluator::new(
             sim.validate().unwrap(),
-            ronap_core::sim::world::Scenes::MazePerSeed,
+            ronap_core::sim::Scenes::MazePerSeed,
         );
         let mut p = Builtin::Geodesic.make().unwrap();
         let rollout = start_episode(&evaluator, p.as_mut(), 7).unwrap();

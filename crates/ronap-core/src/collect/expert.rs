@@ -7,12 +7,10 @@
 //! being improved, as in DAgger) chooses where it goes while the expert labels every state.
 
 use crate::eval::Evaluator;
-use crate::io::datalog::Sample;
-use crate::policy::geodesic::Expert;
-use crate::policy::{Policy, PolicyError, PolicyFactory};
-use crate::run::rollout::Rollout;
-use crate::run::RunError;
-use crate::sim::rng::{stream, Stream};
+use crate::io::Sample;
+use crate::policy::{Expert, Policy, PolicyError, PolicyFactory};
+use crate::run::{Rollout, RunError};
+use crate::sim::{stream, Stream};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -176,7 +174,7 @@ mod tests {
     use super::*;
     use crate::config::SimConfig;
     use crate::geometry::wrap_deg;
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
 
     fn evaluator() -> Evaluator {
         Evaluator::new(

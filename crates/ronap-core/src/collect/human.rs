@@ -9,12 +9,9 @@
 //! [`HumanCollector::act`] and [`HumanCollector::rearm`].
 
 use crate::eval::Evaluator;
-use crate::io::datalog::Sample;
+use crate::io::Sample;
 use crate::run::RunError;
-use crate::sim::episode::{Episode, Status};
-use crate::sim::rng::{stream, Rng, Stream};
-use crate::sim::robot::{DiscreteAction, Pose};
-use crate::sim::world::World;
+use crate::sim::{stream, DiscreteAction, Episode, Pose, Rng, Status, Stream, World};
 use std::sync::Arc;
 
 /// What the latest recorded action did, for the person to see.
@@ -166,7 +163,7 @@ mod tests {
     use super::*;
     use crate::config::ValidConfig;
     use crate::geometry::wrap_deg;
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
 
     fn evaluator() -> Evaluator {
         Evaluator::new(ValidConfig::default(), Scenes::MazePerSeed)

@@ -1,6 +1,12 @@
 //! Labelled data for behaviour cloning, the top layer: an expert planner labelling the states a
-//! driver visits ([`expert`]), and a person at the keys ([`human`]), both writing the data-log
-//! rows of `io::datalog`. Uses every layer below it.
+//! driver visits ([`collect`]), and a person at the keys ([`HumanCollector`]), both writing the
+//! data-log rows of `io::datalog`. Uses every layer below it.
+//!
+//! The files are private: what other crates use is re-exported here, so a file can move without
+//! breaking anyone.
 
-pub mod expert;
-pub mod human;
+mod expert;
+mod human;
+
+pub use expert::{collect, collect_episode, Collection, Posing};
+pub use human::HumanCollector;

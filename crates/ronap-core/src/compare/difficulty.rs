@@ -4,7 +4,7 @@
 
 use crate::geometry::{Point, Vector};
 use crate::plan::shortest_path;
-use crate::sim::world::World;
+use crate::sim::World;
 use serde::Serialize;
 
 /// A path corner counts as a turn when the heading changes by more than this, degrees.

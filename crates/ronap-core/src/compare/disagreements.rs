@@ -4,9 +4,9 @@
 
 use super::{CompareError, Comparison, Contender, PolicyResult};
 use crate::eval::{Evaluator, Recording};
-use crate::io::atomic::{write_atomic, OutputError};
+use crate::io::{write_atomic, OutputError};
 use crate::render::chart;
-use crate::render::player::{player_page, PlayerPage, Trace};
+use crate::render::{player_page, PlayerPage, Trace};
 use std::path::Path;
 
 /// The seeds where the policies disagree most (a split between success and failure first, the
@@ -62,7 +62,7 @@ pub(super) fn disagreement_sheet(
                             .world
                             .as_ref()
                             .map_or(160.0, |w| w.scene().width().max(w.scene().height()));
-                    let picture = crate::render::trajectory::trajectory_image(&record, scale)
+                    let picture = crate::render::trajectory_image(&record, scale)
                         .unwrap_or_else(|| image::RgbImage::new(1, 1));
                     let caption = format!("{}, {} steps", record.outcome.name(), record.steps);
                     (picture, caption)

@@ -6,22 +6,23 @@
 //! `ronap run` writes, so each can be replayed or reused; a run given for reuse must have been made
 //! with the same configuration, scenes and seeds. The figures are deterministic: the bootstrap
 //! draws from a fixed seed.
+//!
+//! The files are private: what other crates use is re-exported here, so a file can move without
+//! breaking anyone.
 
-pub mod difficulty;
+mod difficulty;
 mod disagreements;
-pub mod report;
-pub mod result;
-pub mod stats;
+mod report;
+mod result;
+mod stats;
 
 use crate::config::{OnCollision, ValidConfig};
 use crate::eval::{EvalOptions, Evaluator, Recording};
-use crate::io::atomic::OutputError;
-use crate::io::manifest::{ManifestError, RunManifest};
-use crate::io::run_dir::{RunFiles, RunInfo, RunWriter};
+use crate::io::{ManifestError, OutputError, RunFiles, RunInfo, RunManifest, RunWriter};
 use crate::job::{evaluate_into, evaluate_team_into, RunRequest};
 use crate::policy::{PolicyError, PolicyFactory, TeamPolicyFactory};
 use crate::scene::map::MapSource;
-use crate::sim::world::SceneSpec;
+use crate::sim::SceneSpec;
 use difficulty::{Difficulty, Figure};
 use disagreements::disagreement_sheet;
 pub use disagreements::disagreements;
@@ -889,9 +890,7 @@ fn breakdown(
                     result.bin.members.iter().map(|&i| &p.seeds[i]).collect();
                 let k = rows.iter().filter(|r| r.success()).count();
                 result.success_rate.push(k as f64 / n.max(1) as f64);
-                result
-                    .success_ci95
-                    .push(crate::eval::summary::wilson95(k, n));
+                result.success_ci95.push(crate::eval::wilson95(k, n));
                 result
                     .spl
                     .push(rows.iter().map(|r| r.spl).sum::<f64>() / n.max(1) as f64);

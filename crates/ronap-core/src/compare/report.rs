@@ -5,7 +5,7 @@
 use super::result::{Comparison, PolicyResult};
 use super::stats::ALPHA;
 use crate::eval::Outcome;
-use crate::io::atomic::{write_atomic, OutputError};
+use crate::io::{write_atomic, OutputError};
 use crate::render::chart;
 use base64::Engine as _;
 use std::fmt::Write as _;
@@ -562,7 +562,7 @@ pub fn check_empty(dir: &Path) -> Result<(), OutputError> {
     let other = entries.find(|e| {
         let name = e.file_name();
         // An interrupted comparison's runs/ (each run there guards itself).
-        name != "runs" && name != crate::io::lock::LOCK_FILE
+        name != "runs" && name != crate::io::LOCK_FILE
     });
     match other {
         Some(e) => Err(OutputError::NotARun {

@@ -11,6 +11,9 @@
 //! reads files. The sections sit here, below the layers that use them, rather than beside their
 //! code: a scene, a robot and a policy all read the one validated configuration, and a section
 //! kept in `sim` or `policy` would make this layer import from above it.
+//!
+//! The files are private: what other crates use is re-exported here (`pub use`), and what the
+//! layers above use beside it, `pub(crate) use`, so a file can move without breaking anyone.
 
 mod apf;
 mod crowd;

@@ -4,30 +4,34 @@
 //! Each episode is independent and decided by its seed alone, so records are the same whatever
 //! the thread count; they come back in seed order. A shared cancel flag stops the run between
 //! episodes (Ctrl-C in the CLI) and keeps every finished record.
+//!
+//! The files are private: what other crates use is re-exported here (`pub use`), and what the
+//! layers above use beside it, `pub(crate) use`, so a file can move without breaking anyone.
 
-pub mod metric;
-pub mod ordered;
-pub mod record;
-pub mod side_by_side;
-pub mod summary;
-pub mod team;
+pub(crate) mod metric;
+mod ordered;
+mod record;
+mod side_by_side;
+mod summary;
+mod team;
 
+// The metrics beyond the standard columns, aliased here as the evaluator has kinds of its own.
+pub use metric::{kinds as metric_kinds, Kind as MetricKind};
 pub use record::{EpisodeRecord, Outcome, Recording, StepLog};
 pub use summary::{AmongRobots, Figures, Summary, Tally};
 pub use team::{
     RobotFigures, RobotRecord, TeamFigures, TeamRecord, TeamRunResult, TeamSummary, TeamTally,
 };
 
+// For the layers above only.
+pub(crate) use summary::wilson95;
+pub(crate) use team::{team_outcome, Flow};
+
 use crate::config::ValidConfig;
 use crate::plan::shortest_path_px;
 use crate::policy::{Policy, PolicyError, PolicyFactory};
-use crate::run::rollout::Rollout;
-use crate::run::RunError;
-use crate::sim::episode::Episode;
-use crate::sim::moving::Track;
-use crate::sim::robot::{Action, Pose};
-use crate::sim::split::SeedRanges;
-use crate::sim::world::{Scenes, World, Worlds};
+use crate::run::{Rollout, RunError};
+use crate::sim::{Action, Episode, Pose, Scenes, SeedRanges, Track, World, Worlds};
 use ordered::{run_in_order, Ordered, Window};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -320,11 +324,11 @@ impl Evaluator {
     /// soon as its episode ends (from a worker thread, in any order), then, stripped of its
     /// trajectory and steps, to `sink` in seed order on the calling thread; `sink` returning
     /// `false` stops the run. Memory stays flat however many seeds: workers run at most a
-    /// [`Window`] of episodes ahead of the next record `sink` is waiting for. Setting `cancel`
+    /// `Window` of episodes ahead of the next record `sink` is waiting for. Setting `cancel`
     /// stops the run between episodes; the episodes under way finish and are handed on, so what
     /// `sink` saw is always the first seeds of `options.seeds`. A factory whose policies decide for
     /// several episodes at once ([`PolicyFactory::side_by_side`]) has each worker step that many
-    /// side by side, in blocks of seeds ([`side_by_side`]): the same records, and the cancel flag
+    /// side by side, in blocks of seeds (`side_by_side`): the same records, and the cancel flag
     /// then stops the run between blocks.
     pub fn stream(
         &self,

@@ -55,11 +55,6 @@ impl<T> ReorderBuffer<T> {
     pub fn next(&self) -> usize {
         self.next
     }
-
-    /// Results held (come, but waiting for an earlier one).
-    pub fn held(&self) -> usize {
-        self.waiting.iter().filter(|s| s.is_some()).count()
-    }
 }
 
 /// How far ahead of the next result to hand on workers may claim jobs: the most results a
@@ -196,6 +191,11 @@ pub fn run_in_order<S, T: Send, E: Send>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Results `b` holds (come, but waiting for an earlier one).
+    fn held<T>(b: &ReorderBuffer<T>) -> usize {
+        b.waiting.iter().filter(|s| s.is_some()).count()
+    }
     use std::sync::atomic::AtomicUsize;
 
     #[test]
@@ -204,7 +204,7 @@ mod tests {
         b.insert(7, "c");
         b.insert(6, "b");
         assert_eq!(b.pop(), None);
-        assert_eq!(b.held(), 2);
+        assert_eq!(held(&b), 2);
         b.insert(5, "a");
         assert_eq!(
             (b.pop(), b.pop(), b.pop(), b.pop()),

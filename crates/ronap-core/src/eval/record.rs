@@ -2,10 +2,7 @@
 //! trajectory and steps.
 
 use crate::geometry::Point;
-use crate::sim::episode::{DynamicMetrics, Status};
-use crate::sim::moving::Track;
-use crate::sim::robot::{Action, Pose};
-use crate::sim::world::World;
+use crate::sim::{Action, DynamicMetrics, Pose, Status, Track, World};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -106,7 +103,7 @@ pub(crate) struct Before {
 
 impl Before {
     /// What `robot` senses now, before it steps.
-    pub(crate) fn of(robot: &crate::sim::episode::Episode) -> Self {
+    pub(crate) fn of(robot: &crate::sim::Episode) -> Self {
         Self {
             pose: robot.pose(),
             readings: robot.readings().to_vec(),

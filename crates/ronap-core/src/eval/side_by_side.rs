@@ -8,9 +8,8 @@ use crate::eval::{
     worker_pool, EpisodeRecord, EvalOptions, Evaluator, Failure, Recorder, Recording, RunEnd,
 };
 use crate::policy::{Policy, PolicyError, PolicyFactory};
-use crate::run::rollout::Rollout;
-use crate::run::RunError;
-use crate::sim::episode::Episode;
+use crate::run::{Rollout, RunError};
+use crate::sim::Episode;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
@@ -247,10 +246,8 @@ impl Evaluator {
 mod tests {
     use super::*;
     use crate::config::SimConfig;
-    use crate::policy::mlp::MlpFactory;
-    use crate::policy::Decision;
-    use crate::sim::robot::DiscreteAction;
-    use crate::sim::world::{Scenes, World};
+    use crate::policy::{Decision, MlpFactory};
+    use crate::sim::{DiscreteAction, Scenes, World};
     use std::path::Path;
     use std::sync::atomic::Ordering;
 

@@ -3,7 +3,7 @@
 
 use crate::eval::metric::{Kind, MetricMean};
 use crate::eval::{EpisodeRecord, Outcome};
-use crate::sim::episode::DynamicMetrics;
+use crate::sim::DynamicMetrics;
 use serde::{Deserialize, Serialize};
 
 /// Summary figures of a set of episodes.

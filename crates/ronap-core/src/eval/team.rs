@@ -10,9 +10,8 @@ use crate::eval::{
 use crate::geometry::Point;
 use crate::plan::shortest_path_px;
 use crate::policy::{PolicyError, TeamPolicy, TeamPolicyFactory};
-use crate::run::team::TeamRollout;
-use crate::run::RunError;
-use crate::sim::robot::Pose;
+use crate::run::{RunError, TeamRollout};
+use crate::sim::Pose;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -38,7 +37,7 @@ pub struct RobotRecord {
     /// Steps another robot blocked.
     pub robot_collisions: u32,
     /// How it went among moving obstacles, when there were some.
-    pub dynamic: Option<crate::sim::episode::DynamicMetrics>,
+    pub dynamic: Option<crate::sim::DynamicMetrics>,
     /// Its value of each metric the configuration asks for beyond the standard ones, in the
     /// order of [`crate::eval::metric::kinds`].
     pub metrics: Vec<Option<f64>>,
@@ -49,7 +48,7 @@ pub struct RobotRecord {
     /// Goals it reached.
     pub goals_reached: u32,
     /// A goal list's tour lengths (the driven order's and the optimal one), px.
-    pub tour: Option<crate::run::team::TourLengths>,
+    pub tour: Option<crate::run::TourLengths>,
     /// Its shortest path from start to within epsilon of the goal (on success; through every
     /// goal of a list, the optimal tour less the tolerance at each end of each leg), px.
     pub shortest_px: Option<f64>,
@@ -588,7 +587,7 @@ impl Evaluator {
         names: &[String],
         seed: u64,
         recording: Recording,
-        watch: &mut dyn FnMut(&crate::sim::team::Team),
+        watch: &mut dyn FnMut(&crate::sim::Team),
     ) -> Result<TeamRecord, RunError> {
         let clock = Instant::now();
         let worlds = self.worlds().team(seed);
@@ -603,7 +602,7 @@ impl Evaluator {
         let mut tracks: Vec<Vec<Point>> = vec![Vec::new(); if paths { n } else { 0 }];
         let mut step_logs: Vec<Vec<StepLog>> =
             vec![Vec::new(); if recording.steps { n } else { 0 }];
-        let note = |team: &crate::sim::team::Team, tracks: &mut Vec<Vec<Point>>| {
+        let note = |team: &crate::sim::Team, tracks: &mut Vec<Vec<Point>>| {
             for (k, t) in tracks.iter_mut().enumerate() {
                 if team.present(k) {
                     t.push(team.robot(k).pose().position());
@@ -819,7 +818,7 @@ mod tests {
     use super::*;
     use crate::config::TeamRobotConfig;
     use crate::policy::{factory, PerRobotFactory};
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
 
     fn evaluator(count: u32) -> Evaluator {
         let config = crate::SimConfig {

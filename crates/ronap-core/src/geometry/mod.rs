@@ -6,15 +6,32 @@
 //! Every obstacle in a ronap scene is an axis-aligned box: a maze wall is a thin box along a cell
 //! edge, an image scene is its occupied pixels merged into boxes. These are the exact queries the
 //! sensors and the collision check need, written for boxes so they cost a few nanoseconds each.
+//!
+//! The files are private: what other crates use is re-exported here (`pub use`), and what the
+//! layers above use beside it, `pub(crate) use`, so a file can move without breaking anyone.
 
-pub mod index;
-pub mod orca;
-pub mod point_grid;
+mod index;
+mod orca;
+mod point_grid;
 pub(crate) mod prefetch;
-pub mod ray_grid;
-pub mod reference;
-pub mod shape;
-pub mod social_force;
+mod ray_grid;
+mod reference;
+mod shape;
+pub(crate) mod social_force;
+
+// The crowd-avoidance geometry (ORCA's half-planes, the crowd step) and the reference scene.
+pub use orca::{
+    agent_neighbours, crowd_step, new_velocity, Agent, CrowdAgent, CrowdSettings, Horizon,
+    Obstacles, Real, Surroundings, V2,
+};
+pub use reference::ParryScene;
+
+// For the layers above only.
+pub(crate) use index::BinIndex;
+pub(crate) use orca::{agent_neighbours_among, obstacle_neighbours, Line};
+pub(crate) use point_grid::PointGrid;
+pub(crate) use ray_grid::{GridStart, RayGrid};
+pub(crate) use shape::Shape;
 
 use nalgebra::{Point2, Vector2};
 

@@ -207,16 +207,6 @@ impl RayGrid {
         Self::new(boxes, bounds, bounds.min, cell_px)
     }
 
-    /// Cell side, px.
-    pub fn cell_px(&self) -> f64 {
-        self.cell_px
-    }
-
-    /// Number of cell columns and rows.
-    pub fn size(&self) -> (usize, usize) {
-        (self.cols, self.rows)
-    }
-
     /// The cell holding `p`, if `p` is in the grid. A float cast truncates, which is the floor
     /// here (and saturates, so a hair below the grid is its first cell).
     #[inline]
@@ -481,7 +471,7 @@ mod tests {
         let boxes = [Aabb::from_corners(Point::origin(), Point::new(1.0, 1.0))];
         let bounds = Aabb::from_corners(Point::origin(), Point::new(100_000.0, 100_000.0));
         let grid = RayGrid::new(&boxes, bounds, Point::origin(), 1.0);
-        let (cols, rows) = grid.size();
+        let (cols, rows) = (grid.cols, grid.rows);
         assert!(cols * rows <= MAX_CELLS, "{cols} x {rows}");
         let (from, west) = (Point::new(50_000.0, 0.5), unit(180.0));
         assert_eq!(

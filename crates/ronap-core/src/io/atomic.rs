@@ -139,7 +139,7 @@ pub fn write_atomic(
 }
 
 /// Saves a network as ronap's weights file (safetensors), atomically.
-pub fn save_network(path: &Path, mlp: &crate::policy::mlp::Mlp) -> Result<(), OutputError> {
+pub fn save_network(path: &Path, mlp: &crate::policy::Mlp) -> Result<(), OutputError> {
     let bytes = mlp.to_bytes().map_err(|message| OutputError::Format {
         path: path.to_path_buf(),
         message,

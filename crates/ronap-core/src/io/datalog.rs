@@ -10,9 +10,7 @@
 //! Either way a row becomes the 18-value observation of docs/model.md "Observation" and an action index.
 
 use crate::geometry::{wrap_deg, Point};
-use crate::sim::episode::Episode;
-use crate::sim::robot::{DiscreteAction, Pose};
-use crate::sim::split::SeedRanges;
+use crate::sim::{DiscreteAction, Episode, Pose, SeedRanges};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 

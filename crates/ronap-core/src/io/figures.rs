@@ -5,7 +5,7 @@
 
 use crate::eval::metric::Kind;
 use crate::eval::{Figures, Outcome, RobotFigures, TeamFigures};
-use crate::sim::episode::DynamicMetrics;
+use crate::sim::DynamicMetrics;
 
 /// The file's name inside a run directory (it only ever exists as a partial file).
 pub const FIGURES_FILE: &str = "figures.csv";
@@ -265,7 +265,7 @@ pub fn parse_team(
         path_length_px: f.bits()?,
         collisions: f.parse()?,
         robot_collisions: f.parse()?,
-        flow: crate::eval::team::Flow {
+        flow: crate::eval::Flow {
             sum_of_costs: f.optional()?,
             makespan_lower_bound: f.optional()?,
             sum_of_costs_lower_bound: f.optional()?,
@@ -345,7 +345,7 @@ mod tests {
             path_length_px: 12.5,
             collisions: 1,
             robot_collisions: 4,
-            flow: crate::eval::team::Flow {
+            flow: crate::eval::Flow {
                 sum_of_costs: Some(40),
                 makespan_lower_bound: None,
                 sum_of_costs_lower_bound: Some(7),

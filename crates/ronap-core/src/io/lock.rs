@@ -114,14 +114,14 @@ fn still_named(file: &File, path: &Path) -> bool {
     }
 }
 
-/// The path of `dir`'s lock file.
-pub fn lock_path(dir: &Path) -> PathBuf {
-    dir.join(LOCK_FILE)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The path of `dir`'s lock file.
+    fn lock_path(dir: &Path) -> PathBuf {
+        dir.join(LOCK_FILE)
+    }
 
     #[test]
     fn a_locked_directory_is_refused_with_the_holders_pid_until_released() {

@@ -5,7 +5,7 @@
 use crate::config::{SimConfig, ValidConfig};
 use crate::eval::Summary;
 use crate::scene::map::{MapError, MapSource};
-use crate::sim::world::{SceneSpec, Scenes};
+use crate::sim::{SceneSpec, Scenes};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -16,7 +16,7 @@ pub const SCHEMA_VERSION: u32 = 1;
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunManifest {
-    /// [`SCHEMA_VERSION`] of the writer.
+    /// `SCHEMA_VERSION` of the writer.
     pub schema_version: u32,
     /// The ronap version that wrote the run.
     pub ronap_version: String,

@@ -2,7 +2,7 @@
 //! the episode ends and read back by `ronap replay`.
 
 use crate::eval::{EpisodeRecord, StepLog};
-use crate::sim::robot::{Action, Pose};
+use crate::sim::{Action, Pose};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -77,7 +77,7 @@ pub struct StepsError {
     pub message: String,
 }
 
-/// Reads a step log ([`write_steps`]; the heading may also be a `heading` column, as in data
+/// Reads a step log (`write_steps`; the heading may also be a `heading` column, as in data
 /// logs): one episode's consecutive steps, numbered from 1. Extra columns are ignored.
 pub fn read_steps(path: &Path) -> Result<Vec<LoggedStep>, StepsError> {
     let file = crate::bounded::open_lines(path).map_err(|e| StepsError {
@@ -181,7 +181,7 @@ mod tests {
     use super::*;
     use crate::eval::{Evaluator, Recording};
     use crate::policy::{Builtin, PolicyFactory};
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
 
     #[test]
     fn step_logs_read_back_as_written() {

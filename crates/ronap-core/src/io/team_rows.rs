@@ -4,7 +4,6 @@
 use crate::eval::metric::{self, Kind};
 use crate::eval::{Outcome, TeamRecord};
 use crate::io::run_dir::{metric_cells, start_goal_cells};
-use std::io::Write;
 
 /// Columns of a team run's `episodes.csv` (one row per team episode).
 pub const TEAM_COLUMNS: [&str; 11] = [
@@ -42,16 +41,6 @@ pub fn team_episode_row(r: &TeamRecord) -> Vec<String> {
     ]
 }
 
-/// Writes a team run's `episodes.csv`: one row per team episode.
-pub fn write_team_episodes(records: &[TeamRecord], out: &mut dyn Write) -> std::io::Result<()> {
-    let mut w = csv::Writer::from_writer(out);
-    w.write_record(TEAM_COLUMNS)?;
-    for r in records {
-        w.write_record(team_episode_row(r))?;
-    }
-    w.flush()
-}
-
 /// Columns of a team run's `robots.csv` (one row per robot per episode).
 pub const ROBOT_COLUMNS: [&str; 26] = [
     "seed",
@@ -82,7 +71,7 @@ pub const ROBOT_COLUMNS: [&str; 26] = [
     "waiting_steps",
 ];
 
-/// The columns of `robots.csv` measuring the metrics of `kinds`: [`ROBOT_COLUMNS`], then one
+/// The columns of `robots.csv` measuring the metrics of `kinds`: `ROBOT_COLUMNS`, then one
 /// per metric.
 pub fn robot_columns(kinds: &[Kind]) -> Vec<String> {
     ROBOT_COLUMNS
@@ -128,16 +117,4 @@ pub fn robot_rows(r: &TeamRecord, kinds: &[Kind]) -> Vec<Vec<String>> {
             row
         })
         .collect()
-}
-
-/// Writes a team run's `robots.csv`: one row per robot of every episode.
-pub fn write_robots(records: &[TeamRecord], out: &mut dyn Write) -> std::io::Result<()> {
-    let mut w = csv::Writer::from_writer(out);
-    w.write_record(ROBOT_COLUMNS)?;
-    for r in records {
-        for row in robot_rows(r, &[]) {
-            w.write_record(row)?;
-        }
-    }
-    w.flush()
 }

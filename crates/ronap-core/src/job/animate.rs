@@ -4,9 +4,9 @@
 //! row in `episodes.csv` describes.
 
 use crate::eval::{EpisodeRecord, Evaluator, Outcome, TeamRecord};
-use crate::io::run_dir::RunWriter;
+use crate::io::RunWriter;
 use crate::job::{replay_team, RobotLog};
-use crate::render::gif::{animate, Animation, GifOptions};
+use crate::render::{animate, Animation, GifOptions};
 
 /// Writes the animation `draw` makes of episode `seed` into `writer`'s run, if the run asks for
 /// one of that seed (`--gif`).

@@ -2,12 +2,12 @@
 //! Python's `ronap.evaluate` share.
 
 use super::into::{run_into, Episodes, FileRows, Ran, Tallies};
-use crate::eval::Tally;
-use crate::eval::{EpisodeRecord, EvalOptions, Evaluator, Figures, RunEnd, RunResult, Summary};
-use crate::io::atomic::OutputError;
+use crate::eval::{
+    EpisodeRecord, EvalOptions, Evaluator, Figures, RunEnd, RunResult, Summary, Tally,
+};
 use crate::io::figures;
-use crate::io::manifest::RunManifest;
-use crate::io::run_dir::{finish, lone_headers, manifest, EpisodeRows, Layout, RunWriter};
+use crate::io::{finish, lone_headers, manifest, EpisodeRows, Layout, RunWriter};
+use crate::io::{OutputError, RunManifest};
 use crate::job::{animate, player, RunRequest};
 use crate::policy::{PolicyError, PolicyFactory};
 use std::sync::atomic::AtomicBool;
@@ -148,9 +148,9 @@ impl Tallies<EpisodeRecord> for Lone<'_> {
 mod tests {
     use super::*;
     use crate::eval::{EvalOptions, Evaluator};
-    use crate::io::run_dir::{RunFiles, RunInfo, RunWriter};
+    use crate::io::{RunFiles, RunInfo, RunWriter};
     use crate::policy::{Decision, Policy};
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
     use crate::{Episode, World};
     use std::sync::atomic::AtomicBool;
 
@@ -214,7 +214,7 @@ mod tests {
         };
         let info = RunInfo {
             policy: "random".into(),
-            scenes: crate::sim::world::SceneSpec::MazePerSeed,
+            scenes: crate::sim::SceneSpec::MazePerSeed,
             map: None,
         };
         let cancel = AtomicBool::new(false);

@@ -5,10 +5,8 @@
 //! kind says how its episodes run ([`Episodes`]) and what its rows and figures are
 //! ([`Tallies`]).
 
-use crate::eval::Outcome;
-use crate::eval::{EvalOptions, RunEnd, RunResult};
-use crate::io::atomic::OutputError;
-use crate::io::run_dir::{restore, Pictures, RunWriter, Streams};
+use crate::eval::{EvalOptions, Outcome, RunEnd, RunResult};
+use crate::io::{restore, OutputError, Pictures, RunWriter, Streams};
 use crate::job::RunRequest;
 use crate::policy::PolicyError;
 use std::sync::atomic::AtomicBool;

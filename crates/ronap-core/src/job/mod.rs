@@ -6,6 +6,9 @@
 //! Python and `compare` share. A use-case takes one [`RunRequest`] (what to run, where its
 //! results go, how to stop it) rather than a long list of arguments. Uses every layer up to `io`;
 //! `io` reads and writes formats, `render` draws, and neither runs an episode for this layer.
+//!
+//! The files are private: what other crates use is re-exported here (`pub use`), and what the
+//! layers above use beside it, `pub(crate) use`, so a file can move without breaking anyone.
 
 mod animate;
 mod evaluate;
@@ -21,7 +24,7 @@ pub use replay::{replay_team, ReplayError, RobotLog};
 pub use team::{evaluate_team_into, TeamEvaluation};
 
 use crate::eval::{EvalOptions, Evaluator};
-use crate::io::run_dir::{RunInfo, RunWriter};
+use crate::io::{RunInfo, RunWriter};
 use std::sync::atomic::AtomicBool;
 
 /// An evaluation to run and where its results go.

@@ -3,16 +3,14 @@
 //! the steps a run recorded, or a step log read back, every logged pose held to the model's),
 //! recorded frame by frame into a [`Trace`] that [`crate::render::player`] packs into a page.
 
-use crate::eval::team::team_outcome;
-use crate::eval::{EpisodeRecord, Evaluator, Outcome, TeamRecord};
-use crate::io::run_dir::RunWriter;
-use crate::io::steplog::LoggedStep;
+use crate::eval::{team_outcome, EpisodeRecord, Evaluator, Outcome, TeamRecord};
+use crate::io::{LoggedStep, RunWriter};
 use crate::job::replay::drive_team;
 use crate::job::{ReplayError, RobotLog};
-use crate::render::gif::{check_logged_step, AnimationError};
-use crate::render::player::{player_page, Acted, PlayerPage, Recorder, Trace};
-use crate::sim::episode::Episode;
-use crate::sim::robot::{Action, Pose};
+use crate::render::{
+    check_logged_step, player_page, Acted, AnimationError, PlayerPage, Recorder, Trace,
+};
+use crate::sim::{Action, Episode, Pose};
 
 /// The trace of lone `episode` (as placed) replayed from its logged `steps`, each logged pose
 /// held to the model's.
@@ -229,7 +227,7 @@ mod tests {
     use super::*;
     use crate::eval::Recording;
     use crate::policy::{Builtin, PolicyFactory};
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
 
     const STEPS: Recording = Recording {
         trajectory: false,

@@ -4,13 +4,12 @@
 
 use crate::eval::Evaluator;
 use crate::geometry::Point;
-use crate::io::steplog::LoggedStep;
-use crate::render::gif::{same_pose, Animation, AnimationError, GifOptions, GifWriter};
-use crate::render::team::{team_frame, team_gif_writer};
-use crate::run::team::TeamRollout;
-use crate::run::RunError;
-use crate::sim::robot::{Action, Pose};
-use crate::sim::team::Team;
+use crate::io::LoggedStep;
+use crate::render::{
+    same_pose, team_frame, team_gif_writer, Animation, AnimationError, GifOptions, GifWriter,
+};
+use crate::run::{RunError, TeamRollout};
+use crate::sim::{Action, Pose, Team};
 use image::RgbImage;
 
 impl RobotLog {
@@ -278,7 +277,7 @@ mod tests {
     use crate::config::TeamRobotConfig;
     use crate::eval::{Outcome, Recording};
     use crate::policy::{factory, PerRobotFactory, TeamPolicyFactory};
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
 
     fn logs_of(record: &crate::eval::TeamRecord) -> Vec<RobotLog> {
         RobotLog::of_record(record)

@@ -6,10 +6,9 @@ use crate::eval::{
     EvalOptions, Evaluator, Figures, RunEnd, Summary, Tally, TeamFigures, TeamRecord,
     TeamRunResult, TeamSummary, TeamTally,
 };
-use crate::io::atomic::OutputError;
 use crate::io::figures;
-use crate::io::run_dir::{finish, manifest, timing_row, RunWriter, TIMING_COLUMNS};
-use crate::io::team_rows::{robot_columns, robot_rows, team_episode_row, TEAM_COLUMNS};
+use crate::io::{finish, manifest, timing_row, RunWriter, TIMING_COLUMNS};
+use crate::io::{robot_columns, robot_rows, team_episode_row, OutputError, TEAM_COLUMNS};
 use crate::job::{animate, player, RunRequest};
 use crate::policy::{PolicyError, TeamPolicyFactory};
 use std::sync::atomic::AtomicBool;

@@ -4,9 +4,8 @@
 
 use crate::geometry::{unit, Point, Vector};
 use crate::plan::field::grid_path;
-use crate::scene::freespace::FreeGrid;
-use crate::scene::Scene;
-use crate::sim::world::World;
+use crate::scene::{FreeGrid, Scene};
+use crate::sim::World;
 
 /// Step sizes, px, of [`smooth`]'s corner tightening, coarse to fine.
 const TIGHTEN_STEPS_PX: [f64; 7] = [4.0, 2.0, 1.0, 0.5, 0.25, 0.125, 0.0625];

@@ -16,9 +16,7 @@ use super::{Decision, Policy, PolicyError};
 use crate::config::ApfConfig;
 use crate::geometry::{Point, Vector};
 use crate::scene::Scene;
-use crate::sim::episode::Episode;
-use crate::sim::robot::DiscreteAction;
-use crate::sim::world::World;
+use crate::sim::{DiscreteAction, Episode, World};
 use std::collections::HashSet;
 
 /// The result of the descent.
@@ -126,13 +124,6 @@ pub fn plan(
 pub struct Apf {
     follower: Option<Follower>,
     reached: bool,
-}
-
-impl Apf {
-    /// The planned path, once planned.
-    pub fn path(&self) -> Option<&[Point]> {
-        self.follower.as_ref().map(Follower::path)
-    }
 }
 
 impl Policy for Apf {

@@ -10,9 +10,7 @@
 //! episodes are the same as unbatched, bit for bit, for any policy that decides each row by itself.
 
 use crate::policy::{Decision, Policy, PolicyError, PolicyFactory};
-use crate::sim::episode::Episode;
-use crate::sim::robot::Action;
-use crate::sim::world::World;
+use crate::sim::{Action, Episode, World};
 use std::collections::HashMap;
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
@@ -190,7 +188,7 @@ impl Policy for Worker {
 mod tests {
     use super::*;
     use crate::eval::{EvalOptions, Evaluator};
-    use crate::sim::robot::DiscreteAction;
+    use crate::sim::DiscreteAction;
     use crate::{Scenes, SimConfig};
     use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 

@@ -30,18 +30,11 @@ use super::orca::Orca;
 use super::team::{PerRobot, RobotError, TeamPolicy, TeamPolicyFactory};
 use super::{Decision, Policy, PolicyError};
 use crate::config::{OnArrival, PlannerActions};
-use crate::geometry::orca::{Agent, Horizon, V2};
-use crate::geometry::point_grid::PointGrid;
-use crate::geometry::{Point, Vector};
-use crate::plan::team::{
+use crate::geometry::{Agent, Horizon, Point, PointGrid, Vector, V2};
+use crate::plan::{
     pair_feasible, pair_plan, plan_team, Limits, Pair, PlanFailure, PlanGrid, Schedule, Stop, Task,
 };
-use crate::sim::avoid::{Avoid, Avoider};
-use crate::sim::episode::Episode;
-use crate::sim::rng::{stream, Stream};
-use crate::sim::robot::Action;
-use crate::sim::team::Team;
-use crate::sim::world::World;
+use crate::sim::{stream, Action, Avoid, Avoider, Episode, Stream, Team, World};
 use std::collections::HashSet;
 use std::sync::Arc;
 
@@ -348,7 +341,7 @@ pub struct Coordinated {
     /// The robots' worlds (for the fallback).
     worlds: Vec<Arc<World>>,
     /// The episode's generator of priority orders.
-    rng: Option<crate::sim::rng::Rng>,
+    rng: Option<crate::sim::Rng>,
     /// Plans made since the first.
     replans: u32,
     /// Each robot's cells that no goal of it may be planned on (tried and found blocked).
@@ -1001,7 +994,7 @@ mod tests {
     use super::*;
     use crate::config::TeamRobotConfig;
     use crate::eval::{EvalOptions, Evaluator, Outcome};
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
     use std::sync::atomic::AtomicBool;
 
     /// `robots` robots (leaving on arrival or staying) in an open hall of `side` px, or a

@@ -1,7 +1,7 @@
 //! Seeing what the still scene does not have: laser beams that read an obstacle nearer than the
 //! scene's walls would give (a moving or appeared obstacle), for the policies that give way to it.
 
-use crate::sim::episode::Episode;
+use crate::sim::Episode;
 
 /// A reading shorter than the still scene's by more than this (plus three noise deviations) is
 /// an obstacle the scene does not have, px.

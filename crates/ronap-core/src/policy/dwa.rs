@@ -21,8 +21,7 @@ use super::local::{Local, Planner, Senses};
 use super::Decision;
 use crate::config::{KinematicsKind, PlannerActions};
 use crate::geometry::{unit, wrap_deg, Point};
-use crate::sim::episode::Episode;
-use crate::sim::robot::{Action, DiscreteAction, Pose, Robot};
+use crate::sim::{Action, DiscreteAction, Episode, Pose, Robot};
 
 /// The `dwa` policy: the dynamic window approach towards the geodesic path's lookahead point.
 pub type Dwa = Local<DwaPlanner>;

@@ -8,8 +8,7 @@
 
 use crate::config::{KinematicsKind, RobotConfig};
 use crate::geometry::{wrap_deg, Point};
-use crate::sim::episode::Episode;
-use crate::sim::robot::{Action, DiscreteAction};
+use crate::sim::{Action, DiscreteAction, Episode};
 
 /// Steps without the remaining length shrinking by [`PROGRESS_PX`] before the follower gives up:
 /// two full turns and then some.
@@ -90,11 +89,6 @@ impl Follower {
             backing: 0,
             contacts: 0,
         }
-    }
-
-    /// The path being followed.
-    pub fn path(&self) -> &[Point] {
-        &self.path
     }
 
     /// Where `p` projects onto segment `i`, as a path length.

@@ -8,9 +8,7 @@ use super::follow::{FollowStep, Follower};
 use super::{Decision, Policy, PolicyError};
 use crate::geometry::Point;
 use crate::plan::{grid_path, smooth, DistanceField};
-use crate::sim::episode::Episode;
-use crate::sim::robot::DiscreteAction;
-use crate::sim::world::World;
+use crate::sim::{DiscreteAction, Episode, World};
 
 /// Cost factor of grid steps within a radius of touching a wall.
 const CLOSE_COST: f64 = 4.0;
@@ -21,13 +19,6 @@ const MARGIN_PX: f64 = 6.0;
 #[derive(Debug, Default)]
 pub struct Geodesic {
     follower: Option<Follower>,
-}
-
-impl Geodesic {
-    /// The path being followed, once planned.
-    pub fn path(&self) -> Option<&[crate::geometry::Point]> {
-        self.follower.as_ref().map(Follower::path)
-    }
 }
 
 /// `geodesic-wait`: how near ahead (px beyond the robot's radius) an unexpected obstacle makes

@@ -8,13 +8,8 @@ use super::follow::Follower;
 use super::geodesic::planned;
 use super::{Decision, Policy, PolicyError};
 use crate::config::PlannerActions;
-use crate::geometry::orca::{Agent, V2};
-use crate::geometry::{wrap_deg, Point, Vector};
-use crate::sim::episode::Episode;
-use crate::sim::moving::Movers;
-use crate::sim::robot::{Action, DiscreteAction};
-use crate::sim::team::Team;
-use crate::sim::world::World;
+use crate::geometry::{wrap_deg, Agent, Point, Vector, V2};
+use crate::sim::{Action, DiscreteAction, Episode, Movers, Team, World};
 use std::f64::consts::TAU;
 
 /// How sharply a unicycle's speed falls with the angle between its chord and the velocity it
@@ -296,7 +291,7 @@ pub(super) fn lone_run(config: crate::SimConfig, policy: &str, seeds: u64) -> cr
     use crate::eval::{EvalOptions, Evaluator, Summary};
     let ev = Evaluator::new(
         config.validate().expect("valid"),
-        crate::sim::world::Scenes::MazePerSeed,
+        crate::sim::Scenes::MazePerSeed,
     );
     let f = super::factory(policy, ev.config().observation_size()).expect("policy");
     let options = EvalOptions {

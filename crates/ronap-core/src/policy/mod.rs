@@ -1,30 +1,45 @@
 //! Policies, above `plan`: what decides each step's action, one file per policy. Every policy
 //! implements [`Policy`], so the episode loop and the evaluator never know which one they run.
 //! Uses `config`, `geometry`, `scene`, `sim` and `plan`.
+//!
+//! The files are private: what other crates use is re-exported here (`pub use`), and what the
+//! layers above use beside it, `pub(crate) use`, so a file can move without breaking anyone.
 
-pub mod apf;
-pub mod batched;
-pub mod coordinated;
-pub mod dodge;
-pub mod dwa;
-pub mod follow;
-pub mod geodesic;
+mod apf;
+mod batched;
+mod coordinated;
+mod dodge;
+mod dwa;
+mod follow;
+mod geodesic;
 mod local;
-pub mod mlp;
-pub mod name;
-pub mod orca;
-pub mod random;
-pub mod social_force;
-pub mod team;
+mod mlp;
+mod name;
+mod orca;
+mod random;
+mod social_force;
+mod team;
 
+// The built-in policies by name, and policies deciding for many robots or environments at once.
+pub use batched::{BatchPolicy, Batched};
 pub use name::{factory, Builtin, PolicyNameError};
 pub use team::{
     Joint, JointFactory, PerRobot, PerRobotFactory, RobotError, TeamPolicy, TeamPolicyFactory,
 };
+// The team planner; its name and `drives` are aliased here, as the policy layer holds many names.
+pub use coordinated::{
+    drives as coordinated_drives, Coordinated, CoordinatedFactory, NAME as COORDINATED_NAME,
+};
+// Trained networks.
+pub use mlp::{
+    observation_layout, Activation, DecisionRule, Layer, Mlp, MlpError, MlpFactory, MlpPolicy,
+    Scratch, RRELU_SLOPE, SIDE_BY_SIDE,
+};
 
-use crate::sim::episode::Episode;
-use crate::sim::robot::Action;
-use crate::sim::world::World;
+// For the layers above only.
+pub(crate) use geodesic::Expert;
+
+use crate::sim::{Action, Episode, World};
 
 /// A policy that could not decide.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]
@@ -55,11 +70,7 @@ pub trait Policy: Send {
     /// The decision for robot `k` of `team` when it is driven by this policy alone among the
     /// team's ([`team::PerRobot`]): by default [`Policy::act`] on the robot's own episode; a
     /// policy that avoids the other robots and the team's moving obstacles sees them here.
-    fn act_in_team(
-        &mut self,
-        team: &crate::sim::team::Team,
-        k: usize,
-    ) -> Result<Decision, PolicyError> {
+    fn act_in_team(&mut self, team: &crate::sim::Team, k: usize) -> Result<Decision, PolicyError> {
         self.act(team.robot(k))
     }
 
@@ -72,7 +83,7 @@ pub trait Policy: Send {
     /// What a robot of a team received at the last step (the broadcasts of the robots within
     /// `team.comm_range_px`, nearest first), told before each [`Policy::act`]; the built-in
     /// policies do not listen.
-    fn hear(&mut self, inbox: crate::sim::team::Inbox<'_>) {
+    fn hear(&mut self, inbox: crate::sim::Inbox<'_>) {
         let _ = inbox;
     }
 
@@ -127,7 +138,7 @@ pub trait PolicyFactory: Sync {
     /// The episode seeds the policy was trained or chosen on, where it records them (a trained
     /// network's `training_seeds` and `validation_seeds`): a run over any of them is warned
     /// about ([`crate::eval::held_out_warning`]).
-    fn seeds_seen(&self) -> crate::sim::split::SeedRanges {
-        crate::sim::split::SeedRanges::default()
+    fn seeds_seen(&self) -> crate::sim::SeedRanges {
+        crate::sim::SeedRanges::default()
     }
 }

@@ -10,9 +10,8 @@
 use super::follow::Follower;
 use super::local::{self, Local, Planner, Senses};
 use super::Decision;
-use crate::geometry::orca::Horizon;
-use crate::sim::avoid::{Avoid, Avoider};
-use crate::sim::episode::Episode;
+use crate::geometry::Horizon;
+use crate::sim::{Avoid, Avoider, Episode};
 
 /// The `orca` policy: ORCA towards the geodesic path's lookahead point.
 pub type Orca = Local<OrcaPlanner>;
@@ -63,7 +62,7 @@ mod tests {
     use crate::eval::{EvalOptions, Evaluator, Outcome, Summary};
     use crate::policy::local::lone_run;
     use crate::policy::{factory, PerRobotFactory};
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
     use std::sync::atomic::AtomicBool;
 
     #[test]

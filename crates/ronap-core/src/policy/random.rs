@@ -1,10 +1,7 @@
 //! The random policy: LEFT, AHEAD or RIGHT with equal probability, from the episode's policy stream.
 
 use super::{Decision, Policy, PolicyError};
-use crate::sim::episode::Episode;
-use crate::sim::rng::{stream, Rng, Stream};
-use crate::sim::robot::DiscreteAction;
-use crate::sim::world::World;
+use crate::sim::{stream, DiscreteAction, Episode, Rng, Stream, World};
 use rand::Rng as _;
 
 /// Uniformly random discrete actions.

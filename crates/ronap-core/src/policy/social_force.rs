@@ -9,8 +9,7 @@ use super::follow::Follower;
 use super::local::{self, Local, Planner, Senses};
 use super::Decision;
 use crate::geometry::Point;
-use crate::sim::avoid::social_force_velocity;
-use crate::sim::episode::Episode;
+use crate::sim::{social_force_velocity, Episode};
 
 /// The `social-force` policy: the social force model towards the geodesic path's lookahead point.
 pub type SocialForce = Local<SocialForcePlanner>;

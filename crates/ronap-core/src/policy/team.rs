@@ -5,9 +5,7 @@
 
 use crate::policy::batched::BatchPolicy;
 use crate::policy::{Decision, Policy, PolicyError, PolicyFactory};
-use crate::sim::episode::Episode;
-use crate::sim::team::Team;
-use crate::sim::world::World;
+use crate::sim::{Episode, Team, World};
 use std::sync::Arc;
 
 /// A policy's failure for one robot of a team: the robot, and what went wrong.
@@ -167,7 +165,7 @@ pub struct Joint {
     others: Vec<Option<Box<dyn Policy>>>,
     rows: Vec<f32>,
     robots: Vec<usize>,
-    actions: Vec<crate::sim::robot::Action>,
+    actions: Vec<crate::sim::Action>,
 }
 
 impl Joint {
@@ -313,10 +311,8 @@ impl TeamPolicyFactory for JointFactory {
 mod tests {
     use super::*;
     use crate::config::TeamRobotConfig;
-    use crate::run::team::TeamRollout;
-    use crate::run::RunError;
-    use crate::sim::robot::DiscreteAction;
-    use crate::sim::world::Worlds;
+    use crate::run::{RunError, TeamRollout};
+    use crate::sim::{DiscreteAction, Worlds};
 
     /// Robot 0 drives ahead and says its step; robot 1 gives up at once; robot 2's policy
     /// fails at the third step.
@@ -372,7 +368,7 @@ mod tests {
         config.team.message_size = 1;
         config.team.comm_range_px = 1e5;
         let config = config.validate().expect("valid");
-        let worlds = Worlds::new(config.clone(), crate::sim::world::Scenes::MazePerSeed);
+        let worlds = Worlds::new(config.clone(), crate::sim::Scenes::MazePerSeed);
         let mut policy = Scripted { steps: 0 };
         let mut rollout =
             TeamRollout::start(&config, worlds.team(4), 4, &mut policy).expect("starts");

@@ -3,7 +3,7 @@
 
 use crate::geometry::Point;
 use crate::render::{ray_colour, FLOOR, GOAL, PATH, RANGE_CIRCLE, WALL};
-use crate::sim::robot::Pose;
+use crate::sim::Pose;
 use image::{Rgb, RgbImage};
 
 /// Half the side of the square the first-person view shows, as a multiple of the laser range:
@@ -58,7 +58,7 @@ impl HeadingUp {
 /// the circle of laser range, the rays in their colour classes and an arrow towards the goal.
 /// `size` is the picture's side in pixels; it shows a square of `2 * FIRST_PERSON_HALF_SPAN *
 /// range` px.
-pub fn first_person(episode: &crate::sim::episode::Episode, size: u32) -> RgbImage {
+pub fn first_person(episode: &crate::sim::Episode, size: u32) -> RgbImage {
     let size = size.max(16);
     let laser = episode.laser();
     let range = laser.range_px();

@@ -12,8 +12,7 @@
 
 use crate::geometry::Point;
 use crate::render;
-use crate::sim::episode::Episode;
-use crate::sim::robot::{Action, Pose};
+use crate::sim::{Action, Episode, Pose};
 use image::RgbImage;
 use std::io::Write;
 
@@ -144,6 +143,12 @@ pub struct Animation {
 /// Draws `episode` from its current state through `actions`, a frame every `options.stride`
 /// steps. `logged`, when given, holds the pose before each action, as a data log records it; each
 /// must match the model's.
+///
+/// Stepping the model again, rather than drawing logged numbers, gives exact frames (the pose after
+/// the last action included) from nothing but the scene, the configuration and the actions, so a
+/// replay needs neither the policy nor its randomness; logged poses, when given, are checked
+/// against the model at every step, so a log from another scene or configuration is an error that
+/// names the step instead of a wrong picture.
 pub fn animate(
     mut episode: Episode,
     actions: &[Action],
@@ -373,8 +378,7 @@ fn changed_rect(a: &[u8], b: &[u8], width: usize) -> Option<(usize, usize, usize
 mod tests {
     use super::*;
     use crate::config::ValidConfig;
-    use crate::sim::robot::DiscreteAction;
-    use crate::sim::world::maze_scene;
+    use crate::sim::{maze_scene, DiscreteAction};
     use std::sync::Arc;
 
     fn episode(seed: u64) -> Episode {

@@ -1,25 +1,39 @@
 //! Pictures, above `eval`: the canvas, the top view, the first-person view, trajectory pictures of
-//! finished episodes, animated GIFs and the charts that compare policies ([`chart`]). Uses every
-//! layer below it.
+//! finished episodes, animated GIFs and the charts that compare policies ([`compare_chart`] and
+//! the others of `chart`). Uses every layer below it.
 //!
 //! Drawing scenes to images: white floor, black walls, y flipped so up is up.
 //!
 //! A [`Canvas`] maps scene px to image pixels at `scale` pixels per px. Markers and paths are drawn
 //! in scene coordinates, so callers never deal with the flip.
+//!
+//! The files are private: what other crates use is re-exported here (`pub use`), and what the
+//! layers above use beside it, `pub(crate) use`, so a file can move without breaking anyone.
 
-pub mod chart;
-pub mod first_person;
-pub mod gif;
-pub mod player;
-pub mod team;
-pub mod trajectory;
+pub(crate) mod chart;
+mod first_person;
+mod gif;
+mod player;
+mod team;
+mod trajectory;
 
+// The charts that compare policies.
+pub use chart::{
+    compare_chart, contact_sheet, grouped_bars, outcome_strip, PolicyBars, Series, SheetRow,
+};
 pub use first_person::{first_person, HeadingUp, FIRST_PERSON_HALF_SPAN};
+pub use gif::{animate, AnimationError, GifOptions, View};
+pub use team::{team_frame, team_setup};
+
+// For the layers above only.
+pub(crate) use gif::{check_logged_step, same_pose, Animation, GifWriter};
+pub(crate) use player::{player_page, Acted, PlayerPage, Recorder, Trace};
+pub(crate) use team::{team_gif_writer, team_image};
+pub(crate) use trajectory::trajectory_image;
 
 use crate::geometry::{Aabb, Point};
 use crate::scene::Scene;
-use crate::sim::lidar::{Laser, RayClass};
-use crate::sim::robot::Pose;
+use crate::sim::{Laser, Pose, RayClass};
 use image::{Rgb, RgbImage};
 
 /// Floor colour.
@@ -110,22 +124,22 @@ impl Canvas {
     }
 
     /// Draws the present moving obstacles where they are.
-    pub fn movers(&mut self, movers: &crate::sim::moving::Movers) {
+    pub fn movers(&mut self, movers: &crate::sim::Movers) {
         for m in movers.items().filter(|m| m.present()) {
             self.mover(m.body(), m.position(), MOVER);
         }
     }
 
     /// Draws a moving obstacle's `body` at `center`.
-    pub fn mover(&mut self, body: crate::sim::moving::Body, center: Point, colour: Rgb<u8>) {
+    pub fn mover(&mut self, body: crate::sim::Body, center: Point, colour: Rgb<u8>) {
         match body {
-            crate::sim::moving::Body::Disc(r) => self.fill_disc(center, r, colour),
-            crate::sim::moving::Body::Box(_) => self.fill_box(&body.aabb(center), colour),
+            crate::sim::Body::Disc(r) => self.fill_disc(center, r, colour),
+            crate::sim::Body::Box(_) => self.fill_box(&body.aabb(center), colour),
         }
     }
 
     /// Draws moving obstacles' tracks faded: each a polyline of its positions while present.
-    pub fn tracks(&mut self, tracks: &[crate::sim::moving::Track]) {
+    pub fn tracks(&mut self, tracks: &[crate::sim::Track]) {
         for track in tracks {
             for pair in track.points.windows(2) {
                 if let [Some(a), Some(b)] = pair {
@@ -245,7 +259,7 @@ impl Canvas {
         least: f64,
         colour: Rgb<u8>,
     ) {
-        match crate::sim::robot::Robot::corners(config, pose) {
+        match crate::sim::Robot::corners(config, pose) {
             Some(corners) => {
                 self.fill_polygon(&corners, colour);
                 let p = pose.position();
@@ -282,7 +296,7 @@ impl Canvas {
 
 /// The whole scene with an episode drawn on it: `path` in blue, start red, goal green, the robot
 /// and its current laser scan.
-pub fn top_down(episode: &crate::sim::episode::Episode, path: &[Point], scale: f64) -> RgbImage {
+pub fn top_down(episode: &crate::sim::Episode, path: &[Point], scale: f64) -> RgbImage {
     let config = episode.config();
     let mut canvas = Canvas::new(episode.scene(), scale);
     let least = 4.0 / scale;
@@ -305,7 +319,7 @@ pub fn top_down(episode: &crate::sim::episode::Episode, path: &[Point], scale: f
 pub const RANGE_CIRCLE: Rgb<u8> = Rgb([150, 150, 150]);
 
 /// Every colour the pictures of this module use: floor, walls, markers, path, rays and the range
-/// circle. An animation encodes with exactly these ([`crate::render::gif`]).
+/// circle. An animation encodes with exactly these ([`animate`]).
 pub const PALETTE: [Rgb<u8>; 11] = [
     FLOOR,
     WALL,

@@ -6,7 +6,7 @@ use crate::geometry::Point;
 use crate::render::chart::{policy_colour, POLICY_COUNT};
 use crate::render::gif::{AnimationError, GifWriter};
 use crate::render::Canvas;
-use crate::sim::team::Team;
+use crate::sim::Team;
 use image::{Rgb, RgbImage};
 
 /// `colour` mixed half-way with white, for goals.
@@ -48,7 +48,7 @@ pub fn team_frame(team: &Team, paths: &[Vec<Point>], scale: f64) -> RgbImage {
     let mut canvas = Canvas::new(first.scene(), scale);
     let least = 3.0 / scale;
     for (k, r) in team.robots().iter().enumerate() {
-        if !team.present(k) && r.status() == crate::sim::episode::Status::Success {
+        if !team.present(k) && r.status() == crate::sim::Status::Success {
             continue;
         }
         let tolerance = r.config().episode.goal_tolerance_px;

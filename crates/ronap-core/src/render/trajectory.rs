@@ -2,7 +2,7 @@
 
 use crate::eval::EpisodeRecord;
 use crate::render::{Canvas, GOAL, MOVER, PATH, START};
-use crate::sim::lidar::Laser;
+use crate::sim::Laser;
 
 /// The picture of an episode: the whole scene, the path in blue, the start in red, the goal in
 /// green, the last laser scan in its colour classes, and moving obstacles' tracks faded with each

@@ -9,10 +9,7 @@
 use crate::geometry::Point;
 use crate::run::shaping::Shaper;
 use crate::run::RunError;
-use crate::sim::episode::{Episode, Status, PREFETCH_STAGES};
-use crate::sim::rng::{stream, Rng, Stream};
-use crate::sim::robot::{Action, Pose};
-use crate::sim::world::Worlds;
+use crate::sim::{stream, Action, Episode, Pose, Rng, Status, Stream, Worlds, PREFETCH_STAGES};
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
@@ -638,8 +635,7 @@ impl Lanes {
 mod tests {
     use super::*;
     use crate::config::SimConfig;
-    use crate::sim::robot::DiscreteAction;
-    use crate::sim::world::Scenes;
+    use crate::sim::{DiscreteAction, Scenes};
 
     fn batch(envs: usize, threads: usize, autoreset: Autoreset) -> Batch {
         let mut c = SimConfig::default();

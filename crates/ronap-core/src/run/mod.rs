@@ -1,17 +1,28 @@
-//! Running policies, above `policy`: one episode driven by one policy ([`rollout`]), and many
-//! episodes stepped side by side with automatic resets ([`batch`]), the engine of the vectorised
-//! Python environment and of DQN, and a team of robots driven by a team policy ([`team`]). Uses
-//! every layer up to `policy`.
+//! Running policies, above `policy`: one episode driven by one policy ([`Rollout`]), and many
+//! episodes stepped side by side with automatic resets ([`Batch`]), the engine of the vectorised
+//! Python environment and of DQN, and a team of robots driven by a team policy
+//! ([`TeamRollout`]). Uses every layer up to `policy`.
+//!
+//! The files are private: what other crates use is re-exported here (`pub use`), and what the
+//! layers above use beside it, `pub(crate) use`, so a file can move without breaking anyone.
 
-pub mod batch;
-pub mod rollout;
-pub mod shaping;
-pub mod team;
-pub mod team_batch;
+mod batch;
+mod rollout;
+mod shaping;
+mod team;
+mod team_batch;
+
+pub use batch::{Autoreset, Batch, BatchOptions, EnvStep, SeedOrder};
+pub use rollout::Rollout;
+pub use shaping::Shaper;
+pub use team::TeamRollout;
+pub use team_batch::{RobotStep, TeamBatch};
+
+// For the layers above only.
+pub(crate) use team::TourLengths;
 
 use crate::policy::PolicyError;
-use crate::sim::placement::EpisodeError;
-use crate::sim::robot::Action;
+use crate::sim::{Action, EpisodeError};
 
 /// An episode that could not start, or a policy that failed while driving one.
 #[derive(Debug, thiserror::Error, Clone, PartialEq)]

@@ -5,9 +5,7 @@
 
 use crate::policy::{Decision, Policy, PolicyError};
 use crate::run::RunError;
-use crate::sim::episode::Episode;
-use crate::sim::robot::{Action, Pose};
-use crate::sim::world::World;
+use crate::sim::{Action, Episode, Pose, World};
 use std::sync::Arc;
 
 /// What one step of a rollout did.
@@ -114,7 +112,7 @@ impl Rollout {
             }
         };
         let kind = self.episode.config().robot.kinematics;
-        if !action.is_finite() || !crate::sim::kinematics::accepts(kind, action) {
+        if !action.is_finite() || !crate::sim::accepts(kind, action) {
             return Err(RunError::InvalidAction {
                 seed: self.episode.seed(),
                 step: self.episode.steps() + 1,

@@ -13,8 +13,7 @@
 
 use crate::config::Shaping;
 use crate::plan::LazyField;
-use crate::sim::episode::Episode;
-use crate::sim::world::World;
+use crate::sim::{Episode, World};
 use std::sync::Arc;
 
 /// The shaping of one episode: its field towards the current goal and the current potential.
@@ -101,9 +100,8 @@ fn field(world: &World, episode: &Episode) -> LazyField {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::policy::geodesic::Geodesic;
-    use crate::policy::{Decision, Policy};
-    use crate::sim::robot::{Action, DiscreteAction};
+    use crate::policy::{Builtin, Decision, PolicyFactory};
+    use crate::sim::{Action, DiscreteAction};
     use crate::SimConfig;
 
     /// The default maze of seed 3 with geodesic shaping at `gamma`.
@@ -123,7 +121,7 @@ mod tests {
         let mut episode = world.episode(3).unwrap();
         let mut shaper = Shaper::start(world.clone(), &episode).unwrap();
         let phi0 = shaper.potential();
-        let mut policy = Geodesic::default();
+        let mut policy = Builtin::Geodesic.make().unwrap();
         policy.reset(world, &episode).unwrap();
         let (mut shaped, mut sparse, mut discount) = (0.0, 0.0, 1.0);
         let mut t = 0;
@@ -187,7 +185,7 @@ mod tests {
         let w = world(1.0);
         let mut episode = w.episode(11).unwrap();
         let mut shaper = Shaper::start(w.clone(), &episode).unwrap();
-        let mut rng = crate::sim::rng::stream(5, crate::sim::rng::Stream::Policy);
+        let mut rng = crate::sim::stream(5, crate::sim::Stream::Policy);
         let mut seen = 0;
         for _ in 0..2000 {
             if episode.status().is_done() {

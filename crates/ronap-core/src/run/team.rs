@@ -4,14 +4,10 @@
 //! robot out of the running; it stays where it is, an obstacle to the others.
 
 use crate::geometry::Point;
-use crate::plan::tour::{self, CostMatrix, Order};
-use crate::plan::{path_length, smooth, DistanceField};
-use crate::policy::team::TeamPolicy;
-use crate::policy::Decision;
+use crate::plan::{path_length, smooth, CostMatrix, DistanceField, Order};
+use crate::policy::{Decision, TeamPolicy};
 use crate::run::RunError;
-use crate::sim::robot::Action;
-use crate::sim::team::Team;
-use crate::sim::world::World;
+use crate::sim::{Action, Team, World};
 use std::sync::Arc;
 
 /// One team episode in progress with its robots' policies' reasons for giving up.
@@ -83,7 +79,7 @@ fn plan_tour(
             })
     };
     let tours = CostMatrix::from_fn(nodes.len(), leg).map(|costs| {
-        [Order::Given, Order::Nearest, Order::Optimal].map(|o| tour::order(&costs, o))
+        [Order::Given, Order::Nearest, Order::Optimal].map(|o| crate::plan::order(&costs, o))
     });
     match tours {
         Ok([given, nearest, optimal]) => {
@@ -116,7 +112,7 @@ fn plan_tour(
 
 impl TeamRollout {
     /// The team episode of `seed` under `config` (with its `[[robots]]`) in `worlds` (one per
-    /// entry, [`crate::sim::world::Worlds::team`]), with `policy` reset for it.
+    /// entry, [`crate::sim::Worlds::team`]), with `policy` reset for it.
     pub fn start(
         config: &crate::ValidConfig,
         worlds: Vec<Arc<World>>,
@@ -252,7 +248,7 @@ impl TeamRollout {
             match decision {
                 Some(Decision::Act(action)) if self.team.running(k) => {
                     let kind = self.team.robot(k).config().robot.kinematics;
-                    if !action.is_finite() || !crate::sim::kinematics::accepts(kind, action) {
+                    if !action.is_finite() || !crate::sim::accepts(kind, action) {
                         return Err(RunError::InvalidAction { seed, step, action });
                     }
                     actions[k] = Some(action);

@@ -11,9 +11,7 @@
 use crate::config::ValidConfig;
 use crate::run::team::TeamRollout;
 use crate::run::RunError;
-use crate::sim::episode::Status;
-use crate::sim::robot::Action;
-use crate::sim::world::Worlds;
+use crate::sim::{Action, Status, Worlds};
 use rayon::prelude::*;
 
 /// Environments per parallel task.
@@ -290,8 +288,7 @@ impl Ctx<'_> {
 mod tests {
     use super::*;
     use crate::config::{SimConfig, TeamRobotConfig};
-    use crate::sim::robot::DiscreteAction;
-    use crate::sim::world::Scenes;
+    use crate::sim::{DiscreteAction, Scenes};
 
     fn worlds(count: u32) -> Worlds {
         let mut c = SimConfig {

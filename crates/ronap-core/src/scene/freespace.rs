@@ -42,7 +42,7 @@ impl FreeGrid {
     /// The grid of `scene` for a disc of `radius` px, with cells of `cell_px`; free cells within
     /// `margin_px` of touching an obstacle are also marked [close](FreeGrid::is_close).
     ///
-    /// Cells grow as needed to keep their number under [`MAX_CELLS`].
+    /// Cells grow as needed to keep their number under `MAX_CELLS`.
     pub fn new(scene: &Scene, radius: f64, cell_px: f64, margin_px: f64) -> Self {
         let cell_px = cell_px.max((scene.width() * scene.height() / MAX_CELLS as f64).sqrt());
         let cols = ((scene.width() / cell_px).floor() as usize).max(1);
@@ -634,7 +634,7 @@ mod tests {
             let mut config = crate::config::SimConfig::default();
             config.maze.cols = 5 + seed as u32;
             let config = config.validate().expect("valid");
-            let scene = crate::sim::world::maze_scene(&config, seed);
+            let scene = crate::sim::maze_scene(&config, seed);
             let grid = FreeGrid::new(&scene, 5.0, 5.0, 8.0);
             let cols = grid.size().0 as isize;
             // E, W, N, S, NE, SE, NW, SW.

@@ -338,7 +338,7 @@ impl Maze {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::rng::{stream, Stream};
+    use crate::sim::{stream, Stream};
     use proptest::prelude::*;
 
     proptest! {

@@ -344,7 +344,7 @@ impl MazeRays {
 mod tests {
     use super::*;
     use crate::geometry::unit;
-    use crate::sim::rng::{stream, Stream};
+    use crate::sim::{stream, Stream};
     use rand::{Rng, SeedableRng};
 
     /// The nearest hit testing every box, the way a scan without an index does.

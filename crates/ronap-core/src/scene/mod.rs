@@ -5,23 +5,28 @@
 //!
 //! A scene covers `[0, width] x [0, height]` px. It comes from a generated maze (walls on cell
 //! edges), an image (occupied pixels merged into boxes, everything outside the image an obstacle)
-//! or boxes given by hand. Queries near a point run through a [`BinIndex`] so one costs a single
-//! bin lookup; rays walk a coarse [`RayGrid`] so one costs per cell it crosses, whatever its range.
+//! or boxes given by hand. Queries near a point run through a `BinIndex` so one costs a single
+//! bin lookup; rays walk a coarse `RayGrid` so one costs per cell it crosses, whatever its range.
+//!
+//! The files are private: what other crates use is re-exported here (`pub use`), and what the
+//! layers above use beside it, `pub(crate) use`, so a file can move without breaking anyone.
 
-pub mod freespace;
-pub mod map;
-pub mod maze;
-pub mod maze_rays;
-pub mod warehouse;
+mod freespace;
+pub(crate) mod map;
+mod maze;
+mod maze_rays;
+mod warehouse;
+
+pub use freespace::FreeGrid;
+pub use map::{MapError, MapSource, RosMap};
+pub use maze::Maze;
+
+// For the layers above only.
+pub(crate) use warehouse::Warehouse;
 
 use crate::config::{MapConfig, MazeConfig};
-use crate::geometry::index::BinIndex;
-use crate::geometry::orca::{Obstacles, V2};
 use crate::geometry::prefetch;
-use crate::geometry::ray_grid::{self, RayGrid};
-use crate::geometry::shape::Shape;
-use crate::geometry::{Aabb, Point, Vector};
-use crate::scene::maze::Maze;
+use crate::geometry::{Aabb, BinIndex, GridStart, Obstacles, Point, RayGrid, Shape, Vector, V2};
 use crate::scene::maze_rays::MazeRays;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -218,7 +223,7 @@ pub struct RaysFrom<'a> {
 #[derive(Clone, Copy, Debug)]
 enum RayStart<'a> {
     Maze(&'a MazeRays, maze_rays::Start),
-    Grid(&'a RayGrid, ray_grid::GridStart),
+    Grid(&'a RayGrid, GridStart),
 }
 
 impl RaysFrom<'_> {
@@ -933,7 +938,7 @@ mod tests {
         let config = crate::ValidConfig::default();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
         for seed in 0..20 {
-            let scene = crate::sim::world::maze_scene(&config, seed).with_obstacles(
+            let scene = crate::sim::maze_scene(&config, seed).with_obstacles(
                 vec![],
                 vec![
                     Shape::disc(Point::new(250.0, 250.0), 20.0),

@@ -108,16 +108,6 @@ impl Warehouse {
         }
     }
 
-    /// The free loading area along the bottom, inside the walls.
-    pub fn loading_area(config: &WarehouseConfig) -> Aabb {
-        let layout = Layout::new(config);
-        let t = layout.wall;
-        Aabb::from_corners(
-            Point::new(t, t),
-            Point::new(layout.width - t, t + config.loading_px),
-        )
-    }
-
     /// Every obstacle box: walls, racks, pallets.
     pub fn boxes(&self) -> Vec<Aabb> {
         let mut all = self.walls.clone();
@@ -319,8 +309,18 @@ mod tests {
     use super::*;
     use crate::scene::freespace::FreeGrid;
     use crate::scene::Scene;
-    use crate::sim::rng::{stream, Stream};
+    use crate::sim::{stream, Stream};
     use proptest::prelude::*;
+
+    /// The free loading area along the bottom, inside the walls.
+    fn loading_area(config: &WarehouseConfig) -> Aabb {
+        let layout = Layout::new(config);
+        let t = layout.wall;
+        Aabb::from_corners(
+            Point::new(t, t),
+            Point::new(layout.width - t, t + config.loading_px),
+        )
+    }
 
     fn generate(config: &WarehouseConfig, radius: f64, seed: u64) -> Warehouse {
         Warehouse::generate(config, radius, &mut stream(seed, Stream::Scene))
@@ -533,7 +533,7 @@ mod tests {
         let top = warehouse.racks.iter().map(|r| r.max.y).fold(0.0, f64::max);
         assert_eq!(top, 544.0 - 2.0 - 40.0);
 
-        let loading = Warehouse::loading_area(&config);
+        let loading = loading_area(&config);
         assert_eq!(loading.extents().y, 150.0);
         for b in warehouse.boxes() {
             assert!(!overlaps(&b, &loading), "{b:?} in the loading area");

@@ -4,12 +4,11 @@
 //! gives), or by the social force model (the pushes of the agents and of the still scene).
 
 use crate::config::Forces;
-use crate::geometry::orca::{
-    agent_neighbours_among, new_velocity, obstacle_neighbours, Agent, Horizon, Line, Obstacles,
-    Surroundings,
-};
 use crate::geometry::social_force::{self, Walker};
-use crate::geometry::{Point, Vector};
+use crate::geometry::{
+    agent_neighbours_among, new_velocity, obstacle_neighbours, Agent, Horizon, Line, Obstacles,
+    Point, Surroundings, Vector,
+};
 use crate::scene::Scene;
 
 /// What one agent avoids with.

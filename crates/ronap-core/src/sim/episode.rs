@@ -5,8 +5,7 @@
 
 use crate::config::{OnCollision, ValidConfig, ACTION_MEMORY};
 use crate::geometry::{wrap_deg, Point, Vector};
-use crate::scene::freespace::FreeGrid;
-use crate::scene::Scene;
+use crate::scene::{FreeGrid, Scene};
 use crate::sim::kinematics::Velocity;
 use crate::sim::lidar::Laser;
 use crate::sim::moving::{Body, Disc, Movers};

@@ -2,11 +2,9 @@
 //! placement stream (or fixed by the configuration), with clearance for the robot and in one
 //! connected free region.
 
-use crate::config::RobotPattern;
-use crate::config::ValidConfig;
+use crate::config::{RobotPattern, ValidConfig};
 use crate::geometry::{Point, Vector};
-use crate::scene::freespace::FreeGrid;
-use crate::scene::Scene;
+use crate::scene::{FreeGrid, Scene};
 use crate::sim::rng::{stream, Rng, Stream};
 use crate::sim::robot::Pose;
 use rand::Rng as _;

@@ -11,7 +11,7 @@ use crate::scene::Scene;
 use crate::sim::kinematics::{self, Built, Kinematics, Velocity};
 use std::sync::Arc;
 
-/// The robot's shape and how it moves ([`Kinematics`]).
+/// The robot's shape and how it moves (`Kinematics`).
 #[derive(Clone, Debug)]
 pub struct Robot {
     radius_px: f64,

@@ -3,13 +3,9 @@
 //! says where each seed's episode takes place.
 
 use crate::config::{ObstacleConfig, Pattern, SceneConfig, SceneKind, ValidConfig};
-use crate::geometry::shape::Shape;
-use crate::geometry::{Aabb, Point};
-use crate::scene::freespace::FreeGrid;
+use crate::geometry::{Aabb, Point, Shape};
 use crate::scene::map::{self, MapError, MapSource};
-use crate::scene::maze::Maze;
-use crate::scene::warehouse::Warehouse;
-use crate::scene::Scene;
+use crate::scene::{FreeGrid, Maze, Scene, Warehouse};
 use crate::sim::episode::Episode;
 use crate::sim::placement::{free_grid, needs_region_grid, sample_placement, EpisodeError};
 use crate::sim::rng::{stream, Stream};

@@ -4,9 +4,7 @@
 use crate::config::ValidConfig;
 use crate::eval::metric::{kinds, End, Metric, Other, View};
 use crate::geometry::{Point, Vector};
-use crate::sim::episode::Episode;
-use crate::sim::moving::{Body, Movers};
-use crate::sim::team::Team;
+use crate::sim::{Body, Episode, Movers, Team};
 
 /// The metrics of one robot, and where it was when they last saw it.
 struct Robot {
@@ -129,7 +127,7 @@ impl Gauges {
 mod tests {
     use crate::eval::{Evaluator, Recording};
     use crate::policy::factory;
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
 
     /// Episodes among pedestrians with the crowd metrics on, recording what pictures need.
     fn evaluator() -> Evaluator {

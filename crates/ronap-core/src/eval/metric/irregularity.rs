@@ -62,7 +62,7 @@ mod tests {
     use super::*;
     use crate::eval::Outcome;
     use crate::geometry::{Point, Vector};
-    use crate::sim::robot::Pose;
+    use crate::sim::Pose;
 
     fn run(headings: &[f64], path_length_px: f64) -> Option<f64> {
         let mut m = make(&ValidConfig::default());

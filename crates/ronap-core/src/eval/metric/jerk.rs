@@ -52,7 +52,7 @@ mod tests {
     use super::*;
     use crate::eval::Outcome;
     use crate::geometry::Point;
-    use crate::sim::robot::Pose;
+    use crate::sim::Pose;
 
     fn run(velocities: &[[f64; 2]]) -> Option<f64> {
         let mut m = make(&ValidConfig::default());

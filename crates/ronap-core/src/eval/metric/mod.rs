@@ -20,8 +20,7 @@ pub(crate) use gauges::Gauges;
 use crate::config::ValidConfig;
 use crate::eval::Outcome;
 use crate::geometry::{Point, Vector};
-use crate::sim::moving::Body;
-use crate::sim::robot::Pose;
+use crate::sim::{Body, Pose};
 
 /// What the files call a metric and how they write it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

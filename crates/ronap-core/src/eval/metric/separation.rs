@@ -84,8 +84,7 @@ mod tests {
     use crate::eval::metric::Other;
     use crate::eval::Outcome;
     use crate::geometry::{Point, Vector};
-    use crate::sim::moving::Body;
-    use crate::sim::robot::Pose;
+    use crate::sim::{Body, Pose};
 
     #[test]
     fn steps_within_the_discomfort_distance_are_counted() {

@@ -14,7 +14,7 @@ mod real;
 mod step;
 
 pub use real::{left_of, Real, V2};
-pub use step::{crowd_step, CrowdAgent, CrowdChoice, CrowdSettings};
+pub use step::{crowd_step, CrowdAgent, CrowdSettings};
 
 use program::{linear_program2, linear_program3};
 
@@ -67,7 +67,7 @@ pub struct Vertex<T> {
     pub convex: bool,
 }
 
-/// Still obstacles: polygons, each a counter-clockwise loop of [`Vertex`]es (a two-vertex one is
+/// Still obstacles: polygons, each a counter-clockwise loop of `Vertex`es (a two-vertex one is
 /// a line segment, both sides of which are obstacles).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Obstacles<T> {
@@ -224,7 +224,7 @@ pub struct Surroundings<'a, T> {
     pub agents: &'a [Agent<T>],
     /// The still obstacles.
     pub obstacles: &'a Obstacles<T>,
-    /// The obstacle edges to avoid, nearest first (as [`obstacle_neighbours`] lists them).
+    /// The obstacle edges to avoid, nearest first (as `obstacle_neighbours` lists them).
     pub edges: &'a [usize],
 }
 

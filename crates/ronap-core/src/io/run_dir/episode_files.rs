@@ -5,7 +5,7 @@ use crate::eval::{EpisodeRecord, TeamRecord};
 use crate::io::atomic::{save_image, write_atomic, OutputError};
 use crate::io::fault::{self, Op};
 use crate::io::steplog::{write_step_log, write_steps};
-use crate::render::trajectory::trajectory_image;
+use crate::render::trajectory_image;
 use std::path::Path;
 
 /// Writes the per-episode files a record asks for: its trajectory picture (`png/`) and its step
@@ -44,7 +44,7 @@ pub(super) fn write_team_files(
     steps: Option<&[usize]>,
 ) -> Result<(), OutputError> {
     if picture {
-        if let Some(img) = crate::render::team::team_image(record, 1.0) {
+        if let Some(img) = crate::render::team_image(record, 1.0) {
             let path = dir.join("png").join(format!(
                 "seed-{:06}-{}.png",
                 record.seed,

@@ -20,12 +20,9 @@ use crate::io::figures::{self, FIGURES_FILE};
 use crate::io::manifest::{ManifestError, RunManifest, RunPlan, SCHEMA_VERSION};
 use crate::io::partial::partial_path;
 use crate::scene::map::MapSource;
-use crate::sim::world::SceneSpec;
+use crate::sim::SceneSpec;
 pub(crate) use rows::start_goal_cells;
-pub use rows::{
-    episode_header, episode_row, metric_cells, timing_row, write_episodes, write_timing, Layout,
-    DYNAMIC_COLUMNS, EPISODE_COLUMNS, TIMING_COLUMNS,
-};
+pub use rows::{episode_header, episode_row, metric_cells, timing_row, Layout, TIMING_COLUMNS};
 use std::path::{Path, PathBuf};
 pub use writer::RunWriter;
 pub(crate) use writer::{finish, Streams};
@@ -218,7 +215,7 @@ mod tests {
     use crate::eval::{Evaluator, Seeds};
     use crate::io::manifest::PLAN_FILE;
     use crate::policy::Builtin;
-    use crate::sim::world::Scenes;
+    use crate::sim::Scenes;
     use std::sync::atomic::AtomicBool;
 
     fn setting() -> (ValidConfig, Evaluator, RunInfo) {

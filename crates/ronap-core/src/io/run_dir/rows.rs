@@ -5,8 +5,7 @@ use crate::config::ValidConfig;
 use crate::eval::metric;
 use crate::eval::EpisodeRecord;
 use crate::geometry::Point;
-use crate::sim::robot::Pose;
-use std::io::Write;
+use crate::sim::Pose;
 
 /// Columns of `episodes.csv`.
 pub const EPISODE_COLUMNS: [&str; 14] = [
@@ -33,11 +32,11 @@ pub const DYNAMIC_COLUMNS: [&str; 3] = [
     "near_moving_fraction",
 ];
 
-/// What a lone robot's rows hold beyond [`EPISODE_COLUMNS`]: the moving-obstacle columns when
+/// What a lone robot's rows hold beyond `EPISODE_COLUMNS`: the moving-obstacle columns when
 /// the episodes have moving obstacles, then a column per metric the configuration asks for.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Layout {
-    /// The episodes have moving obstacles ([`DYNAMIC_COLUMNS`]).
+    /// The episodes have moving obstacles (`DYNAMIC_COLUMNS`).
     pub dynamic: bool,
     /// The metrics asked for, in column order.
     pub metrics: &'static [metric::Kind],
@@ -119,35 +118,10 @@ pub fn episode_header(layout: Layout) -> Vec<&'static str> {
     header
 }
 
-/// Writes `episodes.csv`: one row per record, with [`DYNAMIC_COLUMNS`] after the others when the
-/// episodes had moving obstacles.
-pub fn write_episodes(records: &[EpisodeRecord], out: &mut dyn Write) -> std::io::Result<()> {
-    let mut w = csv::Writer::from_writer(out);
-    let layout = Layout {
-        dynamic: records.iter().any(|r| r.dynamic.is_some()),
-        metrics: &[],
-    };
-    w.write_record(episode_header(layout))?;
-    for r in records {
-        w.write_record(episode_row(r, layout))?;
-    }
-    w.flush()
-}
-
 /// Columns of `timing.csv`.
 pub const TIMING_COLUMNS: [&str; 2] = ["seed", "wall_time_ms"];
 
 /// The `timing.csv` row of an episode of `seed` that took `wall_time_s`.
 pub fn timing_row(seed: u64, wall_time_s: f64) -> [String; 2] {
     [seed.to_string(), format!("{:.3}", wall_time_s * 1000.0)]
-}
-
-/// Writes `timing.csv`: each episode's wall time (setup, planning, stepping), milliseconds.
-pub fn write_timing(records: &[EpisodeRecord], out: &mut dyn Write) -> std::io::Result<()> {
-    let mut w = csv::Writer::from_writer(out);
-    w.write_record(TIMING_COLUMNS)?;
-    for r in records {
-        w.write_record(timing_row(r.seed, r.wall_time_s))?;
-    }
-    w.flush()
 }

@@ -4,8 +4,7 @@
 //! `geodesic` policy descends and the yardstick for SPL.
 
 use crate::geometry::Point;
-use crate::scene::freespace::FreeGrid;
-use crate::scene::Scene;
+use crate::scene::{FreeGrid, Scene};
 use search::*;
 
 mod search;
@@ -470,7 +469,7 @@ pub(crate) mod tests {
     use super::*;
     use crate::config::ValidConfig;
     use crate::geometry::Vector;
-    use crate::sim::world::World;
+    use crate::sim::World;
     use rand::{Rng, SeedableRng};
 
     /// Worlds of seeds `0..n` with the default configuration, by turns a maze, a warehouse and
@@ -719,7 +718,7 @@ pub(crate) mod tests {
     /// (under 30% of them over these 8 mazes, against 35% when never steered anew).
     #[test]
     fn a_lazy_field_follows_a_wandering_robot() {
-        use crate::sim::robot::{Action, DiscreteAction};
+        use crate::sim::{Action, DiscreteAction};
         let (mut steered, mut free) = (0, 0);
         for seed in 0..8u64 {
             let world = World::maze(ValidConfig::default(), seed);

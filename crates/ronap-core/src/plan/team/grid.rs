@@ -99,11 +99,6 @@ impl PlanGrid {
         self.cols * self.rows
     }
 
-    /// Whether the grid has no cells (never: it has at least one).
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
     /// Columns and rows.
     pub fn size(&self) -> (usize, usize) {
         (self.cols, self.rows)
@@ -114,7 +109,8 @@ impl PlanGrid {
         self.cell_px
     }
 
-    /// Whether cell `i` is free.
+    /// Whether cell `i` is free (the tests' question; the search asks the links).
+    #[cfg(test)]
     pub fn is_free(&self, i: usize) -> bool {
         self.free[i]
     }

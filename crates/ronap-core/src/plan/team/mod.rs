@@ -8,7 +8,7 @@ mod pair;
 mod schedule;
 mod search;
 
-pub use grid::{PlanGrid, MOVES};
-pub use pair::{pair_feasible, pair_plan, Pair, MAX_STATES};
-pub use schedule::{Schedule, Wait};
+pub use grid::PlanGrid;
+pub use pair::{pair_feasible, pair_plan, Pair};
+pub use schedule::Schedule;
 pub use search::{plan_team, Limits, PlanFailure, Stop, Task};

@@ -417,7 +417,7 @@ pub fn plan_team(
 mod tests {
     use super::*;
     use crate::geometry::Point;
-    use crate::sim::world::World;
+    use crate::sim::World;
     use proptest::prelude::*;
     use rand::SeedableRng;
 

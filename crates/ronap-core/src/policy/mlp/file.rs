@@ -2,7 +2,7 @@
 //! metadata (the format is described in [`crate::policy::mlp`]).
 
 use crate::policy::mlp::network::{Activation, DecisionRule, Layer, Mlp, FORMAT};
-use crate::sim::split::SeedRanges;
+use crate::sim::SeedRanges;
 use nalgebra::{DMatrix, DVector};
 use safetensors::tensor::{Dtype, TensorView};
 use safetensors::SafeTensors;

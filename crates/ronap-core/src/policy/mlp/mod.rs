@@ -13,25 +13,20 @@
 //! - `format`: `ronap-mlp/1`;
 //! - `activation`: `relu`, `tanh`, `leaky_relu:SLOPE`, or `rrelu` (the paper's RReLU; at inference
 //!   it is a leaky ReLU of slope `(1/8 + 1/3) / 2`, PyTorch's evaluation mode);
-//! - `observation`: the observation layout, [`OBSERVATION_LAYOUT`] for the 18 values of docs/model.md "Observation";
+//! - `observation`: the observation layout, [`network::OBSERVATION_LAYOUT`] for the 18 values of
+//!   docs/model.md "Observation";
 //! - `observation_size`: the number of inputs;
 //! - optional, for people: `output` (`q_values` or `logits`), `command` (what trained it),
 //!   `trained` (a description of the training data or run).
 
-pub mod file;
-pub mod network;
+mod file;
+mod network;
 
 pub use file::MlpError;
-pub use network::{
-    observation_layout, Activation, DecisionRule, Layer, Mlp, Scratch, FORMAT, OBSERVATION_LAYOUT,
-    RRELU_SLOPE,
-};
+pub use network::{observation_layout, Activation, DecisionRule, Layer, Mlp, Scratch, RRELU_SLOPE};
 
 use crate::policy::{Decision, Policy, PolicyError, PolicyFactory};
-use crate::sim::episode::Episode;
-use crate::sim::robot::DiscreteAction;
-use crate::sim::split::SeedRanges;
-use crate::sim::world::World;
+use crate::sim::{DiscreteAction, Episode, SeedRanges, World};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -46,10 +41,10 @@ pub const SIDE_BY_SIDE: usize = 16;
 pub struct MlpPolicy {
     mlp: Arc<Mlp>,
     rule: DecisionRule,
-    rng: crate::sim::rng::Rng,
+    rng: crate::sim::Rng,
     scratch: Scratch,
     /// Each lane's policy stream, when episodes run side by side.
-    lane_rngs: Vec<crate::sim::rng::Rng>,
+    lane_rngs: Vec<crate::sim::Rng>,
     /// The lanes' observations, a row each.
     rows: Vec<f32>,
 }
@@ -61,7 +56,7 @@ impl MlpPolicy {
         Self {
             mlp,
             rule,
-            rng: crate::sim::rng::stream(0, crate::sim::rng::Stream::Policy),
+            rng: crate::sim::stream(0, crate::sim::Stream::Policy),
             scratch: Scratch::default(),
             lane_rngs: Vec::new(),
             rows: Vec::new(),
@@ -83,7 +78,7 @@ impl MlpPolicy {
 }
 
 /// The action `rule` picks from the network's `outputs`, drawing from `rng` when it samples.
-fn choose(rule: DecisionRule, outputs: &[f32], rng: &mut crate::sim::rng::Rng) -> DiscreteAction {
+fn choose(rule: DecisionRule, outputs: &[f32], rng: &mut crate::sim::Rng) -> DiscreteAction {
     match rule {
         DecisionRule::Argmax => DiscreteAction::ALL[network::argmax(outputs)],
         DecisionRule::Sample { temperature } => {
@@ -110,7 +105,7 @@ fn choose(rule: DecisionRule, outputs: &[f32], rng: &mut crate::sim::rng::Rng) -
 impl Policy for MlpPolicy {
     fn reset(&mut self, _world: &World, episode: &Episode) -> Result<(), PolicyError> {
         self.check(episode)?;
-        self.rng = crate::sim::rng::stream(episode.seed(), crate::sim::rng::Stream::Policy);
+        self.rng = crate::sim::stream(episode.seed(), crate::sim::Stream::Policy);
         Ok(())
     }
 
@@ -132,11 +127,10 @@ impl Policy for MlpPolicy {
         self.check(episode)?;
         if self.lane_rngs.len() <= lane {
             self.lane_rngs.resize_with(lane + 1, || {
-                crate::sim::rng::stream(0, crate::sim::rng::Stream::Policy)
+                crate::sim::stream(0, crate::sim::Stream::Policy)
             });
         }
-        self.lane_rngs[lane] =
-            crate::sim::rng::stream(episode.seed(), crate::sim::rng::Stream::Policy);
+        self.lane_rngs[lane] = crate::sim::stream(episode.seed(), crate::sim::Stream::Policy);
         Ok(())
     }
 
@@ -239,6 +233,7 @@ impl PolicyFactory for MlpFactory {
 
 #[cfg(test)]
 mod tests {
+    use super::network::OBSERVATION_LAYOUT;
     use super::*;
     use nalgebra::{DMatrix, DVector};
     use safetensors::tensor::TensorView;

@@ -1,7 +1,7 @@
 //! The network: layers, activations and the forward pass, with nalgebra; and how its outputs
 //! become an action ([`DecisionRule`]).
 
-use crate::sim::robot::DiscreteAction;
+use crate::sim::DiscreteAction;
 use nalgebra::{DMatrix, DVector};
 use std::collections::HashMap;
 

@@ -28,7 +28,7 @@ pub(super) fn compare_frames() -> (Frame, Frame) {
 /// policy's SPL over its successful episodes as a box plot (median, quartiles, whiskers to the
 /// furthest values within 1.5 IQR, dots beyond) with a diamond at the mean SPL over all episodes
 /// (y 0-1). Under each bar and box: the policy's name and its success rate or mean SPL. Each
-/// policy has its own colour ([`policy_colour`]), the same in both panels; when names had to be
+/// policy has its own colour (`policy_colour`), the same in both panels; when names had to be
 /// cut or numbered to fit, a legend underneath gives them in full.
 ///
 /// `title` is the line on top, e.g. "success = reached the goal within 10 px, 1000 seeds".

@@ -25,7 +25,7 @@ pub(super) fn grouped_frame(bins: usize, series: usize, label_chars: usize) -> F
 
 /// Grouped bars: along x one group per bin (labelled with the bin's name, e.g. "ratio 1.0-1.3"),
 /// in each group one bar per series (policy) for its success rate with 95% interval whiskers;
-/// y 0-100%. A legend under the plot names the series in their colours ([`policy_colour`]).
+/// y 0-100%. A legend under the plot names the series in their colours (`policy_colour`).
 /// `title` is the line on top.
 ///
 /// There is a group per bin name, or per value in the longest series if more; a series without a

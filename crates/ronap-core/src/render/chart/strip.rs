@@ -118,7 +118,7 @@ pub(super) fn disagrees(outcomes: &[Vec<Outcome>], s: usize) -> bool {
 }
 
 /// The per-seed outcome strip: one row per policy, its name on the left, and one column per seed
-/// in the order given, coloured by outcome ([`outcome_colour`]; a missing outcome is light grey).
+/// in the order given, coloured by outcome (`outcome_colour`; a missing outcome is light grey).
 /// Columns are 4 px wide for up to 300 seeds, down to 1 px; past 1200 px the seeds wrap into
 /// bands, one under the other, each headed by its first and last seed. Under each band's policy
 /// rows a thin row is dark at the seeds where the policies disagree (some succeeded, some did

@@ -16,7 +16,7 @@ pub use trace::{Acted, Recorder, Trace};
 use trace::Move;
 
 use crate::geometry::Point;
-use crate::sim::moving::Body;
+use crate::sim::Body;
 use base64::Engine as _;
 use std::fmt::Write as _;
 

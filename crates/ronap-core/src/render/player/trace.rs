@@ -7,9 +7,7 @@
 use crate::geometry::Point;
 use crate::render::chart::policy_colour;
 use crate::scene::Scene;
-use crate::sim::episode::Episode;
-use crate::sim::moving::{Body, Movers};
-use crate::sim::robot::Action;
+use crate::sim::{Action, Body, Episode, Movers};
 use std::sync::Arc;
 
 /// What one robot did in one step, as the model reported it.

@@ -10,9 +10,7 @@
 
 use super::{free_spot, Body, Disc, Entry, SPOT_TRIES};
 use crate::config::{AgentOrca, Arrival, Forces, MotionKind, MovingConfig, Pattern};
-use crate::geometry::orca::{Agent, Horizon, V2};
-use crate::geometry::point_grid::PointGrid;
-use crate::geometry::{Point, Vector};
+use crate::geometry::{Agent, Horizon, Point, PointGrid, Vector, V2};
 use crate::scene::Scene;
 use crate::sim::avoid::{social_force_velocity, Avoid, Avoider};
 use crate::sim::moving::heading::State;

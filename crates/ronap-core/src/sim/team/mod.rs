@@ -17,11 +17,10 @@
 mod comm;
 mod step;
 
-pub use comm::{Broadcast, Inbox, InboxIter};
+pub use comm::{Broadcast, Inbox};
 
 use crate::config::{OnArrival, TeamConfig, ValidConfig};
-use crate::geometry::point_grid::PointGrid;
-use crate::geometry::{point_segment_distance_squared, Point};
+use crate::geometry::{point_segment_distance_squared, Point, PointGrid};
 use crate::sim::episode::{Episode, Status};
 use crate::sim::moving::{Disc, Movers};
 use crate::sim::placement::{needs_region_grid, sample_placement_with, EpisodeError};
