@@ -25,6 +25,9 @@
 //! | [`collect`] | labelled data: expert and human collection |
 //! | [`compare`] | several policies on the same seeds: paired statistics, pictures, a report |
 
+// Every type the API hands out can be named by its callers (a `pub use` in its layer).
+#![warn(unnameable_types)]
+
 pub mod bounded;
 pub mod collect;
 pub mod compare;

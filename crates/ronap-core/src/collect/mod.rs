@@ -8,5 +8,6 @@
 mod expert;
 mod human;
 
-pub use expert::{collect, collect_episode, Collection, Posing};
-pub use human::HumanCollector;
+pub use expert::{collect, collect_episode, CollectError, Collection, Posing};
+// A human step's outcome, aliased: `eval` has an `Outcome` of its own.
+pub use human::{HumanCollector, Outcome as HumanOutcome};

@@ -27,7 +27,7 @@ pub struct Difficulty {
     /// The narrowest free width across the shortest path (the sum of the free distances to
     /// either side, perpendicular to the path), px.
     pub narrowest_gap_px: Option<f64>,
-    /// Corners of the shortest path where it turns by more than [`TURN_DEG`].
+    /// Corners of the shortest path where it turns by more than `TURN_DEG` (20 degrees).
     pub turns: Option<u32>,
 }
 

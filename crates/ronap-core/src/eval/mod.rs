@@ -16,16 +16,19 @@ mod summary;
 mod team;
 
 // The metrics beyond the standard columns, aliased here as the evaluator has kinds of its own.
-pub use metric::{kinds as metric_kinds, Kind as MetricKind};
+pub use metric::{
+    kinds as metric_kinds, Column as MetricColumn, End as MetricEnd, Kind as MetricKind, Metric,
+    MetricMean, Other as MetricOther, View as MetricView,
+};
 pub use record::{EpisodeRecord, Outcome, Recording, StepLog};
-pub use summary::{AmongRobots, Figures, Summary, Tally};
+pub use summary::{AmongRobots, Figures, MovingSummary, Summary, Tally};
 pub use team::{
-    RobotFigures, RobotRecord, TeamFigures, TeamRecord, TeamRunResult, TeamSummary, TeamTally,
+    Flow, RobotFigures, RobotRecord, TeamFigures, TeamRecord, TeamRunResult, TeamSummary, TeamTally,
 };
 
 // For the layers above only.
 pub(crate) use summary::wilson95;
-pub(crate) use team::{team_outcome, Flow};
+pub(crate) use team::team_outcome;
 
 use crate::config::ValidConfig;
 use crate::plan::shortest_path_px;

@@ -21,17 +21,17 @@ pub(crate) mod social_force;
 
 // The crowd-avoidance geometry (ORCA's half-planes, the crowd step) and the reference scene.
 pub use orca::{
-    agent_neighbours, crowd_step, new_velocity, Agent, CrowdAgent, CrowdSettings, Horizon,
-    Obstacles, Real, Surroundings, V2,
+    agent_neighbours, crowd_step, new_velocity, Agent, CrowdAgent, CrowdChoice, CrowdSettings,
+    Horizon, Line, Obstacles, Real, Surroundings, Vertex, V2,
 };
 pub use reference::ParryScene;
+pub use shape::Shape;
 
 // For the layers above only.
 pub(crate) use index::BinIndex;
-pub(crate) use orca::{agent_neighbours_among, obstacle_neighbours, Line};
+pub(crate) use orca::{agent_neighbours_among, obstacle_neighbours};
 pub(crate) use point_grid::PointGrid;
 pub(crate) use ray_grid::{GridStart, RayGrid};
-pub(crate) use shape::Shape;
 
 use nalgebra::{Point2, Vector2};
 

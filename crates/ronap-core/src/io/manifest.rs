@@ -188,7 +188,7 @@ pub const PLAN_SCHEMA_VERSION: u32 = 1;
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RunPlan {
-    /// [`PLAN_SCHEMA_VERSION`] of the writer.
+    /// `PLAN_SCHEMA_VERSION` of the writer.
     pub schema_version: u32,
     /// The ronap version that wrote the run; another version may run episodes differently.
     pub ronap_version: String,

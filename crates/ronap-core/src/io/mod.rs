@@ -23,19 +23,18 @@ pub use atomic::{check_writable, save_image, save_network, write_atomic, OutputE
 // here: the layer reads many formats).
 pub use datalog::{
     parse as parse_data_log, read as read_data_log, DataLogError, DataLogWriter, DataSet,
-    Format as DataLogFormat,
+    Format as DataLogFormat, Sample,
 };
 // Run directories: the manifest, the episode rows, the step logs, training curves.
-pub use manifest::{ManifestError, RunManifest, PLAN_FILE};
+pub use manifest::{ManifestError, RunManifest, RunPlan, PLAN_FILE};
 pub use run_dir::{
     BlockRun, EpisodeRows, Layout, Pictures, ResumeError, RunFiles, RunInfo, RunWriter,
 };
-pub use steplog::{parse_steps, read_steps, LoggedStep};
+pub use steplog::{parse_steps, read_steps, LoggedStep, StepsError};
 pub use team_rows::{robot_columns, robot_rows, team_episode_row, TEAM_COLUMNS};
 pub use training::{Curves, TrainingLog};
 
 // For the layers above only.
-pub(crate) use datalog::Sample;
 pub(crate) use lock::LOCK_FILE;
 pub(crate) use run_dir::{
     finish, lone_headers, manifest, restore, timing_row, Streams, TIMING_COLUMNS,

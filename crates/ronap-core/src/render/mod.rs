@@ -22,12 +22,13 @@ pub use chart::{
     compare_chart, contact_sheet, grouped_bars, outcome_strip, PolicyBars, Series, SheetRow,
 };
 pub use first_person::{first_person, HeadingUp, FIRST_PERSON_HALF_SPAN};
-pub use gif::{animate, AnimationError, GifOptions, View};
+pub use gif::{animate, Animation, AnimationError, GifOptions, View};
 pub use team::{team_frame, team_setup};
 
 // For the layers above only.
-pub(crate) use gif::{check_logged_step, same_pose, Animation, GifWriter};
-pub(crate) use player::{player_page, Acted, PlayerPage, Recorder, Trace};
+pub(crate) use gif::{check_logged_step, same_pose, GifWriter};
+pub use player::Trace;
+pub(crate) use player::{player_page, Acted, PlayerPage, Recorder};
 pub(crate) use team::{team_gif_writer, team_image};
 pub(crate) use trajectory::trajectory_image;
 

@@ -13,13 +13,12 @@ mod team;
 mod team_batch;
 
 pub use batch::{Autoreset, Batch, BatchOptions, EnvStep, SeedOrder};
-pub use rollout::Rollout;
+pub use rollout::{Rollout, Stepped};
 pub use shaping::Shaper;
-pub use team::TeamRollout;
+pub use team::{TeamRollout, TourLengths};
 pub use team_batch::{RobotStep, TeamBatch};
 
 // For the layers above only.
-pub(crate) use team::TourLengths;
 
 use crate::policy::PolicyError;
 use crate::sim::{Action, EpisodeError};

@@ -22,21 +22,22 @@ mod team;
 mod world;
 
 // A robot, its actions and its laser.
-pub use kinematics::continuous_action;
+pub use kinematics::{continuous_action, Kinematics, Motion, Velocity};
 pub use lidar::{Laser, RayClass};
 pub use robot::{Action, DiscreteAction, Pose, Robot};
 // An episode, where it starts, and the scenes and worlds it runs in.
-pub use episode::{Episode, Status, StepResult};
+pub use episode::{DynamicMetrics, Episode, Status, StepResult};
 pub use placement::{free_grid, needs_region_grid, sample_placement, EpisodeError, Placement};
 pub use split::{SeedRanges, Split};
 pub use world::{maze_scene, warehouse_scene, SceneSpec, Scenes, World, Worlds};
 // Moving obstacles and teams.
-pub use moving::{Body, Movers};
-pub use team::{Inbox, Team};
+pub use moving::{
+    Advance, Agent, Behaviour, Body, Disc, Mover, Movers, MovingError, Neighbours, Track,
+};
+pub use team::{Broadcast, Inbox, InboxIter, Team};
 
 // For the layers above only.
 pub(crate) use avoid::{social_force_velocity, Avoid, Avoider};
-pub(crate) use episode::{DynamicMetrics, PREFETCH_STAGES};
+pub(crate) use episode::PREFETCH_STAGES;
 pub(crate) use kinematics::accepts;
-pub(crate) use moving::Track;
 pub(crate) use rng::{stream, Rng, Stream};

@@ -14,7 +14,7 @@ mod real;
 mod step;
 
 pub use real::{left_of, Real, V2};
-pub use step::{crowd_step, CrowdAgent, CrowdSettings};
+pub use step::{crowd_step, CrowdAgent, CrowdChoice, CrowdSettings};
 
 use program::{linear_program2, linear_program3};
 

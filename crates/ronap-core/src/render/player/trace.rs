@@ -72,7 +72,7 @@ pub(super) struct MoverTrace {
     pub(super) goal: Vec<Option<Point>>,
 }
 
-/// A recorded episode, ready for [`crate::render::player::player_page`].
+/// A recorded episode, ready for the HTML player (`ronap run --html`).
 #[derive(Clone, Debug)]
 pub struct Trace {
     pub(super) scene: Arc<Scene>,

@@ -17,7 +17,7 @@
 mod comm;
 mod step;
 
-pub use comm::{Broadcast, Inbox};
+pub use comm::{Broadcast, Inbox, InboxIter};
 
 use crate::config::{OnArrival, TeamConfig, ValidConfig};
 use crate::geometry::{point_segment_distance_squared, Point, PointGrid};
