@@ -503,48 +503,49 @@ fn run_one(
         &|_| progress(Progress::Episode),
         &|_| true,
     )
-    .map_err(|source| CompareError::Policy {
-        policy: c.name.clone(),
-        source,
-    })?;
-    let end = RunEnding {
+    .map_err(|source| policy_error(c, source))?;
+    let seeds = evaluation.result.records.iter().map(SeedResult::of);
+    RunEnding {
         write_error: evaluation.write_error,
         error: evaluation.result.error.as_ref(),
         cancelled: evaluation.result.cancelled,
-    };
-    end.check(c, dir.as_deref(), out)?;
-    Ok(PolicyResult {
-        name: c.name.clone(),
-        label: label.to_string(),
-        run_dir: dir,
-        reused: false,
         summary: evaluation.summary,
         team: None,
-        seeds: evaluation
-            .result
-            .records
-            .iter()
-            .map(SeedResult::of)
-            .collect(),
-    })
+        seeds: seeds.collect(),
+    }
+    .into_result(c, label, dir, out)
 }
 
-/// How a contender's run ended, lone or team.
+/// The comparison's error when contender `c`'s policy could not be made or run.
+fn policy_error(c: &Contender, source: crate::policy::PolicyError) -> CompareError {
+    CompareError::Policy {
+        policy: c.name.clone(),
+        source,
+    }
+}
+
+/// How a contender's run ended, lone or team, and its figures.
 struct RunEnding<'a> {
     write_error: Option<OutputError>,
     error: Option<&'a crate::run::RunError>,
     cancelled: bool,
+    summary: crate::eval::Summary,
+    team: Option<crate::eval::TeamSummary>,
+    /// Each seed's figures, in seed order.
+    seeds: Vec<SeedResult>,
 }
 
 impl RunEnding<'_> {
-    /// The comparison's error when contender `c`'s run (in `dir`, under `out`) did not finish
-    /// every seed: its files could not be written, an episode failed, or it was interrupted.
-    fn check(
+    /// Contender `c`'s result (labelled `label`, its run in `dir`, under `out`), or the
+    /// comparison's error when the run did not finish every seed: its files could not be
+    /// written, an episode failed, or it was interrupted.
+    fn into_result(
         self,
         c: &Contender,
-        dir: Option<&Path>,
+        label: &str,
+        dir: Option<PathBuf>,
         out: Option<&Path>,
-    ) -> Result<(), CompareError> {
+    ) -> Result<PolicyResult, CompareError> {
         if let Some(e) = self.write_error {
             return Err(e.into());
         }
@@ -552,7 +553,7 @@ impl RunEnding<'_> {
             return Err(CompareError::Run {
                 policy: c.name.clone(),
                 message: e.to_string(),
-                dir: dir.map(Path::to_path_buf).unwrap_or_default(),
+                dir: dir.unwrap_or_default(),
             });
         }
         if self.cancelled {
@@ -560,7 +561,15 @@ impl RunEnding<'_> {
                 dir: out.map(|d| d.join("runs")).unwrap_or_default(),
             });
         }
-        Ok(())
+        Ok(PolicyResult {
+            name: c.name.clone(),
+            label: label.to_string(),
+            run_dir: dir,
+            reused: false,
+            summary: self.summary,
+            team: self.team,
+            seeds: self.seeds,
+        })
     }
 }
 
@@ -585,26 +594,16 @@ fn run_team(
             false
         },
     )
-    .map_err(|source| CompareError::Policy {
-        policy: c.name.clone(),
-        source,
-    })?;
-    let end = RunEnding {
+    .map_err(|source| policy_error(c, source))?;
+    RunEnding {
         write_error: evaluation.write_error,
         error: evaluation.result.error.as_ref(),
         cancelled: evaluation.result.cancelled,
-    };
-    end.check(c, dir.as_deref(), setting.out)?;
-    let seeds = seeds.into_inner();
-    Ok(PolicyResult {
-        name: c.name.clone(),
-        label: label.to_string(),
-        run_dir: dir,
-        reused: false,
         summary: evaluation.summary,
         team: Some(evaluation.team),
-        seeds,
-    })
+        seeds: seeds.into_inner(),
+    }
+    .into_result(c, label, dir, setting.out)
 }
 
 /// Reads the run in `dir` for reuse by policy `name`: its manifest must record the same policy,

@@ -425,6 +425,26 @@ impl SimConfig {
     }
 }
 
+/// Scenes the tests ask for by their shape.
+#[cfg(test)]
+impl SimConfig {
+    /// This configuration in an open hall `side_px` square (a maze of one cell).
+    pub(crate) fn open_hall(mut self, side_px: f64) -> Self {
+        (self.maze.cols, self.maze.rows, self.maze.cell_px) = (1, 1, side_px);
+        self
+    }
+
+    /// This configuration in an open hall `cols` x `cell_px` square when `maze` is false, else in
+    /// a maze of `cols` x `cols` cells.
+    pub(crate) fn hall_or_maze(mut self, maze: bool, cols: u32, cell_px: f64) -> Self {
+        if !maze {
+            return self.open_hall(cell_px * f64::from(cols));
+        }
+        (self.maze.cols, self.maze.rows) = (cols, cols);
+        self
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -10,20 +10,6 @@ use crate::sim::DynamicMetrics;
 /// The file's name inside a run directory (it only ever exists as a partial file).
 pub const FIGURES_FILE: &str = "figures.csv";
 
-/// Columns for a lone robot's episodes.
-pub const LONE_COLUMNS: [&str; 10] = [
-    "seed",
-    "outcome",
-    "steps",
-    "collisions",
-    "path_length_bits",
-    "spl_bits",
-    "return_bits",
-    "dynamic_collisions",
-    "min_clearance_bits",
-    "near_steps",
-];
-
 const TEAM_BASE: [&str; 11] = [
     "seed",
     "outcome",
@@ -38,6 +24,7 @@ const TEAM_BASE: [&str; 11] = [
     "waiting_steps",
 ];
 
+/// A robot's fields: a lone robot's columns after `seed`, and each robot's of a team.
 const ROBOT_FIELDS: [&str; 9] = [
     "outcome",
     "steps",
@@ -57,7 +44,10 @@ fn metric_columns(kinds: &[Kind]) -> impl Iterator<Item = String> + '_ {
 
 /// Columns for a lone robot's episodes measuring the metrics of `kinds`.
 pub fn lone_columns(kinds: &[Kind]) -> Vec<String> {
-    let mut columns: Vec<String> = LONE_COLUMNS.iter().map(|c| c.to_string()).collect();
+    let mut columns: Vec<String> = std::iter::once("seed")
+        .chain(ROBOT_FIELDS)
+        .map(str::to_string)
+        .collect();
     columns.extend(metric_columns(kinds));
     columns
 }

@@ -1006,15 +1006,7 @@ mod tests {
         vanish: bool,
         seeds: u64,
     ) -> Vec<crate::eval::TeamRecord> {
-        let mut c = crate::SimConfig::default();
-        if maze {
-            c.maze.cols = cols;
-            c.maze.rows = cols;
-        } else {
-            c.maze.cols = 1;
-            c.maze.rows = 1;
-            c.maze.cell_px = 100.0 * f64::from(cols);
-        }
+        let mut c = crate::SimConfig::default().hall_or_maze(maze, cols, 100.0);
         c.episode.min_goal_distance_px = 50.0;
         c.robots = vec![TeamRobotConfig {
             count: robots,

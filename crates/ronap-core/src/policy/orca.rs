@@ -106,10 +106,8 @@ mod tests {
                 robot([350.0, 200.0, 180.0], [50.0, 200.0]),
             ],
             ..Default::default()
-        };
-        c.maze.cols = 1;
-        c.maze.rows = 1;
-        c.maze.cell_px = 400.0;
+        }
+        .open_hall(400.0);
         c.episode.min_goal_distance_px = 0.0;
         c.orca.sense_range_px = Some(150.0);
         let ev = Evaluator::new(c.validate().expect("valid"), Scenes::MazePerSeed);

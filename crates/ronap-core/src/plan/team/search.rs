@@ -438,15 +438,7 @@ mod tests {
     /// A scene: an open hall, or a maze of `cols` x `cols` cells, with its grid for discs of
     /// radius 5.
     fn scene(maze: bool, cols: u32, seed: u64) -> PlanGrid {
-        let mut c = crate::SimConfig::default();
-        if maze {
-            c.maze.cols = cols;
-            c.maze.rows = cols;
-        } else {
-            c.maze.cols = 1;
-            c.maze.rows = 1;
-            c.maze.cell_px = 60.0 * f64::from(cols);
-        }
+        let c = crate::SimConfig::default().hall_or_maze(maze, cols, 60.0);
         let world = World::maze(c.validate().expect("valid"), seed);
         PlanGrid::best(world.scene(), 5.5, 18.4, &[])
     }

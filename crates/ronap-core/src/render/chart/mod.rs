@@ -93,15 +93,6 @@ pub fn outcome_colour(outcome: Outcome) -> Rgb<u8> {
     }
 }
 
-const OUTCOMES: [Outcome; 6] = [
-    Outcome::Success,
-    Outcome::Timeout,
-    Outcome::Stuck,
-    Outcome::Collision,
-    Outcome::RewardMin,
-    Outcome::Deadlock,
-];
-
 // ---------------------------------------------------------------------------------------------
 // Input types
 // ---------------------------------------------------------------------------------------------

@@ -144,9 +144,9 @@ pub fn outcome_strip(names: &[String], seeds: &[u64], outcomes: &[Vec<Outcome>])
     let layout = StripLayout::new(seeds.len(), rows, label_chars);
     // Infeasible tasks are keyed only where some are shown.
     let infeasible = outcomes.iter().flatten().any(|o| *o == Outcome::Infeasible);
-    let mut legend: Vec<(Key, String)> = OUTCOMES
+    let mut legend: Vec<(Key, String)> = Outcome::ALL
         .iter()
-        .chain(infeasible.then_some(&Outcome::Infeasible))
+        .filter(|&&o| o != Outcome::Infeasible || infeasible)
         .map(|&o| (Key::Square(outcome_colour(o)), o.name().to_owned()))
         .collect();
     legend.push((Key::Thin(DISAGREE), "policies disagree".to_owned()));

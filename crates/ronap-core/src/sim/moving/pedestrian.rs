@@ -414,10 +414,7 @@ mod tests {
     /// An open 400 px hall with `count` ORCA pedestrians crossing a circle of radius 120, the
     /// robot turning on the spot in a corner.
     fn crossing(count: u32, sees_robots: bool) -> crate::SimConfig {
-        let mut c = crate::SimConfig::default();
-        c.maze.cols = 1;
-        c.maze.rows = 1;
-        c.maze.cell_px = 400.0;
+        let mut c = crate::SimConfig::default().open_hall(400.0);
         c.scene.seed = Some(0);
         c.episode.start = Some([20.0, 20.0, 0.0]);
         c.episode.goal = Some([380.0, 380.0]);

@@ -466,11 +466,9 @@ mod tests {
         let mut c = crate::SimConfig {
             robots: vec![at(150.0), at(190.0)],
             ..Default::default()
-        };
+        }
+        .open_hall(1000.0);
         c.scene.seed = Some(0);
-        c.maze.cols = 1;
-        c.maze.rows = 1;
-        c.maze.cell_px = 1000.0;
         c.robot.shape = crate::config::Shape::Rectangle;
         c.robot.length_px = Some(20.0);
         c.robot.width_px = Some(10.0);
