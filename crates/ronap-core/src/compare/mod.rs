@@ -517,7 +517,7 @@ fn run_one(
 }
 
 /// The comparison's error when contender `c`'s policy could not be made or run.
-fn policy_error(c: &Contender, source: crate::policy::PolicyError) -> CompareError {
+fn policy_error(c: &Contender, source: PolicyError) -> CompareError {
     CompareError::Policy {
         policy: c.name.clone(),
         source,
