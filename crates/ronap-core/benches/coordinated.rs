@@ -5,6 +5,7 @@
 //!
 //! `cargo bench -p ronap-core --bench coordinated`.
 
+use common::big_maze;
 use criterion::{criterion_group, criterion_main, Criterion};
 use ronap_core::config::{OnArrival, SimConfig, TeamRobotConfig};
 use ronap_core::policy::{Coordinated, TeamPolicy};
@@ -12,6 +13,8 @@ use ronap_core::run::TeamRollout;
 use ronap_core::sim::{Scenes, Worlds};
 use ronap_core::ValidConfig;
 use std::time::{Duration, Instant};
+
+mod common;
 
 /// `robots` robots that leave on arrival, in `config`.
 fn with_robots(mut c: SimConfig, robots: u32) -> ValidConfig {
@@ -35,12 +38,7 @@ fn hall() -> ValidConfig {
 
 /// `robots-1000.toml`: 1000 robots in a 40 x 40 maze with 64-beam 360-degree lasers.
 fn thousand() -> ValidConfig {
-    let mut c = SimConfig::default();
-    c.maze.cols = 40;
-    c.maze.rows = 40;
-    c.laser.beams = 64;
-    c.laser.fov_deg = 360.0;
-    c.laser.range_px = 200.0;
+    let mut c = big_maze();
     c.episode.max_steps = 100_000;
     with_robots(c, 1000)
 }

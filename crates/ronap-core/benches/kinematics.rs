@@ -5,11 +5,12 @@
 //! `cargo bench -p ronap-core --bench kinematics`. Target: a `diff_drive` or `ackermann` step
 //! within 20% of the `unicycle` step; the rectangle footprint's step is shown beside them.
 
+use common::bench_steps;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use ronap_core::config::{KinematicsKind, Shape};
-use ronap_core::sim::maze_scene;
-use ronap_core::{Action, Episode, SimConfig};
-use std::sync::Arc;
+use ronap_core::{Action, SimConfig};
+
+mod common;
 
 /// Commands in turn: straight, arcs either way, a turn on the spot.
 const COMMANDS: [(f64, f64); 6] = [
@@ -56,23 +57,12 @@ fn step(c: &mut Criterion) {
         ("unicycle_rectangle", model(KinematicsKind::Unicycle, true)),
     ] {
         let config = sim.validate().expect("valid");
-        let scene = Arc::new(maze_scene(&config, 0));
-        let mut seed = 0;
-        let mut episode = Episode::new(&config, scene.clone(), seed).expect("default scene");
-        let mut k = 0;
-        group.bench_function(name, |b| {
-            b.iter(|| {
-                k += 1;
-                let (v, w_deg) = COMMANDS[k % COMMANDS.len()];
-                let done = episode
-                    .step(Action::Continuous { v, w_deg })
-                    .status
-                    .is_done();
-                if done {
-                    seed += 1;
-                    episode = Episode::new(&config, scene.clone(), seed).expect("default scene");
-                }
-            })
+        bench_steps(&mut group, name, &config, |episode, k| {
+            let (v, w_deg) = COMMANDS[k % COMMANDS.len()];
+            episode
+                .step(Action::Continuous { v, w_deg })
+                .status
+                .is_done()
         });
     }
     group.finish();

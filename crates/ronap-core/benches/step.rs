@@ -7,6 +7,7 @@
 //! open hall (`step/100_orca_pedestrians`) the target is 5 us a step (200,000 steps/s). A 360-beam
 //! scan among 500 discs (`scan/360_beams_200px_500_discs`) within 4x of one among 100.
 
+use common::{bench_steps, PATTERN};
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion, Throughput};
 use ronap_core::geometry::{unit, ParryScene};
 use ronap_core::policy::{Decision, Policy};
@@ -16,8 +17,7 @@ use ronap_core::{Action, DiscreteAction, Episode, Laser, ValidConfig};
 use std::hint::black_box;
 use std::sync::Arc;
 
-/// The action pattern `ronap bench` uses too: mostly ahead, some turns.
-const PATTERN: [usize; 8] = [1, 1, 1, 0, 1, 1, 2, 1];
+mod common;
 
 /// The default configuration with 100 `random_walk` discs (radius 8 px, 2 px a step).
 fn crowd_config() -> ronap_core::SimConfig {
@@ -62,22 +62,11 @@ fn step(c: &mut Criterion) {
         let mut sim = sim;
         sim.episode.max_steps = 1_000_000;
         let config = sim.validate().expect("valid");
-        let scene = Arc::new(maze_scene(&config, 0));
-        let mut seed = 0;
-        let mut episode = Episode::new(&config, scene.clone(), seed).expect("default scene");
-        let mut k = 0;
-        group.bench_function(name, |b| {
-            b.iter(|| {
-                k += 1;
-                let done = episode
-                    .step_index(PATTERN[k % PATTERN.len()])
-                    .map(|r| r.status.is_done())
-                    .unwrap_or(true);
-                if done {
-                    seed += 1;
-                    episode = Episode::new(&config, scene.clone(), seed).expect("default scene");
-                }
-            })
+        bench_steps(&mut group, name, &config, |episode, k| {
+            episode
+                .step_index(PATTERN[k % PATTERN.len()])
+                .map(|r| r.status.is_done())
+                .unwrap_or(true)
         });
     }
     group.finish();

@@ -5,23 +5,18 @@
 //!
 //! `cargo bench -p ronap-core --bench team`.
 
+use common::{big_maze, PATTERN};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use ronap_core::config::{SimConfig, TeamRobotConfig};
 use ronap_core::run::TeamRollout;
 use ronap_core::sim::{Action, DiscreteAction, Scenes, Worlds};
 use std::time::Duration;
 
-/// The action pattern `ronap bench` uses: mostly ahead, some turns.
-const PATTERN: [usize; 8] = [1, 1, 1, 0, 1, 1, 2, 1];
+mod common;
 
 /// `robots` robots with 64-beam 360-degree lasers of range 200 px in a 40 x 40 maze.
 fn big_team(robots: u32) -> SimConfig {
-    let mut c = SimConfig::default();
-    c.maze.cols = 40;
-    c.maze.rows = 40;
-    c.laser.beams = 64;
-    c.laser.fov_deg = 360.0;
-    c.laser.range_px = 200.0;
+    let mut c = big_maze();
     c.episode.max_steps = u32::MAX;
     c.episode.deadlock_steps = u32::MAX;
     c.robots = vec![TeamRobotConfig {
