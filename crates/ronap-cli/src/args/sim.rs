@@ -1,7 +1,7 @@
 //! Model and scene flags: a config file and the flags that override it, resolved once into the
 //! core's validated configuration, and where episodes take place.
 
-use crate::args::{fraction, positive, seed};
+use crate::args::{fraction, positive, seed, ThreadArgs};
 use anyhow::{Context, Result};
 use clap::Args;
 use ronap_core::config::ConfigFile;
@@ -192,6 +192,27 @@ impl SceneArgs {
             }
             _ => Ok(loaded?),
         }
+    }
+}
+
+/// The worker-thread, scene and model flags of the commands that gather their own experience
+/// (`ronap collect`, `ronap train dqn`).
+#[derive(Args, Debug, Clone, Default)]
+pub struct WorkArgs {
+    #[command(flatten)]
+    pub threads: ThreadArgs,
+    #[command(flatten)]
+    pub scenes: SceneArgs,
+    #[command(flatten)]
+    pub sim: SimArgs,
+}
+
+impl WorkArgs {
+    /// The validated configuration (the file, the flags, then `more`) and the scenes.
+    pub fn resolve_with(&self, more: impl FnOnce(&mut SimConfig)) -> Result<(ValidConfig, Scenes)> {
+        let config = self.sim.config_with(more)?;
+        let (scenes, _) = self.scenes.scenes(&self.sim, &config)?;
+        Ok((config, scenes))
     }
 }
 

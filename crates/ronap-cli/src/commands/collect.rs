@@ -3,7 +3,7 @@
 //! data-log format.
 
 use crate::args::named_policy;
-use crate::args::{count, seed, SceneArgs, SimArgs, ThreadArgs};
+use crate::args::{count, seed, WorkArgs};
 use crate::output::cancel_on_ctrl_c;
 use anyhow::{bail, Context, Result};
 use clap::{Args, ValueEnum};
@@ -54,11 +54,7 @@ pub struct CollectArgs {
     #[arg(long, allow_negative_numbers = true, value_name = "SEED", default_value_t = 1_000_000, value_parser = seed)]
     seed_start: u64,
     #[command(flatten)]
-    threads: ThreadArgs,
-    #[command(flatten)]
-    scenes: SceneArgs,
-    #[command(flatten)]
-    sim: SimArgs,
+    work: WorkArgs,
     /// Output CSV [default: <user>_<YYYYmmddHHMMSS>.csv].
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
@@ -83,8 +79,7 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
     if expert != "geodesic" {
         bail!("--expert {expert:?}: unknown expert (expected geodesic)");
     }
-    let config = args.sim.config()?;
-    let (scenes, _) = args.scenes.scenes(&args.sim, &config)?;
+    let (config, scenes) = args.work.resolve_with(|_| {})?;
     let driver = match (&args.driver, args.mode) {
         (Some(_), Mode::Repose) => bail!("--driver needs --mode drive"),
         (Some(name), Mode::Drive) => Some(named_policy("--driver", name, &config)?),
@@ -103,7 +98,7 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
         Mode::Repose => Posing::Repose,
         Mode::Drive => Posing::Drive,
     };
-    let threads = args.threads.count();
+    let threads = args.work.threads.count();
     let cancel = cancel_on_ctrl_c("writing the rows recorded so far");
     let bar = crate::output::progress_bar(
         args.samples,
@@ -188,8 +183,7 @@ fn run_human(args: CollectArgs) -> Result<ExitCode> {
     if args.mode == Mode::Drive {
         bail!("--human records in the paper's re-posing mode: --mode drive is for --expert");
     }
-    let config = args.sim.config()?;
-    let (scenes, _) = args.scenes.scenes(&args.sim, &config)?;
+    let (config, scenes) = args.work.resolve_with(|_| {})?;
     let user = args
         .user
         .clone()

@@ -203,8 +203,16 @@ impl Job {
         Ok((writer, cancel, bar))
     }
 
-    /// The options and manifest information of this run on `threads` workers.
-    fn options(&self, threads: usize) -> (EvalOptions, RunInfo) {
+    /// Runs `evaluate` (one robot's episodes or a team's) on the request of this run's seeds of
+    /// `evaluator` on `threads` workers, into `writer`, stopped when `cancel` is set.
+    fn evaluate<T>(
+        &self,
+        evaluator: &Evaluator,
+        threads: usize,
+        writer: RunWriter,
+        cancel: &AtomicBool,
+        evaluate: impl FnOnce(RunRequest<'_>) -> T,
+    ) -> T {
         let options = EvalOptions {
             seeds: self.seeds.clone(),
             threads,
@@ -216,7 +224,13 @@ impl Job {
             scenes: self.info_scenes.clone(),
             map: self.map.clone(),
         };
-        (options, info)
+        evaluate(RunRequest {
+            evaluator,
+            options: &options,
+            info: &info,
+            writer: Some(writer),
+            cancel,
+        })
     }
 
     /// How the run ended, as the exit says it: a write error or a failed episode (an error
@@ -402,15 +416,9 @@ fn run_lone(
         .with_context(|| format!("cannot start episodes in this scene (seed {first})"))?;
     let (writer, cancel, bar) =
         job.begin(writer, "episodes", format!("ronap run {}", job.policy))?;
-    let (options, info) = job.options(threads);
-    let request = RunRequest {
-        evaluator: &evaluator,
-        options: &options,
-        info: &info,
-        writer: Some(writer),
-        cancel: &cancel,
-    };
-    let evaluation = evaluate_into(request, factory.as_ref(), &|_| bar.inc(1), &|_| false)?;
+    let evaluation = job.evaluate(&evaluator, threads, writer, &cancel, |request| {
+        evaluate_into(request, factory.as_ref(), &|_| bar.inc(1), &|_| false)
+    })?;
     bar.finish_and_clear();
     let (result, summary) = (&evaluation.result, &evaluation.summary);
 
@@ -464,15 +472,9 @@ fn run_team(
         "team episodes",
         format!("ronap run {} robots", names.len()),
     )?;
-    let (options, info) = job.options(threads);
-    let request = RunRequest {
-        evaluator: &evaluator,
-        options: &options,
-        info: &info,
-        writer: Some(writer),
-        cancel: &cancel,
-    };
-    let evaluation = evaluate_team_into(request, &policies, &|_| bar.inc(1), &|_| false)?;
+    let evaluation = job.evaluate(&evaluator, threads, writer, &cancel, |request| {
+        evaluate_team_into(request, &policies, &|_| bar.inc(1), &|_| false)
+    })?;
     bar.finish_and_clear();
     let mut stdout = std::io::stdout().lock();
     writeln!(

@@ -1,6 +1,6 @@
 //! `ronap train bc|dqn`: train a policy network and write it as a safetensors weights file.
 
-use crate::args::{count, fraction, seed, SceneArgs, SimArgs, ThreadArgs};
+use crate::args::{count, fraction, seed, WorkArgs};
 use anyhow::{bail, Context, Result};
 use clap::{Args, Subcommand};
 use indicatif::ProgressBar;
@@ -209,11 +209,7 @@ struct DqnArgs {
     #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 50_000, value_parser = count)]
     report_every: u64,
     #[command(flatten)]
-    threads: ThreadArgs,
-    #[command(flatten)]
-    scenes: SceneArgs,
-    #[command(flatten)]
-    sim: SimArgs,
+    work: WorkArgs,
 }
 
 /// Layer widths from the command line.
@@ -540,7 +536,7 @@ fn train_bc(args: BcArgs) -> Result<ExitCode> {
 
 fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
     check_out(&args.net.out)?;
-    let config = args.sim.config_with(|sim| {
+    let (config, scenes) = args.work.resolve_with(|sim| {
         if let Some(n) = args.max_steps {
             sim.episode.max_steps = n;
         }
@@ -550,7 +546,6 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
         // Shaping keeps the optimal policy exactly at the learner's own discount.
         sim.reward.shaping_gamma = args.shaping_gamma.unwrap_or(args.gamma);
     })?;
-    let (scenes, _) = args.scenes.scenes(&args.sim, &config)?;
     let evaluator = Evaluator::new(config, scenes);
     evaluator
         .world(args.seed_start)
@@ -604,7 +599,7 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
         seed: args.net.seed,
         seed_start: args.seed_start,
     };
-    let threads = args.threads.count();
+    let threads = args.work.threads.count();
     let mut stdout = std::io::stdout().lock();
     writeln!(
         stdout,
@@ -612,7 +607,7 @@ fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
         options.steps,
         options.envs,
         if threads == 1 { "" } else { "s" },
-        args.sim.config()?.observation_size(),
+        args.work.sim.config()?.observation_size(),
         options
             .hidden
             .iter()
