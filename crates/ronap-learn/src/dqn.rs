@@ -537,16 +537,33 @@ mod tests {
         Evaluator::new(open_room_config().validate().unwrap(), Scenes::MazePerSeed)
     }
 
+    /// A small network's options: one hidden layer of `width`, `steps` environment steps over
+    /// `width / 2` environments, batches of `2 * width` after a warm-up of `16 * width` steps.
+    fn small(width: usize, steps: u64) -> DqnOptions {
+        DqnOptions {
+            hidden: vec![width],
+            steps,
+            warmup: 16 * width,
+            batch: 2 * width,
+            envs: width / 2,
+            ..DqnOptions::default()
+        }
+    }
+
+    /// Validation every `every` steps on the `count` seeds from 500, deciding by `decision`,
+    /// under a step limit of `max_steps`.
+    fn validation(every: u64, count: u64, decision: DecisionRule, max_steps: u32) -> Validation {
+        Validation {
+            every,
+            seeds: Seeds::Range { start: 500, count },
+            decision,
+            max_steps: Some(max_steps),
+        }
+    }
+
     #[test]
     fn same_network_on_any_thread_count() {
-        let options = DqnOptions {
-            hidden: vec![16],
-            steps: 2_000,
-            warmup: 256,
-            batch: 32,
-            envs: 8,
-            ..DqnOptions::default()
-        };
+        let options = small(16, 2_000);
         let run = |threads| {
             train(
                 &open_room(),
@@ -571,27 +588,19 @@ mod tests {
         c.reward.shaping = ronap_core::config::Shaping::Geodesic;
         let evaluator = Evaluator::new(c.validate().unwrap(), Scenes::MazePerSeed);
         let options = DqnOptions {
-            hidden: vec![16],
-            steps: 3_000,
-            warmup: 256,
-            batch: 32,
-            envs: 8,
             n_step: 1,
             dueling: false,
             loss: Loss::Mse,
             grad_clip: Some(1.0),
             lr_end_fraction: 0.1,
             prioritized: Some(Priorities::default()),
-            validation: Some(Validation {
-                every: 1000,
-                seeds: Seeds::Range {
-                    start: 500,
-                    count: 10,
-                },
-                decision: DecisionRule::Sample { temperature: 0.3 },
-                max_steps: Some(300),
-            }),
-            ..DqnOptions::default()
+            validation: Some(validation(
+                1000,
+                10,
+                DecisionRule::Sample { temperature: 0.3 },
+                300,
+            )),
+            ..small(16, 3_000)
         };
         let mut reports = Vec::new();
         let mut run = |threads| {
@@ -629,23 +638,10 @@ mod tests {
     fn validation_runs_under_its_own_step_limit() {
         // One step is too few to reach any goal: validation under a one-step limit must find
         // no success, whatever the network, while the training episodes keep their own limit.
-        let evaluator = Evaluator::new(open_room_config().validate().unwrap(), Scenes::MazePerSeed);
+        let evaluator = open_room();
         let options = DqnOptions {
-            hidden: vec![8],
-            steps: 1_000,
-            warmup: 128,
-            batch: 16,
-            envs: 4,
-            validation: Some(Validation {
-                every: 500,
-                seeds: Seeds::Range {
-                    start: 500,
-                    count: 5,
-                },
-                decision: DecisionRule::Argmax,
-                max_steps: Some(1),
-            }),
-            ..DqnOptions::default()
+            validation: Some(validation(500, 5, DecisionRule::Argmax, 1)),
+            ..small(8, 1_000)
         };
         let mut best = Vec::new();
         let mlp = train(&evaluator, &options, 1, HashMap::new(), 500, &mut |r| {
