@@ -1,9 +1,20 @@
 //! End-to-end tests of the `ronap` binary: outputs read back and checked, bad input rejected.
 
 use crate::util::{
-    assert_rejected, assert_rejected_in_empty_dir, assert_rejected_leaving_nothing, ok, repo_root,
-    ronap, stderr, stdout,
+    assert_rejected, assert_rejected_in_empty_dir, assert_rejected_leaving_nothing, ok, ronap,
+    shipped, stderr, stdout,
 };
+
+/// Runs `ronap maze <flags…> --out <out>`.
+fn maze_to(flags: &[&str], out: &std::path::Path) -> std::process::Output {
+    ronap(&[&["maze"], flags, &["--out", out.to_str().unwrap()]].concat())
+}
+
+/// Stdout of `ronap bench --seconds 0.01 <more…>`, a bench too short to time anything but its
+/// header and table.
+fn quick_bench(more: &[&str]) -> String {
+    ok(&ronap(&[&["bench", "--seconds", "0.01"], more].concat()))
+}
 
 #[test]
 fn maze_prints_text_by_default() {
@@ -43,7 +54,7 @@ fn colour_count(img: &image::RgbImage, pred: impl Fn(&image::Rgb<u8>) -> bool) -
 fn maze_draws_every_robot_of_a_team_in_its_colour() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("team.png");
-    let scenario = repo_root().join("scenarios/warehouse-team.toml");
+    let scenario = shipped("warehouse-team.toml");
     let o = ronap(&[
         "maze",
         "--scenario",
@@ -70,14 +81,7 @@ fn maze_draws_every_robot_of_a_team_in_its_colour() {
 fn maze_png_has_walls_floor_start_and_goal() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("maze.png");
-    let o = ronap(&[
-        "maze",
-        "--seed",
-        "7",
-        "--start-goal",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = maze_to(&["--seed", "7", "--start-goal"], &out);
     assert!(o.status.success(), "{}", stderr(&o));
     let img = image::open(&out).unwrap().to_rgb8();
     assert_eq!(img.dimensions(), (1000, 1000));
@@ -93,17 +97,10 @@ fn maze_png_has_walls_floor_start_and_goal() {
     assert!(red > 20 && green > 200, "red {red} green {green}");
     // The same seed draws the same picture; another seed another.
     let again = dir.path().join("again.png");
-    ronap(&[
-        "maze",
-        "--seed",
-        "7",
-        "--start-goal",
-        "--out",
-        again.to_str().unwrap(),
-    ]);
+    maze_to(&["--seed", "7", "--start-goal"], &again);
     assert_eq!(std::fs::read(&out).unwrap(), std::fs::read(&again).unwrap());
     let other = dir.path().join("other.png");
-    ronap(&["maze", "--seed", "8", "--out", other.to_str().unwrap()]);
+    maze_to(&["--seed", "8"], &other);
     assert_ne!(std::fs::read(&out).unwrap(), std::fs::read(&other).unwrap());
 }
 
@@ -111,23 +108,23 @@ fn maze_png_has_walls_floor_start_and_goal() {
 fn maze_flags_shape_the_picture() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("small.pgm");
-    let o = ronap(&[
-        "maze",
-        "--cols",
-        "4",
-        "--rows",
-        "3",
-        "--cell",
-        "50",
-        "--wall-thickness",
-        "4",
-        "--loops",
-        "0",
-        "--scale",
-        "2",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = maze_to(
+        &[
+            "--cols",
+            "4",
+            "--rows",
+            "3",
+            "--cell",
+            "50",
+            "--wall-thickness",
+            "4",
+            "--loops",
+            "0",
+            "--scale",
+            "2",
+        ],
+        &out,
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     // A binary PGM (P5), as map servers read it, not the PAM (P7) `image` writes by default.
     assert_eq!(&std::fs::read(&out).unwrap()[..3], b"P5\n");
@@ -230,10 +227,7 @@ fn bench_reports_steps_per_second_and_scan_time() {
 
 #[test]
 fn bench_takes_its_laser_and_scene_from_the_flags() {
-    let o = ronap(&[
-        "bench",
-        "--seconds",
-        "0.01",
+    let text = quick_bench(&[
         "--threads",
         "1",
         "--beams",
@@ -247,7 +241,6 @@ fn bench_takes_its_laser_and_scene_from_the_flags() {
         "--rows",
         "3",
     ]);
-    let text = ok(&o);
     let header = text.lines().next().unwrap();
     assert!(
         header.contains("maze of seed 0 of 500 x 300 px"),
@@ -263,17 +256,9 @@ fn bench_takes_its_laser_and_scene_from_the_flags() {
         "{scan}"
     );
 
-    let office = repo_root().join("scenarios/office.png");
-    let o = ronap(&[
-        "bench",
-        "--seconds",
-        "0.01",
-        "--threads",
-        "1",
-        "--map",
-        office.to_str().unwrap(),
-    ]);
-    let header = ok(&o).lines().next().unwrap().to_string();
+    let office = shipped("office.png");
+    let bench = quick_bench(&["--threads", "1", "--map", office.to_str().unwrap()]);
+    let header = bench.lines().next().unwrap();
     assert!(header.contains("office.png of 720 x 480 px"), "{header}");
 
     assert_rejected(&["bench", "--beams", "4097"], &["--beams", "4096"]);
@@ -288,12 +273,11 @@ fn bench_takes_its_laser_and_scene_from_the_flags() {
 /// Maze flags for a scene that is not a maze are refused by name, not silently ignored.
 #[test]
 fn maze_flags_are_refused_for_other_scenes() {
-    let root = repo_root();
-    let office = root.join("scenarios/office.png");
+    let office = shipped("office.png");
     let office = office.to_str().unwrap();
-    let warehouse = root.join("scenarios/warehouse-forklifts.toml");
+    let warehouse = shipped("warehouse-forklifts.toml");
     let warehouse = warehouse.to_str().unwrap();
-    let map = root.join("scenarios/map-mover.toml");
+    let map = shipped("map-mover.toml");
     let map = map.to_str().unwrap();
     let out = tempfile::tempdir().unwrap();
     let run = out.path().join("run");
@@ -339,17 +323,7 @@ fn maze_flags_are_refused_for_other_scenes() {
 
 #[test]
 fn bench_sweep_tabulates_every_beam_count_and_range() {
-    let o = ronap(&[
-        "bench",
-        "--sweep",
-        "--seconds",
-        "0.01",
-        "--cols",
-        "4",
-        "--rows",
-        "4",
-    ]);
-    let text = ok(&o);
+    let text = quick_bench(&["--sweep", "--cols", "4", "--rows", "4"]);
     let mut lines = text.lines();
     let header = lines.next().unwrap();
     assert!(

@@ -1,8 +1,26 @@
 //! End-to-end tests of `ronap compare`: the table and every file read back, the same episodes as
 //! separate `ronap run`s, identical policies, reused runs, difficulty bins and bad input.
 
-use crate::util::{assert_rejected, json, ok, repo_root, ronap, rows};
+use crate::util::{assert_rejected, json, ok, repo_root, ronap, rows, run_args, shipped};
 use std::path::Path;
+
+/// The pair of policies most tests compare.
+const APF_GEODESIC: [&str; 4] = ["--policy", "apf", "--policy", "geodesic"];
+
+/// [`APF_GEODESIC`], binned by difficulty.
+const APF_GEODESIC_BY_DIFFICULTY: [&str; 6] = [
+    "--policy",
+    "apf",
+    "--policy",
+    "geodesic",
+    "--by",
+    "difficulty",
+];
+
+/// The first pair's verdict in `compare.json` is `verdict`.
+fn assert_verdict(pair: &serde_json::Value, verdict: &str) {
+    assert_eq!(pair["verdict"].as_str(), Some(verdict), "{pair}");
+}
 
 fn compare(out: &Path, extra: &[&str]) -> String {
     let mut args = vec!["compare", "--seeds", "16", "--out", out.to_str().unwrap()];
@@ -14,7 +32,7 @@ fn compare(out: &Path, extra: &[&str]) -> String {
 fn compare_prints_the_table_and_writes_the_report_and_the_runs() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("cmp");
-    let table = compare(&out, &["--policy", "apf", "--policy", "geodesic"]);
+    let table = compare(&out, &APF_GEODESIC);
     for needle in [
         "success = the robot's centre comes within 10 px",
         "success (95% CI)",
@@ -58,15 +76,7 @@ fn compare_prints_the_table_and_writes_the_report_and_the_runs() {
     assert!(leftovers.is_empty(), "{leftovers:?}");
     // Each policy's run is the one `ronap run` makes.
     let alone = dir.path().join("alone");
-    ok(&ronap(&[
-        "run",
-        "--policy",
-        "apf",
-        "--seeds",
-        "16",
-        "--out",
-        alone.to_str().unwrap(),
-    ]));
+    ok(&ronap(&run_args("apf", &["--seeds", "16"], &alone)));
     assert_eq!(
         std::fs::read(alone.join("episodes.csv")).unwrap(),
         std::fs::read(out.join("runs/apf/episodes.csv")).unwrap()
@@ -93,9 +103,9 @@ fn two_identical_policies_show_no_difference() {
     );
     assert_eq!(pair["mcnemar_p"].as_f64(), Some(1.0));
     assert_eq!(pair["spl_diff"].as_f64(), Some(0.0));
-    assert_eq!(
-        pair["verdict"].as_str(),
-        Some("success: too few discordant seeds; SPL: not significant")
+    assert_verdict(
+        pair,
+        "success: too few discordant seeds; SPL: not significant",
     );
     // They agree on every seed: no contact sheet.
     assert!(!out.join("disagreements.png").exists());
@@ -105,7 +115,7 @@ fn two_identical_policies_show_no_difference() {
 fn a_reused_run_gives_the_same_comparison() {
     let dir = tempfile::tempdir().unwrap();
     let fresh = dir.path().join("fresh");
-    compare(&fresh, &["--policy", "apf", "--policy", "geodesic"]);
+    compare(&fresh, &APF_GEODESIC);
     let reused = dir.path().join("reused");
     let geodesic_run = fresh.join("runs/geodesic");
     let table = compare(
@@ -157,17 +167,7 @@ fn a_reused_run_gives_the_same_comparison() {
 fn by_difficulty_bins_every_seed() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("cmp");
-    let table = compare(
-        &out,
-        &[
-            "--policy",
-            "apf",
-            "--policy",
-            "geodesic",
-            "--by",
-            "difficulty",
-        ],
-    );
+    let table = compare(&out, &APF_GEODESIC_BY_DIFFICULTY);
     assert!(table.contains("by path / straight ratio"), "{table}");
     let report = json(&out.join("compare.json"));
     let by = report["by_difficulty"].as_array().unwrap();
@@ -227,17 +227,7 @@ fn bad_input_is_named() {
 fn one_seed_calls_nothing_and_an_earlier_comparison_leaves_nothing_behind() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("cmp");
-    compare(
-        &out,
-        &[
-            "--policy",
-            "apf",
-            "--policy",
-            "geodesic",
-            "--by",
-            "difficulty",
-        ],
-    );
+    compare(&out, &APF_GEODESIC_BY_DIFFICULTY);
     assert!(out.join("difficulty.png").exists());
     let o = ok(&ronap(&[
         "compare",
@@ -256,9 +246,9 @@ fn one_seed_calls_nothing_and_an_earlier_comparison_leaves_nothing_behind() {
     assert!(o.contains("1 seeds (3 to 3)"), "{o}");
     let pair = &json(&out.join("compare.json"))["pairs"][0];
     assert!(pair["spl_diff_ci95"].is_null(), "{pair}");
-    assert_eq!(
-        pair["verdict"].as_str(),
-        Some("success: too few discordant seeds; SPL: too few seeds")
+    assert_verdict(
+        pair,
+        "success: too few discordant seeds; SPL: too few seeds",
     );
     // The earlier comparison's difficulty picture is gone with it.
     assert!(!out.join("difficulty.png").exists());
@@ -268,16 +258,12 @@ fn one_seed_calls_nothing_and_an_earlier_comparison_leaves_nothing_behind() {
 fn a_fresh_run_never_overwrites_a_reused_one() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("cmp");
-    compare(&out, &["--policy", "apf", "--policy", "geodesic"]);
+    compare(&out, &APF_GEODESIC);
     let apf = out.join("runs/apf");
     let before = std::fs::read(apf.join("episodes.csv")).unwrap();
     // Reuse runs/apf while running another policy whose label is also `apf` into the same --out.
     let weights = dir.path().join("apf.safetensors");
-    std::fs::copy(
-        crate::util::repo_root().join("policies/bc.safetensors"),
-        &weights,
-    )
-    .unwrap();
+    std::fs::copy(repo_root().join("policies/bc.safetensors"), &weights).unwrap();
     let policy = format!("mlp:{}", weights.display());
     assert_rejected(
         &[
@@ -300,8 +286,8 @@ fn a_fresh_run_never_overwrites_a_reused_one() {
 fn a_team_scenario_is_compared_on_team_success_with_a_table_per_robot() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("cmp");
-    let scenario = repo_root().join("scenarios/warehouse-team.toml");
-    let o = ok(&ronap(&[
+    let scenario = shipped("warehouse-team.toml");
+    let team = [
         "compare",
         "--scenario",
         scenario.to_str().unwrap(),
@@ -309,13 +295,16 @@ fn a_team_scenario_is_compared_on_team_success_with_a_table_per_robot() {
         "geodesic",
         "--policy",
         "random",
+    ];
+    let more = [
         "--seeds",
         "6",
         "--max-steps",
         "600",
         "--out",
         out.to_str().unwrap(),
-    ]));
+    ];
+    let o = ok(&ronap(&[&team[..], &more].concat()));
     for part in [
         "team success = each of the 8 robots",
         "Teams (a success: every robot arrived)",
@@ -354,19 +343,7 @@ fn a_team_scenario_is_compared_on_team_success_with_a_table_per_robot() {
     assert!(out.join("compare.png").exists() && out.join("outcomes.png").exists());
     // What a team comparison cannot do yet is refused by name.
     assert_rejected(
-        &[
-            "compare",
-            "--scenario",
-            scenario.to_str().unwrap(),
-            "--policy",
-            "geodesic",
-            "--policy",
-            "random",
-            "--seeds",
-            "2",
-            "--by",
-            "difficulty",
-        ],
+        &[&team[..], &["--seeds", "2", "--by", "difficulty"]].concat(),
         &["--by difficulty", "team scenarios"],
     );
 }

@@ -20,7 +20,7 @@ fn run<'a>(policy: &'a str, scenario: &'a str, seeds: &'a str, out: &'a str) -> 
 
 /// Successes of `policy` over seeds 0 to `seeds - 1` of shipped scenario `name`.
 fn successes(name: &str, policy: &str, seeds: &str, out: &std::path::Path) -> u64 {
-    let scenario = repo_root().join("scenarios").join(name);
+    let scenario = shipped(name);
     let (scenario, out_text) = (scenario.to_str().unwrap(), out.to_str().unwrap());
     ok(&ronap(&run(policy, scenario, seeds, out_text)));
     summary(out)["successes"].as_u64().unwrap()
@@ -47,7 +47,7 @@ fn each_models_scenario_runs_and_its_robot_reaches_goals() {
 fn a_cars_logged_episode_reads_back_its_steering_commands_and_replays() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("run");
-    let scenario = repo_root().join("scenarios/warehouse-forklift.toml");
+    let scenario = shipped("warehouse-forklift.toml");
     let args = run(
         "geodesic",
         scenario.to_str().unwrap(),
@@ -111,7 +111,7 @@ fn a_bad_robot_entry_is_named_with_its_line() {
 #[test]
 fn coordinated_says_it_cannot_drive_a_car() {
     let dir = tempfile::tempdir().unwrap();
-    let team = std::fs::read_to_string(repo_root().join("scenarios/corridor-bay.toml")).unwrap();
+    let team = std::fs::read_to_string(shipped("corridor-bay.toml")).unwrap();
     let file = dir.path().join("cars.toml");
     std::fs::write(
         &file,

@@ -2,7 +2,8 @@
 //! policies against their reported figures.
 
 use crate::util::{
-    assert_rejected, assert_rejected_leaving_nothing, ok, repo_root, ronap, summary, text,
+    assert_rejected, assert_rejected_leaving_nothing, collect_args, ok, repo_root, ronap, run_args,
+    summary, text,
 };
 
 #[test]
@@ -30,15 +31,11 @@ fn collect_train_run_loop() {
 
     // Re-posed rows (the paper's mode) face the goal: direction near 0 or 360.
     let reposed = dir.path().join("reposed.csv");
-    ok(&ronap(&[
-        "collect",
-        "--expert",
+    ok(&ronap(&collect_args(
         "geodesic",
-        "--samples",
-        "200",
-        "--out",
-        reposed.to_str().unwrap(),
-    ]));
+        &["--samples", "200"],
+        &reposed,
+    )));
     let text = std::fs::read_to_string(&reposed).unwrap();
     let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
     let col = header.iter().position(|h| *h == "direction").unwrap();
@@ -83,15 +80,7 @@ fn collect_train_run_loop() {
 
     let run_dir = dir.path().join("run");
     let policy = format!("mlp:{weights_s}@sample:2");
-    ok(&ronap(&[
-        "run",
-        "--policy",
-        &policy,
-        "--seeds",
-        "10",
-        "--out",
-        run_dir.to_str().unwrap(),
-    ]));
+    ok(&ronap(&run_args(&policy, &["--seeds", "10"], &run_dir)));
     assert_eq!(summary(&run_dir)["episodes"], 10);
 }
 
@@ -148,15 +137,7 @@ fn dqn_trains_and_writes_weights() {
 fn bc_writes_its_accuracy_curves_beside_the_weights() {
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("rows.csv");
-    let o = ronap(&[
-        "collect",
-        "--expert",
-        "geodesic",
-        "--samples",
-        "300",
-        "--out",
-        data.to_str().unwrap(),
-    ]);
+    let o = ronap(&collect_args("geodesic", &["--samples", "300"], &data));
     ok(&o);
     let weights = dir.path().join("bc.safetensors");
     ok(&ronap(&[
@@ -287,15 +268,7 @@ fn bad_weights_and_data_are_named() {
     let out = dir.path().join("r");
     let policy = format!("mlp:{}", junk.display());
     assert_rejected_leaving_nothing(
-        &[
-            "run",
-            "--policy",
-            &policy,
-            "--seeds",
-            "1",
-            "--out",
-            out.to_str().unwrap(),
-        ],
+        &run_args(&policy, &["--seeds", "1"], &out),
         &["junk.safetensors", "not a safetensors file"],
         &out,
     );
@@ -374,15 +347,7 @@ fn shipped_policies_reach_their_reported_success() {
             .unwrap()
             .replace("policies/", &format!("{}/", root.display()));
         let dir = tempfile::tempdir().unwrap();
-        ok(&ronap(&[
-            "run",
-            "--policy",
-            &policy,
-            "--seeds",
-            "100",
-            "--out",
-            dir.path().to_str().unwrap(),
-        ]));
+        ok(&ronap(&run_args(&policy, &["--seeds", "100"], dir.path())));
         let got = summary(dir.path())["success_rate"].as_f64().unwrap();
         assert!(
             (got - reported).abs() <= 0.12,
@@ -401,15 +366,11 @@ fn train_fractions_at_the_ends() {
     );
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("expert.csv");
-    ok(&ronap(&[
-        "collect",
-        "--expert",
+    ok(&ronap(&collect_args(
         "geodesic",
-        "--samples",
-        "200",
-        "--out",
-        data.to_str().unwrap(),
-    ]));
+        &["--samples", "200"],
+        &data,
+    )));
     let net = dir.path().join("net.safetensors");
     let out = ok(&ronap(&[
         "train",

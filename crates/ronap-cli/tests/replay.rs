@@ -1,7 +1,7 @@
 //! End-to-end tests of the GIF outputs: `ronap replay` of a step log and `ronap run --gif`, each
 //! decoded back and checked frame by frame; bad input refused with one line and no file.
 
-use crate::util::{assert_rejected, ronap, text};
+use crate::util::{assert_rejected, ronap, run_args, text};
 use image::AnimationDecoder;
 use std::path::Path;
 
@@ -44,20 +44,19 @@ fn steps_of(run: &Path, seed: u64) -> usize {
 /// A run of seeds 6..=7 under `policy` with step logs, in `dir/run`.
 fn logged_run(dir: &Path, policy: &str) -> std::path::PathBuf {
     let run = dir.join("run");
-    let o = ronap(&[
-        "run",
-        "--policy",
+    let o = ronap(&run_args(
         policy,
-        "--seeds",
-        "2",
-        "--seed-start",
-        "6",
-        "--threads",
-        "1",
-        "--log-steps",
-        "--out",
-        run.to_str().unwrap(),
-    ]);
+        &[
+            "--seeds",
+            "2",
+            "--seed-start",
+            "6",
+            "--threads",
+            "1",
+            "--log-steps",
+        ],
+        &run,
+    ));
     assert!(o.status.success(), "{}", text(&o.stderr));
     run
 }
@@ -119,19 +118,11 @@ fn replay_draws_one_frame_per_step_with_the_robot_moving() {
 fn run_gif_writes_the_chosen_seeds_episode() {
     let dir = tempfile::tempdir().unwrap();
     let run = dir.path().join("run");
-    let o = ronap(&[
-        "run",
-        "--policy",
+    let o = ronap(&run_args(
         "apf",
-        "--seeds",
-        "3",
-        "--seed-start",
-        "6",
-        "--gif",
-        "7",
-        "--out",
-        run.to_str().unwrap(),
-    ]);
+        &["--seeds", "3", "--seed-start", "6", "--gif", "7"],
+        &run,
+    ));
     assert!(o.status.success(), "{}", text(&o.stderr));
     let gifs: Vec<_> = std::fs::read_dir(run.join("gif"))
         .unwrap()
@@ -225,17 +216,11 @@ fn bad_replays_are_named_and_write_nothing() {
     // A summary of another setting: the robot meets other walls, and the step where the log
     // leaves the model is named.
     let other = dir.path().join("other");
-    let r = ronap(&[
-        "run",
-        "--policy",
+    let r = ronap(&run_args(
         "random",
-        "--seeds",
-        "1",
-        "--maze-seed",
-        "99",
-        "--out",
-        other.to_str().unwrap(),
-    ]);
+        &["--seeds", "1", "--maze-seed", "99"],
+        &other,
+    ));
     assert!(r.status.success());
     assert_rejected(
         &[
@@ -266,17 +251,7 @@ fn bad_replays_are_named_and_write_nothing() {
 
     let none = dir.path().join("none");
     assert_rejected(
-        &[
-            "run",
-            "--policy",
-            "apf",
-            "--seeds",
-            "3",
-            "--gif",
-            "3",
-            "--out",
-            none.to_str().unwrap(),
-        ],
+        &run_args("apf", &["--seeds", "3", "--gif", "3"], &none),
         &["--gif 3", "0..=2"],
     );
     assert!(!none.exists());

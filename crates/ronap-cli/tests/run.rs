@@ -1,7 +1,10 @@
 //! End-to-end tests of `ronap run`: every output file read back, determinism across thread
 //! counts, the success gate, bad input, maps, APF's local minima, and Ctrl-C.
 
-use crate::util::{assert_rejected, assert_rejected_leaving_nothing, col, json, ronap, rows, text};
+use crate::util::{
+    assert_rejected, assert_rejected_leaving_nothing, col, collect_args, json, ronap, rows,
+    run_args, shipped, text,
+};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -9,20 +12,19 @@ use std::process::Command;
 fn run_writes_episodes_summary_pictures_and_step_logs() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let o = ronap(&[
-        "run",
-        "--policy",
+    let o = ronap(&run_args(
         "geodesic",
-        "--seeds",
-        "6",
-        "--seed-start",
-        "10",
-        "--out",
-        out.to_str().unwrap(),
-        "--png",
-        "2",
-        "--log-steps",
-    ]);
+        &[
+            "--seeds",
+            "6",
+            "--seed-start",
+            "10",
+            "--png",
+            "2",
+            "--log-steps",
+        ],
+        &out,
+    ));
     assert!(o.status.success(), "{}", text(&o.stderr));
     let table = text(&o.stdout);
     for row in [
@@ -100,17 +102,11 @@ fn episodes_csv_is_identical_on_one_and_two_threads() {
         let a = dir.path().join(format!("{policy}-1"));
         let b = dir.path().join(format!("{policy}-2"));
         for (out, threads) in [(&a, "1"), (&b, "2")] {
-            let o = ronap(&[
-                "run",
-                "--policy",
+            let o = ronap(&run_args(
                 policy,
-                "--seeds",
-                "24",
-                "--threads",
-                threads,
-                "--out",
-                out.to_str().unwrap(),
-            ]);
+                &["--seeds", "24", "--threads", threads],
+                out,
+            ));
             assert!(o.status.success(), "{}", text(&o.stderr));
         }
         let (x, y) = (
@@ -128,36 +124,22 @@ fn episodes_csv_is_identical_on_one_and_two_threads() {
 #[test]
 fn min_success_gates_the_exit_code() {
     let dir = tempfile::tempdir().unwrap();
+    let gated = |policy: &str, out: &Path| {
+        ronap(&run_args(
+            policy,
+            &["--seeds", "10", "--min-success", "0.9"],
+            out,
+        ))
+    };
     let out = dir.path().join("r");
-    let o = ronap(&[
-        "run",
-        "--policy",
-        "random",
-        "--seeds",
-        "10",
-        "--min-success",
-        "0.9",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = gated("random", &out);
     assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
     assert!(text(&o.stderr).contains("below --min-success"));
     assert!(
         out.join("episodes.csv").exists(),
         "results are written before the gate"
     );
-    let out = dir.path().join("g");
-    let o = ronap(&[
-        "run",
-        "--policy",
-        "geodesic",
-        "--seeds",
-        "10",
-        "--min-success",
-        "0.9",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = gated("geodesic", &dir.path().join("g"));
     assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
 }
 
@@ -295,17 +277,11 @@ fn ros_map_yaml_is_read() {
     let yaml = dir.path().join("room.yaml");
     std::fs::write(&yaml, "image: room.pgm\nresolution: 0.05\norigin: [-1.0, -2.0, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n").unwrap();
     let out = dir.path().join("r");
-    let o = ronap(&[
-        "run",
-        "--policy",
+    let o = ronap(&run_args(
         "geodesic",
-        "--seeds",
-        "4",
-        "--map",
-        yaml.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+        &["--seeds", "4", "--map", yaml.to_str().unwrap()],
+        &out,
+    ));
     assert!(o.status.success(), "{}", text(&o.stderr));
     let summary = json(&out.join("summary.json"));
     assert_eq!(summary["map"]["Ros"]["resolution_m"], 0.05);
@@ -336,17 +312,7 @@ fn ctrl_c_keeps_the_finished_episodes() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("r");
     let o = signalled(
-        &[
-            "run",
-            "--policy",
-            "random",
-            "--seeds",
-            "1000000",
-            "--threads",
-            "1",
-            "--out",
-            out.to_str().unwrap(),
-        ],
+        &run_args("random", &["--seeds", "1000000", "--threads", "1"], &out),
         "-INT",
     );
     assert_eq!(o.status.code(), Some(130), "{}", text(&o.stderr));
@@ -359,15 +325,7 @@ fn ctrl_c_keeps_the_finished_episodes() {
     assert!(text(&o.stdout).contains("interrupted"));
     // Starting afresh there would lose them: refused until resumed (or removed).
     assert_rejected(
-        &[
-            "run",
-            "--policy",
-            "random",
-            "--seeds",
-            "2",
-            "--out",
-            out.to_str().unwrap(),
-        ],
+        &run_args("random", &["--seeds", "2"], &out),
         &["was interrupted", "ronap run --resume"],
     );
     assert_eq!(rows(&out.join("episodes.csv")).len() - 1, finished);
@@ -381,17 +339,11 @@ fn sigterm_keeps_the_rows_collected() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("rows.csv");
     let o = signalled(
-        &[
-            "collect",
-            "--expert",
+        &collect_args(
             "geodesic",
-            "--samples",
-            "1000000000",
-            "--threads",
-            "1",
-            "--out",
-            out.to_str().unwrap(),
-        ],
+            &["--samples", "1000000000", "--threads", "1"],
+            &out,
+        ),
         "-TERM",
     );
     assert_eq!(o.status.code(), Some(130), "{}", text(&o.stderr));
@@ -412,17 +364,11 @@ fn collect_says_when_the_seeds_run_out() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("rows.csv");
     assert_rejected(
-        &[
-            "collect",
-            "--expert",
+        &collect_args(
             "geodesic",
-            "--samples",
-            "300",
-            "--seed-start",
-            "18446744073709551614",
-            "--out",
-            out.to_str().unwrap(),
-        ],
+            &["--samples", "300", "--seed-start", "18446744073709551614"],
+            &out,
+        ),
         &["--seed-start", "the seeds ran out"],
     );
     assert_eq!(rows(&out).len() - 1, 100);
@@ -437,17 +383,11 @@ fn config_prints_a_file_that_run_accepts() {
     std::fs::write(&cfg, &o.stdout).unwrap();
     assert!(text(&o.stdout).contains("# Largest reading d_max, px.\nrange_px = 50.0"));
     let out = dir.path().join("r");
-    let o = ronap(&[
-        "run",
-        "--policy",
+    let o = ronap(&run_args(
         "random",
-        "--seeds",
-        "2",
-        "--config",
-        cfg.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+        &["--seeds", "2", "--config", cfg.to_str().unwrap()],
+        &out,
+    ));
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert_eq!(json(&out.join("summary.json"))["config"]["maze"]["cols"], 5);
 }
@@ -457,7 +397,7 @@ fn twenty_orca_robots_swap_across_a_circle_all_home_without_contact() {
     // The bar of CrowdNav's and RVO2's circle: on every one of 50 jittered seeds, every robot
     // arrives and no two ever touch.
     let dir = tempfile::tempdir().unwrap();
-    let scenario = crate::util::repo_root().join("scenarios/circle-robots-20.toml");
+    let scenario = shipped("circle-robots-20.toml");
     crate::util::ok(&ronap(&[
         "run",
         "--scenario",
@@ -498,7 +438,7 @@ fn the_crowd_scenarios_run_and_bad_crowd_entries_are_named() {
         ("circle-crossing", "dwa"),
         ("circle-robots-20", "social-force"),
     ] {
-        let scenario = crate::util::repo_root().join(format!("scenarios/{name}.toml"));
+        let scenario = shipped(&format!("{name}.toml"));
         let out = dir.path().join(format!("{name}-{policy}"));
         crate::util::ok(&ronap(&[
             "run",
@@ -579,26 +519,25 @@ fn the_crowd_scenarios_run_and_bad_crowd_entries_are_named() {
             ),
         )
         .unwrap();
-        let o = ronap(&[
-            "run",
-            "--scenario",
-            bad.to_str().unwrap(),
-            "--policy",
-            "orca",
-            "--seeds",
-            "1",
-        ]);
-        let err = crate::util::stderr(&o);
-        assert_eq!(o.status.code(), Some(2), "{err}");
         let entry = if table == "moving" {
             "moving[1]"
         } else {
             entry
         };
-        // The file, the line, the key and the value to blame.
+        // The file, the line, the key and the value to blame: one line, exit code 2.
         let key = format!("{entry}.pattern_radius_px = 5000.0");
-        assert!(err.contains("big.toml:10") && err.contains(&key), "{err}");
-        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        let err = assert_rejected(
+            &[
+                "run",
+                "--scenario",
+                bad.to_str().unwrap(),
+                "--policy",
+                "orca",
+                "--seeds",
+                "1",
+            ],
+            &["big.toml:10", &key],
+        );
         assert!(!err.contains("panick"), "{err}");
     }
 }
@@ -608,19 +547,11 @@ fn split_names_a_seed_space_and_trained_seeds_are_warned_about() {
     let dir = tempfile::tempdir().unwrap();
     let seeds_of = |split: &str, start: &str| {
         let out = dir.path().join(format!("{split}-{start}"));
-        let o = ronap(&[
-            "run",
-            "--policy",
+        let o = ronap(&run_args(
             "geodesic",
-            "--seeds",
-            "3",
-            "--split",
-            split,
-            "--seed-start",
-            start,
-            "--out",
-            out.to_str().unwrap(),
-        ]);
+            &["--seeds", "3", "--split", split, "--seed-start", start],
+            &out,
+        ));
         assert!(o.status.success(), "{}", text(&o.stderr));
         let table = rows(&out.join("episodes.csv"));
         let c = col(&table, "seed");
@@ -656,17 +587,7 @@ fn split_names_a_seed_space_and_trained_seeds_are_warned_about() {
     );
     for (split, warned) in [("validation", true), ("test", false)] {
         let out = dir.path().join(format!("dqn-{split}"));
-        let o = ronap(&[
-            "run",
-            "--policy",
-            policy,
-            "--seeds",
-            "2",
-            "--split",
-            split,
-            "--out",
-            out.to_str().unwrap(),
-        ]);
+        let o = ronap(&run_args(policy, &["--seeds", "2", "--split", split], &out));
         assert!(o.status.success(), "{}", text(&o.stderr));
         let err = text(&o.stderr);
         assert_eq!(err.contains("are among those"), warned, "{split}: {err}");
@@ -676,10 +597,9 @@ fn split_names_a_seed_space_and_trained_seeds_are_warned_about() {
 #[test]
 fn a_crowd_pattern_the_robot_follows_out_of_the_scene_is_named_by_file_and_line() {
     let dir = tempfile::tempdir().unwrap();
-    let text =
-        std::fs::read_to_string(crate::util::repo_root().join("scenarios/circle-crossing.toml"))
-            .unwrap()
-            .replace("pattern_radius_px = 80.0", "pattern_radius_px = 8000.0");
+    let text = std::fs::read_to_string(shipped("circle-crossing.toml"))
+        .unwrap()
+        .replace("pattern_radius_px = 80.0", "pattern_radius_px = 8000.0");
     let line = 1 + text
         .lines()
         .position(|l| l.contains("pattern_radius_px"))
@@ -687,17 +607,11 @@ fn a_crowd_pattern_the_robot_follows_out_of_the_scene_is_named_by_file_and_line(
     let bad = dir.path().join("wide.toml");
     std::fs::write(&bad, text).unwrap();
     let out = dir.path().join("out");
-    let o = ronap(&[
-        "run",
-        "--scenario",
-        bad.to_str().unwrap(),
-        "--policy",
+    let o = ronap(&run_args(
         "orca",
-        "--seeds",
-        "2",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+        &["--scenario", bad.to_str().unwrap(), "--seeds", "2"],
+        &out,
+    ));
     let err = crate::util::stderr(&o);
     assert!(!o.status.success());
     for part in [

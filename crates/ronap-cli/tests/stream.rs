@@ -1,7 +1,7 @@
 //! End-to-end tests of long runs: outputs streamed as episodes finish, a run killed with
 //! SIGKILL finished by `--resume` to the same bytes, one run per directory, a full disk.
 
-use crate::util::{ok, repo_root, ronap, rows, stderr, stdout, BIN};
+use crate::util::{ok, ronap, rows, run_args, shipped, stderr, stdout, BIN};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -128,7 +128,7 @@ fn a_run_killed_with_sigkill_is_resumed_to_the_same_bytes() {
 fn a_team_run_killed_with_sigkill_is_resumed_to_the_same_bytes() {
     // About 30 episodes a second on two cores here (3.5 s): the first rows are flushed after a
     // second (a team episode's rows do not fill a write buffer sooner), well before the end.
-    let scenario = repo_root().join("scenarios/warehouse-team.toml");
+    let scenario = shipped("warehouse-team.toml");
     kill_and_resume(
         &on_two_threads(&scenario, "random", "120"),
         &["episodes.csv", "robots.csv"],
@@ -152,9 +152,9 @@ fn on_two_threads<'a>(scenario: &'a Path, policy: &'a str, seeds: &'a str) -> [&
 }
 
 /// A shipped scenario with the crowd metrics asked for, written into `dir`.
-fn measuring_crowds(dir: &Path, shipped: &str) -> PathBuf {
-    let text = std::fs::read_to_string(repo_root().join("scenarios").join(shipped)).unwrap();
-    let path = dir.join(shipped);
+fn measuring_crowds(dir: &Path, name: &str) -> PathBuf {
+    let text = std::fs::read_to_string(shipped(name)).unwrap();
+    let path = dir.join(name);
     std::fs::write(&path, format!("{text}\n[metrics]\ncrowd = true\n")).unwrap();
     path
 }
@@ -227,11 +227,11 @@ fn crowd_metrics_reach_every_output_and_bad_values_are_named() {
     }
     // Without [metrics] the outputs have none of it.
     let plain = dir.path().join("plain");
-    let shipped = repo_root().join("scenarios/maze-pedestrians.toml");
+    let pedestrians = shipped("maze-pedestrians.toml");
     ok(&ronap(&[
         "run",
         "--scenario",
-        shipped.to_str().unwrap(),
+        pedestrians.to_str().unwrap(),
         "--policy",
         "geodesic-wait",
         "--seeds",
@@ -264,15 +264,7 @@ fn crowd_metrics_reach_every_output_and_bad_values_are_named() {
 fn resuming_a_finished_run_says_so_and_changes_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("r");
-    ok(&ronap(&[
-        "run",
-        "--policy",
-        "geodesic",
-        "--seeds",
-        "5",
-        "--out",
-        out.to_str().unwrap(),
-    ]));
+    ok(&ronap(&run_args("geodesic", &["--seeds", "5"], &out)));
     let before = std::fs::read(out.join("summary.json")).unwrap();
     let o = ronap(&["run", "--resume", out.to_str().unwrap()]);
     let text = ok(&o);
@@ -397,17 +389,11 @@ fn a_full_disk_is_one_clear_error_and_leaves_no_half_written_file() {
         return;
     };
     let out = disk.0.join("run");
-    let o = ronap(&[
-        "run",
-        "--policy",
+    let o = ronap(&run_args(
         "random",
-        "--seeds",
-        "20000",
-        "--max-steps",
-        "20",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+        &["--seeds", "20000", "--max-steps", "20"],
+        &out,
+    ));
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{err}\n{}", stdout(&o));
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");

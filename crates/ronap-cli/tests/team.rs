@@ -2,8 +2,10 @@
 //! swap deadlocks and says so, robots.csv beside team rows, the same bytes on one and two
 //! threads, and bad entries named.
 
-use crate::util::{assert_rejected, col, ok, repo_root, ronap, rows, summary};
-use std::path::{Path, PathBuf};
+use crate::util::{
+    assert_rejected, col, collect_args, ok, ronap, rows, run_args, shipped, summary,
+};
+use std::path::Path;
 
 fn run_team(scenario: &Path, out: &Path, extra: &[&str]) -> String {
     let mut args = vec![
@@ -24,7 +26,7 @@ fn the_corridor_swap_deadlocks_and_is_reported_as_one() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("swap");
     let table = run_team(
-        &repo_root().join("scenarios/corridor-swap.toml"),
+        &shipped("corridor-swap.toml"),
         &out,
         &["--seeds", "3", "--png", "1"],
     );
@@ -64,11 +66,7 @@ fn row<'a>(table: &'a str, name: &str) -> &'a str {
 fn the_corridor_swap_s_robots_table_counts_their_deadlocks_and_robot_collisions() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("swap");
-    let printed = run_team(
-        &repo_root().join("scenarios/corridor-swap.toml"),
-        &out,
-        &["--seeds", "2"],
-    );
+    let printed = run_team(&shipped("corridor-swap.toml"), &out, &["--seeds", "2"]);
     let (team, robots_table) = printed.split_once("per robot:\n").unwrap();
     assert_eq!(row(team, "deadlocks"), "2");
 
@@ -124,15 +122,7 @@ fn the_corridor_swap_s_robots_table_counts_their_deadlocks_and_robot_collisions(
 fn a_lone_run_s_table_and_summary_have_nothing_of_a_team() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("lone");
-    let printed = ok(&ronap(&[
-        "run",
-        "--policy",
-        "apf",
-        "--seeds",
-        "3",
-        "--out",
-        out.to_str().unwrap(),
-    ]));
+    let printed = ok(&ronap(&run_args("apf", &["--seeds", "3"], &out)));
     assert!(row(&printed, "collisions per episode")
         .parse::<f64>()
         .is_ok());
@@ -174,11 +164,7 @@ fn team_runs_are_the_same_on_one_and_two_threads() {
 fn goal_lists_report_every_order_s_tour() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("wh");
-    run_team(
-        &repo_root().join("scenarios/warehouse-team.toml"),
-        &out,
-        &["--seeds", "2"],
-    );
+    run_team(&shipped("warehouse-team.toml"), &out, &["--seeds", "2"]);
     let robots = rows(&out.join("robots.csv"));
     assert_eq!(robots.len(), 1 + 2 * 8);
     let [goals, chosen, given, nearest, optimal] = [
@@ -199,23 +185,13 @@ fn goal_lists_report_every_order_s_tour() {
 
 #[test]
 fn one_robot_commands_refuse_a_team_by_name() {
-    let swap = repo_root().join("scenarios/corridor-swap.toml");
+    let swap = shipped("corridor-swap.toml");
     let s = swap.to_str().unwrap();
     // Expert demonstrations are one robot's (compare and run take teams).
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("rows.csv");
     assert_rejected(
-        &[
-            "collect",
-            "--expert",
-            "geodesic",
-            "--samples",
-            "10",
-            "--scenario",
-            s,
-            "--out",
-            out.to_str().unwrap(),
-        ],
+        &collect_args("geodesic", &["--samples", "10", "--scenario", s], &out),
         &["2 robots", "ronap run --scenario"],
     );
     assert!(!out.exists());
@@ -285,7 +261,7 @@ fn gif_animates_a_team_episode_with_every_robot_in_its_colour() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("swap");
     run_team(
-        &repo_root().join("scenarios/corridor-swap.toml"),
+        &shipped("corridor-swap.toml"),
         &out,
         &["--seeds", "2", "--gif", "1"],
     );
@@ -317,7 +293,7 @@ fn gif_animates_a_team_episode_with_every_robot_in_its_colour() {
     assert!(xs(last, blue).iter().max() > b.iter().max());
     assert!(xs(last, orange).iter().min() < o.iter().min());
     // A seed outside the run is refused before anything runs.
-    let swap = repo_root().join("scenarios/corridor-swap.toml");
+    let swap = shipped("corridor-swap.toml");
     let no = dir.path().join("no");
     assert_rejected(
         &[
@@ -370,7 +346,7 @@ fn bench_times_a_team_step_of_every_robot() {
 
 #[test]
 fn bench_times_a_team_policys_planning_and_steps() {
-    let scenario = repo_root().join("scenarios/corridor-bay.toml");
+    let scenario = shipped("corridor-bay.toml");
     let text = ok(&ronap(&[
         "bench",
         "--scenario",
@@ -399,7 +375,7 @@ fn bench_times_a_team_policys_planning_and_steps() {
 fn log_steps_writes_a_log_per_robot_and_replay_plays_the_team_again() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("team");
-    let scenario = repo_root().join("scenarios/warehouse-team.toml");
+    let scenario = shipped("warehouse-team.toml");
     run_team(&scenario, &out, &["--seeds", "2", "--log-steps"]);
     let robots = rows(&out.join("robots.csv"));
     let (seed, robot, taken) = (
@@ -445,8 +421,7 @@ fn log_steps_writes_a_log_per_robot_and_replay_plays_the_team_again() {
 #[test]
 fn a_team_of_one_runs_as_the_lone_robot_column_for_column() {
     let dir = tempfile::tempdir().unwrap();
-    let pedestrians =
-        std::fs::read_to_string(repo_root().join("scenarios/maze-pedestrians.toml")).unwrap();
+    let pedestrians = std::fs::read_to_string(shipped("maze-pedestrians.toml")).unwrap();
     for (name, base, policy) in [
         ("maze", String::new(), "apf"),
         ("maze", String::new(), "geodesic"),
@@ -511,11 +486,6 @@ fn coordinated(scenario: &Path, out: &Path, seeds: &str, more: &[&str]) -> Strin
     ]);
     args.extend(more);
     ok(&ronap(&args))
-}
-
-/// A shipped scenario's file.
-fn shipped(name: &str) -> PathBuf {
-    repo_root().join("scenarios").join(name)
 }
 
 /// Every team of the run's `seeds` episodes came home without touching a robot or a wall.

@@ -3,7 +3,7 @@
 //! `capture-pane`. Each test has its own tmux server. Without tmux the tests print a notice and
 //! pass; CI installs it (.ci/run).
 
-use crate::util::{col, ok, repo_root, ronap, rows, BIN};
+use crate::util::{col, ok, ronap, rows, shipped, BIN};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
@@ -267,7 +267,7 @@ fn team_view_ends_fitted(name: &str, scenario: &str, width: u16, height: u16) ->
         return String::new();
     };
     let dir = tempfile::tempdir().unwrap();
-    let scenario = repo_root().join("scenarios").join(scenario);
+    let scenario = shipped(scenario);
     let scenario = scenario.to_str().unwrap();
     let run = dir.path().join("run");
     ok(&ronap(&[

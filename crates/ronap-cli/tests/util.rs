@@ -39,9 +39,32 @@ pub fn ok(o: &Output) -> String {
     stdout(o)
 }
 
+/// The arguments of `ronap run --policy <policy> <more…> --out <out>`.
+pub fn run_args<'a>(policy: &'a str, more: &[&'a str], out: &'a Path) -> Vec<&'a str> {
+    with_out(&["run", "--policy", policy], more, out)
+}
+
+/// The arguments of `ronap collect --expert <expert> <more…> --out <out>`.
+pub fn collect_args<'a>(expert: &'a str, more: &[&'a str], out: &'a Path) -> Vec<&'a str> {
+    with_out(&["collect", "--expert", expert], more, out)
+}
+
+/// `head`, then `more`, then `--out <out>`.
+fn with_out<'a>(head: &[&'a str], more: &[&'a str], out: &'a Path) -> Vec<&'a str> {
+    let mut args = head.to_vec();
+    args.extend_from_slice(more);
+    args.extend(["--out", out.to_str().unwrap()]);
+    args
+}
+
 /// The repository root.
 pub fn repo_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// A shipped scenario's file, `name` in the repository's `scenarios/`.
+pub fn shipped(name: &str) -> PathBuf {
+    repo_root().join("scenarios").join(name)
 }
 
 /// A JSON file.
