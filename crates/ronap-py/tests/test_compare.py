@@ -6,15 +6,7 @@ import pathlib
 import pytest
 
 import ronap
-
-
-def toward_goal(obs):
-    d = float(obs[-1]) * 360.0
-    if 15 < d < 180:
-        return 0
-    if 180 <= d < 345:
-        return 2
-    return 1
+from helpers import toward_goal
 
 
 def test_compare_returns_policies_pairs_and_writes_the_report(tmp_path):

@@ -8,6 +8,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import ronap
+from helpers import assert_vec_env_is_single_envs
 
 
 def test_env_checker_passes_without_warnings():
@@ -89,22 +90,8 @@ def test_continuous_actions():
 
 
 def test_vector_env_equals_single_envs_bit_for_bit():
-    n, seed = 6, 100
-    vec = ronap.VecNavEnv(n)
-    singles = [ronap.NavEnv() for _ in range(n)]
-    obs, infos = vec.reset(seed=seed)
-    for i, env in enumerate(singles):
-        o, _ = env.reset(seed=seed + i)
-        assert np.array_equal(obs[i], o)
-    rng = np.random.default_rng(0)
-    for _ in range(200):
-        actions = rng.integers(0, 3, n)
-        obs, rewards, term, trunc, infos = vec.step(actions)
-        for i, env in enumerate(singles):
-            o, r, t, tr, info = env.step(int(actions[i]))
-            assert np.array_equal(obs[i], o)
-            assert rewards[i] == r and term[i] == t and trunc[i] == tr
-            assert infos["distance"][i] == info["distance"]
+    n = 6
+    assert_vec_env_is_single_envs(ronap.VecNavEnv(n), [ronap.NavEnv() for _ in range(n)], 100, 200)
 
 
 def test_vector_env_autoresets_on_the_next_step():

@@ -10,15 +10,7 @@ import numpy as np
 import pytest
 
 import ronap
-
-
-def toward_goal(obs):
-    d = float(obs[-1]) * 360.0
-    if 15 < d < 180:
-        return 0
-    if 180 <= d < 345:
-        return 2
-    return 1
+from helpers import toward_goal
 
 
 def test_builtin_policies_report_like_ronap_run():

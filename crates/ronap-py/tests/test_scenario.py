@@ -14,6 +14,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import ronap
+from helpers import assert_vec_env_is_single_envs
 
 SCENARIO = """\
 # A warehouse with ten people walking about.
@@ -104,22 +105,11 @@ def test_the_moving_obstacles_are_in_the_scene(scenario):
 
 
 def test_vec_env_equals_single_envs_under_a_scenario(scenario):
-    n, seed = 3, 20
+    n = 3
     vec = ronap.VecNavEnv(n, scenario=scenario, threads=2)
     assert vec.config["moving"][0]["count"] == 10
     singles = [ronap.NavEnv(scenario=scenario) for _ in range(n)]
-    obs, _ = vec.reset(seed=seed)
-    for i, env in enumerate(singles):
-        assert np.array_equal(obs[i], env.reset(seed=seed + i)[0])
-    rng = np.random.default_rng(0)
-    for _ in range(40):
-        actions = rng.integers(0, 3, n)
-        obs, rewards, term, trunc, _ = vec.step(actions)
-        for i, env in enumerate(singles):
-            o, r, t, tr, _ = env.step(int(actions[i]))
-            assert np.array_equal(obs[i], o) and rewards[i] == r and (term[i], trunc[i]) == (t, tr)
-        if term.any() or trunc.any():
-            break  # the vector env resets it on the next step; the single ones would not
+    assert_vec_env_is_single_envs(vec, singles, 20, 40, stop_at_an_end=True)
 
 
 def test_evaluate_reports_the_moving_obstacle_metrics(scenario):
