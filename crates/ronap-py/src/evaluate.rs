@@ -278,9 +278,7 @@ pub fn evaluate<'py>(
     // maze_seed, map_path, threads, continuous, out, png, log_steps, thread_safe, batch, rows and
     // force, as ronap.evaluate names them.
     let o = Options::new("evaluate", options);
-    let maze_seed: Option<u64> = o.take("maze_seed", None)?;
-    let map_path: Option<String> = o.take("map_path", None)?;
-    let threads: usize = o.take("threads", 0)?;
+    let (maze_seed, map_path, threads) = o.scene_and_threads()?;
     let continuous: bool = o.take("continuous", false)?;
     let out: Option<std::path::PathBuf> = o.take("out", None)?;
     let png: Option<String> = o.take("png", None)?;
@@ -672,9 +670,7 @@ pub fn compare<'py>(
 ) -> PyResult<PyObject> {
     // As ronap.compare names them.
     let o = Options::new("compare", options);
-    let maze_seed: Option<u64> = o.take("maze_seed", None)?;
-    let map_path: Option<String> = o.take("map_path", None)?;
-    let threads: usize = o.take("threads", 0)?;
+    let (maze_seed, map_path, threads) = o.scene_and_threads()?;
     let continuous: bool = o.take("continuous", false)?;
     let out: Option<std::path::PathBuf> = o.take("out", None)?;
     let runs: Vec<std::path::PathBuf> = o.take("runs", Vec::new())?;
@@ -842,9 +838,7 @@ impl PyBlockRun {
     ) -> PyResult<Self> {
         // maze_seed, map_path, threads and force.
         let o = Options::new("BlockRun", options);
-        let maze_seed: Option<u64> = o.take("maze_seed", None)?;
-        let map_path: Option<String> = o.take("map_path", None)?;
-        let threads: usize = o.take("threads", 0)?;
+        let (maze_seed, map_path, threads) = o.scene_and_threads()?;
         let force: bool = o.take("force", false)?;
         o.finish()?;
         let map_path = map_path.as_deref();

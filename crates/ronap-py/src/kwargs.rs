@@ -37,6 +37,16 @@ impl<'py> Options<'py> {
         }
     }
 
+    /// Where and on how many threads episodes run, the options every run takes: `maze_seed`,
+    /// `map_path` and `threads` (0: all cores), in that order.
+    pub fn scene_and_threads(&self) -> PyResult<(Option<u64>, Option<String>, usize)> {
+        Ok((
+            self.take("maze_seed", None)?,
+            self.take("map_path", None)?,
+            self.take("threads", 0)?,
+        ))
+    }
+
     /// Fails naming any option not taken.
     pub fn finish(self) -> PyResult<()> {
         match self.dict.as_ref().and_then(|d| d.keys().iter().next()) {

@@ -215,9 +215,7 @@ impl VecEnv {
     ) -> PyResult<Self> {
         // maze_seed, map_path, threads, autoreset, continuous and render.
         let o = crate::kwargs::Options::new("VecEnv", options);
-        let maze_seed: Option<u64> = o.take("maze_seed", None)?;
-        let map_path: Option<String> = o.take("map_path", None)?;
-        let threads: usize = o.take("threads", 0)?;
+        let (maze_seed, map_path, threads) = o.scene_and_threads()?;
         let autoreset: String = o.take("autoreset", "next_step".to_string())?;
         let continuous: bool = o.take("continuous", false)?;
         let render: bool = o.take("render", false)?;
