@@ -335,13 +335,7 @@ pub fn evaluate<'py>(
             evaluate_into(prepared.request(&cancel), factory.as_ref(), &|_| {}, &keep)
         })
         .map_err(|e| errors::PolicyError::new_err(e.to_string()))?;
-    interrupt.finish(
-        evaluation.write_error.as_ref(),
-        evaluation.result.error.as_ref(),
-    )?;
-    let d = PyDict::new(py);
-    let summary = serde_json::to_value(&evaluation.summary).unwrap_or_default();
-    d.set_item("summary", conv::json(py, &summary)?)?;
+    let d = interrupt.finish(py, &evaluation)?;
     let episodes = PyList::empty(py);
     let metrics = ronap_core::eval::metric_kinds(config);
     for r in &evaluation.result.records {
@@ -466,17 +460,55 @@ impl Interrupt {
     }
 
     /// How a finished run ends for Python, in order: its files could not be written, a signal
-    /// stopped it (once its files were written), an episode failed.
-    fn finish(
-        self,
-        write_error: Option<&ronap_core::io::OutputError>,
-        run_error: Option<&ronap_core::run::RunError>,
-    ) -> PyResult<()> {
+    /// stopped it (once its files were written), an episode failed; else the dict [`evaluate`]
+    /// returns, its "summary" in.
+    fn finish<'py>(self, py: Python<'py>, ended: &impl Ended) -> PyResult<Bound<'py, PyDict>> {
+        let (write_error, run_error, summary) = ended.ended();
         if let Some(e) = write_error {
             return Err(errors::output(e));
         }
         self.raise()?;
-        run_error.map_or(Ok(()), |e| Err(errors::run(e)))
+        if let Some(e) = run_error {
+            return Err(errors::run(e));
+        }
+        let d = PyDict::new(py);
+        let summary = serde_json::to_value(summary).unwrap_or_default();
+        d.set_item("summary", conv::json(py, &summary)?)?;
+        Ok(d)
+    }
+}
+
+/// A finished evaluation's files' write error, its failed episode's error and the robots'
+/// summary.
+type Ends<'a> = (
+    Option<&'a ronap_core::io::OutputError>,
+    Option<&'a ronap_core::run::RunError>,
+    &'a ronap_core::eval::Summary,
+);
+
+/// A finished evaluation, one robot's or a team's, as [`Interrupt::finish`] reads it.
+trait Ended {
+    /// How it ended.
+    fn ended(&self) -> Ends<'_>;
+}
+
+impl Ended for ronap_core::job::Evaluation {
+    fn ended(&self) -> Ends<'_> {
+        (
+            self.write_error.as_ref(),
+            self.result.error.as_ref(),
+            &self.summary,
+        )
+    }
+}
+
+impl Ended for ronap_core::job::TeamEvaluation {
+    fn ended(&self) -> Ends<'_> {
+        (
+            self.write_error.as_ref(),
+            self.result.error.as_ref(),
+            &self.summary,
+        )
     }
 }
 
@@ -596,13 +628,7 @@ fn evaluate_team<'py>(
                 .map(|e| (e, rows.into_inner()))
         })
         .map_err(|e| errors::PolicyError::new_err(e.to_string()))?;
-    interrupt.finish(
-        evaluation.write_error.as_ref(),
-        evaluation.result.error.as_ref(),
-    )?;
-    let d = PyDict::new(py);
-    let summary = serde_json::to_value(&evaluation.summary).unwrap_or_default();
-    d.set_item("summary", conv::json(py, &summary)?)?;
+    let d = interrupt.finish(py, &evaluation)?;
     let team = serde_json::to_value(&evaluation.team).unwrap_or_default();
     d.set_item("team", conv::json(py, &team)?)?;
     let robot_columns = robot_columns(&[]);
