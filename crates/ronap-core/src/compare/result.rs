@@ -33,14 +33,14 @@ impl SeedResult {
     /// The result in `r`, rounded as `episodes.csv` writes it, so a comparison gives the same
     /// figures whether a run is fresh or read back with `--run`.
     pub(crate) fn of(r: &EpisodeRecord) -> Self {
-        let spl = rounded(r.spl, 4);
-        Self::of_episode(
-            r.seed,
-            r.outcome,
-            (r.steps, r.collisions),
-            r.path_length_px,
-            spl,
-        )
+        Self {
+            seed: r.seed,
+            outcome: r.outcome,
+            steps: r.steps,
+            collisions: r.collisions,
+            path_length_px: rounded(r.path_length_px, 3),
+            spl: rounded(r.spl, 4),
+        }
     }
 
     /// The result of team episode `r`: the team's outcome, steps, summed wall collisions and
@@ -49,30 +49,12 @@ impl SeedResult {
     pub(crate) fn of_team(r: &TeamRecord) -> Self {
         let spl =
             r.robots.iter().map(|x| rounded(x.spl, 4)).sum::<f64>() / r.robots.len().max(1) as f64;
-        Self::of_episode(
-            r.seed,
-            r.outcome,
-            (r.steps, r.collisions),
-            r.path_length_px,
-            spl,
-        )
-    }
-
-    /// An episode's result from its figures, `steps_collisions` its steps and collisions, the
-    /// path length rounded as `episodes.csv` writes it.
-    fn of_episode(
-        seed: u64,
-        outcome: Outcome,
-        (steps, collisions): (u32, u32),
-        path_length_px: f64,
-        spl: f64,
-    ) -> Self {
         Self {
-            seed,
-            outcome,
-            steps,
-            collisions,
-            path_length_px: rounded(path_length_px, 3),
+            seed: r.seed,
+            outcome: r.outcome,
+            steps: r.steps,
+            collisions: r.collisions,
+            path_length_px: rounded(r.path_length_px, 3),
             spl,
         }
     }
