@@ -23,7 +23,8 @@ pub use metric::{
 pub use record::{EpisodeRecord, Outcome, Recording, StepLog};
 pub use summary::{AmongRobots, Figures, MovingSummary, Summary, Tally};
 pub use team::{
-    Flow, RobotFigures, RobotRecord, TeamFigures, TeamRecord, TeamRunResult, TeamSummary, TeamTally,
+    Flow, RobotFigures, RobotLook, RobotRecord, TeamFigures, TeamPicture, TeamRecord,
+    TeamRunResult, TeamSummary, TeamTally,
 };
 
 // For the layers above only.

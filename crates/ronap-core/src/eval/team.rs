@@ -2,6 +2,7 @@
 //! (team success: every robot arrived; makespan; summed path length; robot collisions;
 //! deadlocks), and their summary.
 
+use crate::config::RobotConfig;
 use crate::eval::record::Before;
 use crate::eval::summary::{wilson95, AmongRobots};
 use crate::eval::{
@@ -11,7 +12,7 @@ use crate::geometry::Point;
 use crate::plan::shortest_path_px;
 use crate::policy::{PolicyError, TeamPolicy, TeamPolicyFactory};
 use crate::run::{RunError, TeamRollout};
-use crate::sim::Pose;
+use crate::sim::{Laser, Pose, Track};
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -136,8 +137,33 @@ pub struct TeamRecord {
     pub paths: Vec<Vec<Point>>,
     /// Each robot's steps (the steps it acted), when recorded: a step log per robot.
     pub step_logs: Vec<Vec<StepLog>>,
-    /// The scene, when paths were recorded (for pictures).
-    pub scene: Option<Arc<crate::Scene>>,
+    /// What the episode's picture needs beyond the paths, when they were recorded.
+    pub picture: Option<TeamPicture>,
+}
+
+/// What a team episode's picture needs beyond its robots' records and paths: the scene, each
+/// robot's body, laser and last scan, and the moving obstacles' tracks.
+#[derive(Clone, Debug)]
+pub struct TeamPicture {
+    /// The scene.
+    pub scene: Arc<crate::Scene>,
+    /// Each robot's body, laser, goal tolerance and last readings, in robot order.
+    pub robots: Vec<RobotLook>,
+    /// Each moving obstacle's body and centre at every team step.
+    pub mover_tracks: Vec<Track>,
+}
+
+/// A robot of a team as its episode's picture draws it.
+#[derive(Clone, Debug)]
+pub struct RobotLook {
+    /// Its body.
+    pub body: RobotConfig,
+    /// Its laser.
+    pub laser: Laser,
+    /// Its goal tolerance, px.
+    pub goal_tolerance_px: f64,
+    /// Its last laser readings, px.
+    pub last_readings: Vec<f64>,
 }
 
 impl TeamRecord {
@@ -610,6 +636,13 @@ impl Evaluator {
             }
         };
         note(rollout.team(), &mut tracks);
+        let mut mover_tracks = Vec::new();
+        let note_movers = |team: &crate::sim::Team, mover_tracks: &mut Vec<Track>| {
+            if let (true, Some(movers)) = (paths, team.movers()) {
+                movers.record(mover_tracks);
+            }
+        };
+        note_movers(rollout.team(), &mut mover_tracks);
         let mut waiting = vec![0u32; n];
         let mut at: Vec<Point> = Vec::with_capacity(n);
         loop {
@@ -640,6 +673,7 @@ impl Evaluator {
                 }
             }
             note(team, &mut tracks);
+            note_movers(team, &mut mover_tracks);
             if let Some(g) = &mut gauges {
                 g.watch_team(team);
             }
@@ -747,7 +781,20 @@ impl Evaluator {
             deadlock,
             robots,
             wall_time_s: clock.elapsed().as_secs_f64(),
-            scene: paths.then(|| team.robot(0).scene().clone()),
+            picture: paths.then(|| TeamPicture {
+                scene: team.robot(0).scene().clone(),
+                robots: team
+                    .robots()
+                    .iter()
+                    .map(|r| RobotLook {
+                        body: r.config().robot.clone(),
+                        laser: r.laser().clone(),
+                        goal_tolerance_px: r.config().episode.goal_tolerance_px,
+                        last_readings: r.readings().to_vec(),
+                    })
+                    .collect(),
+                mover_tracks,
+            }),
             paths: tracks,
             step_logs,
         })
@@ -787,7 +834,7 @@ impl Evaluator {
             on_finish(&r);
             r.paths = Vec::new();
             r.step_logs = Vec::new();
-            r.scene = None;
+            r.picture = None;
             Ok(r)
         };
         stream_seeds(options, cancel, &work, sink)

@@ -29,8 +29,8 @@ pub use team::{team_frame, team_setup};
 pub(crate) use gif::{check_logged_step, same_pose, GifWriter};
 pub use player::Trace;
 pub(crate) use player::{player_page, Acted, PlayerPage, Recorder};
-pub(crate) use team::{team_gif_writer, team_image};
-pub(crate) use trajectory::trajectory_image;
+pub(crate) use team::team_gif_writer;
+pub(crate) use trajectory::{team_image, trajectory_image};
 
 use crate::geometry::{Aabb, Point};
 use crate::scene::Scene;

@@ -1,7 +1,7 @@
-//! Pictures of team episodes: the whole scene with every robot's path, start and goal in its own
-//! colour (the colours of [`crate::render::chart::policy_colour`], repeating after ten).
+//! Pictures of team episodes as they run: the whole scene with every robot's path, start and goal
+//! in its own colour (the colours of [`crate::render::chart::policy_colour`], repeating after
+//! ten). Finished episodes' pictures, lone or team, are drawn in `trajectory`.
 
-use crate::eval::TeamRecord;
 use crate::geometry::Point;
 use crate::render::chart::{policy_colour, POLICY_COUNT};
 use crate::render::gif::{AnimationError, GifWriter};
@@ -10,34 +10,8 @@ use crate::sim::Team;
 use image::{Rgb, RgbImage};
 
 /// `colour` mixed half-way with white, for goals.
-fn faded(colour: Rgb<u8>) -> Rgb<u8> {
+pub(crate) fn faded(colour: Rgb<u8>) -> Rgb<u8> {
     Rgb(colour.0.map(|c| ((u16::from(c) + 255) / 2) as u8))
-}
-
-/// The picture of a team episode: each robot's path (2 px), its goal as a faded disc of the goal
-/// tolerance, its start as a ring and where it ended as a disc. Needs the record's paths and
-/// scene (`None` once they are dropped).
-pub fn team_image(record: &TeamRecord, scale: f64) -> Option<RgbImage> {
-    let scene = record.scene.as_ref()?;
-    let mut canvas = Canvas::new(scene, scale);
-    let least = 3.0 / scale;
-    for (k, r) in record.robots.iter().enumerate() {
-        canvas.fill_disc(r.goal, (10.0f64).max(least), faded(policy_colour(k)));
-    }
-    for (k, path) in record.paths.iter().enumerate() {
-        canvas.path(path, 2.0, policy_colour(k));
-    }
-    for (k, r) in record.robots.iter().enumerate() {
-        let colour = policy_colour(k);
-        let radius = 5.0f64.max(least);
-        // The start as a ring, the end as a disc.
-        canvas.fill_disc(r.start.position(), radius * 1.2, colour);
-        canvas.fill_disc(r.start.position(), radius * 0.6, Rgb([255, 255, 255]));
-        if let Some(last) = record.paths.get(k).and_then(|p| p.last()) {
-            canvas.fill_disc(*last, radius, colour);
-        }
-    }
-    Some(canvas.into_image())
 }
 
 /// The picture of a team episode as it stands: each robot's goal as a faded disc of the goal
