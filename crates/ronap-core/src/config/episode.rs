@@ -228,21 +228,13 @@ impl RewardConfig {
 }
 
 impl ObservationConfig {
-    /// Checks the memory's length; `alone`: the configuration has no `[[robots]]` (a team's
-    /// observations carry no history yet).
-    pub(super) fn validate(&self, alone: bool) -> Result<(), ConfigError> {
+    /// Checks the memory's length.
+    pub(super) fn validate(&self) -> Result<(), ConfigError> {
         check(
             (1..=MAX_HISTORY).contains(&self.history),
             "observation.history",
             self.history,
             "must be a whole number from 1 to 64",
-        )?;
-        check(
-            self.history == 1 || alone,
-            "observation.history",
-            self.history,
-            "must be 1 with [[robots]] (a team's observations carry no history yet)",
-        )?;
-        Ok(())
+        )
     }
 }

@@ -384,7 +384,7 @@ impl SimConfig {
         self.laser.validate()?;
         self.episode.validate()?;
         self.reward.validate_terms()?;
-        self.observation.validate(self.robots.is_empty())?;
+        self.observation.validate()?;
         self.reward.validate_shaping()?;
         self.apf.validate()?;
         self.episode.validate_team_fields()?;

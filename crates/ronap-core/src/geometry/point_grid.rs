@@ -17,7 +17,16 @@ pub struct PointGrid {
     items: Vec<u32>,
     /// Each filled point's cell, kept between the counting passes.
     cells: Vec<u32>,
+    /// The counting sort's next free slot of each cell (kept to reuse its allocation).
+    next: Vec<u32>,
+    /// Few points are listed (index, column, row) rather than binned; `None` when binned.
+    listed: Option<Vec<(u32, u32, u32)>>,
 }
+
+/// Up to this many points are listed rather than binned: a query tests each one's cell against
+/// its box, which costs less than clearing and summing every cell of the grid (a team of one or
+/// a few robots steps at a lone robot's speed). The answers are the same cells' points.
+const LISTED: usize = 8;
 
 impl PointGrid {
     /// An empty grid of `cell` px cells over a `width` x `height` scene.
@@ -36,6 +45,8 @@ impl PointGrid {
             starts: vec![0; cols * rows + 1],
             items: Vec::new(),
             cells: Vec::new(),
+            next: Vec::new(),
+            listed: None,
         }
     }
 
@@ -60,6 +71,17 @@ impl PointGrid {
     /// Replaces the grid's points with `points` (index, position), given in increasing index
     /// order.
     pub fn fill(&mut self, points: impl Iterator<Item = (usize, Point)> + Clone) {
+        if points.clone().nth(LISTED).is_none() {
+            let mut listed = self.listed.take().unwrap_or_default();
+            listed.clear();
+            for (i, p) in points {
+                let (c, r) = self.cell_of(p.x, p.y);
+                listed.push((i as u32, c as u32, r as u32));
+            }
+            self.listed = Some(listed);
+            return;
+        }
+        self.listed = None;
         self.cells.clear();
         self.starts.fill(0);
         for (_, p) in points.clone() {
@@ -74,9 +96,10 @@ impl PointGrid {
         self.items.clear();
         self.items.resize(self.cells.len(), 0);
         // Place each point at its cell's next free slot: a stable counting sort.
-        let mut next = self.starts.clone();
+        self.next.clear();
+        self.next.extend_from_slice(&self.starts);
         for ((i, _), &cell) in points.zip(&self.cells) {
-            let at = &mut next[cell as usize];
+            let at = &mut self.next[cell as usize];
             self.items[*at as usize] = i as u32;
             *at += 1;
         }
@@ -96,6 +119,16 @@ impl PointGrid {
         let radius = radius.max(0.0);
         let (c0, r0) = self.cell_of(centre.x - radius, centre.y - radius);
         let (c1, r1) = self.cell_of(centre.x + radius, centre.y + radius);
+        if let Some(listed) = &self.listed {
+            let (c0, r0, c1, r1) = (c0 as u32, r0 as u32, c1 as u32, r1 as u32);
+            out.extend(
+                listed
+                    .iter()
+                    .filter(|&&(_, c, r)| (c0..=c1).contains(&c) && (r0..=r1).contains(&r))
+                    .map(|&(i, _, _)| i),
+            );
+            return;
+        }
         for r in r0..=r1 {
             let row = r * self.cols;
             let (a, b) = (self.starts[row + c0], self.starts[row + c1 + 1]);
@@ -142,5 +175,46 @@ mod tests {
         grid.fill(points.iter().copied().enumerate().take(3));
         grid.near(Point::new(200.0, 150.0), 1000.0, &mut out);
         assert_eq!(out, vec![0, 1, 2]);
+    }
+
+    /// A few points are listed rather than binned; they answer as the binned grid does: the
+    /// same points, those in the cells the box touches.
+    #[test]
+    fn listed_points_answer_as_binned_ones() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let (mut listed, mut binned) = (
+            PointGrid::new(400.0, 300.0, 37.0),
+            PointGrid::new(400.0, 300.0, 37.0),
+        );
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        for _ in 0..200 {
+            let n = rng.random_range(1..=LISTED);
+            let points: Vec<(usize, Point)> = (0..n)
+                .map(|i| {
+                    let p = Point::new(
+                        rng.random_range(-20.0..420.0),
+                        rng.random_range(-20.0..320.0),
+                    );
+                    (i * 3, p)
+                })
+                .collect();
+            listed.fill(points.iter().copied());
+            assert!(listed.listed.is_some());
+            // The same points and enough others (indices from 1000) to be binned.
+            let extra = (0..=LISTED).map(|i| (1000 + i, Point::new(1.0, 1.0)));
+            binned.fill(points.iter().copied().chain(extra));
+            assert!(binned.listed.is_none());
+            for _ in 0..20 {
+                let c = Point::new(
+                    rng.random_range(-50.0..450.0),
+                    rng.random_range(-50.0..350.0),
+                );
+                let r = rng.random_range(0.0..150.0);
+                listed.near(c, r, &mut a);
+                binned.near(c, r, &mut b);
+                b.retain(|&i| i < 1000);
+                assert_eq!(a, b);
+            }
+        }
     }
 }

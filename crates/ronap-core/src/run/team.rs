@@ -24,6 +24,12 @@ pub struct TeamRollout {
     actions: Vec<Option<Action>>,
     /// Why no plan can do the task, when the team policy found so before the first step.
     infeasible: Option<String>,
+    /// A step's buffers, kept between steps: the decisions, the actions being made, a message,
+    /// and each robot's goals reached before the step.
+    decisions: Vec<Option<Decision>>,
+    next_actions: Vec<Option<Action>>,
+    message: Vec<f32>,
+    reached: Vec<u32>,
 }
 
 /// A goal list's tour lengths under each order (geodesic, px; infinite where a leg cannot be
@@ -168,6 +174,10 @@ impl TeamRollout {
             tours,
             message_size: config.team.message_size as usize,
             infeasible: None,
+            decisions: Vec::new(),
+            next_actions: Vec::new(),
+            message: Vec::new(),
+            reached: Vec::new(),
         })
     }
 
@@ -235,13 +245,19 @@ impl TeamRollout {
         let n = self.team.robots().len();
         let step = self.team.steps() + 1;
         let seed = self.team.robot(0).seed();
-        let mut decisions: Vec<Option<Decision>> = vec![None; n];
+        let mut decisions = std::mem::take(&mut self.decisions);
+        decisions.clear();
+        decisions.resize(n, None);
         let failed = policy.act(&self.team, &mut decisions).err();
         // Robot by robot, as the robots decided: a robot's invalid action before the robot
         // whose policy failed is the error.
-        let mut actions: Vec<Option<Action>> = vec![None; n];
-        let mut message = vec![0.0f32; self.message_size];
-        for (k, decision) in decisions.into_iter().enumerate() {
+        let mut actions = std::mem::take(&mut self.next_actions);
+        actions.clear();
+        actions.resize(n, None);
+        let mut message = std::mem::take(&mut self.message);
+        message.clear();
+        message.resize(self.message_size, 0.0);
+        for (k, decision) in decisions.drain(..).enumerate() {
             if failed.as_ref().is_some_and(|(j, _)| *j <= k) {
                 break;
             }
@@ -275,22 +291,22 @@ impl TeamRollout {
                 _ => {}
             }
         }
+        self.decisions = decisions;
+        self.message = message;
         if let Some((_, source)) = failed {
             return Err(RunError::Policy { seed, step, source });
         }
         if self.finished() {
             return Ok(false);
         }
-        let reached: Vec<u32> = self
-            .team
-            .robots()
-            .iter()
-            .map(|r| r.goals_reached())
-            .collect();
+        self.reached.clear();
+        self.reached
+            .extend(self.team.robots().iter().map(|r| r.goals_reached()));
         self.team.step(&actions);
-        self.actions = actions;
+        // The last step's actions are kept; their buffer takes the next step's.
+        self.next_actions = std::mem::replace(&mut self.actions, actions);
         // A robot on to the next goal of its list starts a new leg: its policy plans afresh.
-        for (k, reached) in reached.into_iter().enumerate() {
+        for (k, &reached) in self.reached.iter().enumerate() {
             let r = self.team.robot(k);
             if self.team.running(k) && r.goals_reached() > reached {
                 policy

@@ -503,7 +503,7 @@ impl Episode {
     }
 
     /// With `observation.history` above 1, at the start: every past frame is the first one.
-    fn fill_history(&mut self) {
+    pub(crate) fn fill_history(&mut self) {
         let k = self.config.observation.history as usize;
         let f = self.config.frame_size();
         for j in 1..k {
@@ -513,7 +513,7 @@ impl Episode {
 
     /// With `observation.history` above 1, before a step's sensing: the frames move one back
     /// (the oldest drops out) and `action` becomes the newest remembered action.
-    fn remember(&mut self, action: Action) {
+    pub(crate) fn remember(&mut self, action: Action) {
         let k = self.config.observation.history as usize;
         if k < 2 {
             return;

@@ -72,6 +72,8 @@ pub struct Team {
     grid_after: PointGrid,
     /// The largest robot radius, px.
     max_radius: f64,
+    /// A step's buffers (`None` only while a step uses them).
+    scratch: Option<Box<step::Scratch>>,
 }
 
 /// Whether discs of radii summing to `reach`, moving at once from `a0` to `a1` and from `b0` to
@@ -265,6 +267,7 @@ impl Team {
             grid_before: PointGrid::new(scene.width(), scene.height(), NEAR_CELL_PX),
             grid_after: PointGrid::new(scene.width(), scene.height(), NEAR_CELL_PX),
             max_radius: 0.0,
+            scratch: None,
         };
         team.max_radius = team
             .robots
@@ -279,6 +282,11 @@ impl Team {
             r.set_noise_streams(seed, k);
         }
         team.sense_all();
+        // Their first frames are those sensed among the team: with a history, every past
+        // frame is the first.
+        for r in &mut team.robots {
+            r.fill_history();
+        }
         Ok(team)
     }
 
@@ -374,11 +382,18 @@ impl Team {
 /// For each of `n` robots, its place in the list `robots` (of robot indices), if listed: a
 /// look-up for lists that leave some robots out (those no longer in the scene).
 fn places_of(robots: impl Iterator<Item = usize>, n: usize) -> Vec<Option<u32>> {
-    let mut at = vec![None; n];
+    let mut at = Vec::new();
+    places_into(&mut at, robots, n);
+    at
+}
+
+/// [`places_of`] into `at`, keeping its allocation.
+fn places_into(at: &mut Vec<Option<u32>>, robots: impl Iterator<Item = usize>, n: usize) {
+    at.clear();
+    at.resize(n, None);
     for (m, k) in robots.enumerate() {
         at[k] = Some(m as u32);
     }
-    at
 }
 
 /// Robot `r` as a disc.
@@ -507,16 +522,19 @@ mod tests {
     }
 
     /// A lone robot's configuration and the same robot as a team of one (`[[robots]]` with one
-    /// robot of one entry), with `moving` obstacles and laser noise `sigma`.
+    /// robot of one entry), with `moving` obstacles, laser noise `sigma` and `history` frames
+    /// observed.
     fn lone_and_one(
         moving: Vec<crate::config::MovingConfig>,
         sigma: f64,
+        history: u32,
     ) -> (ValidConfig, ValidConfig) {
         let mut lone = crate::SimConfig {
             moving,
             ..Default::default()
         };
         lone.laser.noise_sigma_px = sigma;
+        lone.observation.history = history;
         lone.episode.max_steps = 400;
         let mut one = lone.clone();
         one.robots = vec![TeamRobotConfig::default()];
@@ -544,9 +562,13 @@ mod tests {
             ..Default::default()
         };
         let cases = [
-            lone_and_one(Vec::new(), 0.0),
-            lone_and_one(vec![walkers, appearing], 0.0),
-            lone_and_one(Vec::new(), 1.5),
+            lone_and_one(Vec::new(), 0.0, 1),
+            lone_and_one(vec![walkers.clone(), appearing.clone()], 0.0, 1),
+            lone_and_one(Vec::new(), 1.5, 1),
+            // Frames and actions remembered, with and without the obstacles (whose steps the
+            // team makes for its robots).
+            lone_and_one(Vec::new(), 0.0, 3),
+            lone_and_one(vec![walkers, appearing], 0.0, 3),
         ];
         let mut steps = 0;
         for (case, (lone_config, one_config)) in cases.iter().enumerate() {

@@ -1,7 +1,7 @@
 //! One step of a team: every running robot's motion swept against the still scene, the moving
 //! obstacles and the other robots' motions, then every robot's sensing among the others.
 
-use super::{disc, places_of, sweeps_touch, Broadcast, Team};
+use super::{disc, places_into, sweeps_touch, Broadcast, Team};
 use crate::geometry::Point;
 use crate::sim::episode::Status;
 use crate::sim::moving::Disc;
@@ -16,94 +16,104 @@ impl Team {
         }
         self.steps += 1;
         let n = self.robots.len();
-        let present: Vec<usize> = (0..n).filter(|&k| self.present(k)).collect();
+        if let Some(action) = self.alone(actions) {
+            self.step_alone(action);
+            return;
+        }
+        // The step's buffers, kept between steps: a step allocates nothing once the team has
+        // stepped.
+        let mut s = self.scratch.take().unwrap_or_default();
+        s.present.clear();
+        s.present.extend((0..n).filter(|&k| self.present(k)));
         // What every robot in the scene broadcasts now, received after the step.
-        let sent: Vec<Broadcast> = present
-            .iter()
-            .map(|&k| Broadcast {
-                from: k,
-                pose: self.robots[k].pose(),
-                goal: self.robots[k].goal(),
-                message: std::mem::replace(
-                    &mut self.outbox[k],
-                    vec![0.0; self.comm.message_size as usize],
-                ),
-            })
-            .collect();
-        let discs: Vec<Disc> = present.iter().map(|&k| disc(&self.robots[k])).collect();
-        let mut touched = vec![false; n];
+        let mut sent = std::mem::take(&mut self.sent);
+        sent.clear();
+        sent.extend(s.present.iter().map(|&k| Broadcast {
+            from: k,
+            pose: self.robots[k].pose(),
+            goal: self.robots[k].goal(),
+            message: std::mem::replace(
+                &mut self.outbox[k],
+                vec![0.0; self.comm.message_size as usize],
+            ),
+        }));
+        s.discs.clear();
+        s.discs
+            .extend(s.present.iter().map(|&k| disc(&self.robots[k])));
+        reset(&mut s.touched, n, false);
         if let Some(movers) = &mut self.movers {
             let scene = self.robots[0].scene().clone();
-            movers.advance_among(self.steps, &scene, &discs, &mut self.touched);
+            movers.advance_among(self.steps, &scene, &s.discs, &mut self.touched);
             for &i in &self.touched {
-                touched[present[i]] = true;
+                s.touched[s.present[i]] = true;
             }
         }
         // Each running robot's motion and what the still scene and the obstacles say of it.
-        let running: Vec<bool> = (0..n).map(|k| self.running(k)).collect();
-        let mut motions: Vec<Option<Motion>> = vec![None; n];
-        let mut wall = vec![false; n];
-        let mut moving = vec![false; n];
+        s.running.clear();
+        s.running.extend((0..n).map(|k| self.running(k)));
+        reset(&mut s.motions, n, None);
+        reset(&mut s.wall, n, false);
+        reset(&mut s.moving, n, false);
         for k in 0..n {
-            let Some(action) = actions.get(k).copied().flatten().filter(|_| running[k]) else {
+            let Some(action) = actions.get(k).copied().flatten().filter(|_| s.running[k]) else {
                 continue;
             };
             let m = self.robots[k].motion(action);
             let r = &self.robots[k];
-            wall[k] = !r.robot().motion_clear(r.scene(), r.pose(), &m);
-            moving[k] = match &self.movers {
+            s.wall[k] = !r.robot().motion_clear(r.scene(), r.pose(), &m);
+            s.moving[k] = match &self.movers {
                 Some(movers) => !r
                     .robot()
                     .motion_clear_by(r.pose(), &m, |a, b, rad| movers.sweep_clear(a, b, rad)),
                 None => false,
             };
-            motions[k] = Some(m);
+            s.motions[k] = Some(m);
         }
         // Robots against robots, until no remaining motion touches another robot.
-        let ends: Vec<Point> = (0..n)
-            .map(|k| match &motions[k] {
-                Some(m) if !wall[k] && !moving[k] => m.end.position(),
-                _ => self.robots[k].pose().position(),
-            })
-            .collect();
-        let starts: Vec<Point> = self.robots.iter().map(|r| r.pose().position()).collect();
-        let radii: Vec<f64> = self
-            .robots
-            .iter()
-            .map(|r| r.config().robot.radius_px)
-            .collect();
-        let mut blocked = vec![false; n];
+        s.ends.clear();
+        s.ends.extend((0..n).map(|k| match &s.motions[k] {
+            Some(m) if !s.wall[k] && !s.moving[k] => m.end.position(),
+            _ => self.robots[k].pose().position(),
+        }));
+        s.starts.clear();
+        s.starts
+            .extend(self.robots.iter().map(|r| r.pose().position()));
+        s.radii.clear();
+        s.radii
+            .extend(self.robots.iter().map(|r| r.config().robot.radius_px));
+        reset(&mut s.blocked, n, false);
+        let (ends, starts, radii) = (&s.ends, &s.starts, &s.radii);
         let moves = |k: usize, blocked: &[bool]| !blocked[k] && ends[k] != starts[k];
         // Each moving robot's candidates: the robots within its reach of its start, in index
         // order (the exact test below decides).
         self.grid_before
-            .fill(present.iter().map(|&k| (k, starts[k])));
-        let max_move = present
+            .fill(s.present.iter().map(|&k| (k, starts[k])));
+        let max_move = s
+            .present
             .iter()
             .map(|&k| (ends[k] - starts[k]).norm())
             .fold(0.0, f64::max);
-        let mut near_start = vec![0usize; n + 1];
-        let mut near: Vec<u32> = Vec::new();
-        let mut found = Vec::new();
+        reset(&mut s.near_start, n + 1, 0);
+        s.near.clear();
         for k in 0..n {
-            near_start[k] = near.len();
-            if present.binary_search(&k).is_ok() && moves(k, &blocked) {
+            s.near_start[k] = s.near.len();
+            if s.present.binary_search(&k).is_ok() && moves(k, &s.blocked) {
                 let reach = (ends[k] - starts[k]).norm() + max_move + radii[k] + self.max_radius;
-                self.grid_before.near(starts[k], reach, &mut found);
-                near.extend(found.iter().filter(|&&j| j as usize != k));
+                self.grid_before.near(starts[k], reach, &mut s.found);
+                s.near.extend(s.found.iter().filter(|&&j| j as usize != k));
             }
         }
-        near_start[n] = near.len();
+        s.near_start[n] = s.near.len();
         loop {
             let mut changed = false;
-            for &i in &present {
-                if !moves(i, &blocked) {
+            for &i in &s.present {
+                if !moves(i, &s.blocked) {
                     continue;
                 }
-                for &j in &near[near_start[i]..near_start[i + 1]] {
+                for &j in &s.near[s.near_start[i]..s.near_start[i + 1]] {
                     let j = j as usize;
                     let reach = radii[i] + radii[j];
-                    let (j0, j1) = if moves(j, &blocked) {
+                    let (j0, j1) = if moves(j, &s.blocked) {
                         (starts[j], ends[j])
                     } else {
                         (starts[j], starts[j])
@@ -114,9 +124,9 @@ impl Team {
                         continue;
                     }
                     if sweeps_touch(starts[i], ends[i], j0, j1, reach) {
-                        blocked[i] = true;
-                        if moves(j, &blocked) {
-                            blocked[j] = true;
+                        s.blocked[i] = true;
+                        if moves(j, &s.blocked) {
+                            s.blocked[j] = true;
                         }
                         changed = true;
                         break;
@@ -131,25 +141,32 @@ impl Team {
         let mut collided = std::mem::take(&mut self.collided);
         collided.clear();
         collided.resize(n, false);
-        let before: Vec<f64> = self.robots.iter().map(|r| r.distance_px()).collect();
+        s.before.clear();
+        s.before.extend(self.robots.iter().map(|r| r.distance_px()));
         let mut moved_any = false;
-        for k in 0..n {
-            if let Some(m) = &motions[k] {
-                collided[k] = self.robots[k].apply(m, wall[k], moving[k], touched[k], blocked[k]);
-                moved_any |= self.robots[k].pose().position() != starts[k];
+        for (k, c) in collided.iter_mut().enumerate() {
+            if let Some(m) = &s.motions[k] {
+                *c = self.robots[k].apply(m, s.wall[k], s.moving[k], s.touched[k], s.blocked[k]);
+                moved_any |= self.robots[k].pose().position() != s.starts[k];
+                if let Some(action) = actions.get(k).copied().flatten() {
+                    self.robots[k].remember(action);
+                }
             }
         }
+        self.scratch = Some(s);
         self.sense_all();
         self.deliver(sent);
-        for k in 0..n {
+        let s = self.scratch.take().unwrap_or_default();
+        for (k, &c) in collided.iter().enumerate() {
             self.rewards[k] = 0.0;
-            if let Some(m) = &motions[k] {
-                self.rewards[k] = self.robots[k].score(before[k], m, collided[k]);
+            if let Some(m) = &s.motions[k] {
+                self.rewards[k] = self.robots[k].score(s.before[k], m, c);
                 if self.robots[k].status() == Status::Success {
                     self.arrived_at[k].get_or_insert(self.steps);
                 }
             }
         }
+        self.scratch = Some(s);
         self.collided = collided;
         self.still_for = if moved_any { 0 } else { self.still_for + 1 };
         // A deadlock is a team's: a team of one that stands still is a lone robot that does,
@@ -164,18 +181,60 @@ impl Team {
         }
     }
 
+    /// The action of a team of one without moving obstacles whose robot acts this step: such a
+    /// step is the lone robot's ([`Team::step_alone`]). `None` for any other step.
+    fn alone(&self, actions: &[Option<Action>]) -> Option<Action> {
+        if self.robots.len() != 1 || self.movers.is_some() || !self.running(0) {
+            return None;
+        }
+        actions.first().copied().flatten()
+    }
+
+    /// A step of a team of one robot, acting alone among still obstacles: the robot's own
+    /// episode steps as a lone robot's does, which is what the team's step would do (no other
+    /// robot to block it, sense or send to), at a lone robot's speed.
+    fn step_alone(&mut self, action: Action) {
+        let at = self.robots[0].pose().position();
+        // What it broadcasts, which no one receives; the next message starts from zeros.
+        let mut sent = std::mem::take(&mut self.sent);
+        sent.clear();
+        sent.push(Broadcast {
+            from: 0,
+            pose: self.robots[0].pose(),
+            goal: self.robots[0].goal(),
+            message: std::mem::replace(
+                &mut self.outbox[0],
+                vec![0.0; self.comm.message_size as usize],
+            ),
+        });
+        self.sent = sent;
+        let r = self.robots[0].step(action);
+        let (reward, collided) = (r.reward, r.collided);
+        self.rewards[0] = reward;
+        self.collided[0] = collided;
+        if self.robots[0].status() == Status::Success {
+            self.arrived_at[0].get_or_insert(self.steps);
+        }
+        let moved = self.robots[0].pose().position() != at;
+        self.still_for = if moved { 0 } else { self.still_for + 1 };
+        self.inbox.clear();
+        self.inbox_starts.fill(0);
+    }
+
     /// Every running robot reads its sensors among the others (discs) and the obstacles.
     pub(super) fn sense_all(&mut self) {
         let n = self.robots.len();
-        let discs: Vec<(usize, Disc)> = (0..n)
-            .filter(|&k| self.present(k))
-            .map(|k| (k, disc(&self.robots[k])))
-            .collect();
-        let of = places_of(discs.iter().map(|(k, _)| *k), n);
+        let mut s = self.scratch.take().unwrap_or_default();
+        s.placed.clear();
+        s.placed.extend(
+            (0..n)
+                .filter(|&k| self.present(k))
+                .map(|k| (k, disc(&self.robots[k]))),
+        );
+        places_into(&mut s.of, s.placed.iter().map(|(k, _)| *k), n);
         let movers = self.movers.take();
-        self.grid_after.fill(discs.iter().map(|(k, d)| (*k, d.at)));
-        let mut others = Vec::with_capacity(discs.len());
-        let mut found = Vec::new();
+        self.grid_after
+            .fill(s.placed.iter().map(|(k, d)| (*k, d.at)));
         for k in 0..n {
             if !self.running(k) && self.steps > 0 {
                 continue;
@@ -186,16 +245,47 @@ impl Team {
             let r = &self.robots[k];
             let reach = r.laser().range_px() + r.config().robot.radius_px + self.max_radius;
             self.grid_after
-                .near_any_order(r.pose().position(), reach, &mut found);
-            others.clear();
-            others.extend(
-                found
+                .near_any_order(r.pose().position(), reach, &mut s.found);
+            s.others.clear();
+            s.others.extend(
+                s.found
                     .iter()
                     .filter(|&&j| j as usize != k)
-                    .filter_map(|&j| of[j as usize].map(|m| discs[m as usize].1)),
+                    .filter_map(|&j| s.of[j as usize].map(|m| s.placed[m as usize].1)),
             );
-            self.robots[k].sense_among(movers.as_deref(), &others);
+            self.robots[k].sense_among(movers.as_deref(), &s.others);
         }
+        self.scratch = Some(s);
         self.movers = movers;
     }
+}
+
+/// `v` made `n` copies of `value`, keeping its allocation.
+fn reset<T: Clone>(v: &mut Vec<T>, n: usize, value: T) {
+    v.clear();
+    v.resize(n, value);
+}
+
+/// Buffers a team's step reuses, so that stepping allocates nothing once the team has stepped.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Scratch {
+    present: Vec<usize>,
+    discs: Vec<Disc>,
+    touched: Vec<bool>,
+    running: Vec<bool>,
+    motions: Vec<Option<Motion>>,
+    wall: Vec<bool>,
+    moving: Vec<bool>,
+    ends: Vec<Point>,
+    starts: Vec<Point>,
+    radii: Vec<f64>,
+    blocked: Vec<bool>,
+    near_start: Vec<usize>,
+    near: Vec<u32>,
+    found: Vec<u32>,
+    before: Vec<f64>,
+    /// The robots in the scene as discs, for sensing, and each robot's place among them.
+    placed: Vec<(usize, Disc)>,
+    of: Vec<Option<u32>>,
+    others: Vec<Disc>,
 }
