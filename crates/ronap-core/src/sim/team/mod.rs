@@ -199,6 +199,8 @@ impl Team {
                     .map_err(of_entry)?;
                 let goals: Vec<Point> = if !entry.goals.is_empty() {
                     entry.goals.iter().map(|g| Point::new(g[0], g[1])).collect()
+                } else if entry.goal_count <= 1 {
+                    vec![placement.goal]
                 } else {
                     let mut goals = vec![placement.goal];
                     let tolerance = cfg.episode.goal_tolerance_px;
