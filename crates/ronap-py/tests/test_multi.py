@@ -37,6 +37,27 @@ def test_parallel_api_test_passes():
     parallel_api_test(corridor(15.0, 100.0, team_message_size=2, team_neighbours=1), num_cycles=50)
 
 
+def test_a_team_observes_a_history():
+    """With ``observation_history=3`` each robot's observation is three frames (its neighbour
+    slots in each) and two remembered actions, inside its space, the previous frame moving back a
+    place at each step; the robot's newest remembered action is the one it took."""
+    env = corridor(15.0, 100.0, team_message_size=1, team_neighbours=1, observation_history=3)
+    parallel_api_test(env, num_cycles=30)
+    obs, _ = env.reset(seed=0)
+    space = env.observation_space("robot_0")
+    frame = (space.shape[0] - 6) // 3
+    first = obs["robot_0"]
+    # At the start every past frame is the first, and no action is remembered.
+    assert np.array_equal(first[frame : 2 * frame], first[:frame])
+    assert np.array_equal(first[2 * frame : 3 * frame], first[:frame])
+    assert not first[3 * frame :].any()
+    obs, *_ = env.step({"robot_0": 1, "robot_1": 0})
+    after = obs["robot_0"]
+    assert space.contains(after)
+    assert np.array_equal(after[frame : 2 * frame], first[:frame])
+    assert np.array_equal(after[3 * frame : 3 * frame + 3], [0.0, 1.0, 0.0])
+
+
 def test_seed_test_passes():
     parallel_seed_test(lambda: ronap.MultiNavEnv(scenario=WAREHOUSE), num_cycles=50)
 

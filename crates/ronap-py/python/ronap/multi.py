@@ -98,8 +98,10 @@ class MultiNavEnv(_Base):
         self.agents: list[str] = []
         self._index = {a: k for k, a in enumerate(self.possible_agents)}
         slots = self._env.slots_size
+        # The JSON leaves `observation` out while it holds its defaults.
+        history = int(self.config.get("observation", {}).get("history", 1))
         self._observation_spaces = {
-            a: _observation_space(size - slots, slots)
+            a: _observation_space(size, slots, history)
             for a, size in zip(self.possible_agents, self._env.observation_sizes)
         }
         self._scales = [np.array(limits, np.float64) for limits in self._env.action_scales]
@@ -284,9 +286,14 @@ def _discrete(agent: str, action: Any) -> Any:
     return int(action) if isinstance(action, (float, np.floating, np.integer)) else action
 
 
-def _observation_space(beams_plus_goal: int, slots: int) -> spaces.Box:
-    low = np.concatenate([np.zeros(beams_plus_goal, np.float32), np.full(slots, -np.inf, np.float32)])
-    high = np.concatenate([np.ones(beams_plus_goal, np.float32), np.full(slots, np.inf, np.float32)])
+def _observation_space(size: int, slots: int, history: int) -> spaces.Box:
+    """A robot's observation of ``size`` values: ``history`` frames, each its beams and goal
+    direction in [0, 1] then ``slots`` neighbour values (unbounded), then three values in [0, 1]
+    for each of the ``history - 1`` remembered actions."""
+    actions = 3 * (history - 1)
+    frame = (size - actions) // history
+    low = np.concatenate([np.zeros(frame - slots, np.float32), np.full(slots, -np.inf, np.float32)] * history + [np.zeros(actions, np.float32)])
+    high = np.concatenate([np.ones(frame - slots, np.float32), np.full(slots, np.inf, np.float32)] * history + [np.ones(actions, np.float32)])
     return spaces.Box(low, high, dtype=np.float32)
 
 
