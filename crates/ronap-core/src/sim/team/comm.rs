@@ -1,7 +1,7 @@
 //! What the robots of a team say to each other: each step's [`Broadcast`]s, what each robot
 //! received of them ([`Inbox`]), and their delivery to the robots within range.
 
-use super::{places_of, Team};
+use super::{places_into, Team};
 use crate::geometry::Point;
 use crate::sim::robot::Pose;
 
@@ -125,10 +125,10 @@ impl Team {
         let k_near = self.comm.neighbours as usize;
         self.sent = sent;
         let sent = &self.sent;
+        let mut s = self.scratch.take().unwrap_or_default();
         // `sent` is in robot order, and the grid holds where the senders were.
-        let of = places_of(sent.iter().map(|b| b.from), self.robots.len());
-        let mut found = Vec::new();
-        let mut near: Vec<(f64, u32)> = Vec::new();
+        places_into(&mut s.of, sent.iter().map(|b| b.from), self.robots.len());
+        let (of, found, near) = (&s.of, &mut s.found, &mut s.heard);
         self.inbox.clear();
         for i in 0..self.robots.len() {
             self.inbox_starts[i] = self.inbox.len() as u32;
@@ -137,7 +137,7 @@ impl Team {
             };
             let at = me.pose.position();
             // Any order: what is kept is sorted by distance, then sender.
-            self.grid_before.near_any_order(at, range, &mut found);
+            self.grid_before.near_any_order(at, range, found);
             near.clear();
             near.extend(
                 found
@@ -170,5 +170,6 @@ impl Team {
             }
         }
         self.inbox_starts[self.robots.len()] = self.inbox.len() as u32;
+        self.scratch = Some(s);
     }
 }

@@ -381,15 +381,8 @@ impl Team {
     }
 }
 
-/// For each of `n` robots, its place in the list `robots` (of robot indices), if listed: a
-/// look-up for lists that leave some robots out (those no longer in the scene).
-fn places_of(robots: impl Iterator<Item = usize>, n: usize) -> Vec<Option<u32>> {
-    let mut at = Vec::new();
-    places_into(&mut at, robots, n);
-    at
-}
-
-/// [`places_of`] into `at`, keeping its allocation.
+/// Into `at`, for each of `n` robots, its place in the list `robots` (of robot indices), if
+/// listed: a look-up for lists that leave some robots out (those no longer in the scene).
 fn places_into(at: &mut Vec<Option<u32>>, robots: impl Iterator<Item = usize>, n: usize) {
     at.clear();
     at.resize(n, None);

@@ -20,23 +20,12 @@ impl Team {
             self.step_alone(action);
             return;
         }
-        // The step's buffers, kept between steps: a step allocates nothing once the team has
-        // stepped.
+        // The step's buffers, kept between steps.
         let mut s = self.scratch.take().unwrap_or_default();
         s.present.clear();
         s.present.extend((0..n).filter(|&k| self.present(k)));
         // What every robot in the scene broadcasts now, received after the step.
-        let mut sent = std::mem::take(&mut self.sent);
-        sent.clear();
-        sent.extend(s.present.iter().map(|&k| Broadcast {
-            from: k,
-            pose: self.robots[k].pose(),
-            goal: self.robots[k].goal(),
-            message: std::mem::replace(
-                &mut self.outbox[k],
-                vec![0.0; self.comm.message_size as usize],
-            ),
-        }));
+        let sent = self.broadcasts(s.present.iter().copied());
         s.discs.clear();
         s.discs
             .extend(s.present.iter().map(|&k| disc(&self.robots[k])));
@@ -181,6 +170,25 @@ impl Team {
         }
     }
 
+    /// What robots `from` broadcast now (pose, goal and message), in the buffer of the last
+    /// step's broadcasts; each one's next message starts from zeros.
+    fn broadcasts(&mut self, from: impl Iterator<Item = usize>) -> Vec<Broadcast> {
+        let mut sent = std::mem::take(&mut self.sent);
+        sent.clear();
+        for k in from {
+            let size = self.comm.message_size as usize;
+            let message = std::mem::replace(&mut self.outbox[k], vec![0.0; size]);
+            let r = &self.robots[k];
+            sent.push(Broadcast {
+                from: k,
+                pose: r.pose(),
+                goal: r.goal(),
+                message,
+            });
+        }
+        sent
+    }
+
     /// The action of a team of one without moving obstacles whose robot acts this step: such a
     /// step is the lone robot's ([`Team::step_alone`]). `None` for any other step.
     fn alone(&self, actions: &[Option<Action>]) -> Option<Action> {
@@ -195,19 +203,8 @@ impl Team {
     /// robot to block it, sense or send to), at a lone robot's speed.
     fn step_alone(&mut self, action: Action) {
         let at = self.robots[0].pose().position();
-        // What it broadcasts, which no one receives; the next message starts from zeros.
-        let mut sent = std::mem::take(&mut self.sent);
-        sent.clear();
-        sent.push(Broadcast {
-            from: 0,
-            pose: self.robots[0].pose(),
-            goal: self.robots[0].goal(),
-            message: std::mem::replace(
-                &mut self.outbox[0],
-                vec![0.0; self.comm.message_size as usize],
-            ),
-        });
-        self.sent = sent;
+        // What it broadcasts, which no one receives.
+        self.sent = self.broadcasts(std::iter::once(0));
         let r = self.robots[0].step(action);
         let (reward, collided) = (r.reward, r.collided);
         self.rewards[0] = reward;
@@ -266,7 +263,8 @@ fn reset<T: Clone>(v: &mut Vec<T>, n: usize, value: T) {
     v.resize(n, value);
 }
 
-/// Buffers a team's step reuses, so that stepping allocates nothing once the team has stepped.
+/// Buffers a team's step reuses, so that once the team has stepped a step allocates nothing but
+/// the robots' messages (none with `team.message_size = 0`).
 #[derive(Clone, Debug, Default)]
 pub(super) struct Scratch {
     present: Vec<usize>,
@@ -282,10 +280,12 @@ pub(super) struct Scratch {
     blocked: Vec<bool>,
     near_start: Vec<usize>,
     near: Vec<u32>,
-    found: Vec<u32>,
+    pub(super) found: Vec<u32>,
     before: Vec<f64>,
     /// The robots in the scene as discs, for sensing, and each robot's place among them.
     placed: Vec<(usize, Disc)>,
-    of: Vec<Option<u32>>,
+    pub(super) of: Vec<Option<u32>>,
     others: Vec<Disc>,
+    /// The broadcasts a robot hears, by distance and place in the step's list.
+    pub(super) heard: Vec<(f64, u32)>,
 }
