@@ -16,7 +16,9 @@
 //! the observation and the team's inbox (a list of dicts: `from`, `pose`, `goal`, `message`,
 //! nearest sender first; empty for a lone robot) and returns an action or `(action, message)`.
 
-use ronap_core::policy::{BatchPolicy, Batched, Decision, Policy, PolicyError, PolicyFactory};
+use ronap_core::policy::{
+    BatchPolicy, Batched, Decision, Policy, PolicyError, PolicyFactory, Rows,
+};
 use ronap_core::{Action, DiscreteAction, Episode, World};
 use std::io::{BufRead, BufReader, Write};
 use std::path::PathBuf;
@@ -209,12 +211,8 @@ impl PyPolicyFactory {
 }
 
 impl BatchPolicy for PyProcess {
-    fn act_batch(
-        &mut self,
-        observations: &[f32],
-        width: usize,
-        actions: &mut Vec<Action>,
-    ) -> Result<(), PolicyError> {
+    fn act_batch(&mut self, batch: Rows<'_>, actions: &mut Vec<Action>) -> Result<(), PolicyError> {
+        let (observations, width) = (batch.values, batch.width);
         let rows = observations.len() / width.max(1);
         let mut line = String::with_capacity(observations.len() * 12 + 16);
         line.push_str(&format!("B {rows} {width}"));
@@ -420,17 +418,12 @@ impl Drop for Pooled {
 }
 
 impl BatchPolicy for Pooled {
-    fn act_batch(
-        &mut self,
-        observations: &[f32],
-        width: usize,
-        actions: &mut Vec<Action>,
-    ) -> Result<(), PolicyError> {
+    fn act_batch(&mut self, rows: Rows<'_>, actions: &mut Vec<Action>) -> Result<(), PolicyError> {
         let process = self
             .process
             .as_mut()
             .ok_or_else(|| PolicyError::Failed("no Python process".into()))?;
-        let result = process.act_batch(observations, width, actions);
+        let result = process.act_batch(rows, actions);
         if result.is_err() {
             // A process that failed (or exited) is not handed to the next episode.
             self.process = None;

@@ -519,18 +519,26 @@ pub fn train(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use ronap_core::config::{EpisodeConfig, MazeConfig};
     use ronap_core::sim::Scenes;
     use ronap_core::SimConfig;
 
     /// A small open room where the goal is always in reach: DQN must learn to head for it.
     fn open_room_config() -> SimConfig {
-        let mut c = SimConfig::default();
-        c.maze.cols = 2;
-        c.maze.rows = 2;
-        c.maze.loops = 1.0;
-        c.episode.min_goal_distance_px = 60.0;
-        c.episode.max_steps = 200;
-        c
+        SimConfig {
+            maze: MazeConfig {
+                cols: 2,
+                rows: 2,
+                loops: 1.0,
+                ..Default::default()
+            },
+            episode: EpisodeConfig {
+                min_goal_distance_px: 60.0,
+                max_steps: 200,
+                ..Default::default()
+            },
+            ..Default::default()
+        }
     }
 
     fn open_room() -> Evaluator {

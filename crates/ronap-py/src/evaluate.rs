@@ -15,7 +15,7 @@ use ronap_core::io::{
 use ronap_core::job::{evaluate_into, evaluate_team_into, RunRequest};
 use ronap_core::policy::{
     coordinated_drives, BatchPolicy, Batched, CoordinatedFactory, Decision, JointFactory, Policy,
-    PolicyError, PolicyFactory, TeamPolicyFactory,
+    PolicyError, PolicyFactory, Rows, TeamPolicyFactory,
 };
 use ronap_core::sim::{continuous_action, Scenes};
 use ronap_core::{Action, Episode, ValidConfig, World};
@@ -223,13 +223,8 @@ impl PyBatchPolicy {
 }
 
 impl BatchPolicy for PyBatchPolicy {
-    fn act_batch(
-        &mut self,
-        observations: &[f32],
-        width: usize,
-        actions: &mut Vec<Action>,
-    ) -> Result<(), PolicyError> {
-        Python::with_gil(|py| self.decide(py, observations, width, actions))
+    fn act_batch(&mut self, rows: Rows<'_>, actions: &mut Vec<Action>) -> Result<(), PolicyError> {
+        Python::with_gil(|py| self.decide(py, rows.values, rows.width, actions))
             .map_err(PolicyError::Failed)
     }
 }

@@ -8,7 +8,7 @@ pub mod policy;
 pub mod sim;
 
 pub use policy::{named_policy, policy_factory, TeamPolicies};
-pub use sim::{EpisodeArgs, SimArgs, WorkArgs};
+pub use sim::{EpisodeArgs, EvalArgs, SimArgs, WorkArgs};
 
 use clap::Args;
 use ronap_core::eval::{held_out_warning, Seeds};

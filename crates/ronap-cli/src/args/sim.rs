@@ -216,6 +216,18 @@ impl WorkArgs {
     }
 }
 
+/// The seed, worker-thread, scene, model and time-out flags of the commands that evaluate
+/// policies on many seeds (`ronap run`, `ronap compare`).
+#[derive(Args, Debug, Clone)]
+pub struct EvalArgs {
+    #[command(flatten)]
+    pub seeds: super::SeedArgs,
+    #[command(flatten)]
+    pub threads: ThreadArgs,
+    #[command(flatten)]
+    pub episodes: EpisodeArgs,
+}
+
 /// The scene, model and time-out flags of the commands that run episodes as evaluated
 /// (`ronap run`, `ronap view`).
 #[derive(Args, Debug, Clone, Default)]

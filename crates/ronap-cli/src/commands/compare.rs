@@ -1,10 +1,7 @@
 //! `ronap compare`: several policies on the same seeds, with paired statistics, pictures and a
 //! report.
 
-use crate::args::{
-    policy_factory, seed_range, warn_if_not_held_out, EpisodeArgs, SeedArgs, TeamPolicies,
-    ThreadArgs,
-};
+use crate::args::{policy_factory, seed_range, warn_if_not_held_out, EvalArgs, TeamPolicies};
 use crate::output::cancel_on_ctrl_c;
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
@@ -40,11 +37,7 @@ pub struct CompareArgs {
     #[arg(long, value_name = "DIR")]
     run: Vec<PathBuf>,
     #[command(flatten)]
-    seeds: SeedArgs,
-    #[command(flatten)]
-    threads: ThreadArgs,
-    #[command(flatten)]
-    episodes: EpisodeArgs,
+    eval: EvalArgs,
     /// Output directory [default: runs/compare-<UTC time>].
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -83,7 +76,7 @@ fn players(s: &str) -> Result<usize, String> {
 
 /// Runs `ronap compare`.
 pub fn run(args: CompareArgs) -> Result<ExitCode> {
-    let (config, scenes, map) = args.episodes.resolve()?;
+    let (config, scenes, map) = args.eval.episodes.resolve()?;
     // Every policy is made (and every reused run read) before anything runs.
     let chosen = with_runs(&args.policy, &args.run)?;
     let names: Vec<String> = chosen.iter().map(|(n, _)| n.clone()).collect();
@@ -108,12 +101,12 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
             reuse,
         });
     }
-    let first = args.seeds.first()?;
-    let seeds = seed_range(first, args.seeds.seeds)?;
-    let end = first + args.seeds.seeds;
+    let first = args.eval.seeds.first()?;
+    let seeds = seed_range(first, args.eval.seeds.seeds)?;
+    let end = first + args.eval.seeds.seeds;
     let range = Seeds::Range {
         start: first,
-        count: args.seeds.seeds,
+        count: args.eval.seeds.seeds,
     };
     for c in contenders.iter().filter(|c| c.reuse.is_none()) {
         warn_if_not_held_out(&c.name, c.factory.as_ref(), &range);
@@ -130,7 +123,7 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
             .with_context(|| format!("cannot start episodes in this scene (seed {first})"))?;
     }
     let out_dir = args.out.clone().unwrap_or_else(default_out_dir);
-    let threads = args.threads.count();
+    let threads = args.eval.threads.count();
     let options = CompareOptions {
         seeds,
         threads,
@@ -142,14 +135,14 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
         replace: args.force,
     };
     let info = CompareInfo {
-        scenes: args.episodes.scenes.spec(&config),
+        scenes: args.eval.episodes.scenes.spec(&config),
         map,
         command: command_line(),
     };
     let cancel = cancel_on_ctrl_c("finishing running episodes and saving the runs");
     let to_run = contenders.iter().filter(|c| c.reuse.is_none()).count() as u64;
     let bar = crate::output::progress_bar(
-        args.seeds.seeds * to_run,
+        args.eval.seeds.seeds * to_run,
         "{prefix} {wide_bar} {pos}/{len} episodes, {per_sec}, eta {eta}",
         "ronap compare".to_string(),
     );

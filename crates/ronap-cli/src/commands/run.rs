@@ -1,9 +1,7 @@
 //! `ronap run`: evaluate a policy over many seeded episodes and write what happened, as it
 //! happens; `--resume` finishes a run stopped short.
 
-use crate::args::{
-    fraction, policy_factory, seed, warn_if_not_held_out, EpisodeArgs, SeedArgs, ThreadArgs,
-};
+use crate::args::{fraction, policy_factory, seed, warn_if_not_held_out, EvalArgs};
 use crate::output::cancel_on_ctrl_c;
 use anyhow::{bail, Context, Result};
 use clap::Args;
@@ -35,11 +33,7 @@ pub struct RunArgs {
     #[arg(long, value_name = "NAME", required_unless_present = "resume")]
     policy: Option<String>,
     #[command(flatten)]
-    seeds: SeedArgs,
-    #[command(flatten)]
-    threads: ThreadArgs,
-    #[command(flatten)]
-    episodes: EpisodeArgs,
+    eval: EvalArgs,
     /// Output directory [default: runs/<policy>-<UTC time>]. episodes.csv and timing.csv are
     /// written as episodes finish (as *.partial until the run ends), so memory stays flat and a
     /// killed run keeps its finished episodes; one run at a time per directory.
@@ -93,9 +87,9 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         return resume(dir);
     }
     // Everything that can be wrong with the input is checked before anything is written.
-    let (config, scenes, map) = args.episodes.resolve()?;
+    let (config, scenes, map) = args.eval.episodes.resolve()?;
     let policy = args.policy.clone().unwrap_or_default();
-    let seeds = args.seeds.range()?;
+    let seeds = args.eval.seeds.range()?;
     let job = Job {
         out_dir: match &args.out {
             Some(d) => d.clone(),
@@ -103,8 +97,8 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
         },
         policy,
         seeds,
-        threads: args.threads.count(),
-        info_scenes: args.episodes.scenes.spec(&config),
+        threads: args.eval.threads.count(),
+        info_scenes: args.eval.episodes.scenes.spec(&config),
         map,
         png: args.png,
         log_steps: args.log_steps,
@@ -121,7 +115,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode> {
             job.policy
         );
     }
-    let scenario = args.episodes.sim.scenario.as_deref();
+    let scenario = args.eval.episodes.sim.scenario.as_deref();
     let run = if config.team_size() > 0 {
         run_team(job, config, scenes, None)
     } else {

@@ -33,14 +33,15 @@ impl SeedResult {
     /// The result in `r`, rounded as `episodes.csv` writes it, so a comparison gives the same
     /// figures whether a run is fresh or read back with `--run`.
     pub(crate) fn of(r: &EpisodeRecord) -> Self {
-        Self {
-            seed: r.seed,
-            outcome: r.outcome,
-            steps: r.steps,
-            collisions: r.collisions,
-            path_length_px: rounded(r.path_length_px, 3),
-            spl: rounded(r.spl, 4),
-        }
+        let spl = rounded(r.spl, 4);
+        Self::rounding(
+            r.seed,
+            r.outcome,
+            r.steps,
+            r.collisions,
+            r.path_length_px,
+            spl,
+        )
     }
 
     /// The result of team episode `r`: the team's outcome, steps, summed wall collisions and
@@ -49,12 +50,31 @@ impl SeedResult {
     pub(crate) fn of_team(r: &TeamRecord) -> Self {
         let spl =
             r.robots.iter().map(|x| rounded(x.spl, 4)).sum::<f64>() / r.robots.len().max(1) as f64;
+        Self::rounding(
+            r.seed,
+            r.outcome,
+            r.steps,
+            r.collisions,
+            r.path_length_px,
+            spl,
+        )
+    }
+
+    /// A result with its path length rounded as the files write it.
+    fn rounding(
+        seed: u64,
+        outcome: Outcome,
+        steps: u32,
+        collisions: u32,
+        path_length_px: f64,
+        spl: f64,
+    ) -> Self {
         Self {
-            seed: r.seed,
-            outcome: r.outcome,
-            steps: r.steps,
-            collisions: r.collisions,
-            path_length_px: rounded(r.path_length_px, 3),
+            seed,
+            outcome,
+            steps,
+            collisions,
+            path_length_px: rounded(path_length_px, 3),
             spl,
         }
     }

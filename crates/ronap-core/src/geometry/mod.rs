@@ -132,6 +132,26 @@ pub(crate) fn least_box_hits(
     });
 }
 
+/// The nearest [`Aabb::ray_hit`] within `max_t` testing every box in turn, the way a scan without
+/// a grid or an index does: what the tests hold the fast scans to.
+#[cfg(test)]
+pub(crate) fn nearest_box_hit(
+    boxes: &[Aabb],
+    origin: Point,
+    inv: Vector,
+    max_t: f64,
+) -> Option<f64> {
+    let mut best = max_t;
+    let mut hit = false;
+    for b in boxes {
+        if let Some(t) = b.ray_hit(origin, inv, best) {
+            best = t;
+            hit = true;
+        }
+    }
+    hit.then_some(best)
+}
+
 /// [`least_box_hits`] as pulp runs it, compiled once per instruction set.
 struct LeastBoxHits<'a> {
     sides: &'a [[f64; 4]],

@@ -343,19 +343,6 @@ mod tests {
     use crate::geometry::unit;
     use rand::{Rng, SeedableRng};
 
-    /// The nearest hit testing every box, the way a scan without a grid does.
-    fn every_box(boxes: &[Aabb], origin: Point, inv: Vector, max_t: f64) -> Option<f64> {
-        let mut best = max_t;
-        let mut hit = false;
-        for b in boxes {
-            if let Some(t) = b.ray_hit(origin, inv, best) {
-                best = t;
-                hit = true;
-            }
-        }
-        hit.then_some(best)
-    }
-
     fn inv(d: Vector) -> Vector {
         Vector::new(1.0 / d.x, 1.0 / d.y)
     }
@@ -431,7 +418,7 @@ mod tests {
                 let inv = inv(unit(deg));
                 let max_t = [0.0, 1.0, 50.0, 500.0, 2000.0][k % 5];
                 let ours = grid.cast(&grid.start(origin), unit(deg), inv, max_t);
-                let all = every_box(&boxes, origin, inv, max_t);
+                let all = crate::geometry::nearest_box_hit(&boxes, origin, inv, max_t);
                 assert_eq!(
                     ours.map(f64::to_bits),
                     all.map(f64::to_bits),

@@ -3,7 +3,7 @@
 
 use crate::eval::metric::{self, Kind};
 use crate::eval::{Outcome, TeamRecord};
-use crate::io::run_dir::{metric_cells, start_goal_cells};
+use crate::io::run_dir::{joined, metric_cells, start_goal_cells, START_GOAL_COLUMNS};
 
 /// Columns of a team run's `episodes.csv` (one row per team episode).
 pub const TEAM_COLUMNS: [&str; 11] = [
@@ -42,34 +42,32 @@ pub fn team_episode_row(r: &TeamRecord) -> Vec<String> {
 }
 
 /// Columns of a team run's `robots.csv` (one row per robot per episode).
-pub const ROBOT_COLUMNS: [&str; 26] = [
-    "seed",
-    "robot",
-    "policy",
-    "outcome",
-    "steps",
-    "arrived_at",
-    "collisions",
-    "robot_collisions",
-    "dynamic_collisions",
-    "goals",
-    "goals_reached",
-    "tour_px",
-    "given_tour_px",
-    "nearest_tour_px",
-    "optimal_tour_px",
-    "path_length_px",
-    "shortest_px",
-    "spl",
-    "start_x",
-    "start_y",
-    "start_heading_deg",
-    "goal_x",
-    "goal_y",
-    "reason",
-    "lower_bound_steps",
-    "waiting_steps",
-];
+pub const ROBOT_COLUMNS: [&str; 26] = joined::<24, 2, 26>(
+    joined::<18, 6, 24>(
+        [
+            "seed",
+            "robot",
+            "policy",
+            "outcome",
+            "steps",
+            "arrived_at",
+            "collisions",
+            "robot_collisions",
+            "dynamic_collisions",
+            "goals",
+            "goals_reached",
+            "tour_px",
+            "given_tour_px",
+            "nearest_tour_px",
+            "optimal_tour_px",
+            "path_length_px",
+            "shortest_px",
+            "spl",
+        ],
+        START_GOAL_COLUMNS,
+    ),
+    ["lower_bound_steps", "waiting_steps"],
+);
 
 /// The columns of `robots.csv` measuring the metrics of `kinds`: `ROBOT_COLUMNS`, then one
 /// per metric.

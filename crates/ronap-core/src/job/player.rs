@@ -278,15 +278,9 @@ mod tests {
 
     #[test]
     fn a_team_trace_from_a_run_record_is_the_record_replayed() {
-        let config = crate::SimConfig {
-            robots: vec![crate::config::TeamRobotConfig {
-                count: 3,
-                ..Default::default()
-            }],
-            ..Default::default()
-        }
-        .validate()
-        .expect("valid");
+        let config = crate::SimConfig::from_toml_str("[[robots]]\ncount = 3")
+            .and_then(crate::SimConfig::validate)
+            .expect("three robots");
         let size = config.observation_size();
         let evaluator = Evaluator::new(config, Scenes::MazePerSeed);
         let geodesic = crate::policy::factory("geodesic", size).expect("geodesic");

@@ -322,11 +322,9 @@ mod tests {
         let mut directions = directions();
         let mut blockers = Blockers::off(out.len());
         for step in TIGHTEN_STEPS_PX {
-            let mut moved = true;
-            let mut rounds = 0;
-            while moved && rounds < 8 {
-                moved = false;
-                rounds += 1;
+            // Up to 8 rounds, until one moves no corner.
+            for _ in 0..8 {
+                let mut moved = false;
                 for k in 1..out.len().saturating_sub(1) {
                     moved |= try_corner(
                         scene,
@@ -337,6 +335,9 @@ mod tests {
                         &mut directions,
                         &mut blockers,
                     );
+                }
+                if !moved {
+                    break;
                 }
             }
         }

@@ -21,14 +21,24 @@ pub const GATHER: Duration = Duration::from_millis(2);
 
 /// A policy that decides for many observations in one call.
 pub trait BatchPolicy: Send {
-    /// Pushes onto `actions` one action for each of the `observations.len() / width` rows of
-    /// `observations` (row-major, `width` values a row), in row order.
-    fn act_batch(
-        &mut self,
-        observations: &[f32],
-        width: usize,
-        actions: &mut Vec<Action>,
-    ) -> Result<(), PolicyError>;
+    /// Pushes onto `actions` one action for each of the observation `rows`, in row order.
+    fn act_batch(&mut self, rows: Rows<'_>, actions: &mut Vec<Action>) -> Result<(), PolicyError>;
+}
+
+/// Observations a row each, row-major: what a [`BatchPolicy`] decides for.
+#[derive(Clone, Copy, Debug)]
+pub struct Rows<'a> {
+    /// Every row's values, one row after the other.
+    pub values: &'a [f32],
+    /// Values a row.
+    pub width: usize,
+}
+
+impl Rows<'_> {
+    /// The number of rows (`values.len() / width`; none when `width` is 0).
+    pub fn count(&self) -> usize {
+        self.values.len().checked_div(self.width).unwrap_or(0)
+    }
 }
 
 #[derive(Default)]
@@ -126,7 +136,13 @@ impl Worker {
             Err("observations of different sizes in one batch".to_string())
         } else {
             let mut policy = shared.policy.lock().unwrap_or_else(|e| e.into_inner());
-            match policy.act_batch(&flat, width, &mut actions) {
+            match policy.act_batch(
+                Rows {
+                    values: &flat,
+                    width,
+                },
+                &mut actions,
+            ) {
                 Ok(()) if actions.len() == batch.len() => Ok(()),
                 Ok(()) => Err(format!(
                     "gave {} actions for {} observations",
@@ -201,14 +217,12 @@ mod tests {
     impl BatchPolicy for Toward {
         fn act_batch(
             &mut self,
-            observations: &[f32],
-            width: usize,
+            rows: Rows<'_>,
             actions: &mut Vec<Action>,
         ) -> Result<(), PolicyError> {
             self.calls.fetch_add(1, Ordering::Relaxed);
-            let rows = observations.len() / width;
-            self.most.fetch_max(rows, Ordering::Relaxed);
-            for row in observations.chunks(width) {
+            self.most.fetch_max(rows.count(), Ordering::Relaxed);
+            for row in rows.values.chunks(rows.width) {
                 actions.push(Action::from(toward(row)));
             }
             Ok(())
@@ -319,12 +333,7 @@ mod tests {
     struct Fails;
 
     impl BatchPolicy for Fails {
-        fn act_batch(
-            &mut self,
-            _: &[f32],
-            _: usize,
-            _: &mut Vec<Action>,
-        ) -> Result<(), PolicyError> {
+        fn act_batch(&mut self, _: Rows<'_>, _: &mut Vec<Action>) -> Result<(), PolicyError> {
             Err(PolicyError::Failed("no idea".into()))
         }
     }

@@ -917,15 +917,10 @@ impl TeamPolicy for Coordinated {
         Ok(())
     }
 
-    fn next_goal(
-        &mut self,
-        robot: usize,
-        world: &World,
-        episode: &Episode,
-    ) -> Result<(), PolicyError> {
+    fn next_goal(&mut self, k: usize, world: &World, episode: &Episode) -> Result<(), PolicyError> {
         // The plan covers every leg; only the fallback's robots plan each leg afresh.
         match &mut self.fallback {
-            Some(p) => p.next_goal(robot, world, episode),
+            Some(p) => p.next_goal(k, world, episode),
             None => Ok(()),
         }
     }

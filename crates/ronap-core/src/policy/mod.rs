@@ -21,7 +21,7 @@ mod social_force;
 mod team;
 
 // The built-in policies by name, and policies deciding for many robots or environments at once.
-pub use batched::{BatchPolicy, Batched};
+pub use batched::{BatchPolicy, Batched, Rows};
 pub use name::{factory, Builtin, PolicyNameError};
 pub use team::{
     Joint, JointFactory, PerRobot, PerRobotFactory, RobotError, TeamPolicy, TeamPolicyFactory,

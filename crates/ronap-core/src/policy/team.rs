@@ -36,14 +36,9 @@ pub trait TeamPolicy: Send {
         let _ = (robot, out);
     }
 
-    /// Robot `robot` reached a goal of its list and drives on to the next (its `episode` now
-    /// heads there): a policy that planned the leg plans afresh.
-    fn next_goal(
-        &mut self,
-        robot: usize,
-        world: &World,
-        episode: &Episode,
-    ) -> Result<(), PolicyError>;
+    /// Robot `k` reached a goal of its list and drives on to the next (its `episode` now heads
+    /// there): a policy that planned the leg plans afresh.
+    fn next_goal(&mut self, k: usize, world: &World, episode: &Episode) -> Result<(), PolicyError>;
 }
 
 /// Makes team policies: one per team episode.
@@ -118,13 +113,8 @@ impl TeamPolicy for PerRobot {
         }
     }
 
-    fn next_goal(
-        &mut self,
-        robot: usize,
-        world: &World,
-        episode: &Episode,
-    ) -> Result<(), PolicyError> {
-        self.policies[robot].reset(world, episode)
+    fn next_goal(&mut self, k: usize, world: &World, episode: &Episode) -> Result<(), PolicyError> {
+        self.policies[k].reset(world, episode)
     }
 }
 
@@ -237,7 +227,13 @@ impl TeamPolicy for Joint {
         let width = self.rows.len() / self.robots.len();
         self.actions.clear();
         self.batch
-            .act_batch(&self.rows, width, &mut self.actions)
+            .act_batch(
+                super::Rows {
+                    values: &self.rows,
+                    width,
+                },
+                &mut self.actions,
+            )
             .map_err(|e| (first, e))?;
         if self.actions.len() != self.robots.len() {
             return Err((
@@ -261,13 +257,8 @@ impl TeamPolicy for Joint {
         }
     }
 
-    fn next_goal(
-        &mut self,
-        robot: usize,
-        world: &World,
-        episode: &Episode,
-    ) -> Result<(), PolicyError> {
-        match &mut self.others[robot] {
+    fn next_goal(&mut self, k: usize, world: &World, episode: &Episode) -> Result<(), PolicyError> {
+        match &mut self.others[k] {
             Some(policy) => policy.reset(world, episode),
             None => Ok(()),
         }

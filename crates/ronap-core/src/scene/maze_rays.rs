@@ -347,19 +347,6 @@ mod tests {
     use crate::sim::{stream, Stream};
     use rand::{Rng, SeedableRng};
 
-    /// The nearest hit testing every box, the way a scan without an index does.
-    fn every_box(boxes: &[Aabb], origin: Point, inv: Vector, max_t: f64) -> Option<f64> {
-        let mut best = max_t;
-        let mut hit = false;
-        for b in boxes {
-            if let Some(t) = b.ray_hit(origin, inv, best) {
-                best = t;
-                hit = true;
-            }
-        }
-        hit.then_some(best)
-    }
-
     #[test]
     fn a_walk_gives_the_bits_every_wall_gives() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(23);
@@ -405,7 +392,7 @@ mod tests {
                 let inv = Vector::new(1.0 / dir.x, 1.0 / dir.y);
                 let max_t = [0.0, 1.0, cell / 2.0, 3.0 * cell, 2.0 * (w + h)][k % 5];
                 let ours = walls.cast(&walls.start(origin), dir, inv, max_t);
-                let all = every_box(&boxes, origin, inv, max_t);
+                let all = crate::geometry::nearest_box_hit(&boxes, origin, inv, max_t);
                 assert_eq!(
                     ours.map(f64::to_bits),
                     all.map(f64::to_bits),

@@ -8,15 +8,22 @@ use crate::geometry::Point;
 use crate::sim::Pose;
 
 /// Columns of `episodes.csv`.
-pub const EPISODE_COLUMNS: [&str; 14] = [
-    "seed",
-    "outcome",
-    "steps",
-    "collisions",
-    "path_length_px",
-    "shortest_px",
-    "spl",
-    "return",
+pub const EPISODE_COLUMNS: [&str; 14] = joined(
+    [
+        "seed",
+        "outcome",
+        "steps",
+        "collisions",
+        "path_length_px",
+        "shortest_px",
+        "spl",
+        "return",
+    ],
+    START_GOAL_COLUMNS,
+);
+
+/// The columns of [`start_goal_cells`], in `episodes.csv` and `robots.csv`.
+pub(crate) const START_GOAL_COLUMNS: [&str; 6] = [
     "start_x",
     "start_y",
     "start_heading_deg",
@@ -24,6 +31,25 @@ pub const EPISODE_COLUMNS: [&str; 14] = [
     "goal_y",
     "reason",
 ];
+
+/// The columns `a` then `b` (`N` is their count together).
+pub(crate) const fn joined<const A: usize, const B: usize, const N: usize>(
+    a: [&'static str; A],
+    b: [&'static str; B],
+) -> [&'static str; N] {
+    assert!(A + B == N, "N must be A + B");
+    let mut out = [""; N];
+    let mut i = 0;
+    while i < A {
+        out[i] = a[i];
+        i += 1;
+    }
+    while i < N {
+        out[i] = b[i - A];
+        i += 1;
+    }
+    out
+}
 
 /// Columns `episodes.csv` gains when the episodes have moving obstacles.
 pub const DYNAMIC_COLUMNS: [&str; 3] = [
