@@ -346,6 +346,49 @@ fn a_team_scenario_is_compared_on_team_success_with_a_table_per_robot() {
         &[&team[..], &["--seeds", "2", "--by", "difficulty"]].concat(),
         &["--by difficulty", "team scenarios"],
     );
+    // Both team runs read back give the same comparison, and run nothing.
+    let runs: Vec<String> = ["geodesic", "random"]
+        .iter()
+        .map(|l| out.join("runs").join(l).to_str().unwrap().to_string())
+        .collect();
+    let reused = dir.path().join("reused");
+    let again = [
+        "compare",
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--run",
+        &runs[0],
+        "--run",
+        &runs[1],
+        "--seeds",
+        "6",
+        "--max-steps",
+        "600",
+        "--out",
+        reused.to_str().unwrap(),
+    ];
+    ok(&ronap(&again));
+    let r = json(&reused.join("compare.json"));
+    assert_eq!(r["pairs"], c["pairs"]);
+    for k in 0..2 {
+        assert_eq!(r["policies"][k]["reused"], true);
+        assert_eq!(r["policies"][k]["team"], c["policies"][k]["team"]);
+    }
+    assert!(!reused.join("runs/geodesic").exists());
+    // A robot row that does not parse is named by file, line, column and value.
+    let robots = out.join("runs/random/robots.csv");
+    let text = std::fs::read_to_string(&robots).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    let spl = header.iter().position(|h| *h == "spl").unwrap();
+    let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
+    let mut cells: Vec<String> = lines[3].split(',').map(str::to_string).collect();
+    cells[spl] = "most".into();
+    lines[3] = cells.join(",");
+    std::fs::write(&robots, lines.join("\n") + "\n").unwrap();
+    let bad = reused.to_str().unwrap().replace("reused", "bad");
+    let mut refused = again;
+    refused[refused.len() - 1] = &bad;
+    assert_rejected(&refused, &["robots.csv", "line 4", "spl = \"most\""]);
 }
 
 #[test]

@@ -311,9 +311,6 @@ pub fn compare(
         if options.by_difficulty {
             return refuse("--by difficulty");
         }
-        if let Some(c) = contenders.iter().find(|c| c.reuse.is_some()) {
-            return refuse(&format!("--run (of {})", c.name));
-        }
         if let Some(c) = contenders.iter().find(|c| c.team.is_none()) {
             return Err(CompareError::Input(format!(
                 "policy {}: no team policy was given for this team scenario",
@@ -458,14 +455,8 @@ fn run_one(
     label: &str,
     index: usize,
 ) -> Result<PolicyResult, CompareError> {
-    let Setting {
-        evaluator,
-        options,
-        info,
-        out,
-        cancel,
-        progress,
-    } = *setting;
+    let (evaluator, options, info) = (setting.evaluator, setting.options, setting.info);
+    let (out, cancel, progress) = (setting.out, setting.cancel, setting.progress);
     let dir = out.map(|d| d.join("runs").join(label));
     let writer = dir
         .as_deref()
@@ -659,22 +650,27 @@ fn read_run(
             "its configuration differs from this comparison's ({field})"
         )));
     }
-    let (rows, places) = read_episodes(&dir.join("episodes.csv")).map_err(mismatch)?;
+    let team = config.team_size() > 0;
+    if team != manifest.team.is_some() {
+        return Err(mismatch(if team {
+            "a lone robot's run; this comparison is of a team".into()
+        } else {
+            "a team's run; this comparison is of a lone robot".into()
+        }));
+    }
+    let (rows, places) = read_results(dir, team).map_err(mismatch)?;
     if rows.iter().map(|r| r.seed).ne(seeds.iter().copied()) {
         return Err(mismatch(
             "episodes.csv does not hold exactly this comparison's seeds".into(),
         ));
     }
-    // The same seeds in the same scenes start and end in the same places: a changed map file or
-    // maze generator shows here even when the manifest reads the same.
+    // The same seeds in the same scenes start (and a lone robot ends) in the same places: a
+    // changed map file or maze generator shows here even when the manifest reads the same.
     let moved = rows
         .par_iter()
         .zip(&places)
         .find_map_first(|(r, recorded)| {
-            let here = evaluator.worlds().episode(r.seed).ok().map(|e| {
-                let (s, g) = (e.start(), e.goal());
-                [s.x, s.y, s.z_deg, g.x, g.y].map(|v| format!("{v:.3}"))
-            });
+            let here = places_here(evaluator, r.seed);
             (here.as_ref() != Some(recorded)).then_some((r.seed, here))
         });
     if let Some((seed, here)) = moved {
@@ -716,61 +712,140 @@ fn first_difference(a: &crate::SimConfig, b: &crate::SimConfig) -> String {
     }
 }
 
-/// The per-seed results in a run's `episodes.csv`, and each seed's start and goal as written
-/// (`start_x, start_y, start_heading_deg, goal_x, goal_y`).
-type Places = Vec<[String; 5]>;
+/// Each seed's places as a run's files write them: a lone robot's start and goal (`start_x,
+/// start_y, start_heading_deg, goal_x, goal_y`), or each robot of a team's start (`start_x,
+/// start_y, start_heading_deg`) in robot order.
+type Places = Vec<Vec<String>>;
 
-fn read_episodes(path: &Path) -> Result<(Vec<SeedResult>, Places), String> {
-    let what = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
-    let mut reader =
-        csv::Reader::from_reader(crate::bounded::open_lines(path).map_err(|e| what(&e))?);
-    let headers = reader.headers().map_err(|e| what(&e))?.clone();
-    let column = |name: &str| {
-        headers
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| what(&format!("no column {name:?}")))
-    };
-    let cols = [
-        column("seed")?,
-        column("outcome")?,
-        column("steps")?,
-        column("collisions")?,
-        column("path_length_px")?,
-        column("spl")?,
-    ];
-    let place_cols = [
-        column("start_x")?,
-        column("start_y")?,
-        column("start_heading_deg")?,
-        column("goal_x")?,
-        column("goal_y")?,
-    ];
+/// The start and goal columns of `episodes.csv` and `robots.csv`.
+const PLACE_COLUMNS: [&str; 5] = [
+    "start_x",
+    "start_y",
+    "start_heading_deg",
+    "goal_x",
+    "goal_y",
+];
+
+/// The places of seed `seed`'s episode here, as [`Places`] holds them (`None` when it cannot
+/// start).
+fn places_here(evaluator: &Evaluator, seed: u64) -> Option<Vec<String>> {
+    let cells = |p: crate::sim::Pose| [p.x, p.y, p.z_deg].map(|v| format!("{v:.3}"));
+    let config = evaluator.config();
+    if config.team_size() > 0 {
+        let team = crate::sim::Team::new(config, &evaluator.worlds().team(seed), seed).ok()?;
+        Some(
+            team.robots()
+                .iter()
+                .flat_map(|r| cells(r.start()))
+                .collect(),
+        )
+    } else {
+        let e = evaluator.worlds().episode(seed).ok()?;
+        let goal = [e.goal().x, e.goal().y].map(|v| format!("{v:.3}"));
+        Some(cells(e.start()).into_iter().chain(goal).collect())
+    }
+}
+
+/// The per-seed results of a run in `dir` and each seed's [`Places`]: a lone robot's from
+/// `episodes.csv`; a team's from `episodes.csv` (the team's outcome, steps, summed collisions
+/// and path length) and `robots.csv` (each robot's start, and the mean of their SPLs as
+/// [`SeedResult::of_team`] takes it).
+fn read_results(dir: &Path, team: bool) -> Result<(Vec<SeedResult>, Places), String> {
+    let mut names = vec!["seed", "outcome", "steps", "collisions", "path_length_px"];
+    if !team {
+        names.push("spl");
+        names.extend(PLACE_COLUMNS);
+    }
+    let episodes = Columns::read(&dir.join("episodes.csv"), &names)?;
     let mut rows = Vec::new();
-    let mut places = Vec::new();
-    for (line, record) in reader.records().enumerate() {
-        let record = record.map_err(|e| what(&e))?;
-        let at = |k: usize| record.get(cols[k]).unwrap_or("");
-        let bad = |k: usize| {
-            what(&format!(
-                "line {}: {} = {:?}",
-                line + 2,
-                headers.get(cols[k]).unwrap_or(""),
-                at(k)
-            ))
-        };
-        let outcome = crate::eval::Outcome::from_name(at(1)).ok_or_else(|| bad(1))?;
+    let mut places: Places = Vec::new();
+    for i in 0..episodes.rows.len() {
+        let outcome = crate::eval::Outcome::from_name(episodes.cell(i, 1))
+            .ok_or_else(|| episodes.bad(i, 1))?;
         rows.push(SeedResult {
-            seed: at(0).parse().map_err(|_| bad(0))?,
+            seed: episodes.get(i, 0)?,
             outcome,
-            steps: at(2).parse().map_err(|_| bad(2))?,
-            collisions: at(3).parse().map_err(|_| bad(3))?,
-            path_length_px: at(4).parse().map_err(|_| bad(4))?,
-            spl: at(5).parse().map_err(|_| bad(5))?,
+            steps: episodes.get(i, 2)?,
+            collisions: episodes.get(i, 3)?,
+            path_length_px: episodes.get(i, 4)?,
+            spl: if team { 0.0 } else { episodes.get(i, 5)? },
         });
-        places.push(place_cols.map(|c| record.get(c).unwrap_or("").to_string()));
+        places.push(match team {
+            true => Vec::new(),
+            false => (6..11).map(|k| episodes.cell(i, k).to_string()).collect(),
+        });
+    }
+    if team {
+        let mut names = vec!["seed", "spl"];
+        names.extend(&PLACE_COLUMNS[..3]);
+        let robots = Columns::read(&dir.join("robots.csv"), &names)?;
+        let at: std::collections::HashMap<u64, usize> =
+            rows.iter().enumerate().map(|(i, r)| (r.seed, i)).collect();
+        let mut spl = vec![0.0; rows.len()];
+        for j in 0..robots.rows.len() {
+            let i = *at
+                .get(&robots.get(j, 0)?)
+                .ok_or_else(|| format!("{}: seed not in episodes.csv", robots.bad(j, 0)))?;
+            spl[i] += robots.get::<f64>(j, 1)?;
+            places[i].extend((2..5).map(|k| robots.cell(j, k).to_string()));
+        }
+        for ((r, spl), p) in rows.iter_mut().zip(spl).zip(&places) {
+            r.spl = spl / (p.len() / 3).max(1) as f64;
+        }
     }
     Ok((rows, places))
+}
+
+/// A CSV file's rows, as the named columns.
+struct Columns {
+    path: PathBuf,
+    names: Vec<&'static str>,
+    /// Each row's cells, in the order of `names`.
+    rows: Vec<Vec<String>>,
+}
+
+impl Columns {
+    /// Reads the columns `names` of the CSV file at `path`; an error names a missing column.
+    fn read(path: &Path, names: &[&'static str]) -> Result<Self, String> {
+        let what = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+        let lines = crate::bounded::open_lines(path).map_err(|e| what(&e))?;
+        let mut reader = csv::Reader::from_reader(lines);
+        let headers = reader.headers().map_err(|e| what(&e))?.clone();
+        let columns = names
+            .iter()
+            .map(|name| {
+                let found = headers.iter().position(|h| h == *name);
+                found.ok_or_else(|| what(&format!("no column {name:?}")))
+            })
+            .collect::<Result<Vec<usize>, String>>()?;
+        let mut rows = Vec::new();
+        for record in reader.records() {
+            let record = record.map_err(|e| what(&e))?;
+            let cell = |&c: &usize| record.get(c).unwrap_or("").to_string();
+            rows.push(columns.iter().map(cell).collect());
+        }
+        Ok(Self {
+            path: path.to_path_buf(),
+            names: names.to_vec(),
+            rows,
+        })
+    }
+
+    /// Cell `k` of row `i`.
+    fn cell(&self, i: usize, k: usize) -> &str {
+        &self.rows[i][k]
+    }
+
+    /// Cell `k` of row `i`, parsed.
+    fn get<T: std::str::FromStr>(&self, i: usize, k: usize) -> Result<T, String> {
+        self.cell(i, k).parse().map_err(|_| self.bad(i, k))
+    }
+
+    /// The error of cell `k` of row `i`: the file, its line, the column and the value.
+    fn bad(&self, i: usize, k: usize) -> String {
+        let (path, name, value) = (self.path.display(), self.names[k], self.cell(i, k));
+        format!("{path}: line {}: {name} = {value:?}", i + 2)
+    }
 }
 
 /// Every seed's difficulty, in seed order, computed on `threads` threads.
