@@ -417,8 +417,8 @@ fn log_steps_writes_a_log_per_robot_and_replay_plays_the_team_again() {
 }
 
 /// A team of one (`[[robots]] count = 1`) is the lone robot, run for run: every column the two
-/// run files share holds the same text, seed by seed, and so do the summary's figures and the
-/// pictures.
+/// run files share holds the same text, seed by seed, and so do the summary's figures, the
+/// pictures and the animations.
 #[test]
 fn a_team_of_one_runs_as_the_lone_robot_column_for_column() {
     let dir = tempfile::tempdir().unwrap();
@@ -445,6 +445,8 @@ fn a_team_of_one_runs_as_the_lone_robot_column_for_column() {
                 "30",
                 "--png",
                 "3",
+                "--gif",
+                "2",
                 "--out",
                 out.to_str().unwrap(),
             ]));
@@ -474,8 +476,8 @@ fn a_team_of_one_runs_as_the_lone_robot_column_for_column() {
             s
         };
         assert_eq!(figures(&lone), figures(&team), "{name} {policy}: summary");
-        let pictures = |dir: &std::path::Path| {
-            let mut found: Vec<_> = std::fs::read_dir(dir.join("png"))
+        let pictures = |dir: &std::path::Path, folder: &str| {
+            let mut found: Vec<_> = std::fs::read_dir(dir.join(folder))
                 .unwrap()
                 .map(|e| e.unwrap().path())
                 .collect();
@@ -485,9 +487,11 @@ fn a_team_of_one_runs_as_the_lone_robot_column_for_column() {
                 .map(|p| (p.file_name().unwrap().to_owned(), std::fs::read(p).unwrap()))
                 .collect::<Vec<_>>()
         };
-        let (a, b) = (pictures(&lone), pictures(&team));
-        assert_eq!(a.len(), 3, "{name} {policy}: {:?}", a.len());
-        assert!(a == b, "{name} {policy}: the pictures differ");
+        for (folder, count) in [("png", 3), ("gif", 1)] {
+            let (a, b) = (pictures(&lone, folder), pictures(&team, folder));
+            assert_eq!(a.len(), count, "{name} {policy} {folder}: {:?}", a.len());
+            assert!(a == b, "{name} {policy}: the {folder} files differ");
+        }
     }
 }
 

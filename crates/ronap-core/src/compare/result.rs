@@ -34,14 +34,8 @@ impl SeedResult {
     /// figures whether a run is fresh or read back with `--run`.
     pub(crate) fn of(r: &EpisodeRecord) -> Self {
         let spl = rounded(r.spl, 4);
-        Self::rounding(
-            r.seed,
-            r.outcome,
-            r.steps,
-            r.collisions,
-            r.path_length_px,
-            spl,
-        )
+        let (seed, outcome, steps, collisions) = (r.seed, r.outcome, r.steps, r.collisions);
+        Self::rounding(seed, outcome, steps, collisions, r.path_length_px, spl)
     }
 
     /// The result of team episode `r`: the team's outcome, steps, summed wall collisions and
@@ -50,14 +44,8 @@ impl SeedResult {
     pub(crate) fn of_team(r: &TeamRecord) -> Self {
         let spl =
             r.robots.iter().map(|x| rounded(x.spl, 4)).sum::<f64>() / r.robots.len().max(1) as f64;
-        Self::rounding(
-            r.seed,
-            r.outcome,
-            r.steps,
-            r.collisions,
-            r.path_length_px,
-            spl,
-        )
+        let (seed, outcome, steps, collisions) = (r.seed, r.outcome, r.steps, r.collisions);
+        Self::rounding(seed, outcome, steps, collisions, r.path_length_px, spl)
     }
 
     /// A result with its path length rounded as the files write it.

@@ -119,7 +119,7 @@ pub fn replay_team(
                 .collect();
             let first = team_frame(team, &paths, options.scale);
             size = first.dimensions();
-            drawing = Some((team_gif_writer(size.0, size.1)?, first));
+            drawing = Some((team_gif_writer(size.0, size.1, team.robots().len())?, first));
             return Ok(());
         };
         for (k, path) in paths.iter_mut().enumerate() {

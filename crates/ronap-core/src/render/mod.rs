@@ -296,24 +296,22 @@ impl Canvas {
 }
 
 /// The whole scene with an episode drawn on it: `path` in blue, start red, goal green, the robot
-/// and its current laser scan.
+/// and its current laser scan (a team of one's [`team_frame`]).
 pub fn top_down(episode: &crate::sim::Episode, path: &[Point], scale: f64) -> RgbImage {
-    let config = episode.config();
-    let mut canvas = Canvas::new(episode.scene(), scale);
-    let least = 4.0 / scale;
-    canvas.fill_disc(
-        episode.goal(),
-        config.episode.goal_tolerance_px.max(least),
-        GOAL,
-    );
-    canvas.path(path, 2.0, PATH);
-    if let Some(movers) = episode.movers() {
-        canvas.movers(movers);
-    }
-    canvas.scan(episode.laser(), episode.pose(), episode.readings());
-    canvas.body(episode.start(), &config.robot, least, START);
-    canvas.body(episode.pose(), &config.robot, least, PATH);
-    canvas.into_image()
+    let robot = trajectory::Drawn {
+        body: &episode.config().robot,
+        start: episode.start(),
+        pose: episode.pose(),
+        goal: episode.goal(),
+        goal_tolerance_px: episode.config().episode.goal_tolerance_px,
+        path,
+        scan: (episode.laser(), episode.readings()),
+        present: true,
+        arrived: false,
+        colours: trajectory::Drawn::colours(0, 1),
+    };
+    let movers = trajectory::Obstacles::Live(episode.movers());
+    trajectory::episode_image(episode.scene(), &[robot], movers, scale)
 }
 
 /// Colour of the circle of laser range in the first-person view.

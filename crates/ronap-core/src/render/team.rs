@@ -5,6 +5,7 @@
 use crate::geometry::Point;
 use crate::render::chart::{policy_colour, POLICY_COUNT};
 use crate::render::gif::{AnimationError, GifWriter};
+use crate::render::trajectory::{episode_image, Drawn, Obstacles};
 use crate::render::Canvas;
 use crate::sim::Team;
 use image::{Rgb, RgbImage};
@@ -14,32 +15,31 @@ pub(crate) fn faded(colour: Rgb<u8>) -> Rgb<u8> {
     Rgb(colour.0.map(|c| ((u16::from(c) + 255) / 2) as u8))
 }
 
-/// The picture of a team episode as it stands: each robot's goal as a faded disc of the goal
-/// tolerance, its path so far (`paths[k]`) and, while it is in the scene, the robot with its
-/// heading, all in its own colour; moving obstacles as they are now.
+/// The picture of a team episode as it stands, as a lone robot's [`crate::render::top_down`] is
+/// drawn: each robot's goal as a disc of the goal tolerance, its path so far (`paths[k]`), its
+/// start and, while it is in the scene, the robot with its heading, each robot in its own colour
+/// (a team of one in the lone robot's, with its laser scan); moving obstacles as they are now.
 pub fn team_frame(team: &Team, paths: &[Vec<Point>], scale: f64) -> RgbImage {
-    let first = team.robot(0);
-    let mut canvas = Canvas::new(first.scene(), scale);
-    let least = 3.0 / scale;
-    for (k, r) in team.robots().iter().enumerate() {
-        if !team.present(k) && r.status() == crate::sim::Status::Success {
-            continue;
-        }
-        let tolerance = r.config().episode.goal_tolerance_px;
-        canvas.fill_disc(r.goal(), tolerance.max(least), faded(policy_colour(k)));
-    }
-    for (k, path) in paths.iter().enumerate() {
-        canvas.path(path, 2.0, policy_colour(k));
-    }
-    if let Some(movers) = team.movers() {
-        canvas.movers(movers);
-    }
-    for (k, r) in team.robots().iter().enumerate() {
-        if team.present(k) {
-            canvas.body(r.pose(), &r.config().robot, least, policy_colour(k));
-        }
-    }
-    canvas.into_image()
+    let n = team.robots().len();
+    let robots: Vec<Drawn<'_>> = team
+        .robots()
+        .iter()
+        .enumerate()
+        .map(|(k, r)| Drawn {
+            body: &r.config().robot,
+            start: r.start(),
+            pose: r.pose(),
+            goal: r.goal(),
+            goal_tolerance_px: r.config().episode.goal_tolerance_px,
+            path: paths.get(k).map_or(&[][..], Vec::as_slice),
+            scan: (r.laser(), r.readings()),
+            present: team.present(k),
+            arrived: r.status() == crate::sim::Status::Success,
+            colours: Drawn::colours(k, n),
+        })
+        .collect();
+    let movers = Obstacles::Live(team.movers());
+    episode_image(team.robot(0).scene(), &robots, movers, scale)
 }
 
 /// The picture of a team's set-up before it moves: each robot's goals, in its visiting order, as
@@ -77,13 +77,23 @@ pub fn team_palette() -> Vec<Rgb<u8>> {
     palette
 }
 
-/// A GIF encoder for team frames of `width` x `height` pixels, in the team palette.
-pub fn team_gif_writer(width: u32, height: u32) -> Result<GifWriter<Vec<u8>>, AnimationError> {
+/// A GIF encoder for frames of a team of `robots` of `width` x `height` pixels: in the team
+/// palette, or a team of one in a lone robot's ([`crate::render::PALETTE`]), so its animation is
+/// the lone robot's.
+pub fn team_gif_writer(
+    width: u32,
+    height: u32,
+    robots: usize,
+) -> Result<GifWriter<Vec<u8>>, AnimationError> {
     let too_large = || AnimationError::TooLarge { width, height };
+    let palette = match robots {
+        1 => crate::render::PALETTE.to_vec(),
+        _ => team_palette(),
+    };
     Ok(GifWriter::with_palette(
         Vec::new(),
         u16::try_from(width).map_err(|_| too_large())?,
         u16::try_from(height).map_err(|_| too_large())?,
-        &team_palette(),
+        &palette,
     )?)
 }

@@ -1,6 +1,7 @@
-//! Pictures of finished episodes like the paper's Figures 7-9: the whole scene with each robot's
-//! path, start, goal and end, and moving obstacles' tracks. A lone robot's picture is its team
-//! of one's: a team's robots are drawn as the lone robot is, each in its own colour.
+//! Pictures of episodes, lone or team, running or finished (like the paper's Figures 7-9): the
+//! whole scene with each robot's path, start, goal and body, and the moving obstacles. A lone
+//! robot's picture is its team of one's: a team's robots are drawn as the lone robot is, each in
+//! its own colour.
 
 use crate::config::RobotConfig;
 use crate::eval::{EpisodeRecord, TeamRecord};
@@ -8,52 +9,92 @@ use crate::geometry::Point;
 use crate::render::chart::policy_colour;
 use crate::render::team::faded;
 use crate::render::{Canvas, GOAL, MOVER, PATH, START};
-use crate::sim::{Laser, Pose, Track};
+use crate::sim::{Laser, Movers, Pose, Track};
 use crate::Scene;
 use image::{Rgb, RgbImage};
 
-/// A robot of a finished episode as its picture draws it.
-struct Drawn<'a> {
-    body: &'a RobotConfig,
-    start: Pose,
-    end: Pose,
-    goal: Point,
-    goal_tolerance_px: f64,
+/// A robot as an episode's picture draws it.
+pub(crate) struct Drawn<'a> {
+    pub body: &'a RobotConfig,
+    pub start: Pose,
+    /// Where it is (or ended).
+    pub pose: Pose,
+    pub goal: Point,
+    pub goal_tolerance_px: f64,
     /// Its centre at every step.
-    path: &'a [Point],
+    pub path: &'a [Point],
     /// Its laser and last readings.
-    scan: (&'a Laser, &'a [f64]),
-    /// Its path and end, its start, and its goal.
-    colours: [Rgb<u8>; 3],
+    pub scan: (&'a Laser, &'a [f64]),
+    /// Whether it is in the scene: a robot taken out is drawn without its body, and without its
+    /// goal when it arrived there.
+    pub present: bool,
+    /// Whether it reached its (last) goal.
+    pub arrived: bool,
+    /// Its path and body, its start, and its goal.
+    pub colours: [Rgb<u8>; 3],
 }
 
-/// The picture of robots' finished episodes in `scene`: each goal as a disc of its tolerance,
-/// moving obstacles' `tracks` faded with each obstacle where it was at the end, each path (2 px),
-/// the last laser scan in its colour classes when there is one robot (a team's scans would hide
-/// its paths), each start and where each robot ended, as its body.
-fn episode_image(scene: &Scene, robots: &[Drawn<'_>], tracks: &[Track], scale: f64) -> RgbImage {
+impl Drawn<'_> {
+    /// Robot `k`'s colours among `n` robots: a lone robot's path, start and goal colours for a
+    /// team of one, else its own colour, faded for its start and goal.
+    pub(crate) fn colours(k: usize, n: usize) -> [Rgb<u8>; 3] {
+        match n {
+            1 => [PATH, START, GOAL],
+            _ => [
+                policy_colour(k),
+                faded(policy_colour(k)),
+                faded(policy_colour(k)),
+            ],
+        }
+    }
+}
+
+/// The moving obstacles of a picture.
+pub(crate) enum Obstacles<'a> {
+    /// As they are now, in a running episode.
+    Live(Option<&'a Movers>),
+    /// Their tracks over a finished episode, each drawn where it ended.
+    Tracks(&'a [Track]),
+}
+
+/// The picture of `robots` in `scene`: each goal as a disc of its tolerance, a finished
+/// episode's obstacle tracks (faded, each obstacle where it ended), each path (2 px), the
+/// obstacles as they are in a running one, the last laser scan in its colour classes when there
+/// is one robot (a team's scans would hide its paths), each start and each robot in the scene,
+/// as its body.
+pub(crate) fn episode_image(
+    scene: &Scene,
+    robots: &[Drawn<'_>],
+    obstacles: Obstacles<'_>,
+    scale: f64,
+) -> RgbImage {
     let mut canvas = Canvas::new(scene, scale);
     let least = 4.0 / scale;
-    for r in robots {
+    for r in robots.iter().filter(|r| r.present || !r.arrived) {
         canvas.fill_disc(r.goal, r.goal_tolerance_px.max(least), r.colours[2]);
     }
-    canvas.tracks(tracks);
-    for track in tracks {
-        if let Some(last) = track.last() {
-            canvas.mover(track.body, last, MOVER);
+    if let Obstacles::Tracks(tracks) = obstacles {
+        canvas.tracks(tracks);
+        for track in tracks {
+            if let Some(last) = track.last() {
+                canvas.mover(track.body, last, MOVER);
+            }
         }
     }
     for r in robots {
         canvas.path(r.path, 2.0, r.colours[0]);
     }
+    if let Obstacles::Live(Some(movers)) = obstacles {
+        canvas.movers(movers);
+    }
     if let [r] = robots {
-        canvas.scan(r.scan.0, r.end, r.scan.1);
+        canvas.scan(r.scan.0, r.pose, r.scan.1);
     }
     for r in robots {
         canvas.body(r.start, r.body, least, r.colours[1]);
     }
-    for r in robots {
-        canvas.body(r.end, r.body, least, r.colours[0]);
+    for r in robots.iter().filter(|r| r.present) {
+        canvas.body(r.pose, r.body, least, r.colours[0]);
     }
     canvas.into_image()
 }
@@ -68,19 +109,17 @@ pub fn trajectory_image(record: &EpisodeRecord, scale: f64) -> Option<RgbImage> 
     let robot = Drawn {
         body: &config.robot,
         start: record.start,
-        end: record.end,
+        pose: record.end,
         goal: record.goal,
         goal_tolerance_px: config.episode.goal_tolerance_px,
         path: &path,
         scan: (&laser, &record.last_readings),
-        colours: [PATH, START, GOAL],
+        present: true,
+        arrived: false,
+        colours: Drawn::colours(0, 1),
     };
-    Some(episode_image(
-        world.scene(),
-        &[robot],
-        &record.mover_tracks,
-        scale,
-    ))
+    let tracks = Obstacles::Tracks(&record.mover_tracks);
+    Some(episode_image(world.scene(), &[robot], tracks, scale))
 }
 
 /// The picture of a team episode: robot `k` in the colour of
@@ -89,6 +128,7 @@ pub fn trajectory_image(record: &EpisodeRecord, scale: f64) -> Option<RgbImage> 
 /// (`None` once they are dropped).
 pub fn team_image(record: &TeamRecord, scale: f64) -> Option<RgbImage> {
     let picture = record.picture.as_ref()?;
+    let n = record.robots.len();
     let robots: Vec<Drawn<'_>> = record
         .robots
         .iter()
@@ -97,25 +137,16 @@ pub fn team_image(record: &TeamRecord, scale: f64) -> Option<RgbImage> {
         .map(|(k, (r, look))| Drawn {
             body: &look.body,
             start: r.start,
-            end: r.end,
+            pose: r.end,
             goal: r.goal,
             goal_tolerance_px: look.goal_tolerance_px,
             path: record.paths.get(k).map_or(&[][..], Vec::as_slice),
             scan: (&look.laser, &look.last_readings),
-            colours: match record.robots.len() {
-                1 => [PATH, START, GOAL],
-                _ => [
-                    policy_colour(k),
-                    faded(policy_colour(k)),
-                    faded(policy_colour(k)),
-                ],
-            },
+            present: true,
+            arrived: false,
+            colours: Drawn::colours(k, n),
         })
         .collect();
-    Some(episode_image(
-        &picture.scene,
-        &robots,
-        &picture.mover_tracks,
-        scale,
-    ))
+    let tracks = Obstacles::Tracks(&picture.mover_tracks);
+    Some(episode_image(&picture.scene, &robots, tracks, scale))
 }
