@@ -18,7 +18,7 @@ use ratatui::widgets::{Block, Paragraph};
 use ratatui::Frame;
 use ronap_core::geometry::{unit, Point};
 use ronap_core::render::{HeadingUp, FIRST_PERSON_HALF_SPAN};
-use ronap_core::sim::{Body, Movers, RayClass, Team};
+use ronap_core::sim::{Body, Movers, RayClass};
 use ronap_core::Episode;
 
 /// Walls within the laser's range (first-person) and everywhere (whole scene).
@@ -270,29 +270,81 @@ impl Shape for Pen {
     }
 }
 
-/// Draws the scene panel in `area`: a block titled `title` holding the episode in `mode`, with
-/// the distance to the goal in its upper right. `path` is the path so far (whole-scene view).
-pub fn scene(
-    frame: &mut Frame,
-    area: Rect,
-    episode: &Episode,
-    path: &[Point],
-    mode: SceneMode,
-    title: &str,
-) {
-    let block = Block::bordered().title(format!(" {title} "));
+/// A robot as the scene panel draws it.
+pub struct Shown<'a> {
+    /// Its episode.
+    pub episode: &'a Episode,
+    /// Its positions so far, start first.
+    pub path: &'a [Point],
+    /// Whether it is in the scene: a robot taken out has no body.
+    pub present: bool,
+    /// Whether its episode goes on: a team robot's goal ring shows only then.
+    pub running: bool,
+    /// Its path's colour and its body's.
+    pub colours: (Color, Color),
+}
+
+impl<'a> Shown<'a> {
+    /// A lone robot (a team of one): its path light blue, its body cyan.
+    pub fn lone(episode: &'a Episode, path: &'a [Point]) -> Self {
+        Self {
+            episode,
+            path,
+            present: true,
+            running: !episode.status().is_done(),
+            colours: (PATH, ROBOT),
+        }
+    }
+}
+
+/// What the scene panel shows: the robots, the one followed, the moving obstacles, the view and
+/// the panel's title.
+pub struct Panel<'a> {
+    /// Every robot, in team order.
+    pub robots: &'a [Shown<'a>],
+    /// The robot followed: its rays, its first-person view and its distance to the goal.
+    pub focus: usize,
+    /// The moving obstacles.
+    pub movers: Option<&'a Movers>,
+    /// Whole scene or first person.
+    pub mode: SceneMode,
+    /// The panel's title.
+    pub title: &'a str,
+}
+
+/// Draws the scene panel in `area`: a block titled with the panel's title holding its robots in
+/// its mode, with the followed robot's distance to its goal in the upper right. One robot is
+/// drawn as the paper's screen draws it (start and goal filled, [`whole_scene`]); a team's robots
+/// each in their colours.
+pub fn scene(frame: &mut Frame, area: Rect, panel: &Panel<'_>) {
+    let block = Block::bordered().title(format!(" {} ", panel.title));
     let inner = block.inner(area);
     frame.render_widget(block, area);
-    if inner.width < 2 || inner.height < 2 {
+    if inner.width < 2 || inner.height < 2 || panel.robots.is_empty() {
         return;
     }
-    let pen = match mode {
-        SceneMode::FirstPerson => first_person(inner, episode),
-        SceneMode::WholeScene => whole_scene(inner, episode, path),
+    let focus = panel.focus.min(panel.robots.len() - 1);
+    let followed = panel.robots[focus].episode;
+    let pen = match panel.mode {
+        SceneMode::FirstPerson => {
+            let mut pen = first_person(inner, followed);
+            let view = HeadingUp::new(followed.pose());
+            if followed.movers().is_none() {
+                movers(&mut pen, panel.movers, |p| view.to_view(p));
+            }
+            for (k, r) in panel.robots.iter().enumerate() {
+                if k != focus && r.present {
+                    let at = view.to_view(r.episode.pose().position());
+                    pen.disc(at, r.episode.config().robot.radius_px, r.colours.1);
+                }
+            }
+            pen
+        }
+        SceneMode::WholeScene => whole_scene(inner, panel.robots, focus, panel.movers),
     };
     pen.render(frame, inner);
     let distance = Paragraph::new(Span::styled(
-        format!("{:.1} px", episode.distance_px()),
+        format!("{:.1} px", followed.distance_px()),
         Style::default().fg(DISTANCE).add_modifier(Modifier::BOLD),
     ))
     .alignment(Alignment::Right);
@@ -396,26 +448,43 @@ fn body(
     }
 }
 
-/// The whole scene: walls, the path so far, the current rays, start, goal and the robot with a
-/// tick along its heading.
-fn whole_scene(area: Rect, episode: &Episode, path: &[Point]) -> Pen {
-    let mut pen = scene_walls(area, episode);
+/// The whole scene: walls, each robot's path so far, the moving obstacles, the followed robot's
+/// rays, then each robot: one robot's start and goal filled, a team robot's goal as a ring while
+/// it runs, and each robot in the scene, the followed one with a tick along its heading.
+fn whole_scene(area: Rect, robots: &[Shown<'_>], focus: usize, obstacles: Option<&Movers>) -> Pen {
+    let followed = robots[focus].episode;
+    let mut pen = scene_walls(area, followed);
     let s = pen.grid.px_per_dot;
-    let pose = episode.pose();
-    trail(&mut pen, path, pose.position(), PATH);
-    movers(&mut pen, episode.movers(), |p| (p.x, p.y));
-    for (end, colour) in rays(episode, |p| (p.x, p.y)) {
+    for r in robots {
+        trail(&mut pen, r.path, r.episode.pose().position(), r.colours.0);
+    }
+    movers(&mut pen, obstacles, |p| (p.x, p.y));
+    let pose = followed.pose();
+    for (end, colour) in rays(followed, |p| (p.x, p.y)) {
         pen.line((pose.x, pose.y), end, colour);
     }
-    let config = episode.config();
-    let start = episode.start().position();
-    pen.disc((start.x, start.y), config.robot.radius_px, START);
-    let goal = episode.goal();
-    pen.disc((goal.x, goal.y), config.episode.goal_tolerance_px, GOAL);
-    let radius = config.robot.radius_px.max(s);
-    body(&mut pen, pose, &config.robot, radius, ROBOT);
-    let tip = pose.position() + unit(pose.z_deg) * radius * 2.5;
-    pen.line((pose.x, pose.y), (tip.x, tip.y), ROBOT);
+    let lone = robots.len() == 1;
+    for (k, r) in robots.iter().enumerate() {
+        let config = r.episode.config();
+        let goal = r.episode.goal();
+        if lone {
+            let start = r.episode.start().position();
+            pen.disc((start.x, start.y), config.robot.radius_px, START);
+            pen.disc((goal.x, goal.y), config.episode.goal_tolerance_px, GOAL);
+        } else if r.running {
+            let ring = config.episode.goal_tolerance_px.max(s);
+            pen.circle((goal.x, goal.y), ring, r.colours.1);
+        }
+        if r.present {
+            let pose = r.episode.pose();
+            let radius = config.robot.radius_px.max(s);
+            body(&mut pen, pose, &config.robot, radius, r.colours.1);
+            if k == focus {
+                let tip = pose.position() + unit(pose.z_deg) * radius * 2.5;
+                pen.line((pose.x, pose.y), (tip.x, tip.y), r.colours.1);
+            }
+        }
+    }
     pen
 }
 
@@ -464,76 +533,6 @@ pub fn robot_colour(k: usize) -> Color {
         Color::Blue,
     ];
     COLOURS[k % COLOURS.len()]
-}
-
-/// Draws a team's scene panel in `area`, titled `title`. Whole scene: every present robot with
-/// its heading, its path (`paths[k]`) and a ring round its current goal, each in its colour, and
-/// robot `focus`'s rays. First person: robot `focus`'s view, the others as discs in their colours.
-pub fn team_scene(
-    frame: &mut Frame,
-    area: Rect,
-    team: &Team,
-    paths: &[Vec<Point>],
-    focus: usize,
-    mode: SceneMode,
-    title: &str,
-) {
-    let block = Block::bordered().title(format!(" {title} "));
-    let inner = block.inner(area);
-    frame.render_widget(block, area);
-    if inner.width < 2 || inner.height < 2 || team.robots().is_empty() {
-        return;
-    }
-    let focus = focus.min(team.robots().len() - 1);
-    let followed = team.robot(focus);
-    let pen = match mode {
-        SceneMode::FirstPerson => {
-            let mut pen = first_person(inner, followed);
-            let view = HeadingUp::new(followed.pose());
-            if followed.movers().is_none() {
-                movers(&mut pen, team.movers(), |p| view.to_view(p));
-            }
-            for (k, r) in team.robots().iter().enumerate() {
-                if k != focus && team.present(k) {
-                    let at = view.to_view(r.pose().position());
-                    pen.disc(at, r.config().robot.radius_px, robot_colour(k));
-                }
-            }
-            pen
-        }
-        SceneMode::WholeScene => {
-            let mut pen = scene_walls(inner, followed);
-            let s = pen.grid.px_per_dot;
-            for (k, r) in team.robots().iter().enumerate() {
-                let path = paths.get(k).map_or(&[][..], Vec::as_slice);
-                trail(&mut pen, path, r.pose().position(), robot_colour(k));
-            }
-            movers(&mut pen, team.movers(), |p| (p.x, p.y));
-            let pose = followed.pose();
-            for (end, colour) in rays(followed, |p| (p.x, p.y)) {
-                pen.line((pose.x, pose.y), end, colour);
-            }
-            for (k, r) in team.robots().iter().enumerate() {
-                let colour = robot_colour(k);
-                if team.running(k) {
-                    let goal = r.goal();
-                    let ring = r.config().episode.goal_tolerance_px.max(s);
-                    pen.circle((goal.x, goal.y), ring, colour);
-                }
-                if team.present(k) {
-                    let pose = r.pose();
-                    let radius = r.config().robot.radius_px.max(s);
-                    body(&mut pen, pose, &r.config().robot, radius, colour);
-                    if k == focus {
-                        let tip = pose.position() + unit(pose.z_deg) * radius * 2.5;
-                        pen.line((pose.x, pose.y), (tip.x, tip.y), colour);
-                    }
-                }
-            }
-            pen
-        }
-    };
-    pen.render(frame, inner);
 }
 
 /// Where the goal is, relative to the heading: `ahead`, `35° left`, `170° right`, `behind`.
@@ -750,8 +749,16 @@ pub fn screen(
     status: Line<'static>,
 ) {
     let title = format!("{} · seed {}", mode.title(), episode.seed());
+    let robots = [Shown::lone(episode, path)];
+    let panel = Panel {
+        robots: &robots,
+        focus: 0,
+        movers: episode.movers(),
+        mode,
+        title: &title,
+    };
     screen_with(frame, name, side, status, |frame, area| {
-        scene(frame, area, episode, path, mode, &title)
+        scene(frame, area, &panel)
     });
 }
 

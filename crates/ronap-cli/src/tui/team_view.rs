@@ -255,15 +255,27 @@ pub fn draw(frame: &mut Frame, state: &TeamViewState) {
         side_panel(state),
         &status(state),
         |frame, area| {
-            draw::team_scene(
-                frame,
-                area,
-                state.team(),
-                &state.paths,
-                state.focus,
+            let team = state.team();
+            let robots: Vec<draw::Shown<'_>> = (0..team.robots().len())
+                .map(|k| draw::Shown {
+                    episode: team.robot(k),
+                    path: state.paths.get(k).map_or(&[][..], Vec::as_slice),
+                    present: team.present(k),
+                    running: team.running(k),
+                    colours: match team.robots().len() {
+                        1 => (draw::PATH, draw::ROBOT),
+                        _ => (draw::robot_colour(k), draw::robot_colour(k)),
+                    },
+                })
+                .collect();
+            let panel = draw::Panel {
+                robots: &robots,
+                focus: state.focus,
+                movers: team.movers(),
                 mode,
-                &title,
-            )
+                title: &title,
+            };
+            draw::scene(frame, area, &panel)
         },
     );
 }
