@@ -1,7 +1,7 @@
 //! End-to-end tests of `ronap compare`: the table and every file read back, the same episodes as
 //! separate `ronap run`s, identical policies, reused runs, difficulty bins and bad input.
 
-use crate::util::{assert_rejected, json, ok, repo_root, ronap, rows, run_args, shipped};
+use crate::util::{assert_rejected, col, json, ok, repo_root, ronap, rows, run_args, shipped};
 use std::path::Path;
 
 /// The pair of policies most tests compare.
@@ -341,11 +341,33 @@ fn a_team_scenario_is_compared_on_team_success_with_a_table_per_robot() {
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("## Teams"), "{report}");
     assert!(out.join("compare.png").exists() && out.join("outcomes.png").exists());
-    // What a team comparison cannot do yet is refused by name.
-    assert_rejected(
-        &[&team[..], &["--seeds", "2", "--by", "difficulty"]].concat(),
-        &["--by difficulty", "team scenarios"],
-    );
+    // By difficulty, a team's seeds are binned by their hardest robot's task.
+    let binned = dir.path().join("binned");
+    let by = [
+        "--seeds",
+        "4",
+        "--max-steps",
+        "300",
+        "--by",
+        "difficulty",
+        "--bins",
+        "2",
+        "--out",
+        binned.to_str().unwrap(),
+    ];
+    let table = ok(&ronap(&[&team[..], &by].concat()));
+    assert!(table.contains("by path / straight ratio"), "{table}");
+    let seeds = rows(&binned.join("seeds.csv"));
+    assert_eq!(seeds.len(), 1 + 4);
+    let (ratio, turns) = (col(&seeds, "ratio"), col(&seeds, "turns"));
+    for r in &seeds[1..] {
+        assert!(r[ratio].parse::<f64>().unwrap() >= 1.0, "{r:?}");
+        assert!(
+            r[turns].parse::<u32>().unwrap() >= 1,
+            "racks to go round: {r:?}"
+        );
+    }
+    image::open(binned.join("difficulty.png")).unwrap();
     // Both team runs read back give the same comparison, and run nothing.
     let runs: Vec<String> = ["geodesic", "random"]
         .iter()

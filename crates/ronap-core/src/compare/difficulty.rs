@@ -36,23 +36,64 @@ impl Difficulty {
     /// them); `None` when no episode can start there.
     pub fn of(world: &World, seed: u64) -> Option<Self> {
         let episode = world.episode(seed).ok()?;
-        let (start, goal) = (episode.start().position(), episode.goal());
+        Some(Self::of_task(
+            world,
+            seed,
+            episode.start().position(),
+            episode.goal(),
+        ))
+    }
+
+    /// The figures of team episode `seed` of `evaluator`: its hardest robot's in each (the
+    /// largest ratio, the narrowest gap, the most turns), and the straight and shortest lengths
+    /// summed over its robots, each robot's task from its start to its first goal. A team is as
+    /// hard as its hardest task, since it succeeds only when every robot arrives; one robot
+    /// without a path leaves the team's path figures empty. `None` when the team cannot be
+    /// placed.
+    pub fn of_team(evaluator: &crate::eval::Evaluator, seed: u64) -> Option<Self> {
+        let worlds = evaluator.worlds().team(seed);
+        let team = crate::sim::Team::new(evaluator.config(), &worlds, seed).ok()?;
+        let mut entry_of = Vec::new();
+        for (e, entry) in evaluator.config().robots.iter().enumerate() {
+            entry_of.extend(std::iter::repeat_n(e, entry.count as usize));
+        }
+        let tasks: Vec<Self> = team
+            .robots()
+            .iter()
+            .zip(entry_of)
+            .map(|(r, e)| Self::of_task(&worlds[e], seed, r.start().position(), r.goal()))
+            .collect();
+        let all = |f: fn(&Self) -> Option<f64>| tasks.iter().map(f).collect::<Option<Vec<f64>>>();
+        let most = |v: Vec<f64>| v.into_iter().fold(f64::NEG_INFINITY, f64::max);
+        Some(Self {
+            seed,
+            straight_px: tasks.iter().map(|t| t.straight_px).sum(),
+            geodesic_px: all(|t| t.geodesic_px).map(|v| v.iter().sum()),
+            ratio: all(|t| t.ratio).map(most),
+            narrowest_gap_px: all(|t| t.narrowest_gap_px)
+                .map(|v| v.into_iter().fold(f64::INFINITY, f64::min)),
+            turns: all(|t| t.turns.map(f64::from)).map(|v| most(v) as u32),
+        })
+    }
+
+    /// The figures of the task from `start` to `goal` in `world`.
+    fn of_task(world: &World, seed: u64, start: Point, goal: Point) -> Self {
         let straight_px = (goal - start).norm();
         let radius = world.config().robot.radius_px;
         let path = shortest_path(world.scene(), world.grid(), start, goal, radius);
         let Some(path) = path else {
-            return Some(Self {
+            return Self {
                 seed,
                 straight_px,
                 geodesic_px: None,
                 ratio: None,
                 narrowest_gap_px: None,
                 turns: None,
-            });
+            };
         };
         let geodesic_px = crate::plan::path_length(&path);
         let reach = world.scene().width().max(world.scene().height());
-        Some(Self {
+        Self {
             seed,
             straight_px,
             geodesic_px: Some(geodesic_px),
@@ -63,7 +104,7 @@ impl Difficulty {
             }),
             narrowest_gap_px: narrowest_gap(world, &path, reach),
             turns: Some(turns(&path)),
-        })
+        }
     }
 
     /// The figure `by` names.

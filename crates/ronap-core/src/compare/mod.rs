@@ -303,14 +303,6 @@ pub fn compare(
     }
     let config = evaluator.config();
     if config.team_size() > 0 {
-        let refuse = |what: &str| {
-            Err(CompareError::Input(format!(
-                "{what}: not for team scenarios ([[robots]]) yet"
-            )))
-        };
-        if options.by_difficulty {
-            return refuse("--by difficulty");
-        }
         if let Some(c) = contenders.iter().find(|c| c.team.is_none()) {
             return Err(CompareError::Input(format!(
                 "policy {}: no team policy was given for this team scenario",
@@ -848,20 +840,16 @@ impl Columns {
     }
 }
 
-/// Every seed's difficulty, in seed order, computed on `threads` threads.
+/// Every seed's difficulty (a team's: [`Difficulty::of_team`]), in seed order, computed on
+/// `threads` threads.
 fn difficulties(evaluator: &Evaluator, seeds: &[u64], threads: usize) -> Vec<Option<Difficulty>> {
-    let compute = || {
-        seeds
-            .par_iter()
-            .map(|&s| Difficulty::of(&evaluator.world(s), s))
-            .collect()
+    let of = |&s: &u64| match evaluator.config().team_size() {
+        0 => Difficulty::of(&evaluator.world(s), s),
+        _ => Difficulty::of_team(evaluator, s),
     };
     match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
-        Ok(pool) => pool.install(compute),
-        Err(_) => seeds
-            .iter()
-            .map(|&s| Difficulty::of(&evaluator.world(s), s))
-            .collect(),
+        Ok(pool) => pool.install(|| seeds.par_iter().map(of).collect()),
+        Err(_) => seeds.iter().map(of).collect(),
     }
 }
 
