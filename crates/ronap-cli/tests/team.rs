@@ -401,6 +401,16 @@ fn log_steps_writes_a_log_per_robot_and_replay_plays_the_team_again() {
     assert!(said.contains("8 robots"), "{said}");
     let gif = steps.join("seed-000001-team-top.gif");
     assert!(std::fs::read(&gif).unwrap().starts_with(b"GIF89a"));
+    // The first-person view is the given log's robot's.
+    let said = ok(&ronap(&[
+        "replay",
+        one.to_str().unwrap(),
+        "--view",
+        "first",
+    ]));
+    assert!(said.contains("frames of 240 x 240"), "{said}");
+    let first = steps.join("seed-000001-robot-2-first.gif");
+    assert!(std::fs::read(&first).unwrap().starts_with(b"GIF89a"));
     // A robot's log bent at one step no longer replays, and the error names the robot.
     let bent = steps.join("seed-000001-robot-5.csv");
     let text = std::fs::read_to_string(&bent).unwrap();
@@ -447,6 +457,7 @@ fn a_team_of_one_runs_as_the_lone_robot_column_for_column() {
                 "3",
                 "--gif",
                 "2",
+                "--log-steps",
                 "--out",
                 out.to_str().unwrap(),
             ]));
@@ -491,6 +502,18 @@ fn a_team_of_one_runs_as_the_lone_robot_column_for_column() {
             let (a, b) = (pictures(&lone, folder), pictures(&team, folder));
             assert_eq!(a.len(), count, "{name} {policy} {folder}: {:?}", a.len());
             assert!(a == b, "{name} {policy}: the {folder} files differ");
+        }
+        // Replayed from its step log, a team of one is the lone robot in either view.
+        for view in ["top", "first"] {
+            let replayed = |log: std::path::PathBuf| {
+                let gif = dir.path().join(format!("{name}-{policy}-{view}.gif"));
+                let args = ["replay", log.to_str().unwrap(), "--view", view, "--out"];
+                ok(&ronap(&[&args[..], &[gif.to_str().unwrap()]].concat()));
+                std::fs::read(gif).unwrap()
+            };
+            let a = replayed(lone.join("steps/seed-000002.csv"));
+            let b = replayed(team.join("steps/seed-000002-robot-0.csv"));
+            assert!(a == b, "{name} {policy}: the replayed {view} views differ");
         }
     }
 }

@@ -30,7 +30,7 @@ pub struct ReplayArgs {
     #[arg(long, value_name = "FILE")]
     summary: Option<PathBuf>,
     /// What each frame shows: `top` (the whole scene with the path so far) or `first` (the
-    /// paper's first-person view).
+    /// paper's first-person view; of a team, the view of the robot whose log is given).
     #[arg(long, value_name = "top|first", default_value = "top", value_parser = view)]
     view: View,
     /// A frame every N steps (the first and last states always get one).
@@ -46,7 +46,8 @@ pub struct ReplayArgs {
     #[arg(long, allow_negative_numbers = true, value_name = "N", default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=50))]
     fps: u32,
     /// The GIF to write [default: beside the log, named after it: seed-<seed>-top.gif or
-    /// seed-<seed>-first.gif; for a team, seed-<seed>-team-top.gif].
+    /// seed-<seed>-first.gif; for a team, seed-<seed>-team-top.gif or
+    /// seed-<seed>-robot-<k>-first.gif].
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
     /// Write an HTML player of the episode to FILE (ending in .html) instead of a GIF: one
@@ -117,14 +118,16 @@ pub fn run(args: ReplayArgs) -> Result<ExitCode> {
         }
     }
     let out = args.out.clone().unwrap_or_else(|| {
-        // A team's logs are one per robot; its animation is the team's: seed-<seed>-team-top.gif.
+        // A team's logs are one per robot; its top view is the team's: seed-<seed>-team-top.gif.
         let stem = args.steps.with_extension("");
         let name = stem
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
         let name = match name.rsplit_once("-robot-") {
-            Some((seed, _)) if config.team_size() > 0 => format!("{seed}-team"),
+            Some((seed, _)) if config.team_size() > 0 && args.view == View::TopDown => {
+                format!("{seed}-team")
+            }
             _ => name,
         };
         stem.with_file_name(format!("{name}-{}.gif", args.view.name()))
@@ -152,10 +155,12 @@ pub fn run(args: ReplayArgs) -> Result<ExitCode> {
     }
     let options = options(args.view, args.stride, args.scale, args.size, args.fps);
     if evaluator.config().team_size() > 0 {
-        if args.view == View::FirstPerson {
-            bail!("--view first: a team episode is replayed from above only (--view top)");
-        }
         let logs = team_logs(&args.steps, seed)?;
+        // The first-person view is the given log's robot's.
+        let options = GifOptions {
+            follow: robot_of(&args.steps).unwrap_or(0),
+            ..options
+        };
         let animation = replay_team(&evaluator, seed, &logs, &options)
             .with_context(|| format!("cannot replay {}", args.steps.display()))?;
         ronap_core::io::write_atomic(&out, |w| w.write_all(&animation.bytes))?;
@@ -231,6 +236,12 @@ fn write_player(
         page.len() as f64 / 1024.0
     )?;
     Ok(ExitCode::SUCCESS)
+}
+
+/// The robot whose log `path` is, from its name `seed-<seed>-robot-<k>.csv`.
+fn robot_of(path: &Path) -> Option<usize> {
+    let stem = path.file_stem()?.to_str()?;
+    stem.rsplit_once("-robot-")?.1.parse().ok()
 }
 
 /// Every robot's log of the team episode of `seed` whose robot log `one` is: the files

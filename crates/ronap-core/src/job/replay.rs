@@ -6,7 +6,8 @@ use crate::eval::Evaluator;
 use crate::geometry::Point;
 use crate::io::LoggedStep;
 use crate::render::{
-    same_pose, team_frame, team_gif_writer, Animation, AnimationError, GifOptions, GifWriter,
+    first_person, same_pose, team_frame, team_gif_writer, Animation, AnimationError, GifOptions,
+    GifWriter, View,
 };
 use crate::run::{RunError, TeamRollout};
 use crate::sim::{Action, Pose, Team};
@@ -99,8 +100,9 @@ pub enum ReplayError {
 }
 
 /// Replays team episode `seed` of `evaluator` from `logs` (one for every robot of the team) and
-/// draws it from above every `options.stride` steps at `options.scale`, as the run's `--gif`
-/// drew it. A robot whose log ends while it still runs gives up there, as its policy did.
+/// draws it every `options.stride` steps: from above at `options.scale`, as the run's `--gif`
+/// drew it, or as robot `options.follow` sees it (the first-person view of a lone robot's
+/// replay). A robot whose log ends while it still runs gives up there, as its policy did.
 pub fn replay_team(
     evaluator: &Evaluator,
     seed: u64,
@@ -108,6 +110,19 @@ pub fn replay_team(
     options: &GifOptions,
 ) -> Result<Animation, ReplayError> {
     let stride = options.stride.max(1);
+    if options.view == View::FirstPerson && options.follow >= logs.len() {
+        return Err(ReplayError::Robot {
+            robot: options.follow,
+            message: format!(
+                "the view follows it, but the team has {} robots",
+                logs.len()
+            ),
+        });
+    }
+    let frame = |team: &Team, paths: &[Vec<Point>]| match options.view {
+        View::TopDown => team_frame(team, paths, options.scale),
+        View::FirstPerson => first_person(team.robot(options.follow), options.size_px),
+    };
     let mut paths: Vec<Vec<Point>> = Vec::new();
     // Each frame is written when the next one is known, so the last can be held longer.
     let mut drawing: Option<(GifWriter<Vec<u8>>, RgbImage)> = None;
@@ -117,9 +132,14 @@ pub fn replay_team(
             paths = (0..team.robots().len())
                 .map(|k| vec![team.robot(k).pose().position()])
                 .collect();
-            let first = team_frame(team, &paths, options.scale);
+            let first = frame(team, &paths);
             size = first.dimensions();
-            drawing = Some((team_gif_writer(size.0, size.1, team.robots().len())?, first));
+            // A first-person frame has a lone robot's colours only.
+            let robots = match options.view {
+                View::TopDown => team.robots().len(),
+                View::FirstPerson => 1,
+            };
+            drawing = Some((team_gif_writer(size.0, size.1, robots)?, first));
             return Ok(());
         };
         for (k, path) in paths.iter_mut().enumerate() {
@@ -132,7 +152,7 @@ pub fn replay_team(
         // last logged step leave it running here, and the run drew no frame for that step.
         if step.number % stride == 0 || (step.number == step.last && step.finished) {
             if let Some((writer, pending)) = &mut drawing {
-                let frame = team_frame(team, &paths, options.scale);
+                let frame = frame(team, &paths);
                 writer
                     .add(pending, options.frame_delay_cs)
                     .map_err(AnimationError::from)?;

@@ -61,6 +61,8 @@ pub struct GifOptions {
     pub scale: f64,
     /// First-person view: side of the square picture, pixels.
     pub size_px: u32,
+    /// First-person view of a team: the robot whose view it is (0 for a lone robot).
+    pub follow: usize,
     /// Time each frame shows, hundredths of a second (the GIF unit).
     pub frame_delay_cs: u16,
     /// Time the last frame shows before the animation loops, hundredths of a second.
@@ -74,6 +76,7 @@ impl Default for GifOptions {
             stride: 1,
             scale: 0.4,
             size_px: 240,
+            follow: 0,
             frame_delay_cs: 5,
             last_frame_delay_cs: 150,
         }
