@@ -341,6 +341,9 @@ fn a_team_scenario_is_compared_on_team_success_with_a_table_per_robot() {
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     assert!(report.contains("## Teams"), "{report}");
     assert!(out.join("compare.png").exists() && out.join("outcomes.png").exists());
+    // The contact sheet draws each policy's team episode where they disagree most.
+    let sheet = image::open(out.join("disagreements.png")).unwrap();
+    assert!(sheet.width() > 300, "{}", sheet.width());
     // By difficulty, a team's seeds are binned by their hardest robot's task.
     let binned = dir.path().join("binned");
     let by = [

@@ -28,7 +28,8 @@ pub fn disagreements(policies: &[PolicyResult], rows: usize) -> Vec<usize> {
 }
 
 /// The contact sheet of the seeds where the policies disagree most: each policy's trajectory
-/// there (the episode run again, recording its path). `None` when they agree everywhere.
+/// there (the episode run again, recording its path; a team's, every robot's paths). `None` when
+/// they agree everywhere.
 pub(super) fn disagreement_sheet(
     evaluator: &Evaluator,
     contenders: &[Contender],
@@ -39,37 +40,65 @@ pub(super) fn disagreement_sheet(
     if chosen.is_empty() {
         return Ok(None);
     }
+    let made = |c: &Contender, source| CompareError::Policy {
+        policy: c.name.clone(),
+        source,
+    };
+    let team = evaluator.config().team_size() > 0;
+    // A lone robot's policies are made once; a team's afresh for each episode.
     let mut policies = Vec::new();
     for c in contenders {
-        policies.push(c.factory.make().map_err(|source| CompareError::Policy {
-            policy: c.name.clone(),
-            source,
-        })?);
+        policies.push(match team {
+            true => None,
+            false => Some(c.factory.make().map_err(|e| made(c, e))?),
+        });
     }
     let recording = Recording {
         trajectory: true,
         steps: false,
     };
+    // Pictures 160 pixels along the scene's longer side.
+    let scale = |scene: &crate::Scene| 160.0 / scene.width().max(scene.height()).max(1.0);
     let mut sheet_rows = Vec::new();
     for &i in &chosen {
         let seed = comparison.policies[0].seeds[i].seed;
         let mut cells = Vec::new();
-        for policy in policies.iter_mut() {
-            let cell = match evaluator.run_episode(policy.as_mut(), seed, recording) {
-                Ok(record) => {
-                    let scale = 160.0
-                        / record
+        for (c, policy) in contenders.iter().zip(policies.iter_mut()) {
+            let drawn = match (&c.team, policy.as_deref_mut()) {
+                (Some(factory), _) if team => {
+                    let mut policy = factory.make().map_err(|e| made(c, e))?;
+                    let names = factory.names();
+                    evaluator
+                        .run_team_episode(policy.as_mut(), &names, seed, recording)
+                        .map(|r| {
+                            let picture = r
+                                .picture
+                                .as_ref()
+                                .and_then(|p| crate::render::team_image(&r, scale(&p.scene)));
+                            (picture, r.outcome, r.steps)
+                        })
+                        .map_err(|e| e.to_string())
+                }
+                (_, Some(policy)) => evaluator
+                    .run_episode(policy, seed, recording)
+                    .map(|r| {
+                        let picture = r
                             .world
                             .as_ref()
-                            .map_or(160.0, |w| w.scene().width().max(w.scene().height()));
-                    let picture = crate::render::trajectory_image(&record, scale)
-                        .unwrap_or_else(|| image::RgbImage::new(1, 1));
-                    let caption = format!("{}, {} steps", record.outcome.name(), record.steps);
-                    (picture, caption)
-                }
-                Err(e) => (image::RgbImage::new(1, 1), format!("failed: {e}")),
+                            .and_then(|w| crate::render::trajectory_image(&r, scale(w.scene())));
+                        (picture, r.outcome, r.steps)
+                    })
+                    .map_err(|e| e.to_string()),
+                // A team scenario's contender always has a team policy (the comparison checks).
+                (_, None) => Err("no team policy".to_string()),
             };
-            cells.push(cell);
+            cells.push(match drawn {
+                Ok((picture, outcome, steps)) => (
+                    picture.unwrap_or_else(|| image::RgbImage::new(1, 1)),
+                    format!("{}, {steps} steps", outcome.name()),
+                ),
+                Err(e) => (image::RgbImage::new(1, 1), format!("failed: {e}")),
+            });
         }
         sheet_rows.push(chart::SheetRow {
             label: format!("seed {seed}"),

@@ -414,13 +414,7 @@ pub fn compare(
     };
     if let Some(dir) = out {
         progress(Progress::Report);
-        // The contact sheet redraws one robot's episodes; a team's pictures are its run's.
-        let rows = if config.team_size() > 0 {
-            0
-        } else {
-            options.sheet_rows
-        };
-        let sheet = disagreement_sheet(evaluator, contenders, &comparison, rows)?;
+        let sheet = disagreement_sheet(evaluator, contenders, &comparison, options.sheet_rows)?;
         report::remove_earlier(dir)?;
         let players =
             disagreements::write_players(evaluator, contenders, &comparison, dir, options.players)?;
