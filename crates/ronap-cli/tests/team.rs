@@ -433,11 +433,14 @@ fn log_steps_writes_a_log_per_robot_and_replay_plays_the_team_again() {
 fn a_team_of_one_runs_as_the_lone_robot_column_for_column() {
     let dir = tempfile::tempdir().unwrap();
     let pedestrians = std::fs::read_to_string(shipped("maze-pedestrians.toml")).unwrap();
+    // The robot follows the crowd's circle there.
+    let crossing = std::fs::read_to_string(shipped("circle-crossing.toml")).unwrap();
     for (name, base, policy) in [
         ("maze", String::new(), "apf"),
         ("maze", String::new(), "geodesic"),
         ("pedestrians", pedestrians.clone(), "geodesic-wait"),
         ("pedestrians", pedestrians, "orca"),
+        ("crossing", crossing, "social-force"),
     ] {
         let lone_file = dir.path().join(format!("{name}-{policy}-lone.toml"));
         let team_file = dir.path().join(format!("{name}-{policy}-team.toml"));

@@ -132,13 +132,24 @@ impl RobotPattern {
 }
 
 /// Checks every `[[crowd]]` entry (`crowd[i]`) as the `[[moving]]` entry it stands for, and that
-/// at most one puts the robot on its pattern, and only a lone robot whose start and goal
-/// `[episode]` leaves unset. Gives the robot's pattern, if one does.
+/// at most one puts the robot on its pattern, and only a lone robot (or a team of one) whose
+/// start and goal `[episode]` (or its `[[robots]]` entry) leaves unset. Gives the robot's
+/// pattern, if one does.
 pub(super) fn validate_crowds(
     crowds: &[CrowdConfig],
     fixed_start_or_goal: bool,
-    team: bool,
+    robots: &[super::TeamRobotConfig],
 ) -> Result<Option<RobotPattern>, ConfigError> {
+    // A team of one is the lone robot: it may follow a pattern as the lone robot does.
+    let team = match robots {
+        [] => false,
+        [one] => one.count != 1,
+        _ => true,
+    };
+    let fixed_start_or_goal = fixed_start_or_goal
+        || robots
+            .iter()
+            .any(|r| r.start.is_some() || r.goal.is_some() || !r.goals.is_empty());
     let mut robot = None;
     for (i, c) in crowds.iter().enumerate() {
         let f = |name: &str| format!("crowd[{i}].{name}");
@@ -160,13 +171,13 @@ pub(super) fn validate_crowds(
                 !team,
                 &f("robot_follows"),
                 true,
-                "a team's robots are placed by their [[robots]] entries",
+                "a team's robots are placed by their [[robots]] entries (a team of one may follow it)",
             )?;
             check(
                 !fixed_start_or_goal,
                 &f("robot_follows"),
                 true,
-                "episode.start and episode.goal already place the robot: leave them unset",
+                "a fixed start or goal ([episode] or the [[robots]] entry) already places the robot: leave them unset",
             )?;
             robot = Some(RobotPattern {
                 entry: i,
@@ -243,7 +254,21 @@ mod tests {
             .unwrap()
             .validate()
             .unwrap_err();
-        assert!(e.to_string().contains("episode.start"), "{e}");
+        assert!(e.to_string().contains("[episode]"), "{e}");
+        // A team of one follows a pattern as the lone robot does; a team, or one whose entry
+        // places it, does not.
+        let follows =
+            "[[crowd]]\nrobot_follows = true\npattern = \"circle\"\npattern_radius_px = 50.0\n";
+        for (robots, ok) in [
+            ("[[robots]]\ncount = 1\n", true),
+            ("[[robots]]\ncount = 2\n", false),
+            ("[[robots]]\n[[robots]]\n", false),
+            ("[[robots]]\nstart = [10.0, 10.0, 0.0]\n", false),
+        ] {
+            let text = format!("{follows}{robots}");
+            let c = SimConfig::from_toml_str(&text).unwrap().validate();
+            assert_eq!(c.is_ok(), ok, "{robots}: {c:?}");
+        }
     }
 
     #[test]

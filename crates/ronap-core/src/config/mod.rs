@@ -265,7 +265,11 @@ impl ValidConfig {
             c.episode.start = e.start;
             c.episode.goal = e.goal.or(e.goals.first().copied());
         }
-        ValidConfig::plain(c)
+        // Only a team of one follows a crowd's pattern (validated), as the lone robot does.
+        ValidConfig {
+            robot_pattern: self.robot_pattern.clone().filter(|_| k == 0),
+            ..ValidConfig::plain(c)
+        }
     }
 
     /// The query distance scenes are indexed for: the laser range or a step plus the robot
@@ -393,7 +397,7 @@ impl SimConfig {
         scene::validate_obstacles(&self.obstacles)?;
         moving::validate_moving(&self.moving)?;
         let fixed = self.episode.start.is_some() || self.episode.goal.is_some();
-        let robot_pattern = crowd::validate_crowds(&self.crowd, fixed, !self.robots.is_empty())?;
+        let robot_pattern = crowd::validate_crowds(&self.crowd, fixed, &self.robots)?;
         team::validate_robots(&self.robots)?;
         self.team.validate()?;
         self.metrics.validate()?;

@@ -154,7 +154,7 @@ impl Team {
             for _ in 0..entry.count {
                 let jittered = jittered(world.config(), scene, entry.jitter_px, &mut jitter)?;
                 let cfg = jittered.as_ref().unwrap_or(world.config());
-                let both_fixed = cfg.episode.start.is_some() && cfg.episode.goal.is_some();
+                let both_fixed = cfg.start_and_goal_fixed();
                 let grid = (!both_fixed && needs_region_grid(cfg, scene)).then(|| world.grid());
                 // A fixed start is not drawn, so nothing else keeps it apart from the others.
                 if let Some([x, y, _]) = cfg.episode.start {
