@@ -212,8 +212,7 @@ impl PyPolicyFactory {
 
 impl BatchPolicy for PyProcess {
     fn act_batch(&mut self, batch: Rows<'_>, actions: &mut Vec<Action>) -> Result<(), PolicyError> {
-        let (observations, width) = (batch.values, batch.width);
-        let rows = observations.len() / width.max(1);
+        let (observations, width, rows) = (batch.values, batch.width, batch.count());
         let mut line = String::with_capacity(observations.len() * 12 + 16);
         line.push_str(&format!("B {rows} {width}"));
         for v in observations {

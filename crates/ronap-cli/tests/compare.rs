@@ -161,6 +161,25 @@ fn a_reused_run_gives_the_same_comparison() {
         ],
         &["--run", "episode.max_steps", "2000", "900"],
     );
+    // Nor is a lone robot's run read as a team's.
+    let two = dir.path().join("two.toml");
+    std::fs::write(&two, "[[robots]]\ncount = 2\n").unwrap();
+    assert_rejected(
+        &[
+            "compare",
+            "--scenario",
+            two.to_str().unwrap(),
+            "--seeds",
+            "16",
+            "--policy",
+            "apf",
+            "--run",
+            geodesic_run.to_str().unwrap(),
+            "--out",
+            dir.path().join("z").to_str().unwrap(),
+        ],
+        &["--run", "a lone robot's run", "a team"],
+    );
 }
 
 #[test]
@@ -342,8 +361,15 @@ fn a_team_scenario_is_compared_on_team_success_with_a_table_per_robot() {
     assert!(report.contains("## Teams"), "{report}");
     assert!(out.join("compare.png").exists() && out.join("outcomes.png").exists());
     // The contact sheet draws each policy's team episode where they disagree most.
-    let sheet = image::open(out.join("disagreements.png")).unwrap();
-    assert!(sheet.width() > 300, "{}", sheet.width());
+    let sheet = image::open(out.join("disagreements.png"))
+        .unwrap()
+        .to_rgb8();
+    let coloured = sheet
+        .pixels()
+        .filter(|p| p.0.iter().max().unwrap() - p.0.iter().min().unwrap() > 60)
+        .count();
+    // The robots' coloured paths, not only the policies' coloured names above the columns.
+    assert!(coloured > 3000, "{coloured} coloured pixels");
     // By difficulty, a team's seeds are binned by their hardest robot's task.
     let binned = dir.path().join("binned");
     let by = [
@@ -414,6 +440,10 @@ fn a_team_scenario_is_compared_on_team_success_with_a_table_per_robot() {
     let mut refused = again;
     refused[refused.len() - 1] = &bad;
     assert_rejected(&refused, &["robots.csv", "line 4", "spl = \"most\""]);
+    // A robot's row missing is named with the seed and the count episodes.csv gives.
+    lines.remove(3);
+    std::fs::write(&robots, lines.join("\n") + "\n").unwrap();
+    assert_rejected(&refused, &["robots.csv", "7 rows of seed", "8 robots"]);
 }
 
 #[test]

@@ -157,16 +157,10 @@ impl PyBatchPolicy {
         })
     }
 
-    fn decide(
-        &self,
-        py: Python<'_>,
-        observations: &[f32],
-        width: usize,
-        actions: &mut Vec<Action>,
-    ) -> Result<(), String> {
-        let rows = observations.len() / width.max(1);
-        let obs = PyArray1::from_slice(py, observations)
-            .reshape([rows, width])
+    fn decide(&self, py: Python<'_>, batch: Rows<'_>, out: &mut Vec<Action>) -> Result<(), String> {
+        let rows = batch.count();
+        let obs = PyArray1::from_slice(py, batch.values)
+            .reshape([rows, batch.width])
             .map_err(|e| e.to_string())?;
         let raised = |e: PyErr| {
             format!(
@@ -204,13 +198,13 @@ impl PyBatchPolicy {
                 let action = continuous_action(&self.robot, v).ok_or_else(|| {
                     format!("returned action {v:?} for row {row}: expected finite numbers")
                 })?;
-                actions.push(action.scaled(&scale));
+                out.push(action.scaled(&scale));
             }
         } else {
             let array = checked(&[rows])?;
             let indices: Vec<i64> = array.extract().map_err(|e| e.to_string())?;
             for (row, &i) in indices.iter().enumerate() {
-                actions.push(conv::discrete(i).ok_or_else(|| {
+                out.push(conv::discrete(i).ok_or_else(|| {
                     format!(
                         "returned action {i} for row {row}: expected 0 (LEFT), 1 (AHEAD) or \
                          2 (RIGHT)"
@@ -224,8 +218,7 @@ impl PyBatchPolicy {
 
 impl BatchPolicy for PyBatchPolicy {
     fn act_batch(&mut self, rows: Rows<'_>, actions: &mut Vec<Action>) -> Result<(), PolicyError> {
-        Python::with_gil(|py| self.decide(py, rows.values, rows.width, actions))
-            .map_err(PolicyError::Failed)
+        Python::with_gil(|py| self.decide(py, rows, actions)).map_err(PolicyError::Failed)
     }
 }
 

@@ -214,8 +214,8 @@ impl MultiEnv {
         Ok((obs, rewards, terminated, truncated, infos))
     }
 
-    /// The whole scene as it stands, every robot in its own colour with its path so far,
-    /// `scale` pixels per px.
+    /// The whole scene as it stands, every robot in its own colour with its goal, start and path
+    /// so far (a team of one as `NavEnv` draws its robot), `scale` pixels per px.
     fn render<'py>(&self, py: Python<'py>, scale: f64) -> PyResult<Bound<'py, PyArray3<u8>>> {
         if !(scale.is_finite() && scale > 0.0 && scale <= 16.0) {
             return Err(errors::ConfigError::new_err(format!(

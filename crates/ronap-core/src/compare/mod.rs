@@ -18,6 +18,7 @@ mod stats;
 
 use crate::config::{OnCollision, ValidConfig};
 use crate::eval::{EvalOptions, Evaluator, Recording};
+use crate::io::START_GOAL_COLUMNS;
 use crate::io::{ManifestError, OutputError, RunFiles, RunInfo, RunManifest, RunWriter};
 use crate::job::{evaluate_into, evaluate_team_into, RunRequest};
 use crate::policy::{PolicyError, PolicyFactory, TeamPolicyFactory};
@@ -630,12 +631,6 @@ fn read_run(
             manifest.scenes, info.scenes
         )));
     }
-    if &manifest.config != config.as_sim_config() {
-        let field = first_difference(&manifest.config, config.as_sim_config());
-        return Err(mismatch(format!(
-            "its configuration differs from this comparison's ({field})"
-        )));
-    }
     let team = config.team_size() > 0;
     if team != manifest.team.is_some() {
         return Err(mismatch(if team {
@@ -643,6 +638,12 @@ fn read_run(
         } else {
             "a team's run; this comparison is of a lone robot".into()
         }));
+    }
+    if &manifest.config != config.as_sim_config() {
+        let field = first_difference(&manifest.config, config.as_sim_config());
+        return Err(mismatch(format!(
+            "its configuration differs from this comparison's ({field})"
+        )));
     }
     let (rows, places) = read_results(dir, team).map_err(mismatch)?;
     if rows.iter().map(|r| r.seed).ne(seeds.iter().copied()) {
@@ -703,15 +704,6 @@ fn first_difference(a: &crate::SimConfig, b: &crate::SimConfig) -> String {
 /// start_y, start_heading_deg`) in robot order.
 type Places = Vec<Vec<String>>;
 
-/// The start and goal columns of `episodes.csv` and `robots.csv`.
-const PLACE_COLUMNS: [&str; 5] = [
-    "start_x",
-    "start_y",
-    "start_heading_deg",
-    "goal_x",
-    "goal_y",
-];
-
 /// The places of seed `seed`'s episode here, as [`Places`] holds them (`None` when it cannot
 /// start).
 fn places_here(evaluator: &Evaluator, seed: u64) -> Option<Vec<String>> {
@@ -735,64 +727,108 @@ fn places_here(evaluator: &Evaluator, seed: u64) -> Option<Vec<String>> {
 /// The per-seed results of a run in `dir` and each seed's [`Places`]: a lone robot's from
 /// `episodes.csv`; a team's from `episodes.csv` (the team's outcome, steps, summed collisions
 /// and path length) and `robots.csv` (each robot's start, and the mean of their SPLs as
-/// [`SeedResult::of_team`] takes it).
+/// [`SeedResult::of_team`] takes it), read row by row.
 fn read_results(dir: &Path, team: bool) -> Result<(Vec<SeedResult>, Places), String> {
     let mut names = vec!["seed", "outcome", "steps", "collisions", "path_length_px"];
-    if !team {
+    if team {
+        names.push("robots");
+    } else {
         names.push("spl");
-        names.extend(PLACE_COLUMNS);
+        names.extend(&START_GOAL_COLUMNS[..5]);
     }
-    let episodes = Columns::read(&dir.join("episodes.csv"), &names)?;
     let mut rows = Vec::new();
     let mut places: Places = Vec::new();
-    for i in 0..episodes.rows.len() {
-        let outcome = crate::eval::Outcome::from_name(episodes.cell(i, 1))
-            .ok_or_else(|| episodes.bad(i, 1))?;
+    let mut robots: Vec<usize> = Vec::new();
+    Columns::each(&dir.join("episodes.csv"), &names, &mut |row| {
+        let outcome = crate::eval::Outcome::from_name(row.cell(1)).ok_or_else(|| row.bad(1))?;
         rows.push(SeedResult {
-            seed: episodes.get(i, 0)?,
+            seed: row.get(0)?,
             outcome,
-            steps: episodes.get(i, 2)?,
-            collisions: episodes.get(i, 3)?,
-            path_length_px: episodes.get(i, 4)?,
-            spl: if team { 0.0 } else { episodes.get(i, 5)? },
+            steps: row.get(2)?,
+            collisions: row.get(3)?,
+            path_length_px: row.get(4)?,
+            spl: if team { 0.0 } else { row.get(5)? },
         });
-        places.push(match team {
-            true => Vec::new(),
-            false => (6..11).map(|k| episodes.cell(i, k).to_string()).collect(),
-        });
-    }
+        if team {
+            robots.push(row.get(5)?);
+            places.push(Vec::new());
+        } else {
+            places.push((6..11).map(|k| row.cell(k).to_string()).collect());
+        }
+        Ok(())
+    })?;
     if team {
-        let mut names = vec!["seed", "spl"];
-        names.extend(&PLACE_COLUMNS[..3]);
-        let robots = Columns::read(&dir.join("robots.csv"), &names)?;
         let at: std::collections::HashMap<u64, usize> =
             rows.iter().enumerate().map(|(i, r)| (r.seed, i)).collect();
         let mut spl = vec![0.0; rows.len()];
-        for j in 0..robots.rows.len() {
+        let mut counted = vec![0; rows.len()];
+        let path = dir.join("robots.csv");
+        let mut names = vec!["seed", "spl"];
+        names.extend(&START_GOAL_COLUMNS[..3]);
+        Columns::each(&path, &names, &mut |row| {
+            let seed: u64 = row.get(0)?;
             let i = *at
-                .get(&robots.get(j, 0)?)
-                .ok_or_else(|| format!("{}: seed not in episodes.csv", robots.bad(j, 0)))?;
-            spl[i] += robots.get::<f64>(j, 1)?;
-            places[i].extend((2..5).map(|k| robots.cell(j, k).to_string()));
-        }
-        for ((r, spl), p) in rows.iter_mut().zip(spl).zip(&places) {
-            r.spl = spl / (p.len() / 3).max(1) as f64;
+                .get(&seed)
+                .ok_or_else(|| format!("{}: seed not in episodes.csv", row.bad(0)))?;
+            spl[i] += row.get::<f64>(1)?;
+            counted[i] += 1;
+            places[i].extend((2..5).map(|k| row.cell(k).to_string()));
+            Ok(())
+        })?;
+        for (i, r) in rows.iter_mut().enumerate() {
+            if counted[i] != robots[i] {
+                return Err(format!(
+                    "{}: {} rows of seed {}, whose row in episodes.csv says {} robots",
+                    path.display(),
+                    counted[i],
+                    r.seed,
+                    robots[i]
+                ));
+            }
+            r.spl = spl[i] / counted[i].max(1) as f64;
         }
     }
     Ok((rows, places))
 }
 
-/// A CSV file's rows, as the named columns.
-struct Columns {
-    path: PathBuf,
-    names: Vec<&'static str>,
-    /// Each row's cells, in the order of `names`.
-    rows: Vec<Vec<String>>,
+/// Reading the named columns of a CSV file row by row.
+struct Columns;
+
+/// A row of [`Columns::each`]: its cells in the order of the names asked for.
+struct Row<'a> {
+    path: &'a Path,
+    names: &'a [&'a str],
+    /// The file's line (the header is line 1).
+    line: usize,
+    cells: Vec<&'a str>,
+}
+
+impl Row<'_> {
+    /// Cell `k`.
+    fn cell(&self, k: usize) -> &str {
+        self.cells[k]
+    }
+
+    /// Cell `k`, parsed.
+    fn get<T: std::str::FromStr>(&self, k: usize) -> Result<T, String> {
+        self.cell(k).parse().map_err(|_| self.bad(k))
+    }
+
+    /// The error of cell `k`: the file, its line, the column and the value.
+    fn bad(&self, k: usize) -> String {
+        let (path, line, name) = (self.path.display(), self.line, self.names[k]);
+        format!("{path}: line {line}: {name} = {:?}", self.cell(k))
+    }
 }
 
 impl Columns {
-    /// Reads the columns `names` of the CSV file at `path`; an error names a missing column.
-    fn read(path: &Path, names: &[&'static str]) -> Result<Self, String> {
+    /// Hands each row of the CSV file at `path`, as the columns `names`, to `take`, one at a
+    /// time (memory stays flat however long the file); an error names a missing column.
+    fn each(
+        path: &Path,
+        names: &[&str],
+        take: &mut dyn FnMut(&Row<'_>) -> Result<(), String>,
+    ) -> Result<(), String> {
         let what = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
         let lines = crate::bounded::open_lines(path).map_err(|e| what(&e))?;
         let mut reader = csv::Reader::from_reader(lines);
@@ -804,33 +840,22 @@ impl Columns {
                 found.ok_or_else(|| what(&format!("no column {name:?}")))
             })
             .collect::<Result<Vec<usize>, String>>()?;
-        let mut rows = Vec::new();
-        for record in reader.records() {
-            let record = record.map_err(|e| what(&e))?;
-            let cell = |&c: &usize| record.get(c).unwrap_or("").to_string();
-            rows.push(columns.iter().map(cell).collect());
+        let mut record = csv::StringRecord::new();
+        let mut line = 1;
+        while reader.read_record(&mut record).map_err(|e| what(&e))? {
+            line += 1;
+            let cells = columns
+                .iter()
+                .map(|&c| record.get(c).unwrap_or(""))
+                .collect();
+            take(&Row {
+                path,
+                names,
+                line,
+                cells,
+            })?;
         }
-        Ok(Self {
-            path: path.to_path_buf(),
-            names: names.to_vec(),
-            rows,
-        })
-    }
-
-    /// Cell `k` of row `i`.
-    fn cell(&self, i: usize, k: usize) -> &str {
-        &self.rows[i][k]
-    }
-
-    /// Cell `k` of row `i`, parsed.
-    fn get<T: std::str::FromStr>(&self, i: usize, k: usize) -> Result<T, String> {
-        self.cell(i, k).parse().map_err(|_| self.bad(i, k))
-    }
-
-    /// The error of cell `k` of row `i`: the file, its line, the column and the value.
-    fn bad(&self, i: usize, k: usize) -> String {
-        let (path, name, value) = (self.path.display(), self.names[k], self.cell(i, k));
-        format!("{path}: line {}: {name} = {value:?}", i + 2)
+        Ok(())
     }
 }
 

@@ -37,5 +37,6 @@ pub use training::{Curves, TrainingLog};
 // For the layers above only.
 pub(crate) use lock::LOCK_FILE;
 pub(crate) use run_dir::{
-    finish, lone_headers, manifest, restore, timing_row, Streams, TIMING_COLUMNS,
+    finish, lone_headers, manifest, restore, timing_row, Streams, START_GOAL_COLUMNS,
+    TIMING_COLUMNS,
 };

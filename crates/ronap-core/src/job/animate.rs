@@ -36,9 +36,20 @@ pub(crate) fn lone(evaluator: &Evaluator, record: &EpisodeRecord) -> Result<Anim
     animate(episode, &actions, None, &GifOptions::default()).map_err(|e| e.to_string())
 }
 
-/// The top-view animation of team episode `record`, whose robots' steps were recorded, drawn as
-/// a lone robot's is (a team of one's is the lone robot's, byte for byte).
+/// The top-view animation of team episode `record`, whose robots' steps were recorded: a team of
+/// one at a lone robot's scale (its animation is the lone robot's, byte for byte), a team of
+/// several about 500 pixels along the scene's longer side.
 pub(crate) fn team(evaluator: &Evaluator, record: &TeamRecord) -> Result<Animation, String> {
+    let seed = record.seed;
+    let mut options = GifOptions::default();
+    if record.robots.len() > 1 {
+        let scene_side = evaluator
+            .worlds()
+            .team(seed)
+            .first()
+            .map_or(1000.0, |w| w.scene().width().max(w.scene().height()));
+        options.scale = (500.0 / scene_side).clamp(0.1, 4.0);
+    }
     let logs = RobotLog::of_record(record);
-    replay_team(evaluator, record.seed, &logs, &GifOptions::default()).map_err(|e| e.to_string())
+    replay_team(evaluator, seed, &logs, &options).map_err(|e| e.to_string())
 }
