@@ -3,7 +3,7 @@
 //! threads, and bad entries named.
 
 use crate::util::{
-    assert_rejected, col, collect_args, ok, ronap, rows, run_args, shipped, summary,
+    assert_rejected, col, collect_args, ok, repo_root, ronap, rows, run_args, shipped, summary,
 };
 use std::path::Path;
 
@@ -519,6 +519,68 @@ fn a_team_of_one_runs_as_the_lone_robot_column_for_column() {
             assert!(a == b, "{name} {policy}: the replayed {view} views differ");
         }
     }
+}
+
+/// Every shipped scenario of one robot, given `[[robots]] count = 1`, runs as its lone robot:
+/// every column `robots.csv` shares with `episodes.csv` holds the same text, seed by seed.
+#[test]
+fn every_shipped_lone_scenario_is_its_team_of_one() {
+    let dir = tempfile::tempdir().unwrap();
+    // The scenarios with the maps they name, copied.
+    let copies = dir.path().join("scenarios");
+    std::fs::create_dir(&copies).unwrap();
+    let shipped_dir = repo_root().join("scenarios");
+    for entry in std::fs::read_dir(&shipped_dir).unwrap() {
+        let path = entry.unwrap().path();
+        std::fs::copy(&path, copies.join(path.file_name().unwrap())).unwrap();
+    }
+    let mut compared = 0;
+    for entry in std::fs::read_dir(&shipped_dir).unwrap() {
+        let name = entry.unwrap().file_name().to_string_lossy().into_owned();
+        let path = copies.join(&name);
+        let text = std::fs::read_to_string(&path).unwrap_or_default();
+        let Some(name) = name.strip_suffix(".toml") else {
+            continue;
+        };
+        if text.contains("[[robots]]") {
+            continue;
+        }
+        let team_file = copies.join(format!("{name}-team-of-one.toml"));
+        std::fs::write(&team_file, format!("{text}\n[[robots]]\ncount = 1\n")).unwrap();
+        let run = |file: &Path, out: &str| {
+            let out = dir.path().join(out);
+            let args = [
+                "run",
+                "--scenario",
+                file.to_str().unwrap(),
+                "--policy",
+                "geodesic",
+            ];
+            let more = ["--seeds", "4", "--out", out.to_str().unwrap()];
+            let o = ronap(&[&args[..], &more].concat());
+            (o, out)
+        };
+        let (lone, lone_out) = run(&path, &format!("{name}-lone"));
+        let (team, team_out) = run(&team_file, &format!("{name}-team"));
+        ok(&lone);
+        ok(&team);
+        let episodes = rows(&lone_out.join("episodes.csv"));
+        let robots = rows(&team_out.join("robots.csv"));
+        assert_eq!(episodes.len(), robots.len(), "{name}");
+        let shared: Vec<&String> = episodes[0]
+            .iter()
+            .filter(|c| robots[0].contains(c))
+            .collect();
+        assert!(shared.len() >= 12, "{name}: {shared:?}");
+        for column in shared {
+            let (a, b) = (col(&episodes, column), col(&robots, column));
+            for (e, r) in episodes.iter().zip(&robots).skip(1) {
+                assert_eq!(e[a], r[b], "{name}: seed {} {column}", e[0]);
+            }
+        }
+        compared += 1;
+    }
+    assert!(compared >= 10, "only {compared} scenarios");
 }
 
 /// `ronap run --scenario FILE --policy coordinated --seeds N` into `out`: its table.
