@@ -146,10 +146,9 @@ pub(super) fn validate_crowds(
         [one] => one.count != 1,
         _ => true,
     };
-    let fixed_start_or_goal = fixed_start_or_goal
-        || robots
-            .iter()
-            .any(|r| r.start.is_some() || r.goal.is_some() || !r.goals.is_empty());
+    let entry_places = robots
+        .iter()
+        .any(|r| r.start.is_some() || r.goal.is_some() || !r.goals.is_empty());
     let mut robot = None;
     for (i, c) in crowds.iter().enumerate() {
         let f = |name: &str| format!("crowd[{i}].{name}");
@@ -177,7 +176,13 @@ pub(super) fn validate_crowds(
                 !fixed_start_or_goal,
                 &f("robot_follows"),
                 true,
-                "a fixed start or goal ([episode] or the [[robots]] entry) already places the robot: leave them unset",
+                "episode.start and episode.goal already place the robot: leave them unset",
+            )?;
+            check(
+                !entry_places,
+                &f("robot_follows"),
+                true,
+                "the [[robots]] entry's start or goals already place the robot: leave them unset",
             )?;
             robot = Some(RobotPattern {
                 entry: i,
@@ -254,7 +259,7 @@ mod tests {
             .unwrap()
             .validate()
             .unwrap_err();
-        assert!(e.to_string().contains("[episode]"), "{e}");
+        assert!(e.to_string().contains("episode.start"), "{e}");
         // A team of one follows a pattern as the lone robot does; a team, or one whose entry
         // places it, does not.
         let follows =
