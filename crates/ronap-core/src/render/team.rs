@@ -5,15 +5,10 @@
 use crate::geometry::Point;
 use crate::render::chart::{policy_colour, POLICY_COUNT};
 use crate::render::gif::{AnimationError, GifWriter};
-use crate::render::trajectory::{episode_image, Drawn, Obstacles};
+use crate::render::trajectory::{episode_image, faded, Drawn, Obstacles};
 use crate::render::Canvas;
 use crate::sim::Team;
 use image::{Rgb, RgbImage};
-
-/// `colour` mixed half-way with white, for goals.
-pub(crate) fn faded(colour: Rgb<u8>) -> Rgb<u8> {
-    Rgb(colour.0.map(|c| ((u16::from(c) + 255) / 2) as u8))
-}
 
 /// The picture of a team episode as it stands, as a lone robot's [`crate::render::top_down`] is
 /// drawn: each robot's goal as a disc of the goal tolerance, its path so far (`paths[k]`), its

@@ -7,11 +7,15 @@ use crate::config::RobotConfig;
 use crate::eval::{EpisodeRecord, TeamRecord};
 use crate::geometry::Point;
 use crate::render::chart::policy_colour;
-use crate::render::team::faded;
 use crate::render::{Canvas, GOAL, MOVER, PATH, START};
 use crate::sim::{Laser, Movers, Pose, Track};
 use crate::Scene;
 use image::{Rgb, RgbImage};
+
+/// `colour` mixed half-way with white, for goals.
+pub(crate) fn faded(colour: Rgb<u8>) -> Rgb<u8> {
+    Rgb(colour.0.map(|c| ((u16::from(c) + 255) / 2) as u8))
+}
 
 /// A robot as an episode's picture draws it.
 pub(crate) struct Drawn<'a> {
