@@ -130,56 +130,34 @@ fn a_reused_run_gives_the_same_comparison() {
     assert_eq!(a["pairs"], b["pairs"]);
     assert_eq!(b["policies"][1]["reused"], true);
     assert!(!reused.join("runs/geodesic").exists());
-    // A run of other seeds, or of another configuration, is refused by name.
-    assert_rejected(
-        &[
-            "compare",
-            "--seeds",
-            "10",
-            "--policy",
-            "apf",
-            "--run",
-            geodesic_run.to_str().unwrap(),
-            "--out",
-            dir.path().join("x").to_str().unwrap(),
-        ],
-        &["--run", "seeds 0..15", "0..9"],
-    );
-    assert_rejected(
-        &[
-            "compare",
-            "--seeds",
-            "16",
-            "--policy",
-            "apf",
-            "--run",
-            geodesic_run.to_str().unwrap(),
-            "--max-steps",
-            "900",
-            "--out",
-            dir.path().join("y").to_str().unwrap(),
-        ],
-        &["--run", "episode.max_steps", "2000", "900"],
-    );
-    // Nor is a lone robot's run read as a team's.
+    // A run of other seeds, or of another configuration, is refused by name, and a lone robot's
+    // run is not read as a team's.
     let two = dir.path().join("two.toml");
     std::fs::write(&two, "[[robots]]\ncount = 2\n").unwrap();
-    assert_rejected(
-        &[
-            "compare",
-            "--scenario",
-            two.to_str().unwrap(),
-            "--seeds",
-            "16",
-            "--policy",
-            "apf",
-            "--run",
-            geodesic_run.to_str().unwrap(),
-            "--out",
-            dir.path().join("z").to_str().unwrap(),
-        ],
-        &["--run", "a lone robot's run", "a team"],
-    );
+    let reuse = ["--policy", "apf", "--run", geodesic_run.to_str().unwrap()];
+    for (more, out, names) in [
+        (&["--seeds", "10"][..], "x", &["seeds 0..15", "0..9"][..]),
+        (
+            &["--seeds", "16", "--max-steps", "900"],
+            "y",
+            &["episode.max_steps", "2000", "900"],
+        ),
+        (
+            &["--seeds", "16", "--scenario", two.to_str().unwrap()],
+            "z",
+            &["a lone robot's run", "a team"],
+        ),
+    ] {
+        let out = dir.path().join(out);
+        let args = [
+            &["compare"][..],
+            more,
+            &reuse,
+            &["--out", out.to_str().unwrap()],
+        ]
+        .concat();
+        assert_rejected(&args, &[&["--run"][..], names].concat());
+    }
 }
 
 #[test]
