@@ -285,14 +285,23 @@ pub struct Shown<'a> {
 }
 
 impl<'a> Shown<'a> {
-    /// A lone robot (a team of one): its path light blue, its body cyan.
+    /// A lone robot (a team of one), in [`Shown::colours`].
     pub fn lone(episode: &'a Episode, path: &'a [Point]) -> Self {
         Self {
             episode,
             path,
             present: true,
             running: !episode.status().is_done(),
-            colours: (PATH, ROBOT),
+            colours: Self::colours(0, 1),
+        }
+    }
+
+    /// Robot `k`'s path and body colours among `n` robots: a lone robot's (path light blue, body
+    /// cyan) for a team of one, else its own colour for both.
+    pub fn colours(k: usize, n: usize) -> (Color, Color) {
+        match n {
+            1 => (PATH, ROBOT),
+            _ => (robot_colour(k), robot_colour(k)),
         }
     }
 }

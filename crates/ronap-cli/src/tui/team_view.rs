@@ -262,10 +262,7 @@ pub fn draw(frame: &mut Frame, state: &TeamViewState) {
                     path: state.paths.get(k).map_or(&[][..], Vec::as_slice),
                     present: team.present(k),
                     running: team.running(k),
-                    colours: match team.robots().len() {
-                        1 => (draw::PATH, draw::ROBOT),
-                        _ => (draw::robot_colour(k), draw::robot_colour(k)),
-                    },
+                    colours: draw::Shown::colours(k, team.robots().len()),
                 })
                 .collect();
             let panel = draw::Panel {

@@ -53,15 +53,11 @@ impl Difficulty {
     pub fn of_team(evaluator: &crate::eval::Evaluator, seed: u64) -> Option<Self> {
         let worlds = evaluator.worlds().team(seed);
         let team = crate::sim::Team::new(evaluator.config(), &worlds, seed).ok()?;
-        let mut entry_of = Vec::new();
-        for (e, entry) in evaluator.config().robots.iter().enumerate() {
-            entry_of.extend(std::iter::repeat_n(e, entry.count as usize));
-        }
         let tasks: Vec<Self> = team
             .robots()
             .iter()
-            .zip(entry_of)
-            .map(|(r, e)| Self::of_task(&worlds[e], seed, r.start().position(), r.goal()))
+            .zip(crate::run::robot_worlds(evaluator.config(), &worlds))
+            .map(|(r, w)| Self::of_task(&w, seed, r.start().position(), r.goal()))
             .collect();
         let all = |f: fn(&Self) -> Option<f64>| tasks.iter().map(f).collect::<Option<Vec<f64>>>();
         let most = |v: Vec<f64>| v.into_iter().fold(f64::NEG_INFINITY, f64::max);

@@ -298,18 +298,7 @@ impl Canvas {
 /// The whole scene with an episode drawn on it: `path` in blue, start red, goal green, the robot
 /// and its current laser scan (a team of one's [`team_frame`]).
 pub fn top_down(episode: &crate::sim::Episode, path: &[Point], scale: f64) -> RgbImage {
-    let robot = trajectory::Drawn {
-        body: &episode.config().robot,
-        start: episode.start(),
-        pose: episode.pose(),
-        goal: episode.goal(),
-        goal_tolerance_px: episode.config().episode.goal_tolerance_px,
-        path,
-        scan: (episode.laser(), episode.readings()),
-        present: true,
-        arrived: false,
-        colours: trajectory::Drawn::colours(0, 1),
-    };
+    let robot = trajectory::Drawn::running(episode, path, 0, 1);
     let movers = trajectory::Obstacles::Live(episode.movers());
     trajectory::episode_image(episode.scene(), &[robot], movers, scale)
 }

@@ -21,16 +21,8 @@ pub fn team_frame(team: &Team, paths: &[Vec<Point>], scale: f64) -> RgbImage {
         .iter()
         .enumerate()
         .map(|(k, r)| Drawn {
-            body: &r.config().robot,
-            start: r.start(),
-            pose: r.pose(),
-            goal: r.goal(),
-            goal_tolerance_px: r.config().episode.goal_tolerance_px,
-            path: paths.get(k).map_or(&[][..], Vec::as_slice),
-            scan: (r.laser(), r.readings()),
             present: team.present(k),
-            arrived: r.status() == crate::sim::Status::Success,
-            colours: Drawn::colours(k, n),
+            ..Drawn::running(r, paths.get(k).map_or(&[][..], Vec::as_slice), k, n)
         })
         .collect();
     let movers = Obstacles::Live(team.movers());

@@ -8,7 +8,7 @@ use crate::eval::{EpisodeRecord, TeamRecord};
 use crate::geometry::Point;
 use crate::render::chart::policy_colour;
 use crate::render::{Canvas, GOAL, MOVER, PATH, START};
-use crate::sim::{Laser, Movers, Pose, Track};
+use crate::sim::{Episode, Laser, Movers, Pose, Track};
 use crate::Scene;
 use image::{Rgb, RgbImage};
 
@@ -38,7 +38,24 @@ pub(crate) struct Drawn<'a> {
     pub colours: [Rgb<u8>; 3],
 }
 
-impl Drawn<'_> {
+impl<'a> Drawn<'a> {
+    /// Robot `k` of `n`, its `episode` running, as it stands: in the scene, with its path so far
+    /// and its current scan, in [`Drawn::colours`].
+    pub(crate) fn running(episode: &'a Episode, path: &'a [Point], k: usize, n: usize) -> Self {
+        Self {
+            body: &episode.config().robot,
+            start: episode.start(),
+            pose: episode.pose(),
+            goal: episode.goal(),
+            goal_tolerance_px: episode.config().episode.goal_tolerance_px,
+            path,
+            scan: (episode.laser(), episode.readings()),
+            present: true,
+            arrived: episode.status() == crate::sim::Status::Success,
+            colours: Self::colours(k, n),
+        }
+    }
+
     /// Robot `k`'s colours among `n` robots: a lone robot's path, start and goal colours for a
     /// team of one, else its own colour, faded for its start and goal.
     pub(crate) fn colours(k: usize, n: usize) -> [Rgb<u8>; 3] {

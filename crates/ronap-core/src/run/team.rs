@@ -324,7 +324,7 @@ impl TeamRollout {
 }
 
 /// Each robot's world: its entry's.
-fn robot_worlds(config: &crate::ValidConfig, worlds: &[Arc<World>]) -> Vec<Arc<World>> {
+pub(crate) fn robot_worlds(config: &crate::ValidConfig, worlds: &[Arc<World>]) -> Vec<Arc<World>> {
     config
         .robots
         .iter()
