@@ -389,8 +389,7 @@ pub fn train(
                 s.action.and_then(Action::discrete).map_or(0, |a| a as u32),
                 s.reward as f32,
                 &next[row],
-                done,
-                s.status.is_terminated(),
+                s.status,
             ) {
                 replay.push(&t);
             }

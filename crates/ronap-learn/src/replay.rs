@@ -5,6 +5,7 @@ use crate::LearnError;
 use candle_core::{Device, Tensor};
 use rand::Rng as _;
 use rand_chacha::ChaCha8Rng;
+use ronap_core::Status;
 use std::collections::VecDeque;
 
 /// One (possibly n-step) transition: the return `reward` of up to n steps from `observation`
@@ -245,18 +246,19 @@ impl NStep {
         }
     }
 
-    /// Adds the step from `observation` by `action` with `reward`, to `next`; returns the
-    /// transitions that are complete: the one starting `n` steps back, or, when the episode
-    /// ended (`done`, `terminated` if not by a time-out), every one still pending.
+    /// Adds the step from `observation` by `action` with `reward`, to `next`, after which the
+    /// episode stands at `status`; returns the transitions that are complete: the one starting
+    /// `n` steps back, or, when the episode ended, every one still pending (bootstrapped when
+    /// it ended by a time-out, not by the task).
     pub fn add(
         &mut self,
         observation: &[f32],
         action: u32,
         reward: f32,
         next: &[f32],
-        done: bool,
-        terminated: bool,
+        status: Status,
     ) -> Vec<Transition> {
+        let (done, terminated) = (status.is_done(), status.is_terminated());
         let (n, gamma) = (self.n, self.gamma);
         self.steps.push_back((observation.to_vec(), action, reward));
         let mut out = Vec::new();
@@ -310,8 +312,7 @@ mod tests {
                 k as u32,
                 *r,
                 &obs(k as f32 + 1.0),
-                false,
-                false,
+                Status::Running,
             ));
         }
         // Three steps in: the first transition, 1 + 0.5*2 + 0.25*4 = 3, bootstrapped by 0.125
@@ -324,7 +325,7 @@ mod tests {
         assert_eq!(got[0].bootstrap, 0.125);
         // The episode ends at the goal on the fourth step: the two pending and the last one,
         // none bootstrapped.
-        let end = n.add(&obs(3.0), 1, 8.0, &obs(4.0), true, true);
+        let end = n.add(&obs(3.0), 1, 8.0, &obs(4.0), Status::Success);
         let rewards: Vec<f32> = end.iter().map(|t| t.reward).collect();
         assert_eq!(
             rewards,
@@ -335,13 +336,13 @@ mod tests {
             .all(|t| t.bootstrap == 0.0 && t.next_observation == obs(4.0)));
         // A time-out ends the episode without ending the task: the pending ones bootstrap.
         let mut n = NStep::new(3, g);
-        n.add(&obs(0.0), 0, 1.0, &obs(1.0), false, false);
-        let end = n.add(&obs(1.0), 0, 1.0, &obs(2.0), true, false);
+        n.add(&obs(0.0), 0, 1.0, &obs(1.0), Status::Running);
+        let end = n.add(&obs(1.0), 0, 1.0, &obs(2.0), Status::TimeOut);
         let b: Vec<f32> = end.iter().map(|t| t.bootstrap).collect();
         assert_eq!(b, vec![0.25, 0.5]);
         // One step: Algorithm 1's targets.
         let mut n = NStep::new(1, 0.9);
-        let t = n.add(&obs(0.0), 2, -1.0, &obs(1.0), false, false);
+        let t = n.add(&obs(0.0), 2, -1.0, &obs(1.0), Status::Running);
         assert_eq!(t[0].reward, -1.0);
         assert!((t[0].bootstrap - 0.9).abs() < 1e-7);
     }

@@ -753,15 +753,15 @@ pub fn compare<'py>(
     let cancel = AtomicBool::new(false);
     let comparison = py
         .allow_threads(|| {
-            cmp::compare(
-                &evaluator,
-                &contenders,
-                &options,
-                &info,
-                out.as_deref(),
-                &cancel,
-                &|_| {},
-            )
+            let request = cmp::CompareRequest {
+                evaluator: &evaluator,
+                contenders: &contenders,
+                options: &options,
+                info: &info,
+                out: out.as_deref(),
+                cancel: &cancel,
+            };
+            cmp::compare(request, &|_| {})
         })
         .map_err(|e| match e {
             cmp::CompareError::Output(e) => errors::out_dir(e),

@@ -6,7 +6,8 @@ use crate::output::cancel_on_ctrl_c;
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use ronap_core::compare::{
-    compare, with_runs, CompareError, CompareInfo, CompareOptions, Contender, Progress,
+    compare, with_runs, CompareError, CompareInfo, CompareOptions, CompareRequest, Contender,
+    Progress,
 };
 use ronap_core::eval::{Evaluator, Seeds};
 use ronap_core::io::OutputError;
@@ -146,22 +147,20 @@ pub fn run(args: CompareArgs) -> Result<ExitCode> {
         "{prefix} {wide_bar} {pos}/{len} episodes, {per_sec}, eta {eta}",
         "ronap compare".to_string(),
     );
-    let result = compare(
-        &evaluator,
-        &contenders,
-        &options,
-        &info,
-        Some(&out_dir),
-        &cancel,
-        &|p| match p {
-            Progress::Running { label, .. } => bar.set_prefix(format!("ronap compare: {label}")),
-            Progress::Episode => bar.inc(1),
-            Progress::Difficulty { seeds } => {
-                bar.set_prefix(format!("difficulty of {seeds} seeds"))
-            }
-            Progress::Report => bar.set_prefix("pictures and report"),
-        },
-    );
+    let request = CompareRequest {
+        evaluator: &evaluator,
+        contenders: &contenders,
+        options: &options,
+        info: &info,
+        out: Some(&out_dir),
+        cancel: &cancel,
+    };
+    let result = compare(request, &|p| match p {
+        Progress::Running { label, .. } => bar.set_prefix(format!("ronap compare: {label}")),
+        Progress::Episode => bar.inc(1),
+        Progress::Difficulty { seeds } => bar.set_prefix(format!("difficulty of {seeds} seeds")),
+        Progress::Report => bar.set_prefix("pictures and report"),
+    });
     bar.finish_and_clear();
     let comparison = match result {
         Ok(c) => c,

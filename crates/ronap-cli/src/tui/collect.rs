@@ -209,8 +209,7 @@ pub fn draw(frame: &mut Frame, view: &HumanView) {
     let here = [episode.pose().position()];
     draw::screen(
         frame,
-        episode,
-        &here,
+        draw::Shown::lone(episode, &here),
         view.mode,
         "ronap collect",
         side_lines(view),

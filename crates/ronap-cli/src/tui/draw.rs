@@ -746,23 +746,23 @@ pub fn fitted_screen(
     frame.render_widget(Paragraph::new(rows), areas.status);
 }
 
-/// A whole screen: the scene of `episode` (with `path`, titled with the mode and seed), the side
+/// A whole screen: the scene of the lone `robot` (titled with the mode and seed), the side
 /// panel titled `name` when there is room, and the status line.
 pub fn screen(
     frame: &mut Frame,
-    episode: &Episode,
-    path: &[Point],
+    robot: Shown<'_>,
     mode: SceneMode,
     name: &str,
     side: Vec<Line<'static>>,
     status: Line<'static>,
 ) {
-    let title = format!("{} · seed {}", mode.title(), episode.seed());
-    let robots = [Shown::lone(episode, path)];
+    let title = format!("{} · seed {}", mode.title(), robot.episode.seed());
+    let movers = robot.episode.movers();
+    let robots = [robot];
     let panel = Panel {
         robots: &robots,
         focus: 0,
-        movers: episode.movers(),
+        movers,
         mode,
         title: &title,
     };

@@ -268,8 +268,7 @@ fn side_lines(state: &ViewState) -> Vec<Line<'static>> {
 pub fn draw(frame: &mut Frame, state: &ViewState) {
     draw::screen(
         frame,
-        state.episode(),
-        &state.path,
+        draw::Shown::lone(state.episode(), &state.path),
         state.controls.mode,
         "ronap view",
         side_lines(state),

@@ -260,17 +260,37 @@ pub enum Progress<'a> {
     Report,
 }
 
+/// A comparison to make, and where its files go (the use-case's request, as a run's
+/// [`crate::job::RunRequest`]).
+pub struct CompareRequest<'a> {
+    /// The episodes' configuration and scenes.
+    pub evaluator: &'a Evaluator,
+    /// The policies to compare (at least two), each run or read from a finished run.
+    pub contenders: &'a [Contender],
+    /// The seeds, threads and the statistics' settings.
+    pub options: &'a CompareOptions,
+    /// What the report records: the scenes, the map, the command.
+    pub info: &'a CompareInfo,
+    /// The comparison's directory (`None`: figures only, no files).
+    pub out: Option<&'a Path>,
+    /// Set (Ctrl-C, a signal) to stop between episodes, keeping the runs that finished.
+    pub cancel: &'a AtomicBool,
+}
+
 /// Runs (or reads) every contender on `options.seeds` and compares them; with `out`, writes the
 /// runs to `out/runs/<label>/` and the comparison's files to `out`.
 pub fn compare(
-    evaluator: &Evaluator,
-    contenders: &[Contender],
-    options: &CompareOptions,
-    info: &CompareInfo,
-    out: Option<&Path>,
-    cancel: &AtomicBool,
+    request: CompareRequest<'_>,
     progress: &(dyn Fn(Progress) + Sync),
 ) -> Result<Comparison, CompareError> {
+    let CompareRequest {
+        evaluator,
+        contenders,
+        options,
+        info,
+        out,
+        cancel,
+    } = request;
     if contenders.len() < 2 {
         return Err(CompareError::Input(format!(
             "{} polic{} given: a comparison needs at least two",

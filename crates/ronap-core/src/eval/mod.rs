@@ -344,7 +344,7 @@ impl Evaluator {
     ) -> Result<RunEnd, PolicyError> {
         let lanes = factory.side_by_side();
         if lanes > 1 {
-            return self.stream_side_by_side(factory, options, lanes, cancel, on_finish, sink);
+            return self.stream_side_by_side(factory, options, cancel, on_finish, sink);
         }
         // Policies are made at most once per worker and handed from episode to episode, so a
         // costly policy (a Python process, a loaded network) is set up `threads` times, not once

@@ -157,11 +157,11 @@ impl Evaluator {
         &self,
         factory: &dyn PolicyFactory,
         options: &EvalOptions,
-        lanes: usize,
         cancel: &AtomicBool,
         on_finish: &(dyn Fn(&EpisodeRecord) + Sync),
         sink: &mut dyn FnMut(EpisodeRecord) -> bool,
     ) -> Result<RunEnd, PolicyError> {
+        let lanes = factory.side_by_side();
         let clock = Instant::now();
         let pool = worker_pool(options.threads)?;
         let count = options.seeds.len();

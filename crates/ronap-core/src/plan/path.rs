@@ -44,7 +44,7 @@ fn tighten(scene: &Scene, mut out: Vec<Point>, radius: f64, blockers: &mut Block
                 if still[k] {
                     continue;
                 }
-                if try_corner(scene, &mut out, k, step, radius, &mut directions, blockers) {
+                if try_corner(scene, &mut out, k, step, &mut directions, blockers) {
                     moved = true;
                     still[k - 1] = false;
                     still[k + 1] = false;
@@ -93,17 +93,18 @@ fn directions() -> Vec<Vector> {
 }
 
 /// Tries moving corner `k` of `out` (neither end) by `step` in each of `directions` and towards
-/// each neighbour, taking each move that shortens the path with the disc clear; whether it moved.
-/// A move that one of `blockers` clearly blocks is refused without the scene's tests.
+/// each neighbour, taking each move that shortens the path with the disc (of `blockers`' radius)
+/// clear; whether it moved. A move that one of `blockers` clearly blocks is refused without the
+/// scene's tests.
 fn try_corner(
     scene: &Scene,
     out: &mut [Point],
     k: usize,
     step: f64,
-    radius: f64,
     directions: &mut Vec<Vector>,
     blockers: &mut Blockers,
 ) -> bool {
+    let radius = blockers.radius;
     let (a, b) = (out[k - 1], out[k + 1]);
     let start = out[k];
     let length = |p: Point| (p - a).norm() + (b - p).norm();
@@ -190,11 +191,11 @@ impl Blockers {
 
     /// Blockers that refuse nothing: every move tested by the scene, as before they were kept.
     #[cfg(test)]
-    fn off(corners: usize) -> Self {
+    fn off(corners: usize, radius: f64) -> Self {
         Self {
             by_corner: vec![NO_BOX; corners],
             within2: -1.0,
-            radius: 0.0,
+            radius,
             refused: 0,
         }
     }
@@ -320,21 +321,13 @@ mod tests {
     fn smooth_trying_every_corner(scene: &Scene, points: &[Point], radius: f64) -> Vec<Point> {
         let mut out = with_midpoints(&jump_ahead(scene, points, radius));
         let mut directions = directions();
-        let mut blockers = Blockers::off(out.len());
+        let mut blockers = Blockers::off(out.len(), radius);
         for step in TIGHTEN_STEPS_PX {
             // Up to 8 rounds, until one moves no corner.
             for _ in 0..8 {
                 let mut moved = false;
                 for k in 1..out.len().saturating_sub(1) {
-                    moved |= try_corner(
-                        scene,
-                        &mut out,
-                        k,
-                        step,
-                        radius,
-                        &mut directions,
-                        &mut blockers,
-                    );
+                    moved |= try_corner(scene, &mut out, k, step, &mut directions, &mut blockers);
                 }
                 if !moved {
                     break;
@@ -407,7 +400,7 @@ mod tests {
             let n = start.len();
             let mut blockers = Blockers::new(scene, points, n, radius);
             let ours = tighten(scene, start.clone(), radius, &mut blockers);
-            let tested = tighten(scene, start, radius, &mut Blockers::off(n));
+            let tested = tighten(scene, start, radius, &mut Blockers::off(n, radius));
             assert_eq!(bits(&ours), bits(&tested), "{case}");
             refused += blockers.refused;
             corners += ours.len();

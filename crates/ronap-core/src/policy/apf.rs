@@ -48,18 +48,32 @@ pub fn potential(scene: &Scene, config: &ApfConfig, radius: f64, goal: Point, q:
     u
 }
 
+/// What [`plan`] descends: from where to where, for which disc, and for how long.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Descent {
+    /// Where the descent begins.
+    pub start: Point,
+    /// Where it heads.
+    pub goal: Point,
+    /// The disc's radius, px.
+    pub radius: f64,
+    /// How near `goal` counts as reaching it, px.
+    pub tolerance: f64,
+    /// The most positions the descent runs.
+    pub max_positions: usize,
+}
+
 /// Algorithm 3: descend the potential from `start` over the 8-neighbour lattice until within
 /// `tolerance` of `goal`, or until the descent revisits a position (a local minimum or an
 /// oscillation) or runs `max_positions` positions.
-pub fn plan(
-    scene: &Scene,
-    config: &ApfConfig,
-    radius: f64,
-    start: Point,
-    goal: Point,
-    tolerance: f64,
-    max_positions: usize,
-) -> ApfPlan {
+pub fn plan(scene: &Scene, config: &ApfConfig, descent: &Descent) -> ApfPlan {
+    let Descent {
+        start,
+        goal,
+        radius,
+        tolerance,
+        max_positions,
+    } = *descent;
     let h = config.lattice_px;
     let offsets: [(i64, i64); 8] = [
         (1, 0),
@@ -133,15 +147,14 @@ impl Policy for Apf {
         let lattice = config.apf.lattice_px;
         // A bound far above any path that does not loop: four times the scene's perimeter.
         let max_positions = (8.0 * (scene.width() + scene.height()) / lattice).ceil() as usize + 16;
-        let plan = plan(
-            scene,
-            &config.apf,
-            config.robot.radius_px,
-            episode.pose().position(),
-            episode.goal(),
-            config.episode.goal_tolerance_px,
+        let descent = Descent {
+            start: episode.pose().position(),
+            goal: episode.goal(),
+            radius: config.robot.radius_px,
+            tolerance: config.episode.goal_tolerance_px,
             max_positions,
-        );
+        };
+        let plan = plan(scene, &config.apf, &descent);
         self.reached = plan.reached;
         let mut path = plan.path;
         if plan.reached {
@@ -215,15 +228,14 @@ mod tests {
     #[test]
     fn open_room_descent_reaches_the_goal() {
         let scene = room(vec![]);
-        let p = plan(
-            &scene,
-            &ApfConfig::default(),
-            5.0,
-            Point::new(30.0, 40.0),
-            Point::new(260.0, 170.0),
-            10.0,
-            10_000,
-        );
+        let descent = Descent {
+            start: Point::new(30.0, 40.0),
+            goal: Point::new(260.0, 170.0),
+            radius: 5.0,
+            tolerance: 10.0,
+            max_positions: 10_000,
+        };
+        let p = plan(&scene, &ApfConfig::default(), &descent);
         assert!(p.reached);
         assert!((p.path.last().unwrap() - Point::new(260.0, 170.0)).norm() <= 10.0);
     }
@@ -240,15 +252,14 @@ mod tests {
             lattice_px: 20.0,
             ..ApfConfig::default()
         };
-        let p = plan(
-            &scene,
-            &config,
-            5.0,
-            Point::new(100.0, 100.0),
-            Point::new(200.0, 100.0),
-            10.0,
-            10_000,
-        );
+        let descent = Descent {
+            start: Point::new(100.0, 100.0),
+            goal: Point::new(200.0, 100.0),
+            radius: 5.0,
+            tolerance: 10.0,
+            max_positions: 10_000,
+        };
+        let p = plan(&scene, &config, &descent);
         assert!(!p.reached);
         assert!(p.path.iter().all(|q| q.x < 149.0), "{:?}", p.path);
     }
@@ -262,15 +273,14 @@ mod tests {
             Aabb::from_corners(Point::new(80.0, 138.0), Point::new(142.0, 140.0)),
         ];
         let scene = room(cup);
-        let p = plan(
-            &scene,
-            &ApfConfig::default(),
-            5.0,
-            Point::new(110.0, 100.0),
-            Point::new(260.0, 100.0),
-            10.0,
-            10_000,
-        );
+        let descent = Descent {
+            start: Point::new(110.0, 100.0),
+            goal: Point::new(260.0, 100.0),
+            radius: 5.0,
+            tolerance: 10.0,
+            max_positions: 10_000,
+        };
+        let p = plan(&scene, &ApfConfig::default(), &descent);
         assert!(!p.reached);
         // Trapped against the cup's back wall, well before the position bound.
         let end = *p.path.last().unwrap();

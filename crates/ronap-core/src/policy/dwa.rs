@@ -62,19 +62,19 @@ impl DwaPlanner {
     }
 
     /// Rolls out from `me`'s pose: `first` for one step, `then` for the rest.
-    /// The rollout stops where it reaches the goal. A contact is a gap to a thing below `margin`
-    /// (or below the gap the robot already keeps to that thing, less a hundredth of a px, when
-    /// that is smaller: a robot already near a wall may stay as near).
+    /// The rollout stops where it reaches the goal. A contact is a gap to a thing below the
+    /// safety margin (or below the gap the robot already keeps to that thing, less a hundredth
+    /// of a px, when that is smaller: a robot already near a wall may stay as near).
     fn roll(
         &self,
         me: &Episode,
         senses: &Senses,
         robot: &Robot,
-        margin: f64,
         first: Action,
         then: Action,
     ) -> Rollout {
         let config = me.config();
+        let margin = config.dwa.safety_margin_px;
         let r = config.robot.radius_px;
         let mut pose = me.pose();
         // The body's own velocity carries over from step to step: a model with acceleration
@@ -230,10 +230,9 @@ impl Planner for DwaPlanner {
             }
         };
         let body = Robot::new(robot);
-        let margin = dwa.safety_margin_px;
         let mut best: Option<(bool, f64, Action)> = None;
         for (first, then, speed) in candidates {
-            let roll = self.roll(me, senses, &body, margin, first, then);
+            let roll = self.roll(me, senses, &body, first, then);
             // Steps it takes to stop from `speed` (a discrete robot stops at once).
             let stopping = match dwa.actions {
                 PlannerActions::Continuous => (speed / dwa.linear_accel_px).ceil().max(1.0),

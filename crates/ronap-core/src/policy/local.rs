@@ -95,41 +95,27 @@ impl Senses {
 
     /// Senses round a lone robot within `range`.
     pub(super) fn lone(&mut self, me: &Episode, range: f64) {
-        self.sense(me, me.movers(), &[], None, 0, range);
+        self.sense(me, me.movers(), None, range);
     }
 
     /// Senses round robot `k` of `team` within `range`.
     pub(super) fn in_team(&mut self, team: &Team, k: usize, range: f64) {
-        let robots: Vec<(usize, &Episode)> = team
-            .robots()
-            .iter()
-            .enumerate()
-            .filter(|&(j, _)| team.present(j))
-            .collect();
         self.index = k;
-        self.sense(
-            team.robot(k),
-            team.movers(),
-            &robots,
-            Some(k),
-            team.robots().len(),
-            range,
-        );
+        self.sense(team.robot(k), team.movers(), Some((team, k)), range);
     }
 
-    /// The agents round `me` (the moving obstacles `movers`, then `robots`: a team's present
-    /// robots by index, `me` among them as `index`; none for a lone robot) within `range`, with
+    /// The agents round `me` (the moving obstacles `movers`, then the present robots of `team`
+    /// by index, `me` among them as robot `index`; none for a lone robot) within `range`, with
     /// their velocities, into `self.agents` (`me` first); remembers where each is for the next
-    /// step. `team_size`: robots in the team (0 alone).
+    /// step.
     fn sense(
         &mut self,
         me: &Episode,
         movers: Option<&Movers>,
-        robots: &[(usize, &Episode)],
-        index: Option<usize>,
-        team_size: usize,
+        team: Option<(&Team, usize)>,
         range: f64,
     ) {
+        let team_size = team.map_or(0, |(t, _)| t.robots().len());
         let config = me.config();
         let p = me.pose().position();
         let velocity = self.last_me.map_or(Vector::zeros(), |l| p - l);
@@ -158,15 +144,17 @@ impl Senses {
                 seen(i, at, o.body().bounding_radius(), &mut self.agents);
             }
         }
-        for &(k, r) in robots {
-            if Some(k) != index {
-                let radius = r.config().robot.radius_px;
-                seen(
-                    mover_count + k,
-                    Some(r.pose().position()),
-                    radius,
-                    &mut self.agents,
-                );
+        if let Some((team, index)) = team {
+            for (k, r) in team.robots().iter().enumerate() {
+                if k != index && team.present(k) {
+                    let radius = r.config().robot.radius_px;
+                    seen(
+                        mover_count + k,
+                        Some(r.pose().position()),
+                        radius,
+                        &mut self.agents,
+                    );
+                }
             }
         }
     }

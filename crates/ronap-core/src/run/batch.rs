@@ -150,10 +150,12 @@ pub struct Batch {
 }
 
 /// A run of environments with their observation rows, final-observation rows and step records.
-type Run<'a> = (
-    ((&'a mut [Env], &'a mut [f32]), &'a mut [f32]),
-    &'a mut [EnvStep],
-);
+struct Run<'a> {
+    envs: &'a mut [Env],
+    obs: &'a mut [f32],
+    last: &'a mut [f32],
+    out: &'a mut [EnvStep],
+}
 
 /// The environments and their rows in the flat buffers, apart from what a step only reads.
 struct Lanes {
@@ -512,15 +514,13 @@ impl Lanes {
         let d = self.observation_size;
         let n = self.envs.len();
         let Some(pool) = self.pool.as_ref().filter(|_| n > MIN_PER_TASK) else {
-            let first = Self::run(
-                0,
-                &mut self.envs,
-                &mut self.observations,
-                &mut self.final_observations,
-                &mut self.steps,
-                d,
-                &f,
-            );
+            let all = Run {
+                envs: &mut self.envs,
+                obs: &mut self.observations,
+                last: &mut self.final_observations,
+                out: &mut self.steps,
+            };
+            let first = all.step(0, d, &f);
             return first.map_or(Ok(()), |(_, e)| Err(e));
         };
         let helpers = pool.current_num_threads();
@@ -533,6 +533,12 @@ impl Lanes {
             .zip(self.observations.chunks_mut(len * d))
             .zip(self.final_observations.chunks_mut(len * d))
             .zip(self.steps.chunks_mut(len))
+            .map(|(((envs, obs), last), out)| Run {
+                envs,
+                obs,
+                last,
+                out,
+            })
             .enumerate()
             .collect();
         let total = runs.len();
@@ -541,10 +547,10 @@ impl Lanes {
         let first: Mutex<Option<(usize, RunError)>> = Mutex::new(None);
         let work = || loop {
             let next = queue.lock().unwrap_or_else(PoisonError::into_inner).next();
-            let Some((r, (((envs, obs), last), out))) = next else {
+            let Some((r, run)) = next else {
                 return;
             };
-            let failed = Self::run(r * len, envs, obs, last, out, d, &f);
+            let failed = run.step(r * len, d, &f);
             if let Some((i, e)) = failed {
                 let mut slot = first.lock().unwrap_or_else(PoisonError::into_inner);
                 if slot.as_ref().is_none_or(|(j, _)| i < *j) {
@@ -590,21 +596,27 @@ impl Lanes {
         let first = first.into_inner().unwrap_or_else(PoisonError::into_inner);
         first.map_or(Ok(()), |(_, e)| Err(e))
     }
+}
 
-    /// [`Lanes::for_each`] over one run of environments from `base`, in order, asking for each
-    /// environment's memory a few environments ahead (see [`Episode::prefetch`]): a thousand
-    /// scenes do not fit the caches, and a step would otherwise wait on each link of the chain
-    /// from the episode to the boxes near its robot in turn.
-    fn run(
+impl Run<'_> {
+    /// [`Lanes::for_each`] over this run of environments (from environment `base`, `d` values
+    /// an observation row), in order, asking for each environment's memory a few environments
+    /// ahead (see [`Episode::prefetch`]): a thousand scenes do not fit the caches, and a step
+    /// would otherwise wait on each link of the chain from the episode to the boxes near its
+    /// robot in turn.
+    fn step(
+        self,
         base: usize,
-        envs: &mut [Env],
-        obs: &mut [f32],
-        last: &mut [f32],
-        out: &mut [EnvStep],
         d: usize,
         f: &(impl Fn(usize, &mut Env, &mut [f32], &mut [f32], &mut EnvStep) -> Result<(), RunError>
               + Sync),
     ) -> Option<(usize, RunError)> {
+        let Self {
+            envs,
+            obs,
+            last,
+            out,
+        } = self;
         let mut first = None;
         for j in 0..envs.len() {
             for stage in 0..PREFETCH_STAGES {

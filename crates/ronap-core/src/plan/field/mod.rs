@@ -525,7 +525,7 @@ pub(crate) mod tests {
                     });
                     let st = &steps.by_close[usize::from(slow)];
                     assert_eq!(
-                        improving(&cells, i, cell.cost, open, slow, st, &offsets),
+                        improving(&cells, i, open, slow, st, &offsets),
                         each,
                         "cell {i} cost {} open {open:#b} slow {slow:#b}",
                         cell.cost

@@ -206,7 +206,7 @@ impl Work {
                 // which of two equal-cost parents a cell keeps.
                 let open = moves[i] as u32;
                 let (slow, st) = steps.of(slow[i]);
-                let mut better = improving(cells, i, cost, open, slow, st, &offsets);
+                let mut better = improving(cells, i, open, slow, st, &offsets);
                 while better != 0 {
                     let k = better.trailing_zeros() as usize;
                     better &= better - 1;
@@ -364,7 +364,7 @@ impl Work {
                 closed.push(i as u32);
                 let open = moves[i] as u32;
                 let (slow, st) = steps.of(slow[i]);
-                let mut better = improving(cells, i, cost, open, slow, st, &offsets);
+                let mut better = improving(cells, i, open, slow, st, &offsets);
                 while better != 0 {
                     let k = better.trailing_zeros() as usize;
                     better &= better - 1;
@@ -532,7 +532,7 @@ impl Default for Steps {
     }
 }
 
-/// Which open moves from cell `i` (at `cost`; `open` and `slow` its open and close moves as
+/// Which open moves from cell `i` (at its cost; `open` and `slow` its open and close moves as
 /// bits, `st` its moves' step costs) improve the cell they reach, as bits. Found for all eight
 /// before any is taken (they reach eight different cells), without a branch on each: whether a
 /// neighbour improves is a coin toss to the branch predictor.
@@ -540,7 +540,6 @@ impl Default for Steps {
 pub(super) fn improving(
     cells: &[Node],
     i: usize,
-    cost: u32,
     open: u32,
     slow: u8,
     st: &[u32; 8],
@@ -556,6 +555,7 @@ pub(super) fn improving(
             <&[Node; 3]>::try_from(&cells[i + w - 1..i + w + 2]),
         );
         if let (Ok(south), Ok(row), Ok(north)) = rows {
+            let cost = row[1].cost;
             if slow == 0 {
                 // No close move: two offers, in registers.
                 let (axis, diagonal) = (cost + st[0], cost + st[4]);
@@ -582,7 +582,7 @@ pub(super) fn improving(
                     | lt(7, &south[0]));
         }
     }
-    improving_each(cells, i, cost, open, st, offsets)
+    improving_each(cells, i, cells[i].cost, open, st, offsets)
 }
 
 /// [`improving`] one move at a time, for any cell: a closed move looks at the cell itself, which

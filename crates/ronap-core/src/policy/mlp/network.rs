@@ -269,7 +269,17 @@ impl pulp::WithSimd for ForwardRows<'_> {
             if rows == 1 {
                 add_columns(simd, y, x, weights, outs);
             } else {
-                add_rows(simd, y, x, weights, ins, outs, rows);
+                add_rows(
+                    simd,
+                    y,
+                    x,
+                    Weights {
+                        values: weights,
+                        ins,
+                        outs,
+                    },
+                    rows,
+                );
             }
             if i < last {
                 mlp.activation.apply(y);
@@ -285,33 +295,25 @@ impl pulp::WithSimd for ForwardRows<'_> {
 /// four rows at a time: each weight loaded serves four rows, and a block's weights (a few
 /// kilobytes) stay in the first-level cache for all the rows.
 #[inline(always)]
-fn add_rows<S: pulp::Simd>(
-    simd: S,
-    y: &mut [f32],
-    x: &[f32],
-    weights: &[f32],
-    ins: usize,
-    outs: usize,
-    rows: usize,
-) {
+fn add_rows<S: pulp::Simd>(simd: S, y: &mut [f32], x: &[f32], layer: Weights, rows: usize) {
     let lanes = S::F32_LANES;
-    let shape = Shape { ins, outs };
+    let outs = layer.outs;
     let mut o = 0;
     while o + 2 * lanes <= outs {
         each_group(rows, |r, n| match n {
-            4 => add_block::<S, 4, 2>(simd, y, x, weights, shape, r, o),
-            3 => add_block::<S, 3, 2>(simd, y, x, weights, shape, r, o),
-            2 => add_block::<S, 2, 2>(simd, y, x, weights, shape, r, o),
-            _ => add_block::<S, 1, 2>(simd, y, x, weights, shape, r, o),
+            4 => add_block::<S, 4, 2>(simd, y, x, layer, r, o),
+            3 => add_block::<S, 3, 2>(simd, y, x, layer, r, o),
+            2 => add_block::<S, 2, 2>(simd, y, x, layer, r, o),
+            _ => add_block::<S, 1, 2>(simd, y, x, layer, r, o),
         });
         o += 2 * lanes;
     }
     while o + lanes <= outs {
         each_group(rows, |r, n| match n {
-            4 => add_block::<S, 4, 1>(simd, y, x, weights, shape, r, o),
-            3 => add_block::<S, 3, 1>(simd, y, x, weights, shape, r, o),
-            2 => add_block::<S, 2, 1>(simd, y, x, weights, shape, r, o),
-            _ => add_block::<S, 1, 1>(simd, y, x, weights, shape, r, o),
+            4 => add_block::<S, 4, 1>(simd, y, x, layer, r, o),
+            3 => add_block::<S, 3, 1>(simd, y, x, layer, r, o),
+            2 => add_block::<S, 2, 1>(simd, y, x, layer, r, o),
+            _ => add_block::<S, 1, 1>(simd, y, x, layer, r, o),
         });
         o += lanes;
     }
@@ -319,14 +321,14 @@ fn add_rows<S: pulp::Simd>(
     while o < outs {
         let w = (outs - o).min(NARROW);
         each_group(rows, |r, n| match w {
-            8 => add_narrow::<8>(y, x, weights, shape, r..r + n, o),
-            7 => add_narrow::<7>(y, x, weights, shape, r..r + n, o),
-            6 => add_narrow::<6>(y, x, weights, shape, r..r + n, o),
-            5 => add_narrow::<5>(y, x, weights, shape, r..r + n, o),
-            4 => add_narrow::<4>(y, x, weights, shape, r..r + n, o),
-            3 => add_narrow::<3>(y, x, weights, shape, r..r + n, o),
-            2 => add_narrow::<2>(y, x, weights, shape, r..r + n, o),
-            _ => add_narrow::<1>(y, x, weights, shape, r..r + n, o),
+            8 => add_narrow::<8>(y, x, layer, r..r + n, o),
+            7 => add_narrow::<7>(y, x, layer, r..r + n, o),
+            6 => add_narrow::<6>(y, x, layer, r..r + n, o),
+            5 => add_narrow::<5>(y, x, layer, r..r + n, o),
+            4 => add_narrow::<4>(y, x, layer, r..r + n, o),
+            3 => add_narrow::<3>(y, x, layer, r..r + n, o),
+            2 => add_narrow::<2>(y, x, layer, r..r + n, o),
+            _ => add_narrow::<1>(y, x, layer, r..r + n, o),
         });
         o += w;
     }
@@ -344,12 +346,15 @@ const NARROW: usize = 8;
 fn add_narrow<const W: usize>(
     y: &mut [f32],
     x: &[f32],
-    weights: &[f32],
-    shape: Shape,
+    layer: Weights,
     rows: std::ops::Range<usize>,
     o: usize,
 ) {
-    let Shape { ins, outs } = shape;
+    let Weights {
+        values: weights,
+        ins,
+        outs,
+    } = layer;
     let mut acc = [[0.0f32; W]; 4];
     for (a, r) in acc.iter_mut().zip(rows.clone()) {
         a.copy_from_slice(&y[r * outs + o..r * outs + o + W]);
@@ -372,9 +377,10 @@ fn add_narrow<const W: usize>(
     }
 }
 
-/// A layer's inputs and outputs.
+/// A layer's column-major weights (column j holds the weights from input j) and its shape.
 #[derive(Clone, Copy)]
-struct Shape {
+struct Weights<'a> {
+    values: &'a [f32],
     ins: usize,
     outs: usize,
 }
@@ -397,12 +403,15 @@ fn add_block<S: pulp::Simd, const R: usize, const V: usize>(
     simd: S,
     y: &mut [f32],
     x: &[f32],
-    weights: &[f32],
-    shape: Shape,
+    layer: Weights,
     r: usize,
     o: usize,
 ) {
-    let Shape { ins, outs } = shape;
+    let Weights {
+        values: weights,
+        ins,
+        outs,
+    } = layer;
     let n = V * S::F32_LANES;
     let xs: [&[f32]; R] = std::array::from_fn(|k| &x[(r + k) * ins..(r + k + 1) * ins]);
     let mut acc = [[simd.splat_f32s(0.0); V]; R];
@@ -435,26 +444,27 @@ fn add_block<S: pulp::Simd, const R: usize, const V: usize>(
 fn add_columns<S: pulp::Simd>(simd: S, y: &mut [f32], x: &[f32], weights: &[f32], outputs: usize) {
     // One row: `x` is its inputs and `y` its outputs.
     let mut o = 0;
-    let shape = Shape {
+    let layer = Weights {
+        values: weights,
         ins: x.len(),
         outs: outputs,
     };
     while o + 8 * S::F32_LANES <= outputs {
-        add_block::<S, 1, 8>(simd, y, x, weights, shape, 0, o);
+        add_block::<S, 1, 8>(simd, y, x, layer, 0, o);
         o += 8 * S::F32_LANES;
     }
     // Four at once where they fit: each output's sum is a chain of dependent adds, so fewer
     // than about four vectors side by side wait on the adder's latency.
     while o + 4 * S::F32_LANES <= outputs {
-        add_block::<S, 1, 4>(simd, y, x, weights, shape, 0, o);
+        add_block::<S, 1, 4>(simd, y, x, layer, 0, o);
         o += 4 * S::F32_LANES;
     }
     while o + 2 * S::F32_LANES <= outputs {
-        add_block::<S, 1, 2>(simd, y, x, weights, shape, 0, o);
+        add_block::<S, 1, 2>(simd, y, x, layer, 0, o);
         o += 2 * S::F32_LANES;
     }
     while o + S::F32_LANES <= outputs {
-        add_block::<S, 1, 1>(simd, y, x, weights, shape, 0, o);
+        add_block::<S, 1, 1>(simd, y, x, layer, 0, o);
         o += S::F32_LANES;
     }
     for o in o..outputs {

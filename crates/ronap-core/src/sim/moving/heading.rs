@@ -59,6 +59,8 @@ pub(super) struct State {
     /// The furthest an obstacle moves in a step on either axis (its speed), px, with a margin
     /// for rounding.
     pub(super) drift: f64,
+    /// The key of the turn streams ([`State::keyed`]).
+    key: u64,
 }
 
 /// Steps between bringing the obstacles' order by band and x up to date: sorting costs more
@@ -113,8 +115,17 @@ impl pulp::WithSimd for Pass<'_> {
 const FIT_MARGIN: f64 = 1e-9;
 
 impl State {
+    /// No obstacles yet; obstacle k will turn by draws of its own SplitMix64 stream, starting at
+    /// the k-th number of the one `key` starts.
+    pub(super) fn keyed(key: u64) -> Self {
+        Self {
+            key,
+            ..Self::default()
+        }
+    }
+
     /// Adds an obstacle of `entry` at `position` heading along `dir` at `speed` px a step,
-    /// checked against a robot within `near_robot` px, turning from the turn stream at `stream`.
+    /// checked against a robot within `near_robot` px.
     pub(super) fn push(
         &mut self,
         entry: &Entry,
@@ -122,9 +133,10 @@ impl State {
         dir: Vector,
         speed: f64,
         near_robot: f64,
-        stream: u64,
     ) {
-        self.stream.push(stream);
+        let k = self.stream.len() as u64;
+        let first = self.key.wrapping_add((k + 1).wrapping_mul(SPLIT_MIX_GAMMA));
+        self.stream.push(split_mix(first));
         self.drift = self.drift.max(speed * (1.0 + 1e-9));
         self.bound.push(entry.body.bounding_radius());
         self.near_robot2.push(near_robot * near_robot);

@@ -27,7 +27,6 @@ pub use waypoints::Waypoints;
 use crate::config::{MotionKind, MovingConfig, MovingShape, ValidConfig};
 use crate::geometry::{point_segment_distance_squared, unit, Point, Vector};
 use crate::scene::Scene;
-use crate::sim::rng::{split_mix, SPLIT_MIX_GAMMA};
 use crate::sim::rng::{stream, Rng, Stream};
 use heading::{State, RESORT_EVERY};
 use rand::Rng as _;
@@ -243,14 +242,9 @@ impl Movers {
             robots.iter().copied().zip(goals.iter().copied()).collect();
         // Pattern pedestrians placed so far: starts and goals, with their radii.
         let mut taken: Vec<(Point, f64)> = Vec::new();
-        let mut state = State::default();
-        // Each obstacle turns by draws of its own SplitMix64 stream, obstacle k's starting at
-        // the k-th number of the one keyed by the episode's walk stream: the turns are drawn
-        // side by side, and take nothing from the moving-obstacle stream.
-        let walk_key: u64 = stream(seed, Stream::Walk).random();
-        let turn_stream = |k: usize| {
-            split_mix(walk_key.wrapping_add((k as u64 + 1).wrapping_mul(SPLIT_MIX_GAMMA)))
-        };
+        // Each obstacle turns by draws of its own stream, keyed by the episode's walk stream:
+        // the turns are drawn side by side, and take nothing from the moving-obstacle stream.
+        let mut state = State::keyed(stream(seed, Stream::Walk).random());
         let mut reach: f64 = 0.0;
         for (entry, m) in config.moving.iter().enumerate() {
             // Entries past the file's own `[[moving]]` ones are its crowds.
@@ -306,7 +300,7 @@ impl Movers {
                     Self::make(m, body, scene, robots, goals, &mut rng).map_err(err)?
                 };
                 let near = speed + body.bounding_radius() + robot_radius;
-                state.push(&e, position, dir, speed, near, turn_stream(entries.len()));
+                state.push(&e, position, dir, speed, near);
                 entries.push(e);
                 behaviours.push(behaviour);
             }
@@ -516,14 +510,15 @@ impl Movers {
             state.sort_keys();
         }
         if let Some(crowd) = &mut self.crowd {
-            crowd.plan(
-                &mut self.entries,
+            let near = Neighbours {
                 state,
-                &mut self.pedestrians,
+                entries: &self.entries,
                 robots,
-                scene,
-                &mut self.rng,
-            );
+            };
+            crowd.plan(&near, &mut self.pedestrians, scene, &mut self.rng);
+            for &i in crowd.vanished() {
+                self.entries[i].gone = true;
+            }
         }
         state.turn_and_look_ahead(&self.centres);
         for (i, e) in self.entries.iter().enumerate() {

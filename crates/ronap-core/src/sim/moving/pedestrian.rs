@@ -8,12 +8,11 @@
 //! from a crowd pattern (`circle`, `square`, `random`), are fixed, or are drawn in free space,
 //! all from the obstacles' own random stream.
 
-use super::{free_spot, Body, Disc, Entry, SPOT_TRIES};
+use super::{free_spot, Body, Disc, Neighbours, SPOT_TRIES};
 use crate::config::{AgentOrca, Arrival, Forces, MotionKind, MovingConfig, Pattern};
 use crate::geometry::{Agent, Horizon, Point, PointGrid, Vector, V2};
 use crate::scene::Scene;
 use crate::sim::avoid::{social_force_velocity, Avoid, Avoider};
-use crate::sim::moving::heading::State;
 use crate::sim::rng::Rng;
 use rand::Rng as _;
 use std::f64::consts::TAU;
@@ -224,21 +223,34 @@ pub(super) struct Crowd {
     grid: Option<PointGrid>,
     /// The agents near the one planning (scratch).
     near: Vec<u32>,
+    /// The entries of the pedestrians that vanished at their goals in the last planning.
+    vanished: Vec<usize>,
 }
 
 impl Crowd {
+    /// The entries of the pedestrians that vanished at their goals in the last
+    /// [`Crowd::plan`].
+    pub(super) fn vanished(&self) -> &[usize] {
+        &self.vanished
+    }
+
     /// Chooses this step's velocity of every present pedestrian (`pedestrians[i]` of entry `i`)
-    /// from where everyone stands, with the robots `robots` where they stand; a pedestrian at its
-    /// goal stays, vanishes (`entries[i]` gone) or draws a new goal from `rng`.
+    /// from where everyone stands (`near`: the obstacles and the robots); a pedestrian at its
+    /// goal stays, vanishes (listed in [`Crowd::vanished`], for its entry to be gone) or draws a
+    /// new goal from `rng`.
     pub(super) fn plan(
         &mut self,
-        entries: &mut [Entry],
-        state: &State,
+        near: &Neighbours,
         pedestrians: &mut [Option<Pedestrian>],
-        robots: &[Disc],
         scene: &Scene,
         rng: &mut Rng,
     ) {
+        let Neighbours {
+            state,
+            entries,
+            robots,
+        } = *near;
+        self.vanished.clear();
         self.last.resize(entries.len(), None);
         self.agents.clear();
         self.owners.clear();
@@ -307,7 +319,7 @@ impl Crowd {
                 match p.on_arrival {
                     Arrival::Stay => Vector::zeros(),
                     Arrival::Vanish => {
-                        entries[i].gone = true;
+                        self.vanished.push(i);
                         p.next = Vector::zeros();
                         continue;
                     }
