@@ -16,7 +16,7 @@ mod orca;
 mod vec_env;
 
 use conv::{Config, Scenario};
-use numpy::{PyArray2, PyArray3, PyArrayMethods};
+use numpy::PyArray3;
 use pyo3::prelude::*;
 use ronap_core::SimConfig;
 
@@ -24,25 +24,6 @@ use ronap_core::SimConfig;
 #[pyfunction]
 fn default_config_json() -> String {
     serde_json::to_string(&SimConfig::default()).unwrap_or_default()
-}
-
-/// The maze of `seed` as an occupancy array (rows from the top, like the picture): True where a
-/// wall is, one entry per `1 / scale` px.
-#[pyfunction]
-#[pyo3(signature = (seed, config, scale = 1.0))]
-fn maze_occupancy<'py>(
-    py: Python<'py>,
-    seed: u64,
-    config: &Config,
-    scale: f64,
-) -> PyResult<Bound<'py, PyArray2<bool>>> {
-    let img = maze_picture(seed, config, scale)?;
-    let (w, h) = img.dimensions();
-    let data: Vec<bool> = img
-        .pixels()
-        .map(|p| p.0 == ronap_core::render::WALL.0)
-        .collect();
-    numpy::PyArray1::from_vec(py, data).reshape([h as usize, w as usize])
 }
 
 /// The maze of `seed` as an RGB picture (white floor, black walls), `scale` pixels per px.
@@ -97,7 +78,6 @@ fn _ronap(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<multi_env::VecMultiEnv>()?;
     m.add_function(wrap_pyfunction!(default_config_json, m)?)?;
     m.add_function(wrap_pyfunction!(split_range, m)?)?;
-    m.add_function(wrap_pyfunction!(maze_occupancy, m)?)?;
     m.add_function(wrap_pyfunction!(maze_image, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_policies, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
@@ -106,6 +86,8 @@ fn _ronap(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mlp::write_mlp, m)?)?;
     m.add_function(wrap_pyfunction!(mlp::mlp_outputs, m)?)?;
     m.add_function(wrap_pyfunction!(orca::orca_step, m)?)?;
+    let [r, g, b] = ronap_core::render::WALL.0;
+    m.add("WALL_RGB", (r, g, b))?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

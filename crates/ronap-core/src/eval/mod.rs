@@ -18,7 +18,7 @@ mod team;
 // The metrics beyond the standard columns, aliased here as the evaluator has kinds of its own.
 pub use metric::{
     kinds as metric_kinds, Column as MetricColumn, End as MetricEnd, Kind as MetricKind, Metric,
-    MetricMean, Other as MetricOther, View as MetricView,
+    MetricMean, Other as MetricOther, View as MetricView, CROWD as CROWD_METRICS,
 };
 pub use record::{EpisodeRecord, Outcome, Recording, StepLog};
 pub use summary::{AmongRobots, Figures, MovingSummary, Summary, Tally};
@@ -37,6 +37,7 @@ use crate::policy::{Policy, PolicyError, PolicyFactory};
 use crate::run::{Rollout, RunError};
 use crate::sim::{Action, Episode, Pose, Scenes, SeedRanges, Track, World, Worlds};
 use ordered::{run_in_order, Ordered, Window};
+use side_by_side::SideBySide;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::Instant;
@@ -344,7 +345,14 @@ impl Evaluator {
     ) -> Result<RunEnd, PolicyError> {
         let lanes = factory.side_by_side();
         if lanes > 1 {
-            return self.stream_side_by_side(factory, options, cancel, on_finish, sink);
+            let side_by_side = SideBySide {
+                evaluator: self,
+                factory,
+                options,
+                lanes,
+                on_finish,
+            };
+            return side_by_side.stream(cancel, sink);
         }
         // Policies are made at most once per worker and handed from episode to episode, so a
         // costly policy (a Python process, a loaded network) is set up `threads` times, not once

@@ -149,19 +149,35 @@ impl Evaluator {
         }
         failed
     }
+}
 
-    /// [`Evaluator::stream`] for a policy deciding for `lanes` episodes at once: each job is a
-    /// block of [`SIDE_BY_SIDE_BLOCK`] lane-fuls of seeds, run side by side on one worker
-    /// ([`Evaluator::run_side_by_side`]), so the cancel flag stops the run between blocks.
-    pub(crate) fn stream_side_by_side(
-        &self,
-        factory: &dyn PolicyFactory,
-        options: &EvalOptions,
+/// [`Evaluator::stream`] for a policy deciding for `lanes` episodes at once: each job is a block
+/// of [`SIDE_BY_SIDE_BLOCK`] lane-fuls of seeds, run side by side on one worker
+/// ([`Evaluator::run_side_by_side`]), so the cancel flag stops the run between blocks.
+pub(crate) struct SideBySide<'a> {
+    pub(crate) evaluator: &'a Evaluator,
+    pub(crate) factory: &'a dyn PolicyFactory,
+    pub(crate) options: &'a EvalOptions,
+    pub(crate) lanes: usize,
+    /// Each record as its episode ends, in any order.
+    pub(crate) on_finish: &'a (dyn Fn(&EpisodeRecord) + Sync),
+}
+
+impl SideBySide<'_> {
+    /// Streams the records to `sink` in seed order, without their paths, until it refuses one or
+    /// `cancel` is set; how the run ended.
+    pub(crate) fn stream(
+        self,
         cancel: &AtomicBool,
-        on_finish: &(dyn Fn(&EpisodeRecord) + Sync),
         sink: &mut dyn FnMut(EpisodeRecord) -> bool,
     ) -> Result<RunEnd, PolicyError> {
-        let lanes = factory.side_by_side();
+        let Self {
+            evaluator,
+            factory,
+            options,
+            lanes,
+            on_finish,
+        } = self;
         let clock = Instant::now();
         let pool = worker_pool(options.threads)?;
         let count = options.seeds.len();
@@ -181,7 +197,7 @@ impl Evaluator {
                 .filter_map(|i| options.seeds.get(i))
                 .collect();
             let mut records: Vec<Option<EpisodeRecord>> = seeds.iter().map(|_| None).collect();
-            let failed = self.run_side_by_side(
+            let failed = evaluator.run_side_by_side(
                 policy.as_mut(),
                 &seeds,
                 lanes,

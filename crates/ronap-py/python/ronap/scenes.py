@@ -13,7 +13,8 @@ from .config import checked_config
 def maze_occupancy(seed: int, scale: float = 1.0, config: Mapping[str, Any] | None = None, **fields: Any) -> np.ndarray:
     """The maze of ``seed`` as a boolean array, True on walls; rows from the top like the
     picture, ``scale`` entries per px."""
-    return _ronap.maze_occupancy(seed, checked_config(config, fields), scale)
+    image = _ronap.maze_image(seed, checked_config(config, fields), scale)
+    return (image == np.array(_ronap.WALL_RGB, dtype=np.uint8)).all(axis=2)
 
 
 def maze_image(seed: int, scale: float = 1.0, config: Mapping[str, Any] | None = None, **fields: Any) -> np.ndarray:

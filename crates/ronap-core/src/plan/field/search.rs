@@ -181,8 +181,11 @@ impl Work {
         }
         let n = cells.len();
         // As long as the cells, so a cell's index needs checking only once.
-        let (moves, slow) = (&grid.moves()[..n], &grid.close_moves()[..n]);
-        let offsets = grid.move_offsets();
+        let moves = Moves {
+            open: &grid.moves()[..n],
+            close: &grid.close_moves()[..n],
+            offsets: grid.move_offsets(),
+        };
         let mut current = 0u32;
         // Buckets found empty in a row: a whole ring of them, and no cell is left to settle.
         let mut idle = 0;
@@ -202,16 +205,9 @@ impl Work {
                     // Improved since it was put here, and settled then.
                     continue;
                 }
-                // Open moves as bits in the order E, W, N, S, NE, SE, NW, SW: the order decides
-                // which of two equal-cost parents a cell keeps.
-                let open = moves[i] as u32;
-                let (slow, st) = steps.of(slow[i]);
-                let mut better = improving(cells, i, open, slow, st, &offsets);
-                while better != 0 {
-                    let k = better.trailing_zeros() as usize;
-                    better &= better - 1;
-                    let j = i.wrapping_add(offsets[k] as usize);
-                    let to = cost + st[k];
+                // The moves' order decides which of two equal-cost parents a cell keeps.
+                for (_, j, step) in moves.improving(cells, i, steps) {
+                    let to = cost + step;
                     cells[j] = Node {
                         cost: to,
                         parent: i as u32,
@@ -339,8 +335,11 @@ impl Work {
         };
         let (cells, closed, front) = (&mut self.cells, &mut self.closed, &mut self.front);
         let steps = &self.steps;
-        let (moves, slow) = (grid.moves(), grid.close_moves());
-        let offsets = grid.move_offsets();
+        let moves = Moves {
+            open: grid.moves(),
+            close: grid.close_moves(),
+            offsets: grid.move_offsets(),
+        };
         // Column and row changes of the moves E, W, N, S, NE, SE, NW, SW.
         const DC: [u32; 8] = [1, u32::MAX, 0, 0, 1, 1, u32::MAX, u32::MAX];
         const DR: [u32; 8] = [0, 0, 1, u32::MAX, 1, u32::MAX, 1, u32::MAX];
@@ -362,14 +361,8 @@ impl Work {
                     continue;
                 }
                 closed.push(i as u32);
-                let open = moves[i] as u32;
-                let (slow, st) = steps.of(slow[i]);
-                let mut better = improving(cells, i, open, slow, st, &offsets);
-                while better != 0 {
-                    let k = better.trailing_zeros() as usize;
-                    better &= better - 1;
-                    let j = i.wrapping_add(offsets[k] as usize);
-                    let nd = cost + st[k];
+                for (k, j, step) in moves.improving(cells, i, steps) {
+                    let nd = cost + step;
                     cells[j].cost = nd;
                     let (nc, nr) = (c.wrapping_add(DC[k]), r.wrapping_add(DR[k]));
                     let ahead = (nd + least(nc, nr) - current) as usize;
@@ -529,6 +522,53 @@ impl Steps {
 impl Default for Steps {
     fn default() -> Self {
         Self::new(1.0)
+    }
+}
+
+/// A grid's moves as the searches read them: each cell's open and close moves, as bits in the
+/// order E, W, N, S, NE, SE, NW, SW, and each move's offset in the cells.
+#[derive(Clone, Copy)]
+struct Moves<'a> {
+    open: &'a [u8],
+    close: &'a [u8],
+    offsets: [isize; 8],
+}
+
+impl Moves<'_> {
+    /// The open moves from cell `i` that improve the cell they reach ([`improving`]), in the
+    /// moves' order, with their step costs under `steps`.
+    #[inline(always)]
+    fn improving<'s>(&self, cells: &[Node], i: usize, steps: &'s Steps) -> Improving<'s> {
+        let (slow, st) = steps.of(self.close[i]);
+        let open = u32::from(self.open[i]);
+        Improving {
+            better: improving(cells, i, open, slow, st, &self.offsets),
+            i,
+            offsets: self.offsets,
+            st,
+        }
+    }
+}
+
+/// [`Moves::improving`]'s moves: each as its index `k`, the cell it reaches and its step cost.
+struct Improving<'s> {
+    better: u32,
+    i: usize,
+    offsets: [isize; 8],
+    st: &'s [u32; 8],
+}
+
+impl Iterator for Improving<'_> {
+    type Item = (usize, usize, u32);
+
+    #[inline(always)]
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.better == 0 {
+            return None;
+        }
+        let k = self.better.trailing_zeros() as usize;
+        self.better &= self.better - 1;
+        Some((k, self.i.wrapping_add(self.offsets[k] as usize), self.st[k]))
     }
 }
 

@@ -269,17 +269,7 @@ impl pulp::WithSimd for ForwardRows<'_> {
             if rows == 1 {
                 add_columns(simd, y, x, weights, outs);
             } else {
-                add_rows(
-                    simd,
-                    y,
-                    x,
-                    Weights {
-                        values: weights,
-                        ins,
-                        outs,
-                    },
-                    rows,
-                );
+                add_rows(simd, y, x, Weights { weights, ins, outs }, rows);
             }
             if i < last {
                 mlp.activation.apply(y);
@@ -350,11 +340,7 @@ fn add_narrow<const W: usize>(
     rows: std::ops::Range<usize>,
     o: usize,
 ) {
-    let Weights {
-        values: weights,
-        ins,
-        outs,
-    } = layer;
+    let Weights { weights, ins, outs } = layer;
     let mut acc = [[0.0f32; W]; 4];
     for (a, r) in acc.iter_mut().zip(rows.clone()) {
         a.copy_from_slice(&y[r * outs + o..r * outs + o + W]);
@@ -380,7 +366,7 @@ fn add_narrow<const W: usize>(
 /// A layer's column-major weights (column j holds the weights from input j) and its shape.
 #[derive(Clone, Copy)]
 struct Weights<'a> {
-    values: &'a [f32],
+    weights: &'a [f32],
     ins: usize,
     outs: usize,
 }
@@ -407,11 +393,7 @@ fn add_block<S: pulp::Simd, const R: usize, const V: usize>(
     r: usize,
     o: usize,
 ) {
-    let Weights {
-        values: weights,
-        ins,
-        outs,
-    } = layer;
+    let Weights { weights, ins, outs } = layer;
     let n = V * S::F32_LANES;
     let xs: [&[f32]; R] = std::array::from_fn(|k| &x[(r + k) * ins..(r + k + 1) * ins]);
     let mut acc = [[simd.splat_f32s(0.0); V]; R];
@@ -445,7 +427,7 @@ fn add_columns<S: pulp::Simd>(simd: S, y: &mut [f32], x: &[f32], weights: &[f32]
     // One row: `x` is its inputs and `y` its outputs.
     let mut o = 0;
     let layer = Weights {
-        values: weights,
+        weights,
         ins: x.len(),
         outs: outputs,
     };
