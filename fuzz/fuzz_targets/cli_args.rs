@@ -1,6 +1,7 @@
 //! The command line: the input split at NUL bytes into arguments after `ronap`, parsed as the
 //! binary parses them (clap's checks of the command definition run too, in this debug-assertion
-//! build), and any error rendered as the binary renders it.
+//! build), and any error rendered as the binary renders it. Every command but `train`: the fuzz
+//! build leaves out ronap-cli's `learn` feature (fuzz/Cargo.toml).
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;

@@ -9,7 +9,7 @@ mod py_policy;
 mod tui;
 
 use clap::{Parser, Subcommand};
-use commands::{bench, collect, compare, config, maze, replay, run, train, view};
+use commands::{bench, collect, compare, config, maze, replay, run, view};
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -72,7 +72,8 @@ enum Command {
     /// Measure how fast this machine steps a scene and what its laser costs per ray.
     Bench(bench::BenchArgs),
     /// Train a policy network (behaviour cloning or DQN) and write its weights file.
-    Train(train::TrainArgs),
+    #[cfg(feature = "learn")]
+    Train(commands::train::TrainArgs),
     /// Print the whole configuration as TOML, a comment on every field: a file to copy and edit
     /// for --config.
     Config(config::ConfigArgs),
@@ -124,7 +125,8 @@ pub fn main() -> ExitCode {
         Command::Replay(args) => replay::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Collect(args) => collect::run(args),
-        Command::Train(args) => train::run(args),
+        #[cfg(feature = "learn")]
+        Command::Train(args) => commands::train::run(args),
         Command::Config(args) => config::run(args),
     };
     match result {

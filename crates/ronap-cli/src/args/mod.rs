@@ -26,6 +26,7 @@ pub fn positive(s: &str) -> Result<f64, String> {
 }
 
 /// Parses a finite number of at least 0.
+#[cfg_attr(not(feature = "learn"), allow(dead_code))] // only `train` takes one today
 pub fn non_negative(s: &str) -> Result<f64, String> {
     let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number"))?;
     if v.is_finite() && v >= 0.0 {
@@ -53,6 +54,7 @@ pub fn seed(s: &str) -> Result<u64, String> {
 }
 
 /// Parses a fraction in (0, 1].
+#[cfg_attr(not(feature = "learn"), allow(dead_code))] // only `train` takes one today
 pub fn share(s: &str) -> Result<f64, String> {
     match fraction(s)? {
         0.0 => Err("must be above 0 and at most 1".into()),

@@ -8,5 +8,6 @@ pub mod config;
 pub mod maze;
 pub mod replay;
 pub mod run;
+#[cfg(feature = "learn")]
 pub mod train;
 pub mod view;
