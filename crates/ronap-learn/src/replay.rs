@@ -248,8 +248,8 @@ impl NStep {
 
     /// Adds the step from `observation` by `action` with `reward`, to `next`, after which the
     /// episode stands at `status`; returns the transitions that are complete: the one starting
-    /// `n` steps back, or, when the episode ended, every one still pending (bootstrapped when
-    /// it ended by a time-out, not by the task).
+    /// `n` steps back, or, when the episode ended, every one still pending (bootstrapped unless
+    /// the task itself ended it: [`Status::is_terminated`]).
     pub fn add(
         &mut self,
         observation: &[f32],

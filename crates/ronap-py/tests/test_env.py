@@ -150,6 +150,9 @@ def test_mazes_as_arrays():
     assert img.shape == (500, 500, 3)
     small = ronap.maze_occupancy(7, scale=0.5)
     assert np.array_equal(small, np.all(img == 0, axis=-1))
+    # Walls run along the cells' borders: the centre of every 100 px cell is floor.
+    assert not occ[50::100, 50::100].any()
+    assert occ[10:-10, 10:-10].any()
     assert set(ronap.policies()) == {
         "apf",
         "geodesic",
