@@ -13,10 +13,6 @@ use commands::{bench, collect, compare, config, maze, replay, run, view};
 use std::io::Write;
 use std::process::ExitCode;
 
-/// The team view's keys and what they do, for the terminal tests that look for them on screen.
-#[doc(hidden)]
-pub use tui::team_view::KEYS as TEAM_VIEW_KEYS;
-
 /// Exit code for bad input: arguments, config files, maps, output paths.
 const EXIT_BAD_INPUT: u8 = 2;
 

@@ -324,7 +324,15 @@ fn team_view_ends_fitted(name: &str, scenario: &str, width: u16, height: u16) ->
         "{screen}"
     );
     // Every key, with what it does.
-    for (key, what) in ronap_cli::TEAM_VIEW_KEYS {
+    for (key, what) in [
+        ("space", "pause / resume"),
+        ("+ -", "faster / slower"),
+        ("tab", "follow the next robot"),
+        ("m", "whole scene / first person"),
+        ("s", "one step, when paused"),
+        ("r n", "restart / next seed"),
+        ("q", "quit"),
+    ] {
         let help = format!("│{key:<8}{what}");
         assert!(screen.contains(&help), "{help:?} not in:\n{screen}");
     }

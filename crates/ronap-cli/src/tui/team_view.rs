@@ -158,7 +158,7 @@ fn message(state: &TeamViewState) -> Option<(String, Color)> {
 }
 
 /// The keys of the team view and what they do.
-pub const KEYS: [(&str, &str); 7] = [
+const KEYS: [(&str, &str); 7] = [
     ("space", "pause / resume"),
     ("+ -", "faster / slower"),
     ("tab", "follow the next robot"),

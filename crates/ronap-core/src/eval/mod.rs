@@ -18,7 +18,7 @@ mod team;
 // The metrics beyond the standard columns, aliased here as the evaluator has kinds of its own.
 pub use metric::{
     kinds as metric_kinds, Column as MetricColumn, End as MetricEnd, Kind as MetricKind, Metric,
-    MetricMean, Other as MetricOther, View as MetricView, CROWD as CROWD_METRICS,
+    MetricMean, Other as MetricOther, View as MetricView,
 };
 pub use record::{EpisodeRecord, Outcome, Recording, StepLog};
 pub use summary::{AmongRobots, Figures, MovingSummary, Summary, Tally};
