@@ -25,9 +25,17 @@ pub struct Walker {
 
 /// The push of another agent at `at` of radius `radius` on `me`, whose desired direction of
 /// motion is `desired` (a unit vector, or zero for none: every direction weighs 1).
+#[inline]
 pub fn agent_force(f: &Forces, me: &Walker, desired: Vector, at: Point, radius: f64) -> Vector {
     let away = me.position - at;
-    let d = away.norm();
+    let d2 = away.norm_squared();
+    // Most candidates a walker is handed are out of reach: turned away before the square root,
+    // with room for its rounding, so those within reach are exactly the ones the test below
+    // keeps.
+    if d2 > f.neighbour_dist_px * f.neighbour_dist_px * (1.0 + 1e-9) {
+        return Vector::zeros();
+    }
+    let d = d2.sqrt();
     if d == 0.0 || d > f.neighbour_dist_px {
         return Vector::zeros();
     }
@@ -43,6 +51,7 @@ pub fn agent_force(f: &Forces, me: &Walker, desired: Vector, at: Point, radius: 
 }
 
 /// The push of a still obstacle whose nearest point to `me` is `nearest`; none from inside it.
+#[inline]
 pub fn obstacle_force(f: &Forces, me: &Walker, nearest: Point) -> Vector {
     let away = me.position - nearest;
     let d = away.norm();
@@ -54,6 +63,7 @@ pub fn obstacle_force(f: &Forces, me: &Walker, nearest: Point) -> Vector {
 
 /// `exp(x)` with `x` held at most 50 (`e^50`, 5e21): deep overlaps with a short decay length
 /// would otherwise overflow to infinity and give NaN velocities.
+#[inline]
 fn push_factor(x: f64) -> f64 {
     x.min(50.0).exp()
 }
