@@ -76,7 +76,15 @@ def test_some_pages_have_marked_blocks():
     assert len(MARKED) >= 5, [str(p) for p in MARKED]
 
 
-@pytest.mark.parametrize("page", MARKED, ids=lambda p: str(p.relative_to(ROOT)))
+def with_group(page):
+    """A page whose blocks start a local Ray instance runs in the worker that runs tests/test_ray.py
+    (scripts/test runs pytest on both cores with pytest-xdist): one local Ray instance at a time."""
+    if "ronap.ray" in page.read_text():
+        return pytest.param(page, marks=pytest.mark.xdist_group("ray"))
+    return page
+
+
+@pytest.mark.parametrize("page", [with_group(p) for p in MARKED], ids=lambda p: str(p.relative_to(ROOT)))
 def test_marked_blocks_run(page, tmp_path, ronap_bin):
     for folder in ("scenarios", "policies", "examples"):
         shutil.copytree(ROOT / folder, tmp_path / folder)

@@ -20,6 +20,10 @@ from ray.thirdparty_files import psutil  # Ray's own copy
 import ronap
 import ronap.ray
 
+# Every test here shares one worker when pytest-xdist spreads the suite over the cores (scripts/test),
+# with the guides' blocks that start Ray: one local Ray instance at a time.
+pytestmark = pytest.mark.xdist_group("ray")
+
 ROOT = pathlib.Path(__file__).resolve().parents[3]
 TIMING = {"wall_time_s", "steps_per_second"}
 
