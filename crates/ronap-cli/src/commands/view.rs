@@ -55,9 +55,9 @@ pub fn run(args: ViewArgs) -> Result<ExitCode> {
         .with_context(|| format!("cannot start policy {}", args.policy))?;
     let rollout =
         start_episode(&evaluator, policy.as_mut(), args.seed).map_err(anyhow::Error::msg)?;
-    let state = ViewState::new(rollout, &args.policy, args.speed);
+    let state = ViewState::new(rollout, &args.policy);
     let mut session = Session::start("view")?;
-    let mut view = ViewApp::new(Lone::new(state, &evaluator, policy.as_mut()));
+    let mut view = ViewApp::new(Lone::new(state, &evaluator, policy.as_mut()), args.speed);
     let code = app::run(&mut session, &mut view)?;
     drop(session);
     if let Some(Ending::Failed(why)) = &view.watched.state.ending {
@@ -71,9 +71,9 @@ fn run_team(args: ViewArgs, config: ValidConfig, scenes: Scenes) -> Result<ExitC
     let policies = TeamPolicies::new(&config, &args.policy)?;
     let evaluator = Evaluator::new(config, scenes);
     terminal::require_terminal("view")?;
-    let watch = TeamWatch::start(&evaluator, &policies, args.seed, args.speed)?;
+    let watch = TeamWatch::start(&evaluator, &policies, args.seed)?;
     let mut session = Session::start("view")?;
-    let mut view = ViewApp::new(watch);
+    let mut view = ViewApp::new(watch, args.speed);
     let code = app::run(&mut session, &mut view)?;
     drop(session);
     if let Some(Ending::Failed(why)) = &view.watched.state.ending {

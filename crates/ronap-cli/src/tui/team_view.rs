@@ -5,8 +5,9 @@
 //! each other, as robots.csv counts them) and how the episode ended, fitted to the terminal so
 //! that at 80x24 the keys and the whole status line are on screen.
 //!
-//! [`TeamViewState`] is everything on screen and [`draw`] a pure function of it; [`TeamWatch`]
-//! steps the policies for [`crate::tui::view::ViewApp`], the loop the lone view runs too.
+//! [`TeamViewState`] is the team episode on screen and [`draw`] a pure function of it and the
+//! keys' [`Controls`]; [`TeamWatch`] steps the policies for [`crate::tui::view::ViewApp`], the
+//! loop (and the controls) the lone view has too.
 
 use crate::args::TeamPolicies;
 use crate::tui::draw::{self, SceneMode};
@@ -22,7 +23,7 @@ use ronap_core::run::{RunError, TeamRollout};
 use ronap_core::sim::Team;
 use ronap_core::{Episode, Status};
 
-/// Everything the team view shows.
+/// The team episode the view shows (the keys' settings are [`crate::tui::view::ViewApp`]'s).
 pub struct TeamViewState {
     /// The team episode.
     pub rollout: TeamRollout,
@@ -34,15 +35,13 @@ pub struct TeamViewState {
     pub names: Vec<String>,
     /// The robot whose rays and first-person view are shown.
     pub focus: usize,
-    /// The view, pause and speed the keys set.
-    pub controls: Controls,
     /// Why the episode stopped, when the robots' statuses do not say.
     pub ending: Option<Ending>,
 }
 
 impl TeamViewState {
     /// The view of `rollout` (seed `seed`), just started, with robot `k` under `names[k]`.
-    pub fn new(rollout: TeamRollout, seed: u64, names: Vec<String>, speed: u32) -> Self {
+    pub fn new(rollout: TeamRollout, seed: u64, names: Vec<String>) -> Self {
         let team = rollout.team();
         let paths = (0..team.robots().len())
             .map(|k| vec![team.robot(k).pose().position()])
@@ -53,7 +52,6 @@ impl TeamViewState {
             paths,
             names,
             focus: 0,
-            controls: Controls::new(SceneMode::WholeScene, speed),
             ending: None,
         }
     }
@@ -112,16 +110,16 @@ fn collisions<'a>(robots: impl IntoIterator<Item = &'a Episode>) -> String {
 
 /// The status line: state, step, robots at their goals, collisions with walls and with each
 /// other, speed and how it ended, in as many parts as the screen's width needs rows.
-pub fn status(state: &TeamViewState) -> draw::Status {
+pub fn status(state: &TeamViewState, controls: &Controls) -> draw::Status {
     let team = state.team();
     draw::Status {
         finished: state.finished(),
-        paused: state.controls.paused,
+        paused: controls.paused,
         figures: vec![
             format!("step {}", team.steps()),
             format!("at goal {}/{}", state.arrived(), team.robots().len()),
             format!("collisions: {}", collisions(team.robots())),
-            format!("{} steps/s", state.controls.speed),
+            format!("{} steps/s", controls.speed),
         ],
         message: message(state),
     }
@@ -169,7 +167,7 @@ const KEYS: [(&str, &str); 7] = [
 ];
 
 /// The side panel: the team, then the followed robot, the legend and the keys.
-fn side_panel(state: &TeamViewState) -> draw::SidePanel<'static> {
+fn side_panel(state: &TeamViewState, controls: &Controls) -> draw::SidePanel<'static> {
     let team = state.team();
     let k = state.focus;
     let r = team.robot(k);
@@ -184,7 +182,7 @@ fn side_panel(state: &TeamViewState) -> draw::SidePanel<'static> {
             format!("{} / {}", state.arrived(), team.robots().len()),
         ),
         draw::field("collisions", collisions(team.robots())),
-        draw::field("speed", format!("{} steps/s", state.controls.speed)),
+        draw::field("speed", format!("{} steps/s", controls.speed)),
         Line::raw(""),
         Line::from(vec![
             Span::styled(
@@ -237,9 +235,9 @@ fn status_word(team: &Team, k: usize) -> String {
     .to_string()
 }
 
-/// Draws the whole screen for `state`.
-pub fn draw(frame: &mut Frame, state: &TeamViewState) {
-    let mode = state.controls.mode;
+/// Draws the whole screen for `state` as `controls` set it.
+pub fn draw(frame: &mut Frame, state: &TeamViewState, controls: &Controls) {
+    let mode = controls.mode;
     let title = match mode {
         SceneMode::WholeScene => format!("{} · seed {}", mode.title(), state.seed),
         SceneMode::FirstPerson => format!(
@@ -252,8 +250,8 @@ pub fn draw(frame: &mut Frame, state: &TeamViewState) {
     draw::fitted_screen(
         frame,
         "ronap view",
-        side_panel(state),
-        &status(state),
+        side_panel(state, controls),
+        &status(state, controls),
         |frame, area| {
             let team = state.team();
             let robots: Vec<draw::Shown<'_>> = (0..team.robots().len())
@@ -305,17 +303,12 @@ fn start_team(
 }
 
 impl<'a> TeamWatch<'a> {
-    /// The team episode of `seed` from `evaluator` under `policies`, at `speed` steps a second.
-    pub fn start(
-        evaluator: &'a Evaluator,
-        policies: &TeamPolicies,
-        seed: u64,
-        speed: u32,
-    ) -> Result<Self> {
+    /// The team episode of `seed` from `evaluator` under `policies`.
+    pub fn start(evaluator: &'a Evaluator, policies: &TeamPolicies, seed: u64) -> Result<Self> {
         let mut made = policies.start()?;
         let rollout = start_team(evaluator, made.as_mut(), seed).map_err(anyhow::Error::msg)?;
         Ok(Self {
-            state: TeamViewState::new(rollout, seed, policies.names.clone(), speed),
+            state: TeamViewState::new(rollout, seed, policies.names.clone()),
             evaluator,
             policies: made,
         })
@@ -323,13 +316,7 @@ impl<'a> TeamWatch<'a> {
 }
 
 impl Watched for TeamWatch<'_> {
-    fn controls(&self) -> &Controls {
-        &self.state.controls
-    }
-
-    fn controls_mut(&mut self) -> &mut Controls {
-        &mut self.state.controls
-    }
+    const MODE: SceneMode = SceneMode::WholeScene;
 
     fn finished(&self) -> bool {
         self.state.finished()
@@ -346,10 +333,9 @@ impl Watched for TeamWatch<'_> {
     fn restart(&mut self, seed: u64) {
         match start_team(self.evaluator, self.policies.as_mut(), seed) {
             Ok(rollout) => {
-                let (controls, focus) = (self.state.controls, self.state.focus);
+                let focus = self.state.focus;
                 let names = std::mem::take(&mut self.state.names);
-                self.state = TeamViewState::new(rollout, seed, names, controls.speed);
-                self.state.controls = controls;
+                self.state = TeamViewState::new(rollout, seed, names);
                 self.state.focus = focus.min(self.state.team().robots().len() - 1);
             }
             Err(why) => self.state.ending = Some(Ending::Failed(why)),
@@ -361,14 +347,15 @@ impl Watched for TeamWatch<'_> {
         self.state.focus = (self.state.focus + 1) % n;
     }
 
-    fn draw(&self, frame: &mut Frame) {
-        draw(frame, &self.state)
+    fn draw(&self, frame: &mut Frame, controls: &Controls) {
+        draw(frame, &self.state, controls)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::tui::app::App;
     use crate::tui::view::{KeyAction, ViewApp};
     use ratatui::backend::TestBackend;
     use ratatui::buffer::Buffer;
@@ -384,9 +371,14 @@ mod tests {
         Evaluator::new(config, scenes)
     }
 
-    fn render(state: &TeamViewState, w: u16, h: u16) -> Buffer {
+    /// The controls the team view starts with at 20 steps a second.
+    fn whole_scene() -> Controls {
+        Controls::new(SceneMode::WholeScene, 20)
+    }
+
+    fn render(state: &TeamViewState, controls: &Controls, w: u16, h: u16) -> Buffer {
         let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
-        terminal.draw(|f| draw(f, state)).unwrap();
+        terminal.draw(|f| draw(f, state, controls)).unwrap();
         terminal.backend().buffer().clone()
     }
 
@@ -414,7 +406,7 @@ mod tests {
     fn every_robot_is_drawn_in_its_colour_with_its_path_and_tab_follows_the_next() {
         let evaluator = evaluator("warehouse-team.toml");
         let policies = TeamPolicies::new(evaluator.config(), "geodesic").unwrap();
-        let mut app = ViewApp::new(TeamWatch::start(&evaluator, &policies, 3, 20).unwrap());
+        let mut app = ViewApp::new(TeamWatch::start(&evaluator, &policies, 3).unwrap(), 20);
         let n = app.watched.state.team().robots().len();
         assert!(n >= 2);
         for _ in 0..40 {
@@ -422,7 +414,7 @@ mod tests {
         }
         let state = &app.watched.state;
         assert!(state.paths.iter().all(|p| p.len() > 1));
-        let buf = render(state, 120, 40);
+        let buf = render(state, &app.controls, 120, 40);
         let screen = text(&buf);
         assert!(screen.contains("whole scene · seed 3"), "{screen}");
         assert!(screen.contains("step 40"), "{screen}");
@@ -437,16 +429,13 @@ mod tests {
         // Tab follows robot 1; M shows its first-person view.
         let key = |c| KeyEvent::new(c, KeyModifiers::NONE);
         assert_eq!(
-            app.watched.state.controls.handle_key(&key(KeyCode::Tab)),
+            app.controls.handle_key(&key(KeyCode::Tab)),
             KeyAction::NextRobot
         );
         app.watched.next_robot();
         assert_eq!(app.watched.state.focus, 1);
-        app.watched
-            .state
-            .controls
-            .handle_key(&key(KeyCode::Char('m')));
-        let screen = text(&render(&app.watched.state, 120, 40));
+        app.controls.handle_key(&key(KeyCode::Char('m')));
+        let screen = text(&render(&app.watched.state, &app.controls, 120, 40));
         assert!(screen.contains("first person of robot 1"), "{screen}");
         assert!(screen.contains("robot 1"), "{screen}");
     }
@@ -455,32 +444,40 @@ mod tests {
     fn the_corridor_swap_ends_in_a_deadlock_the_status_line_names() {
         let evaluator = evaluator("corridor-swap.toml");
         let policies = TeamPolicies::new(evaluator.config(), "geodesic").unwrap();
-        let mut watch = TeamWatch::start(&evaluator, &policies, 0, 20).unwrap();
+        let mut watch = TeamWatch::start(&evaluator, &policies, 0).unwrap();
         let mut steps = 0;
         while !watch.finished() && steps < 100_000 {
             watch.advance();
             steps += 1;
         }
         assert!(watch.finished());
-        let status = text(&render(&watch.state, 100, 30));
+        let status = text(&render(&watch.state, &whole_scene(), 100, 30));
         assert!(
             status.contains("deadlock") || status.contains("TaskComplete"),
             "{status}"
         );
         assert!(status.contains("■ ended"), "{status}");
-        // Restart keeps the controls and starts the seed again.
-        watch.state.controls.speed = 100;
-        watch.restart(0);
-        assert_eq!(watch.state.team().steps(), 0);
-        assert_eq!(watch.state.controls.speed, 100);
-        assert!(!watch.finished());
+        // R starts the seed again and keeps the controls.
+        let mut app = ViewApp::new(watch, 100);
+        app.controls
+            .handle_key(&KeyEvent::new(KeyCode::Char(' '), KeyModifiers::NONE));
+        let restart = KeyEvent::new(KeyCode::Char('r'), KeyModifiers::NONE);
+        assert!(app.key(&restart).unwrap().is_none());
+        assert_eq!(app.watched.state.team().steps(), 0);
+        assert!(!app.watched.finished());
+        let kept = Controls {
+            paused: true,
+            speed: 100,
+            ..whole_scene()
+        };
+        assert_eq!(app.controls, kept);
     }
 
     #[test]
     fn robot_collisions_are_shown_as_the_run_records_them_with_every_key_at_80_by_24() {
         let evaluator = evaluator("corridor-swap.toml");
         let policies = TeamPolicies::new(evaluator.config(), "geodesic").unwrap();
-        let mut watch = TeamWatch::start(&evaluator, &policies, 1, 20).unwrap();
+        let mut watch = TeamWatch::start(&evaluator, &policies, 1).unwrap();
         while !watch.finished() && watch.state.team().steps() < 100_000 {
             watch.advance();
         }
@@ -499,7 +496,7 @@ mod tests {
             record.collisions, record.robot_collisions
         );
         for (w, h) in [(80, 24), (120, 40)] {
-            let screen = text(&render(&watch.state, w, h));
+            let screen = text(&render(&watch.state, &whole_scene(), w, h));
             let lines: Vec<&str> = screen.lines().collect();
             let first = lines
                 .iter()
@@ -527,12 +524,12 @@ mod tests {
     fn every_size_draws_without_panicking() {
         let evaluator = evaluator("warehouse-team.toml");
         let policies = TeamPolicies::new(evaluator.config(), "apf").unwrap();
-        let mut watch = TeamWatch::start(&evaluator, &policies, 0, 20).unwrap();
+        let mut watch = TeamWatch::start(&evaluator, &policies, 0).unwrap();
         watch.advance();
         for mode in [SceneMode::WholeScene, SceneMode::FirstPerson] {
-            watch.state.controls.mode = mode;
+            let controls = Controls::new(mode, 20);
             for (w, h) in [(20, 5), (40, 12), (80, 24), (200, 60)] {
-                let screen = text(&render(&watch.state, w, h));
+                let screen = text(&render(&watch.state, &controls, w, h));
                 if w >= 40 && h >= 12 {
                     assert!(screen.contains("step 1"), "{w}x{h}");
                 }

@@ -3,8 +3,9 @@
 //! keys, and a status line with the step, the collisions, and the paper's "TaskComplete" and
 //! "CollisionWarning" messages.
 //!
-//! [`ViewState`] is everything on screen and [`draw`] a pure function of it; [`ViewApp`] steps the
-//! policy at the chosen speed between keys, in the loop of [`crate::tui::app`].
+//! [`ViewState`] is the episode on screen and [`draw`] a pure function of it and the keys'
+//! [`Controls`]; [`ViewApp`] holds the controls and steps the policy at the chosen speed between
+//! keys, in the loop of [`crate::tui::app`], for the lone view and the team view alike.
 
 use crate::tui::app::App;
 use crate::tui::draw::{self, SceneMode};
@@ -37,7 +38,7 @@ pub enum Ending {
     Failed(String),
 }
 
-/// Everything `ronap view` shows.
+/// The episode `ronap view` shows (the keys' settings are [`ViewApp`]'s).
 pub struct ViewState {
     /// The episode and the policy's say in it.
     pub rollout: Rollout,
@@ -45,8 +46,6 @@ pub struct ViewState {
     pub path: Vec<Point>,
     /// The policy's name as given.
     pub policy: String,
-    /// The view, pause and speed the keys set.
-    pub controls: Controls,
     /// The step of the latest collision.
     pub last_collision: Option<u32>,
     /// Why the episode stopped, when its status does not say.
@@ -55,12 +54,11 @@ pub struct ViewState {
 
 impl ViewState {
     /// The view of `rollout`, just started, under `policy`.
-    pub fn new(rollout: Rollout, policy: &str, speed: u32) -> Self {
+    pub fn new(rollout: Rollout, policy: &str) -> Self {
         Self {
             path: vec![rollout.episode().pose().position()],
             rollout,
             policy: policy.to_string(),
-            controls: Controls::new(SceneMode::FirstPerson, speed),
             last_collision: None,
             ending: None,
         }
@@ -101,9 +99,9 @@ impl ViewState {
     }
 
     /// Whether to show "CollisionWarning": the latest step collided, or one within the last
-    /// half second at the current speed, so a warning stays long enough to read.
-    pub fn warning(&self) -> bool {
-        let linger = (self.controls.speed / 2).max(1);
+    /// half second at `speed` steps a second, so a warning stays long enough to read.
+    pub fn warning(&self, speed: u32) -> bool {
+        let linger = (speed / 2).max(1);
         self.last_collision
             .is_some_and(|k| self.episode().steps().saturating_sub(k) < linger)
     }
@@ -195,24 +193,24 @@ impl Controls {
 }
 
 /// The status line: state, step, collisions, speed and the latest message.
-pub fn status_line(state: &ViewState) -> Line<'static> {
+pub fn status_line(state: &ViewState, controls: &Controls) -> Line<'static> {
     let e = state.episode();
     draw::status_line(
         state.finished(),
-        state.controls.paused,
+        controls.paused,
         format!(
             " · step {} · collisions {} · {} steps/s",
             e.steps(),
             e.collisions(),
-            state.controls.speed
+            controls.speed
         ),
-        message(state),
+        message(state, controls.speed),
     )
 }
 
 /// The message of the moment, in its colour: the paper's "TaskComplete" and "CollisionWarning",
-/// or why the episode ended.
-fn message(state: &ViewState) -> Option<(String, Color)> {
+/// or why the episode ended (a warning lingers half a second at `speed` steps a second).
+fn message(state: &ViewState, speed: u32) -> Option<(String, Color)> {
     let e = state.episode();
     let ended = match e.status() {
         Status::Success => Some(("TaskComplete".to_string(), Color::Green)),
@@ -228,13 +226,13 @@ fn message(state: &ViewState) -> Option<(String, Color)> {
     };
     ended.or_else(|| {
         state
-            .warning()
+            .warning(speed)
             .then(|| ("CollisionWarning".to_string(), Color::Red))
     })
 }
 
 /// The side panel's lines.
-fn side_lines(state: &ViewState) -> Vec<Line<'static>> {
+fn side_lines(state: &ViewState, controls: &Controls) -> Vec<Line<'static>> {
     let e = state.episode();
     let lines = vec![
         draw::field("seed", e.seed().to_string()),
@@ -248,7 +246,7 @@ fn side_lines(state: &ViewState) -> Vec<Line<'static>> {
         draw::field("heading", format!("{:.1}°", e.pose().z_deg)),
         draw::field("collisions", e.collisions().to_string()),
         draw::field("path", format!("{:.1} px", e.path_length_px())),
-        draw::field("speed", format!("{} steps/s", state.controls.speed)),
+        draw::field("speed", format!("{} steps/s", controls.speed)),
     ];
     draw::side_panel(
         lines,
@@ -264,15 +262,15 @@ fn side_lines(state: &ViewState) -> Vec<Line<'static>> {
     )
 }
 
-/// Draws the whole screen for `state`.
-pub fn draw(frame: &mut Frame, state: &ViewState) {
+/// Draws the whole screen for `state` as `controls` set it.
+pub fn draw(frame: &mut Frame, state: &ViewState, controls: &Controls) {
     draw::screen(
         frame,
         draw::Shown::lone(state.episode(), &state.path),
-        state.controls.mode,
+        controls.mode,
         "ronap view",
-        side_lines(state),
-        status_line(state),
+        side_lines(state, controls),
+        status_line(state, controls),
     );
 }
 
@@ -290,29 +288,22 @@ pub fn start_episode(
 }
 
 /// What a view steps and draws: one robot's episode ([`Lone`]) or a team's
-/// ([`crate::tui::team_view::TeamWatch`]).
+/// ([`crate::tui::team_view::TeamWatch`]); the keys' settings are [`ViewApp`]'s.
 pub trait Watched {
-    /// The keys' settings.
-    fn controls(&self) -> &Controls;
-    /// The keys' settings, to change.
-    fn controls_mut(&mut self) -> &mut Controls;
+    /// The scene view it starts in.
+    const MODE: SceneMode;
     /// Whether the episode is over (or failed).
     fn finished(&self) -> bool;
     /// One step of the policies.
     fn advance(&mut self);
     /// The episode's seed.
     fn seed(&self) -> u64;
-    /// Starts the episode of `seed` in place, keeping the controls (a failure is shown).
+    /// Starts the episode of `seed` in place (a failure is shown).
     fn restart(&mut self, seed: u64);
     /// Follows the next robot, if there are several.
     fn next_robot(&mut self) {}
-    /// Draws the whole screen.
-    fn draw(&self, frame: &mut Frame);
-
-    /// Whether the loop should be stepping.
-    fn running(&self) -> bool {
-        !self.controls().paused && !self.finished()
-    }
+    /// Draws the whole screen as `controls` set it.
+    fn draw(&self, frame: &mut Frame, controls: &Controls);
 }
 
 /// One robot's episode under its policy, for [`ViewApp`].
@@ -335,13 +326,7 @@ impl<'a> Lone<'a> {
 }
 
 impl Watched for Lone<'_> {
-    fn controls(&self) -> &Controls {
-        &self.state.controls
-    }
-
-    fn controls_mut(&mut self) -> &mut Controls {
-        &mut self.state.controls
-    }
+    const MODE: SceneMode = SceneMode::FirstPerson;
 
     fn finished(&self) -> bool {
         self.state.finished()
@@ -358,17 +343,13 @@ impl Watched for Lone<'_> {
     fn restart(&mut self, seed: u64) {
         let state = &mut self.state;
         match start_episode(self.evaluator, self.policy, seed) {
-            Ok(rollout) => {
-                let controls = state.controls;
-                *state = ViewState::new(rollout, &state.policy, controls.speed);
-                state.controls = controls;
-            }
+            Ok(rollout) => *state = ViewState::new(rollout, &state.policy),
             Err(why) => state.ending = Some(Ending::Failed(why)),
         }
     }
 
-    fn draw(&self, frame: &mut Frame) {
-        draw(frame, &self.state)
+    fn draw(&self, frame: &mut Frame, controls: &Controls) {
+        draw(frame, &self.state, controls)
     }
 }
 
@@ -376,29 +357,37 @@ impl Watched for Lone<'_> {
 pub struct ViewApp<W> {
     /// What is on screen.
     pub watched: W,
+    /// The view, pause and speed the keys set (kept across restarts).
+    pub controls: Controls,
     owed: f64,
     last_tick: Instant,
 }
 
 impl<W: Watched> ViewApp<W> {
-    /// The app over `watched`.
-    pub fn new(watched: W) -> Self {
+    /// The app over `watched`, running at `speed` steps a second in the view it starts in.
+    pub fn new(watched: W, speed: u32) -> Self {
         Self {
             watched,
+            controls: Controls::new(W::MODE, speed),
             owed: 0.0,
             last_tick: Instant::now(),
         }
+    }
+
+    /// Whether the loop should be stepping.
+    fn running(&self) -> bool {
+        !self.controls.paused && !self.watched.finished()
     }
 }
 
 impl<W: Watched> App for ViewApp<W> {
     fn draw(&self, frame: &mut Frame) {
-        self.watched.draw(frame)
+        self.watched.draw(frame, &self.controls)
     }
 
     fn wait(&self) -> Duration {
-        if self.watched.running() {
-            let speed = f64::from(self.watched.controls().speed);
+        if self.running() {
+            let speed = f64::from(self.controls.speed);
             let next = ((1.0 - self.owed).max(0.0) / speed).min(POLL.as_secs_f64());
             Duration::from_secs_f64(next)
         } else {
@@ -408,7 +397,7 @@ impl<W: Watched> App for ViewApp<W> {
 
     fn key(&mut self, key: &KeyEvent) -> Result<Option<ExitCode>> {
         let w = &mut self.watched;
-        let next_seed = match w.controls_mut().handle_key(key) {
+        let next_seed = match self.controls.handle_key(key) {
             KeyAction::None => None,
             KeyAction::Quit => return Ok(Some(ExitCode::SUCCESS)),
             KeyAction::Interrupt => return Ok(Some(ExitCode::from(130))),
@@ -435,12 +424,12 @@ impl<W: Watched> App for ViewApp<W> {
     fn tick(&mut self) -> Result<bool> {
         let now = Instant::now();
         let mut changed = false;
-        if self.watched.running() {
+        if self.running() {
             // Never more than a quarter second of catching up after a slow frame.
-            let speed = f64::from(self.watched.controls().speed);
+            let speed = f64::from(self.controls.speed);
             self.owed =
                 (self.owed + (now - self.last_tick).as_secs_f64() * speed).min(speed / 4.0 + 1.0);
-            while self.owed >= 1.0 && self.watched.running() {
+            while self.owed >= 1.0 && self.running() {
                 self.watched.advance();
                 self.owed -= 1.0;
                 changed = true;
@@ -469,16 +458,25 @@ mod tests {
             Evaluator::new(ValidConfig::default(), ronap_core::sim::Scenes::MazePerSeed);
         let mut p = policy.make().unwrap();
         let rollout = start_episode(&evaluator, p.as_mut(), 7).unwrap();
-        let mut state = ViewState::new(rollout, policy.name(), 20);
+        let mut state = ViewState::new(rollout, policy.name());
         while !state.finished() && !stop(&state) {
             state.advance(p.as_mut());
         }
         state
     }
 
+    /// The controls `ronap view` starts with at 20 steps a second.
+    fn first_person() -> Controls {
+        Controls::new(SceneMode::FirstPerson, 20)
+    }
+
     fn render(state: &ViewState, w: u16, h: u16) -> Buffer {
+        render_as(state, &first_person(), w, h)
+    }
+
+    fn render_as(state: &ViewState, controls: &Controls, w: u16, h: u16) -> Buffer {
         let mut terminal = Terminal::new(TestBackend::new(w, h)).unwrap();
-        terminal.draw(|f| draw(f, state)).unwrap();
+        terminal.draw(|f| draw(f, state, controls)).unwrap();
         terminal.backend().buffer().clone()
     }
 
@@ -620,11 +618,12 @@ mod tests {
 
     #[test]
     fn m_shows_the_whole_scene_with_the_path_in_blue() {
-        let mut state = state_of(Builtin::Geodesic, |s| s.episode().steps() >= 60);
+        let state = state_of(Builtin::Geodesic, |s| s.episode().steps() >= 60);
         let m = KeyEvent::new(KeyCode::Char('m'), KeyModifiers::NONE);
-        assert_eq!(state.controls.handle_key(&m), KeyAction::None);
-        assert_eq!(state.controls.mode, SceneMode::WholeScene);
-        let buf = render(&state, 80, 24);
+        let mut controls = first_person();
+        assert_eq!(controls.handle_key(&m), KeyAction::None);
+        assert_eq!(controls.mode, SceneMode::WholeScene);
+        let buf = render_as(&state, &controls, 80, 24);
         let scene = inner(draw::layout(buf.area).scene);
         assert!(row(&buf, 0).contains("whole scene · seed 7"));
         assert!(dots(&buf, scene, draw::PATH).len() >= 5);
@@ -632,8 +631,8 @@ mod tests {
         assert!(!dots(&buf, scene, draw::GOAL).is_empty());
         assert!(dots(&buf, scene, draw::WALL).len() > 200);
         insta::assert_snapshot!("view_whole_scene_seed_7", TestBackendView(&buf));
-        state.controls.handle_key(&m);
-        assert_eq!(state.controls.mode, SceneMode::FirstPerson);
+        controls.handle_key(&m);
+        assert_eq!(controls.mode, SceneMode::FirstPerson);
     }
 
     #[test]
@@ -651,20 +650,21 @@ mod tests {
         );
         let mut p = Builtin::Geodesic.make().unwrap();
         let rollout = start_episode(&evaluator, p.as_mut(), 7).unwrap();
-        let mut state = ViewState::new(rollout, "geodesic", 20);
+        let mut state = ViewState::new(rollout, "geodesic");
         let buf = render(&state, 80, 24);
         let scene = inner(draw::layout(buf.area).scene);
         // 30 discs of radius 8 px: some dots in the first-person view are not needed, but the
         // legend says what the colour means.
         assert!((0..24).any(|y| row(&buf, y).contains("moving obstacle")));
         let m = KeyEvent::new(KeyCode::Char('m'), KeyModifiers::NONE);
-        state.controls.handle_key(&m);
-        let before = dots(&render(&state, 80, 24), scene, draw::MOVER);
+        let mut controls = first_person();
+        controls.handle_key(&m);
+        let before = dots(&render_as(&state, &controls, 80, 24), scene, draw::MOVER);
         assert!(before.len() >= 15, "{} moving-obstacle cells", before.len());
         for _ in 0..20 {
             state.advance(p.as_mut());
         }
-        let after = dots(&render(&state, 80, 24), scene, draw::MOVER);
+        let after = dots(&render_as(&state, &controls, 80, 24), scene, draw::MOVER);
         assert_ne!(before, after, "the obstacles moved");
     }
 
@@ -712,28 +712,29 @@ mod tests {
 
     #[test]
     fn keys_pause_change_speed_and_quit() {
-        let mut state = state_of(Builtin::Random, |s| s.episode().steps() >= 1);
+        let state = state_of(Builtin::Random, |s| s.episode().steps() >= 1);
         let key = |c| KeyEvent::new(KeyCode::Char(c), KeyModifiers::NONE);
-        state.controls.handle_key(&key(' '));
-        assert!(state.controls.paused && !state.finished());
-        assert!(row(&render(&state, 80, 24), 23).contains("paused"));
-        assert_eq!(state.controls.handle_key(&key('s')), KeyAction::Step);
-        state.controls.handle_key(&key(' '));
-        assert!(!state.controls.paused && !state.finished());
-        assert_eq!(state.controls.handle_key(&key('s')), KeyAction::None);
-        state.controls.handle_key(&key('+'));
-        assert_eq!(state.controls.speed, 50);
-        state.controls.handle_key(&key('-'));
-        state.controls.handle_key(&key('-'));
-        assert_eq!(state.controls.speed, 10);
+        let mut controls = first_person();
+        controls.handle_key(&key(' '));
+        assert!(controls.paused && !state.finished());
+        assert!(row(&render_as(&state, &controls, 80, 24), 23).contains("paused"));
+        assert_eq!(controls.handle_key(&key('s')), KeyAction::Step);
+        controls.handle_key(&key(' '));
+        assert!(!controls.paused && !state.finished());
+        assert_eq!(controls.handle_key(&key('s')), KeyAction::None);
+        controls.handle_key(&key('+'));
+        assert_eq!(controls.speed, 50);
+        controls.handle_key(&key('-'));
+        controls.handle_key(&key('-'));
+        assert_eq!(controls.speed, 10);
         for _ in 0..20 {
-            state.controls.handle_key(&key('-'));
+            controls.handle_key(&key('-'));
         }
-        assert_eq!(state.controls.speed, 1);
-        assert_eq!(state.controls.handle_key(&key('q')), KeyAction::Quit);
+        assert_eq!(controls.speed, 1);
+        assert_eq!(controls.handle_key(&key('q')), KeyAction::Quit);
         let ctrl_c = KeyEvent::new(KeyCode::Char('c'), KeyModifiers::CONTROL);
-        assert_eq!(state.controls.handle_key(&ctrl_c), KeyAction::Interrupt);
-        assert_eq!(state.controls.handle_key(&key('n')), KeyAction::Next);
+        assert_eq!(controls.handle_key(&ctrl_c), KeyAction::Interrupt);
+        assert_eq!(controls.handle_key(&key('n')), KeyAction::Next);
     }
 
     #[test]
