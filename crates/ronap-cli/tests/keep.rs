@@ -298,7 +298,7 @@ const CRASH_RUN: [&str; 7] = [
     "--policy",
     "geodesic",
     "--seeds",
-    "400",
+    "200",
     "--threads",
     "2",
 ];
@@ -318,7 +318,7 @@ fn finish_and_compare(out: &Path, full: &Path, what: &str) {
             } else {
                 assert_eq!(
                     bytes.iter().filter(|&&c| c == b'\n').count(),
-                    401,
+                    201,
                     "{what}: {file} half-written"
                 );
             }
