@@ -509,7 +509,11 @@ mod tests {
             let own = &record.robots[0];
             let own = format!(
                 "collisions walls {}, robots {}",
-                own.collisions, own.robot_collisions
+                own.collisions,
+                own.team
+                    .as_ref()
+                    .expect("a robot of a team")
+                    .robot_collisions
             );
             assert!(screen.contains(&own), "{screen}");
             for (key, what) in KEYS {

@@ -20,11 +20,11 @@ pub use metric::{
     kinds as metric_kinds, Column as MetricColumn, End as MetricEnd, Kind as MetricKind, Metric,
     MetricMean, Other as MetricOther, View as MetricView,
 };
-pub use record::{EpisodeRecord, Outcome, Recording, StepLog};
+pub use record::{EpisodeRecord, InTeam, Outcome, Recording, StepLog};
 pub use summary::{AmongRobots, Figures, MovingSummary, Summary, Tally};
 pub use team::{
-    Flow, RobotFigures, RobotLook, RobotRecord, TeamFigures, TeamPicture, TeamRecord,
-    TeamRunResult, TeamSummary, TeamTally,
+    Flow, RobotFigures, RobotLook, TeamFigures, TeamPicture, TeamRecord, TeamRunResult,
+    TeamSummary, TeamTally,
 };
 
 // For the layers above only.
@@ -310,6 +310,7 @@ impl Evaluator {
             metrics,
             step_log,
             world: Some(world),
+            team: None,
         }
     }
 

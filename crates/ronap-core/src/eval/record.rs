@@ -1,5 +1,6 @@
-//! What an evaluation keeps of each episode: how it ended, its figures, and on request its
-//! trajectory and steps.
+//! What an evaluation keeps of each robot's episode: how it ended, its figures, and on request its
+//! trajectory and steps; one record for a lone robot and for each robot of a team (which adds
+//! its place in the team).
 
 use crate::geometry::Point;
 use crate::sim::{Action, DynamicMetrics, Pose, Status, Track, World};
@@ -138,10 +139,11 @@ pub struct Recording {
     pub steps: bool,
 }
 
-/// One finished episode.
+/// One robot's finished episode: a lone robot's, or one robot's of a team episode (whose
+/// [`crate::eval::TeamRecord`] holds one per robot, each with its [`InTeam`]).
 #[derive(Clone, Debug)]
 pub struct EpisodeRecord {
-    /// The seed.
+    /// The seed (a team's robots share their episode's).
     pub seed: u64,
     /// How it ended.
     pub outcome: Outcome,
@@ -160,7 +162,8 @@ pub struct EpisodeRecord {
     pub spl: f64,
     /// Summed reward.
     pub total_reward: f64,
-    /// Wall time of the episode (setup, planning and stepping), seconds.
+    /// Wall time of the episode (setup, planning and stepping), seconds; a team's robots have
+    /// none of their own (their team's record has it).
     pub wall_time_s: f64,
     /// Start pose.
     pub start: Pose,
@@ -168,11 +171,12 @@ pub struct EpisodeRecord {
     pub goal: Point,
     /// Final pose.
     pub end: Pose,
-    /// Final laser readings, px.
+    /// Final laser readings, px (a team's robots': when the trajectory or steps are recorded).
     pub last_readings: Vec<f64>,
-    /// Poses from start to end, when recorded.
+    /// Poses from start to end (a team's robot: while it is in the scene), when recorded.
     pub trajectory: Vec<Pose>,
-    /// Each moving obstacle's body and centre at each pose of `trajectory`, when recorded.
+    /// Each moving obstacle's body and centre at each pose of `trajectory`, when recorded (a
+    /// team's are its picture's, [`crate::eval::TeamPicture::mover_tracks`]).
     pub mover_tracks: Vec<Track>,
     /// How the episode went among moving obstacles; `None` without any.
     pub dynamic: Option<DynamicMetrics>,
@@ -181,14 +185,46 @@ pub struct EpisodeRecord {
     pub metrics: Vec<Option<f64>>,
     /// Steps, when recorded.
     pub step_log: Vec<StepLog>,
-    /// The world the episode ran in; dropped by [`EpisodeRecord::strip`], since a per-seed world
-    /// holds its scene and grids.
+    /// The world the episode ran in (a lone robot's); dropped by [`EpisodeRecord::strip`], since
+    /// a per-seed world holds its scene and grids.
     pub world: Option<Arc<World>>,
+    /// Its place in its team, for a robot of a team episode; `None` for a lone robot.
+    pub team: Option<InTeam>,
+}
+
+/// What a robot's record holds as one of a team: which robot it is, and the figures a team's
+/// `robots.csv` gives beyond a lone robot's.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct InTeam {
+    /// Its index in the team.
+    pub robot: usize,
+    /// The policy that drove it.
+    pub policy: String,
+    /// The team step at which it reached its goal.
+    pub arrived_at: Option<u32>,
+    /// Steps another robot blocked.
+    pub robot_collisions: u32,
+    /// Goals it had (1, or a goal list's length).
+    pub goals: u32,
+    /// Goals it reached.
+    pub goals_reached: u32,
+    /// A goal list's tour lengths (the driven order's and the optimal one), px.
+    pub tour: Option<crate::run::TourLengths>,
+    /// The fewest steps its own task takes alone: its shortest path (through every goal of a
+    /// list, cut by the tolerance as `shortest_px` is) at its largest step, whatever the
+    /// outcome; `None` without a path.
+    pub lower_bound_steps: Option<u32>,
+    /// Steps it acted without moving (waiting, turning on the spot, blocked).
+    pub waiting_steps: u32,
 }
 
 impl EpisodeRecord {
-    /// Drops the recorded trajectory, steps and world (after they have been written out).
+    /// Drops the recorded trajectory, steps and world (after they have been written out), and a
+    /// team's robot's last readings (kept only for its picture and step log).
     pub fn strip(&mut self) {
+        if self.team.is_some() {
+            self.last_readings = Vec::new();
+        }
         self.trajectory = Vec::new();
         self.mover_tracks = Vec::new();
         self.step_log = Vec::new();

@@ -6,7 +6,8 @@ use crate::config::RobotConfig;
 use crate::eval::record::Before;
 use crate::eval::summary::{wilson95, AmongRobots};
 use crate::eval::{
-    stream_seeds, EvalOptions, Evaluator, Failure, Outcome, Recording, RunEnd, Runs, StepLog,
+    stream_seeds, EpisodeRecord, EvalOptions, Evaluator, Failure, InTeam, Outcome, Recording,
+    RunEnd, Runs, StepLog,
 };
 use crate::geometry::Point;
 use crate::plan::shortest_path_px;
@@ -17,88 +18,6 @@ use serde::{Deserialize, Serialize};
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::Instant;
-
-/// One robot of a finished team episode.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RobotRecord {
-    /// Its index in the team.
-    pub robot: usize,
-    /// The policy that drove it.
-    pub policy: String,
-    /// How its episode ended.
-    pub outcome: Outcome,
-    /// Why its policy gave up, for [`Outcome::Stuck`].
-    pub reason: Option<String>,
-    /// Steps it acted.
-    pub steps: u32,
-    /// The team step at which it reached its goal.
-    pub arrived_at: Option<u32>,
-    /// Steps a wall blocked.
-    pub collisions: u32,
-    /// Steps another robot blocked.
-    pub robot_collisions: u32,
-    /// How it went among moving obstacles, when there were some.
-    pub dynamic: Option<crate::sim::DynamicMetrics>,
-    /// Its value of each metric the configuration asks for beyond the standard ones, in the
-    /// order of [`crate::eval::metric::kinds`].
-    pub metrics: Vec<Option<f64>>,
-    /// Distance driven, px.
-    pub path_length_px: f64,
-    /// Goals it had (1, or a goal list's length).
-    pub goals: u32,
-    /// Goals it reached.
-    pub goals_reached: u32,
-    /// A goal list's tour lengths (the driven order's and the optimal one), px.
-    pub tour: Option<crate::run::TourLengths>,
-    /// Its shortest path from start to within epsilon of the goal (on success; through every
-    /// goal of a list, the optimal tour less the tolerance at each end of each leg), px.
-    pub shortest_px: Option<f64>,
-    /// SPL.
-    pub spl: f64,
-    /// The fewest steps its own task takes alone: its shortest path (through every goal of a
-    /// list, cut by the tolerance as `shortest_px` is) at its largest step, whatever the
-    /// outcome; `None` without a path.
-    pub lower_bound_steps: Option<u32>,
-    /// Steps it acted without moving (waiting, turning on the spot, blocked).
-    pub waiting_steps: u32,
-    /// Summed reward.
-    pub total_reward: f64,
-    /// Start pose.
-    pub start: Pose,
-    /// Final pose.
-    pub end: Pose,
-    /// Goal.
-    pub goal: Point,
-}
-
-impl RobotRecord {
-    /// The robot's episode as a lone robot's record (its figures; no trajectory), so the usual
-    /// [`crate::eval::Summary`] can sum up a team run's robots.
-    pub fn as_episode(&self, seed: u64) -> crate::eval::EpisodeRecord {
-        crate::eval::EpisodeRecord {
-            seed,
-            outcome: self.outcome,
-            reason: self.reason.clone(),
-            steps: self.steps,
-            collisions: self.collisions,
-            path_length_px: self.path_length_px,
-            shortest_px: self.shortest_px,
-            spl: self.spl,
-            total_reward: self.total_reward,
-            wall_time_s: 0.0,
-            start: self.start,
-            goal: self.goal,
-            end: self.end,
-            last_readings: Vec::new(),
-            trajectory: Vec::new(),
-            mover_tracks: Vec::new(),
-            dynamic: self.dynamic,
-            metrics: self.metrics.clone(),
-            step_log: Vec::new(),
-            world: None,
-        }
-    }
-}
 
 /// One finished team episode.
 #[derive(Clone, Debug)]
@@ -115,7 +34,7 @@ pub struct TeamRecord {
     /// Flow: each robot's arrival step, summed, when all arrived.
     pub sum_of_costs: Option<u64>,
     /// The makespan's lower bound: the longest of the robots' own lower bounds
-    /// ([`RobotRecord::lower_bound_steps`]), when each has one.
+    /// ([`InTeam::lower_bound_steps`]), when each has one.
     pub makespan_lower_bound: Option<u32>,
     /// The flow's lower bound: the robots' own lower bounds summed, when each has one.
     pub sum_of_costs_lower_bound: Option<u64>,
@@ -129,20 +48,19 @@ pub struct TeamRecord {
     pub robot_collisions: u32,
     /// Whether it ended in a deadlock.
     pub deadlock: bool,
-    /// Each robot's record.
-    pub robots: Vec<RobotRecord>,
+    /// Each robot's record (each with its [`InTeam`]), in robot order: its poses (while it is in
+    /// the scene) and last readings when the trajectory was recorded, the steps it acted when
+    /// steps were.
+    pub robots: Vec<EpisodeRecord>,
     /// Wall time, seconds.
     pub wall_time_s: f64,
-    /// Each robot's centre at every step from the start (while present), when recorded.
-    pub paths: Vec<Vec<Point>>,
-    /// Each robot's steps (the steps it acted), when recorded: a step log per robot.
-    pub step_logs: Vec<Vec<StepLog>>,
-    /// What the episode's picture needs beyond the paths, when they were recorded.
+    /// What the episode's picture needs beyond its robots' records, when their trajectories
+    /// were recorded.
     pub picture: Option<TeamPicture>,
 }
 
-/// What a team episode's picture needs beyond its robots' records and paths: the scene, each
-/// robot's body, laser and last scan, and the moving obstacles' tracks.
+/// What a team episode's picture needs beyond its robots' records: the scene, each robot's body
+/// and laser, and the moving obstacles' tracks.
 #[derive(Clone, Debug)]
 pub struct TeamPicture {
     /// The scene.
@@ -162,8 +80,6 @@ pub struct RobotLook {
     pub laser: Laser,
     /// Its goal tolerance, px.
     pub goal_tolerance_px: f64,
-    /// Its last laser readings, px.
-    pub last_readings: Vec<f64>,
 }
 
 impl TeamRecord {
@@ -625,13 +541,13 @@ impl Evaluator {
             g.watch_team(rollout.team());
         }
         let paths = recording.trajectory;
-        let mut tracks: Vec<Vec<Point>> = vec![Vec::new(); if paths { n } else { 0 }];
+        let mut tracks: Vec<Vec<Pose>> = vec![Vec::new(); if paths { n } else { 0 }];
         let mut step_logs: Vec<Vec<StepLog>> =
             vec![Vec::new(); if recording.steps { n } else { 0 }];
-        let note = |team: &crate::sim::Team, tracks: &mut Vec<Vec<Point>>| {
+        let note = |team: &crate::sim::Team, tracks: &mut Vec<Vec<Pose>>| {
             for (k, t) in tracks.iter_mut().enumerate() {
                 if team.present(k) {
-                    t.push(team.robot(k).pose().position());
+                    t.push(team.robot(k).pose());
                 }
             }
         };
@@ -680,6 +596,8 @@ impl Evaluator {
             watch(team);
         }
         let team = rollout.team();
+        let mut tracks = tracks.into_iter();
+        let mut step_logs = step_logs.into_iter();
         let mut robots = Vec::new();
         for (k, r) in team.robots().iter().enumerate() {
             let outcome = if rollout.infeasible().is_some() {
@@ -715,35 +633,74 @@ impl Evaluator {
                 arrived_at: team.arrived_at(k),
                 path_length_px: r.path_length_px(),
             };
-            robots.push(RobotRecord {
-                robot: k,
-                policy: names.get(k).cloned().unwrap_or_default(),
+            robots.push(EpisodeRecord {
+                seed,
                 outcome,
                 reason: rollout
                     .infeasible()
                     .or(rollout.gave_up(k))
                     .map(str::to_string),
                 steps: r.steps(),
-                arrived_at: team.arrived_at(k),
                 collisions: r.collisions(),
-                robot_collisions: r.robot_collisions(),
-                dynamic: r.dynamic_metrics(),
-                metrics: gauges.as_ref().map_or_else(Vec::new, |g| g.values(k, &end)),
-                goals: team.goals(k).len() as u32,
-                goals_reached: r.goals_reached(),
-                tour,
                 path_length_px: r.path_length_px(),
                 shortest_px,
                 spl,
-                lower_bound_steps,
-                waiting_steps: waiting[k],
                 total_reward: r.total_reward(),
+                wall_time_s: 0.0,
                 start: r.start(),
-                end: r.pose(),
                 goal: r.goal(),
+                end: r.pose(),
+                last_readings: if recording.trajectory || recording.steps {
+                    r.readings().to_vec()
+                } else {
+                    Vec::new()
+                },
+                trajectory: tracks.next().unwrap_or_default(),
+                mover_tracks: Vec::new(),
+                dynamic: r.dynamic_metrics(),
+                metrics: gauges.as_ref().map_or_else(Vec::new, |g| g.values(k, &end)),
+                step_log: step_logs.next().unwrap_or_default(),
+                world: None,
+                team: Some(InTeam {
+                    robot: k,
+                    policy: names.get(k).cloned().unwrap_or_default(),
+                    arrived_at: team.arrived_at(k),
+                    robot_collisions: r.robot_collisions(),
+                    goals: team.goals(k).len() as u32,
+                    goals_reached: r.goals_reached(),
+                    tour,
+                    lower_bound_steps,
+                    waiting_steps: waiting[k],
+                }),
             });
         }
+        let places: Vec<&InTeam> = robots.iter().filter_map(|r| r.team.as_ref()).collect();
         let all_arrived = robots.iter().all(|r| r.outcome == Outcome::Success);
+        let makespan = all_arrived.then(|| {
+            places
+                .iter()
+                .filter_map(|t| t.arrived_at)
+                .max()
+                .unwrap_or(0)
+        });
+        let sum_of_costs = all_arrived.then(|| {
+            places
+                .iter()
+                .filter_map(|t| t.arrived_at)
+                .map(u64::from)
+                .sum()
+        });
+        let makespan_lower_bound = places
+            .iter()
+            .map(|t| t.lower_bound_steps)
+            .collect::<Option<Vec<u32>>>()
+            .map(|b| b.into_iter().max().unwrap_or(0));
+        let sum_of_costs_lower_bound = places
+            .iter()
+            .map(|t| t.lower_bound_steps.map(u64::from))
+            .sum();
+        let waiting_steps = places.iter().map(|t| u64::from(t.waiting_steps)).sum();
+        let robot_collisions = places.iter().map(|t| t.robot_collisions).sum();
         let deadlock = team.deadlocked();
         let outcomes: Vec<Outcome> = robots.iter().map(|r| r.outcome).collect();
         let outcome = team_outcome(&outcomes);
@@ -751,33 +708,14 @@ impl Evaluator {
             seed,
             outcome,
             steps: team.steps(),
-            makespan: all_arrived.then(|| {
-                robots
-                    .iter()
-                    .filter_map(|r| r.arrived_at)
-                    .max()
-                    .unwrap_or(0)
-            }),
-            sum_of_costs: all_arrived.then(|| {
-                robots
-                    .iter()
-                    .filter_map(|r| r.arrived_at)
-                    .map(u64::from)
-                    .sum()
-            }),
-            makespan_lower_bound: robots
-                .iter()
-                .map(|r| r.lower_bound_steps)
-                .collect::<Option<Vec<u32>>>()
-                .map(|b| b.into_iter().max().unwrap_or(0)),
-            sum_of_costs_lower_bound: robots
-                .iter()
-                .map(|r| r.lower_bound_steps.map(u64::from))
-                .sum(),
-            waiting_steps: robots.iter().map(|r| u64::from(r.waiting_steps)).sum(),
+            makespan,
+            sum_of_costs,
+            makespan_lower_bound,
+            sum_of_costs_lower_bound,
+            waiting_steps,
             path_length_px: robots.iter().map(|r| r.path_length_px).sum(),
             collisions: robots.iter().map(|r| r.collisions).sum(),
-            robot_collisions: robots.iter().map(|r| r.robot_collisions).sum(),
+            robot_collisions,
             deadlock,
             robots,
             wall_time_s: clock.elapsed().as_secs_f64(),
@@ -790,13 +728,10 @@ impl Evaluator {
                         body: r.config().robot.clone(),
                         laser: r.laser().clone(),
                         goal_tolerance_px: r.config().episode.goal_tolerance_px,
-                        last_readings: r.readings().to_vec(),
                     })
                     .collect(),
                 mover_tracks,
             }),
-            paths: tracks,
-            step_logs,
         })
     }
 
@@ -832,8 +767,7 @@ impl Evaluator {
                 .run_team_episode(policy.as_mut(), &names, seed, options.recording_of(seed))
                 .map_err(Failure::Run)?;
             on_finish(&r);
-            r.paths = Vec::new();
-            r.step_logs = Vec::new();
+            r.robots.iter_mut().for_each(EpisodeRecord::strip);
             r.picture = None;
             Ok(r)
         };
@@ -898,7 +832,14 @@ mod tests {
                 .expect("runs")
                 .records
                 .into_iter()
-                .map(|r| (r.seed, r.outcome, r.steps, r.makespan, r.robots))
+                .map(|r| {
+                    let robots: Vec<_> = r
+                        .robots
+                        .iter()
+                        .map(|x| (x.outcome, x.steps, x.path_length_px, x.spl, x.team.clone()))
+                        .collect();
+                    (r.seed, r.outcome, r.steps, r.makespan, robots)
+                })
                 .collect::<Vec<_>>()
         };
         let one = run(1);
@@ -907,7 +848,8 @@ mod tests {
         for (_, outcome, _, makespan, robots) in &one {
             assert_eq!(robots.len(), 4);
             if *outcome == Outcome::Success {
-                assert_eq!(*makespan, robots.iter().filter_map(|x| x.arrived_at).max());
+                let arrived = robots.iter().filter_map(|x| x.4.as_ref()?.arrived_at);
+                assert_eq!(*makespan, arrived.max());
             }
         }
         // Four geodesic robots in a maze mostly all arrive.
@@ -920,9 +862,10 @@ mod tests {
             .expect("runs")
             .records;
         let summary = TeamSummary::new(&records, 1.0);
-        assert!(records
-            .iter()
-            .all(|r| r.robots.iter().all(|x| x.goals == 1 && x.tour.is_none())));
+        assert!(records.iter().all(|r| r.robots.iter().all(|x| {
+            let t = x.team.as_ref().expect("a robot of a team");
+            t.goals == 1 && t.tour.is_none()
+        })));
         assert!(summary.robot_success_rate > 0.5, "{summary:?}");
     }
 
@@ -1000,22 +943,23 @@ mod tests {
         let mut arrived = 0;
         for r in &records {
             for x in &r.robots {
-                let t = x.tour.expect("a goal list");
+                let place = x.team.as_ref().expect("a robot of a team");
+                let t = place.tour.expect("a goal list");
                 assert!(
                     t.optimal <= t.nearest + 1e-9 && t.optimal <= t.given + 1e-9,
                     "{t:?}"
                 );
                 assert_eq!(t.chosen_px(), t.optimal);
-                assert_eq!(x.goals, 4);
-                assert!(x.goals_reached <= 4);
+                assert_eq!(place.goals, 4);
+                assert!(place.goals_reached <= 4);
                 if x.outcome == Outcome::Success {
                     arrived += 1;
-                    assert_eq!(x.goals_reached, 4);
+                    assert_eq!(place.goals_reached, 4);
                     // Never shorter than the optimal tour (less the goals' tolerances).
                     let shortest = x.shortest_px.expect("success");
                     assert!(x.path_length_px >= shortest - 1e-6, "{x:?}");
                 } else {
-                    assert!(x.goals_reached < 4);
+                    assert!(place.goals_reached < 4);
                 }
             }
         }

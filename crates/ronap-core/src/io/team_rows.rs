@@ -2,7 +2,7 @@
 //! of each), their columns, and the writers of whole files.
 
 use crate::eval::metric::{self, Kind};
-use crate::eval::{Outcome, TeamRecord};
+use crate::eval::{EpisodeRecord, InTeam, Outcome, TeamRecord};
 use crate::io::run_dir::{joined, metric_cells, start_goal_cells, START_GOAL_COLUMNS};
 
 /// Columns of a team run's `episodes.csv` (one row per team episode).
@@ -79,40 +79,43 @@ pub fn robot_columns(kinds: &[Kind]) -> Vec<String> {
         .collect()
 }
 
-/// The `robots.csv` rows of `r`: one per robot, with the metrics of `kinds`.
+/// The `robots.csv` rows of `r`: one per robot ([`robot_row`]), with the metrics of `kinds`.
 pub fn robot_rows(r: &TeamRecord, kinds: &[Kind]) -> Vec<Vec<String>> {
-    r.robots
-        .iter()
-        .map(|x| {
-            let mut row = vec![
-                r.seed.to_string(),
-                x.robot.to_string(),
-                x.policy.clone(),
-                x.outcome.name().to_string(),
-                x.steps.to_string(),
-                x.arrived_at.map_or(String::new(), |a| a.to_string()),
-                x.collisions.to_string(),
-                x.robot_collisions.to_string(),
-                x.dynamic
-                    .map_or(String::new(), |d| d.collisions.to_string()),
-                x.goals.to_string(),
-                x.goals_reached.to_string(),
-                x.tour
-                    .map_or(String::new(), |t| format!("{:.3}", t.chosen_px())),
-                x.tour.map_or(String::new(), |t| format!("{:.3}", t.given)),
-                x.tour
-                    .map_or(String::new(), |t| format!("{:.3}", t.nearest)),
-                x.tour
-                    .map_or(String::new(), |t| format!("{:.3}", t.optimal)),
-                format!("{:.3}", x.path_length_px),
-                x.shortest_px.map_or(String::new(), |l| format!("{l:.3}")),
-                format!("{:.4}", x.spl),
-            ];
-            row.extend(start_goal_cells(x.start, x.goal, x.reason.as_deref()));
-            row.push(x.lower_bound_steps.map_or(String::new(), |b| b.to_string()));
-            row.push(x.waiting_steps.to_string());
-            row.extend(metric_cells(kinds, &x.metrics));
-            row
-        })
-        .collect()
+    r.robots.iter().map(|x| robot_row(x, kinds)).collect()
+}
+
+/// The `robots.csv` row of robot record `x`, with the metrics of `kinds` (every robot of a
+/// [`TeamRecord`] has its [`InTeam`]; a record without one would get the default's cells).
+fn robot_row(x: &EpisodeRecord, kinds: &[Kind]) -> Vec<String> {
+    let lone = InTeam::default();
+    let t = x.team.as_ref().unwrap_or(&lone);
+    let mut row = vec![
+        x.seed.to_string(),
+        t.robot.to_string(),
+        t.policy.clone(),
+        x.outcome.name().to_string(),
+        x.steps.to_string(),
+        t.arrived_at.map_or(String::new(), |a| a.to_string()),
+        x.collisions.to_string(),
+        t.robot_collisions.to_string(),
+        x.dynamic
+            .map_or(String::new(), |d| d.collisions.to_string()),
+        t.goals.to_string(),
+        t.goals_reached.to_string(),
+        t.tour
+            .map_or(String::new(), |t| format!("{:.3}", t.chosen_px())),
+        t.tour.map_or(String::new(), |t| format!("{:.3}", t.given)),
+        t.tour
+            .map_or(String::new(), |t| format!("{:.3}", t.nearest)),
+        t.tour
+            .map_or(String::new(), |t| format!("{:.3}", t.optimal)),
+        format!("{:.3}", x.path_length_px),
+        x.shortest_px.map_or(String::new(), |l| format!("{l:.3}")),
+        format!("{:.4}", x.spl),
+    ];
+    row.extend(start_goal_cells(x.start, x.goal, x.reason.as_deref()));
+    row.push(t.lower_bound_steps.map_or(String::new(), |b| b.to_string()));
+    row.push(t.waiting_steps.to_string());
+    row.extend(metric_cells(kinds, &x.metrics));
+    row
 }

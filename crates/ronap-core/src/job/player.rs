@@ -296,8 +296,8 @@ mod tests {
         let trace = team_record(&evaluator, &record, "geodesic").expect("replays");
         assert_eq!(trace.robots(), 3);
         assert_eq!(trace.frames(), record.steps as usize + 1);
-        for (k, log) in record.step_logs.iter().enumerate() {
-            for (f, s) in log.iter().enumerate() {
+        for (k, robot) in record.robots.iter().enumerate() {
+            for (f, s) in robot.step_log.iter().enumerate() {
                 let p = trace.position(k, f).expect("frame");
                 assert_eq!((p.x, p.y), (s.pose.x, s.pose.y), "robot {k} frame {f}");
             }

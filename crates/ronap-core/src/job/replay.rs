@@ -17,12 +17,13 @@ impl RobotLog {
     /// The logs of every robot of `record`, from the steps it recorded.
     pub(crate) fn of_record(record: &crate::eval::TeamRecord) -> Vec<RobotLog> {
         record
-            .step_logs
+            .robots
             .iter()
             .enumerate()
-            .map(|(robot, steps)| RobotLog {
+            .map(|(robot, r)| RobotLog {
                 robot,
-                steps: steps
+                steps: r
+                    .step_log
                     .iter()
                     .map(|s| LoggedStep {
                         seed: record.seed,
@@ -361,10 +362,10 @@ mod tests {
                 .iter()
                 .filter(|r| r.outcome == Outcome::Stuck)
                 .count();
-            for (k, log) in record.step_logs.iter().enumerate() {
+            for (k, robot) in record.robots.iter().enumerate() {
                 assert_eq!(
-                    log.len() as u32,
-                    record.robots[k].steps,
+                    robot.step_log.len() as u32,
+                    robot.steps,
                     "seed {seed} robot {k}"
                 );
             }

@@ -54,10 +54,6 @@ pub fn evaluate_team_into(
         evaluator: request.evaluator,
         factory,
         policy: &request.info.policy,
-        // Each robot's beam count, for its step log's columns.
-        beams: (0..config.team_size())
-            .map(|k| config.team_robot(k).laser.beams as usize)
-            .collect(),
     };
     let Ran {
         result: run,
@@ -100,7 +96,6 @@ pub fn evaluate_team_into(
 struct TeamEpisodes<'a> {
     evaluator: &'a Evaluator,
     factory: &'a dyn TeamPolicyFactory,
-    beams: Vec<usize>,
     /// The policy's name, for players' titles.
     policy: &'a str,
 }
@@ -124,7 +119,7 @@ impl Episodes<TeamRecord> for TeamEpisodes<'_> {
         player::write_if_asked(writer, r.seed, r.outcome, || {
             player::team_record(self.evaluator, r, self.policy)
         });
-        writer.team_episode(r, &self.beams);
+        writer.team_episode(r);
     }
 }
 
@@ -167,11 +162,7 @@ impl Tallies<TeamRecord> for Teams<'_> {
 
     fn add(&mut self, r: TeamRecord, write: &mut dyn FnMut(&[FileRows]) -> bool) -> bool {
         let t = TeamFigures::of(&r);
-        let lone: Vec<Figures> = r
-            .robots
-            .iter()
-            .map(|x| Figures::of(&x.as_episode(r.seed)))
-            .collect();
+        let lone: Vec<Figures> = r.robots.iter().map(Figures::of).collect();
         let rows = [
             vec![team_episode_row(&r)],
             vec![timing_row(r.seed, r.wall_time_s).to_vec()],

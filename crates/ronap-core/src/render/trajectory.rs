@@ -4,7 +4,7 @@
 //! its own colour.
 
 use crate::config::RobotConfig;
-use crate::eval::{EpisodeRecord, TeamRecord};
+use crate::eval::{EpisodeRecord, RobotLook, TeamRecord};
 use crate::geometry::Point;
 use crate::render::chart::policy_colour;
 use crate::render::{Canvas, GOAL, MOVER, PATH, START};
@@ -125,49 +125,61 @@ pub(crate) fn episode_image(
 pub fn trajectory_image(record: &EpisodeRecord, scale: f64) -> Option<RgbImage> {
     let world = record.world.as_ref()?;
     let config = world.config();
-    let path: Vec<_> = record.trajectory.iter().map(|p| p.position()).collect();
     let laser = Laser::new(&config.laser);
-    let robot = Drawn {
-        body: &config.robot,
-        start: record.start,
-        pose: record.end,
-        goal: record.goal,
+    let look = RobotLook {
+        body: config.robot.clone(),
+        laser,
         goal_tolerance_px: config.episode.goal_tolerance_px,
-        path: &path,
-        scan: (&laser, &record.last_readings),
-        present: true,
-        arrived: false,
-        colours: Drawn::colours(0, 1),
     };
     let tracks = Obstacles::Tracks(&record.mover_tracks);
-    Some(episode_image(world.scene(), &[robot], tracks, scale))
+    Some(finished_image(
+        world.scene(),
+        &[(record, &look)],
+        tracks,
+        scale,
+    ))
 }
 
 /// The picture of a team episode: robot `k` in the colour of
 /// [`crate::render::chart::policy_colour`]`(k)`, its start and goal faded; a team of one in the
-/// lone robot's colours, so its picture is the lone robot's. Needs the record's paths and picture
-/// (`None` once they are dropped).
+/// lone robot's colours, so its picture is the lone robot's. Needs the robots' trajectories and
+/// the record's picture (`None` once they are dropped).
 pub fn team_image(record: &TeamRecord, scale: f64) -> Option<RgbImage> {
     let picture = record.picture.as_ref()?;
-    let n = record.robots.len();
-    let robots: Vec<Drawn<'_>> = record
-        .robots
+    let robots: Vec<_> = record.robots.iter().zip(&picture.robots).collect();
+    let tracks = Obstacles::Tracks(&picture.mover_tracks);
+    Some(finished_image(&picture.scene, &robots, tracks, scale))
+}
+
+/// The picture of finished episodes' `robots` (each robot's record and how it looks) in `scene`:
+/// robot `k` of `n` in [`Drawn::colours`], each with its trajectory and last scan.
+fn finished_image(
+    scene: &Scene,
+    robots: &[(&EpisodeRecord, &RobotLook)],
+    obstacles: Obstacles<'_>,
+    scale: f64,
+) -> RgbImage {
+    let paths: Vec<Vec<Point>> = robots
         .iter()
-        .zip(&picture.robots)
+        .map(|(r, _)| r.trajectory.iter().map(|p| p.position()).collect())
+        .collect();
+    let n = robots.len();
+    let drawn: Vec<Drawn<'_>> = robots
+        .iter()
+        .zip(&paths)
         .enumerate()
-        .map(|(k, (r, look))| Drawn {
+        .map(|(k, ((r, look), path))| Drawn {
             body: &look.body,
             start: r.start,
             pose: r.end,
             goal: r.goal,
             goal_tolerance_px: look.goal_tolerance_px,
-            path: record.paths.get(k).map_or(&[][..], Vec::as_slice),
-            scan: (&look.laser, &look.last_readings),
+            path,
+            scan: (&look.laser, &r.last_readings),
             present: true,
             arrived: false,
             colours: Drawn::colours(k, n),
         })
         .collect();
-    let tracks = Obstacles::Tracks(&picture.mover_tracks);
-    Some(episode_image(&picture.scene, &robots, tracks, scale))
+    episode_image(scene, &drawn, obstacles, scale)
 }

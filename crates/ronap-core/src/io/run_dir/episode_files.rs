@@ -4,7 +4,7 @@
 use crate::eval::{EpisodeRecord, TeamRecord};
 use crate::io::atomic::{save_image, write_atomic, OutputError};
 use crate::io::fault::{self, Op};
-use crate::io::steplog::{write_step_log, write_steps};
+use crate::io::steplog::write_steps;
 use crate::render::trajectory_image;
 use std::path::Path;
 
@@ -35,13 +35,13 @@ pub(super) fn write_episode_files(
     Ok(())
 }
 
-/// Writes team episode `record`'s picture (when `picture`) and its robots' step logs (those it
-/// recorded).
+/// Writes team episode `record`'s picture (when `picture`) and its robots' step logs (when
+/// `steps`), a log per robot.
 pub(super) fn write_team_files(
     dir: &Path,
     record: &TeamRecord,
     picture: bool,
-    steps: Option<&[usize]>,
+    steps: bool,
 ) -> Result<(), OutputError> {
     if picture {
         if let Some(img) = crate::render::team_image(record, 1.0) {
@@ -53,15 +53,14 @@ pub(super) fn write_team_files(
             save_image(&path, &img)?;
         }
     }
-    let Some(beams) = steps else {
+    if !steps {
         return Ok(());
-    };
-    for (k, steps) in record.step_logs.iter().enumerate() {
+    }
+    for (k, robot) in record.robots.iter().enumerate() {
         let path = dir
             .join("steps")
             .join(format!("seed-{:06}-robot-{k}.csv", record.seed));
-        let beams = beams.get(k).copied().unwrap_or_default();
-        write_atomic(&path, |out| write_step_log(record.seed, beams, steps, out))?;
+        write_atomic(&path, |out| write_steps(robot, out))?;
     }
     Ok(())
 }

@@ -433,9 +433,9 @@ impl RunWriter {
     }
 
     /// Writes the per-episode files of team episode `record` (its picture; when the run writes
-    /// step logs, one per robot, `steps/seed-SEED-robot-K.csv`, robot `k`'s laser having
-    /// `beams[k]` beams); a failure is kept for the end, as [`RunWriter::episode`] does.
-    pub fn team_episode(&self, record: &TeamRecord, beams: &[usize]) {
+    /// step logs, one per robot, `steps/seed-SEED-robot-K.csv`); a failure is kept for the end,
+    /// as [`RunWriter::episode`] does.
+    pub fn team_episode(&self, record: &TeamRecord) {
         if let Err(e) = self.make_ready() {
             return self.note(e);
         }
@@ -443,8 +443,7 @@ impl RunWriter {
             .files
             .pictures
             .is_some_and(|p| p.wants_seed(record.seed, record.outcome, self.first_seed));
-        let steps = self.files.steps.then_some(beams);
-        if let Err(e) = write_team_files(&self.dir, record, picture, steps) {
+        if let Err(e) = write_team_files(&self.dir, record, picture, self.files.steps) {
             self.note(e);
         }
     }
