@@ -325,17 +325,17 @@ pub fn info<'py>(
     Ok(d)
 }
 
-/// `episode` drawn as `view` asks: "top" (the whole scene and `path`, `scale` pixels per px) or
-/// "first_person" (the paper's rotating view, `scale` pixels a side).
+/// `episode` drawn as `view` asks: "top" (the whole scene as `top(scale)` draws it, `scale`
+/// pixels per px) or "first_person" (the paper's rotating view, `scale` pixels a side).
 pub fn render<'py>(
     py: Python<'py>,
     episode: &ronap_core::Episode,
-    path: &[ronap_core::geometry::Point],
+    top: &dyn Fn(f64) -> image::RgbImage,
     view: &str,
     scale: f64,
 ) -> PyResult<Bound<'py, PyArray3<u8>>> {
     let img = match view {
-        "top" => ronap_core::render::top_down(episode, path, scale),
+        "top" => top(scale),
         "first_person" => ronap_core::render::first_person(episode, scale as u32),
         other => {
             return Err(crate::errors::ConfigError::new_err(format!(

@@ -1,15 +1,13 @@
-//! One environment: an episode at a time, stepped from Python.
+//! One environment: an episode at a time, stepped from Python; its robot is a team of one on the
+//! core `MultiEnv` shares ([`TeamEnv`]).
 
 use crate::conv::{self, Config};
-use crate::errors::{self, ActionError};
+use crate::errors::ActionError;
+use crate::team_env::TeamEnv;
 use numpy::{PyArray1, PyArray3};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use ronap_core::run::Shaper;
-use ronap_core::sim::Worlds;
-use ronap_core::{Episode, Point};
 
-/// One RoNAP environment.
 /// What `Env.step` returns: observation, reward, terminated, truncated and info.
 type Stepped<'py> = (
     Bound<'py, PyArray1<f32>>,
@@ -19,14 +17,10 @@ type Stepped<'py> = (
     Bound<'py, PyDict>,
 );
 
+/// One RoNAP environment.
 #[pyclass(module = "ronap._ronap")]
 pub struct Env {
-    worlds: Worlds,
-    episode: Option<Episode>,
-    /// The shaping of the episode's reward, under `reward.shaping`.
-    shaper: Option<Shaper>,
-    path: Vec<Point>,
-    continuous: bool,
+    core: TeamEnv,
 }
 
 #[pymethods]
@@ -41,13 +35,8 @@ impl Env {
         map_path: Option<&str>,
         continuous: bool,
     ) -> PyResult<Self> {
-        let (_, scenes, _) = conv::scenes(config.valid(), maze_seed, map_path)?;
         Ok(Self {
-            worlds: Worlds::new(config.valid().clone(), scenes),
-            episode: None,
-            shaper: None,
-            path: Vec::new(),
-            continuous,
+            core: TeamEnv::new(config.valid(), maze_seed, map_path, continuous)?,
         })
     }
 
@@ -57,15 +46,10 @@ impl Env {
         py: Python<'py>,
         seed: u64,
     ) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyDict>)> {
-        let world = self.worlds.world(seed);
-        let episode = world
-            .episode(seed)
-            .map_err(|e| errors::scene(format!("seed {seed}: {e}")))?;
-        self.shaper = Shaper::start(world, &episode);
-        self.path = vec![episode.pose().position()];
-        let obs = PyArray1::from_slice(py, episode.observation());
-        let info = conv::info(py, &episode, false)?;
-        self.episode = Some(episode);
+        let team = self.core.reset(py, seed)?;
+        let robot = team.robot(0);
+        let obs = PyArray1::from_slice(py, robot.observation());
+        let info = conv::info(py, robot, false)?;
         Ok((obs, info))
     }
 
@@ -74,31 +58,24 @@ impl Env {
     /// deg]` for a car-like one.
     #[getter]
     fn action_scale(&self) -> Vec<f64> {
-        self.worlds.config().robot.action_scale()
+        self.core.config().robot.action_scale()
     }
 
     /// Takes one step; returns (observation, reward, terminated, truncated, info).
     fn step<'py>(&mut self, py: Python<'py>, action: &Bound<'py, PyAny>) -> PyResult<Stepped<'py>> {
-        let robot = &self.worlds.config().robot;
-        let action = conv::action(action, self.continuous.then_some(robot))
+        let chosen = self
+            .core
+            .action(0, action)
             .map_err(|why| ActionError::new_err(format!("action {action}: {why}")))?;
-        let episode = self
-            .episode
-            .as_mut()
-            .ok_or_else(|| errors::RonapError::new_err("step() before reset()"))?;
-        let r = episode.step(action);
-        let (mut reward, collided, status) = (r.reward, r.collided, r.status);
-        if let Some(shaper) = self.shaper.as_mut() {
-            reward = shaper.step(episode, reward);
-        }
-        self.path.push(episode.pose().position());
-        let (terminated, truncated) = conv::ends(status);
+        let (team, rewards) = self.core.step(py, &[Some(chosen)])?;
+        let robot = team.robot(0);
+        let (terminated, truncated) = conv::ends(robot.status());
         Ok((
-            PyArray1::from_slice(py, episode.observation()),
-            reward,
+            PyArray1::from_slice(py, robot.observation()),
+            rewards[0],
             terminated,
             truncated,
-            conv::info(py, episode, collided)?,
+            conv::info(py, robot, team.collided(0))?,
         ))
     }
 
@@ -111,16 +88,14 @@ impl Env {
         view: &str,
         scale: f64,
     ) -> PyResult<Bound<'py, PyArray3<u8>>> {
-        let episode = self
-            .episode
-            .as_ref()
-            .ok_or_else(|| errors::RonapError::new_err("render() before reset()"))?;
-        conv::render(py, episode, &self.path, view, scale)
+        let team = self.core.team("render")?;
+        let top = |scale| self.core.top_view(team, scale);
+        conv::render(py, team.robot(0), &top, view, scale)
     }
 
     /// Length of the observation: beams + 1.
     #[getter]
     fn observation_size(&self) -> usize {
-        self.worlds.config().observation_size()
+        self.core.config().observation_size()
     }
 }

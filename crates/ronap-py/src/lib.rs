@@ -13,6 +13,7 @@ mod kwargs;
 mod mlp;
 mod multi_env;
 mod orca;
+mod team_env;
 mod vec_env;
 
 use conv::{Config, Scenario};

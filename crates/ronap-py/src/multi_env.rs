@@ -1,22 +1,19 @@
-//! Several robots in one episode, stepped from Python: the core's [`TeamRollout`] with actions
-//! (and messages) chosen outside. The PettingZoo class `ronap.MultiNavEnv` is built on it.
+//! Several robots in one episode, stepped from Python: the core's team rollout with actions
+//! (and messages) chosen outside, on the core `Env` shares ([`TeamEnv`]). The PettingZoo class `ronap.MultiNavEnv` is built on it.
 
 use crate::conv::{self, Config};
 use crate::errors::{self, ActionError};
+use crate::team_env::TeamEnv;
 use numpy::{PyArray1, PyArray3, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use ronap_core::run::{RobotStep, TeamBatch, TeamRollout};
+use ronap_core::run::{RobotStep, TeamBatch};
 use ronap_core::sim::{Action, Team, Worlds};
-use ronap_core::Point;
 
-/// Several robots in one scene, an episode at a time.
+/// Several robots in one scene, an episode at a time, on the core `Env` shares ([`TeamEnv`]).
 #[pyclass(module = "ronap._ronap")]
 pub struct MultiEnv {
-    worlds: Worlds,
-    rollout: Option<TeamRollout>,
-    paths: Vec<Vec<Point>>,
-    continuous: bool,
+    core: TeamEnv,
 }
 
 /// Robot `k`'s info dictionary: its episode's figures, plus what it received at the last step.
@@ -38,14 +35,6 @@ fn robot_info<'py>(py: Python<'py>, team: &Team, k: usize) -> PyResult<Bound<'py
     }
     d.set_item("inbox", inbox)?;
     Ok(d)
-}
-
-impl MultiEnv {
-    fn rollout(&self, what: &str) -> PyResult<&TeamRollout> {
-        self.rollout
-            .as_ref()
-            .ok_or_else(|| errors::RonapError::new_err(format!("{what}() before reset()")))
-    }
 }
 
 /// Each robot's observation and info.
@@ -98,39 +87,22 @@ impl MultiEnv {
         map_path: Option<&str>,
         continuous: bool,
     ) -> PyResult<Self> {
-        let valid = config.valid();
-        if valid.team_size() == 0 {
+        if config.valid().team_size() == 0 {
             return Err(errors::ConfigError::new_err(
                 "MultiNavEnv needs a team: a scenario with [[robots]] entries \
                  (or robots=[{\"count\": N}])",
             ));
         }
-        let (_, scenes, _) = conv::scenes(valid, maze_seed, map_path)?;
         Ok(Self {
-            worlds: Worlds::new(valid.clone(), scenes),
-            rollout: None,
-            paths: Vec::new(),
-            continuous,
+            core: TeamEnv::new(config.valid(), maze_seed, map_path, continuous)?,
         })
     }
 
     /// Starts the team episode of `seed` (the same as `ronap run` seed `seed`); returns
     /// (observations, infos), one per robot.
     fn reset<'py>(&mut self, py: Python<'py>, seed: u64) -> PyResult<Observed<'py>> {
-        let worlds = self.worlds.team(seed);
-        let config = self.worlds.config().clone();
-        let rollout = py
-            .allow_threads(|| TeamRollout::placed(&config, worlds, seed))
-            .map_err(|e| errors::run(&e))?;
-        let team = rollout.team();
-        self.paths = team
-            .robots()
-            .iter()
-            .map(|r| vec![r.pose().position()])
-            .collect();
-        let out = observe(py, team)?;
-        self.rollout = Some(rollout);
-        Ok(out)
+        let team = self.core.reset(py, seed)?;
+        observe(py, team)
     }
 
     /// One step of the team: `actions[k]` for robot `k` (None: it stands still, as robots
@@ -144,13 +116,7 @@ impl MultiEnv {
         actions: Vec<Option<Bound<'py, PyAny>>>,
         messages: Option<Messages<'py>>,
     ) -> PyResult<TeamStepped<'py>> {
-        let continuous = self.continuous;
-        let n = self.rollout("step")?.team().robots().len();
-        // Each robot's own, for continuous actions (its kinematics say what they hold).
-        let robots: Vec<_> = (0..n)
-            .filter(|_| continuous)
-            .map(|k| self.worlds.config().team_robot(k).robot.clone())
-            .collect();
+        let n = self.core.team("step")?.robots().len();
         if actions.len() != n {
             return Err(ActionError::new_err(format!(
                 "{} actions for {n} robots",
@@ -161,15 +127,11 @@ impl MultiEnv {
         for (k, a) in actions.iter().enumerate() {
             chosen.push(match a {
                 None => None,
-                Some(a) => Some(conv::action(a, robots.get(k)).map_err(|why| {
+                Some(a) => Some(self.core.action(k, a).map_err(|why| {
                     ActionError::new_err(format!("robot_{k}'s action {a}: {why}"))
                 })?),
             });
         }
-        let rollout = self
-            .rollout
-            .as_mut()
-            .ok_or_else(|| errors::RonapError::new_err("step() before reset()"))?;
         if let Some(messages) = &messages {
             if messages.len() != n {
                 return Err(ActionError::new_err(format!(
@@ -177,6 +139,7 @@ impl MultiEnv {
                     messages.len()
                 )));
             }
+            let rollout = self.core.rollout_mut("step")?;
             for (k, m) in messages.iter().enumerate() {
                 if let Some(m) = m {
                     let m = m.as_slice().map_err(|_| {
@@ -191,15 +154,7 @@ impl MultiEnv {
                 }
             }
         }
-        py.allow_threads(|| rollout.step(&chosen));
-        let team = rollout.team();
-        for (path, r) in self.paths.iter_mut().zip(team.robots()) {
-            let p = r.pose().position();
-            if path.last() != Some(&p) {
-                path.push(p);
-            }
-        }
-        let rewards = team.rewards().to_vec();
+        let (team, rewards) = self.core.step(py, &chosen)?;
         let terminated = team
             .robots()
             .iter()
@@ -222,20 +177,20 @@ impl MultiEnv {
                 "render scale = {scale}: must be between 0 and 16"
             )));
         }
-        let team = self.rollout("render")?.team();
-        conv::image(py, ronap_core::render::team_frame(team, &self.paths, scale))
+        let team = self.core.team("render")?;
+        conv::image(py, self.core.top_view(team, scale))
     }
 
     /// Robots in the team.
     #[getter]
     fn robots(&self) -> usize {
-        self.worlds.config().team_size()
+        self.core.robots()
     }
 
     /// Each robot's observation length (its beams + 1 + the neighbour slots).
     #[getter]
     fn observation_sizes(&self) -> Vec<usize> {
-        let config = self.worlds.config();
+        let config = self.core.config();
         (0..config.team_size())
             .map(|k| config.team_robot(k).observation_size())
             .collect()
@@ -245,7 +200,7 @@ impl MultiEnv {
     /// `Env.action_scale`).
     #[getter]
     fn action_scales(&self) -> Vec<Vec<f64>> {
-        let config = self.worlds.config();
+        let config = self.core.config();
         (0..config.team_size())
             .map(|k| config.team_robot(k).robot.action_scale())
             .collect()
@@ -254,20 +209,20 @@ impl MultiEnv {
     /// The floats of the neighbour slots at the end of each observation.
     #[getter]
     fn slots_size(&self) -> usize {
-        let team = &self.worlds.config().team;
+        let team = &self.core.config().team;
         team.neighbours as usize * team.slot_size()
     }
 
     /// Floats in a robot's message.
     #[getter]
     fn message_size(&self) -> usize {
-        self.worlds.config().team.message_size as usize
+        self.core.config().team.message_size as usize
     }
 
     /// Steps so far in this episode.
     #[getter]
     fn steps(&self) -> u32 {
-        self.rollout.as_ref().map_or(0, |r| r.team().steps())
+        self.core.team("steps").map_or(0, |t| t.steps())
     }
 }
 

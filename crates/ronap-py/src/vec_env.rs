@@ -363,7 +363,8 @@ impl VecEnv {
             .episode(i)
             .ok_or_else(|| errors::RonapError::new_err("render() before reset()"))?;
         let path = self.paths.as_ref().map_or(&[][..], |p| &p[i][..]);
-        conv::render(py, episode, path, view, scale)
+        let top = |scale| ronap_core::render::top_down(episode, path, scale);
+        conv::render(py, episode, &top, view, scale)
     }
 
     /// Number of environments.

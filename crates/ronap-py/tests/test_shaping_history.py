@@ -64,3 +64,61 @@ def test_geodesic_shaping_changes_the_reward_alike_in_nav_env_and_vec_env() -> N
         ronap.NavEnv(config={"reward": {"shaping": "geodesic", "shaping_gamma": 1.5}})
     with pytest.raises(ronap.ConfigError, match="shaping"):
         ronap.NavEnv(config={"reward": {"shaping": "straight"}})
+
+
+@pytest.mark.parametrize(
+    "config",
+    [
+        {"reward": {"shaping": "geodesic", "shaping_gamma": 0.97}},
+        {"moving": [{"count": 8, "shape": "disc", "radius_px": 6.0, "motion": "random_walk", "speed_px": 2.0}]},
+        {"episode": {"start": [150.0, 150.0, 0.0], "goal": [450.0, 350.0]}, "observation": {"history": 2}},
+    ],
+)
+def test_a_team_of_one_plays_the_lone_robots_episodes(config) -> None:
+    """NavEnv and MultiNavEnv share one core, on which a lone robot is a team of one; both
+    play what VecNavEnv's batch (the core's lone engine) plays, reward shaping included."""
+    # The team's one entry places its robot where `[episode]` placed the lone one.
+    episode = dict(config.get("episode", {}))
+    entry = {"count": 1, **{k: episode.pop(k) for k in ("start", "goal") if k in episode}}
+    team = ronap.MultiNavEnv(config={**config, "episode": episode, "robots": [entry]})
+    lone = ronap.NavEnv(config=config)
+    vec = ronap.VecNavEnv(1, config=config, autoreset_mode="disabled")
+    rng = np.random.default_rng(2)
+    for seed in (5, 6):
+        t_obs, _ = team.reset(seed=seed)
+        l_obs, _ = lone.reset(seed=seed)
+        v_obs, _ = vec.reset(seed=seed)
+        np.testing.assert_array_equal(t_obs["robot_0"], v_obs[0])
+        np.testing.assert_array_equal(l_obs, v_obs[0])
+        for _ in range(250):
+            a = int(rng.integers(3))
+            t_obs, t_r, t_term, t_trunc, _ = team.step({"robot_0": a})
+            l_obs, l_r, l_term, l_trunc, _ = lone.step(a)
+            v_obs, v_r, v_term, v_trunc, _ = vec.step(np.array([a]))
+            np.testing.assert_array_equal(t_obs["robot_0"], v_obs[0])
+            np.testing.assert_array_equal(l_obs, v_obs[0])
+            assert t_r["robot_0"] == pytest.approx(v_r[0], abs=1e-12)
+            assert l_r == pytest.approx(v_r[0], abs=1e-12)
+            assert (t_term["robot_0"], t_trunc["robot_0"]) == (l_term, l_trunc) == (v_term[0], v_trunc[0])
+            if l_term or l_trunc:
+                break
+
+
+def test_a_team_s_rewards_are_shaped_robot_by_robot() -> None:
+    shaped = ronap.MultiNavEnv(config={"robots": [{"count": 3}], "reward": {"shaping": "geodesic"}})
+    plain = ronap.MultiNavEnv(config={"robots": [{"count": 3}]})
+    shaped.reset(seed=1)
+    plain.reset(seed=1)
+    differ = 0
+    for _ in range(20):
+        actions = {a: 1 for a in shaped.agents}
+        _, r_shaped, *_ = shaped.step(actions)
+        _, r_plain, *_ = plain.step(actions)
+        assert r_shaped.keys() == r_plain.keys()
+        differ += sum(abs(r_shaped[a] - r_plain[a]) > 1e-9 for a in r_shaped)
+    assert differ > 0
+
+
+def test_a_team_refuses_the_lone_robots_fixed_start() -> None:
+    with pytest.raises(ronap.ConfigError, match=r"episode\.start.*robots\[i\]\.start"):
+        ronap.MultiNavEnv(config={"episode": {"start": [150.0, 150.0, 0.0]}, "robots": [{"count": 1}]})

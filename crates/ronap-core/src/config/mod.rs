@@ -225,6 +225,25 @@ impl ValidConfig {
         self.robots.iter().map(|r| r.count as usize).sum()
     }
 
+    /// This configuration as a team's: itself when it has `[[robots]]`, else its one robot as a
+    /// team of one (one `[[robots]]` entry, which takes over `[episode]`'s fixed start and goal
+    /// if any), whose episodes are the lone robot's, step for step (docs/model.md "Several
+    /// robots").
+    pub fn as_team(&self) -> ValidConfig {
+        let mut team = self.clone();
+        if team.team_size() > 0 {
+            return team;
+        }
+        for c in std::iter::once(&mut team.effective).chain(team.written.as_deref_mut()) {
+            c.robots = vec![TeamRobotConfig {
+                start: c.episode.start.take(),
+                goal: c.episode.goal.take(),
+                ..TeamRobotConfig::default()
+            }];
+        }
+        team
+    }
+
     /// The `[[robots]]` entry of team robot `k` (from 0, in entry order).
     pub fn team_entry(&self, k: usize) -> Option<&TeamRobotConfig> {
         let mut left = k;
@@ -399,6 +418,26 @@ impl SimConfig {
         let fixed = self.episode.start.is_some() || self.episode.goal.is_some();
         let robot_pattern = crowd::validate_crowds(&self.crowd, fixed, &self.robots)?;
         team::validate_robots(&self.robots)?;
+        // A team's robots are placed by their entries; `[episode]`'s would go unheeded.
+        if !self.robots.is_empty() {
+            let fixed = [
+                (
+                    "episode.start",
+                    self.episode.start.map(|s| format!("{s:?}")),
+                ),
+                ("episode.goal", self.episode.goal.map(|g| format!("{g:?}"))),
+            ];
+            for (field, value) in fixed {
+                if let Some(v) = value {
+                    check(
+                        false,
+                        field,
+                        v,
+                        "a team's robots are placed by their [[robots]] entries: set robots[i].start and robots[i].goal instead",
+                    )?;
+                }
+            }
+        }
         self.team.validate()?;
         self.metrics.validate()?;
         self.orca.validate()?;
@@ -452,6 +491,34 @@ impl SimConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_team_is_placed_by_its_entries_and_a_lone_robot_is_its_team_of_one() {
+        for (line, field) in [
+            ("start = [150.0, 150.0, 0.0]", "episode.start"),
+            ("goal = [450.0, 350.0]", "episode.goal"),
+        ] {
+            let text = format!("[episode]\n{line}\n[[robots]]\ncount = 1\n");
+            let e = SimConfig::from_toml_str(&text)
+                .and_then(SimConfig::validate)
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(field) && e.contains("robots[i].start"), "{e}");
+        }
+        let mut lone = SimConfig::default();
+        lone.episode.start = Some([150.0, 150.0, 0.0]);
+        lone.episode.goal = Some([450.0, 350.0]);
+        let lone = lone.validate().expect("valid");
+        let one = lone.as_team();
+        assert_eq!(one.team_size(), 1);
+        assert_eq!((one.episode.start, one.episode.goal), (None, None));
+        let robot = one.team_robot(0);
+        assert_eq!(
+            (robot.episode.start, robot.episode.goal),
+            (lone.episode.start, lone.episode.goal)
+        );
+        assert_eq!(one.as_team(), one);
+    }
 
     #[test]
     fn defaults_are_the_spec_values_and_valid() {

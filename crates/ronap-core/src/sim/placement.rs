@@ -2,7 +2,7 @@
 //! placement stream (or fixed by the configuration), with clearance for the robot and in one
 //! connected free region.
 
-use crate::config::{RobotPattern, ValidConfig};
+use crate::config::{Pattern, RobotPattern, ValidConfig};
 use crate::geometry::{Point, Vector};
 use crate::scene::{FreeGrid, Scene};
 use crate::sim::rng::{stream, Rng, Stream};
@@ -108,6 +108,17 @@ fn section(entry: Option<usize>) -> String {
 }
 
 impl EpisodeError {
+    /// This error blamed on the crowd pattern that places `config`'s robot in `scene`, when one
+    /// does ([`EpisodeError::of_pattern`]); else as it is.
+    pub(crate) fn of_config(self, config: &ValidConfig, scene: &Scene) -> Self {
+        match config.robot_pattern() {
+            Some(p) if p.pattern != Pattern::Random => {
+                self.of_pattern(p, scene.width(), scene.height())
+            }
+            _ => self,
+        }
+    }
+
     /// This error with a start or goal that is not free blamed on the crowd pattern that put
     /// it there (`pattern`), in a scene of `width` x `height` px.
     pub(crate) fn of_pattern(self, pattern: &RobotPattern, width: f64, height: f64) -> Self {

@@ -2,7 +2,7 @@
 //! computed on first use and shared by placement, planners and path metrics; and [`Scenes`], which
 //! says where each seed's episode takes place.
 
-use crate::config::{ObstacleConfig, Pattern, SceneConfig, SceneKind, ValidConfig};
+use crate::config::{ObstacleConfig, SceneConfig, SceneKind, ValidConfig};
 use crate::geometry::{Aabb, Point, Shape};
 use crate::scene::map::{self, MapError, MapSource};
 use crate::scene::{FreeGrid, Maze, Scene, Warehouse};
@@ -112,12 +112,7 @@ impl World {
         let both_fixed = self.config.start_and_goal_fixed();
         let grid =
             (!both_fixed && needs_region_grid(&self.config, &self.scene)).then(|| self.grid());
-        let blame = |e: EpisodeError| match self.config.robot_pattern() {
-            Some(p) if p.pattern != Pattern::Random => {
-                e.of_pattern(p, self.scene.width(), self.scene.height())
-            }
-            _ => e,
-        };
+        let blame = |e: EpisodeError| e.of_config(&self.config, &self.scene);
         let placement = sample_placement(&self.config, &self.scene, grid, seed).map_err(blame)?;
         Episode::with_placement(&self.config, self.scene.clone(), seed, placement).map_err(blame)
     }

@@ -179,8 +179,9 @@ impl Team {
                         (start - s).norm() >= gap && (goal - g).norm() >= gap
                     })
                 };
-                // A fixed start or goal is the entry's, not `[episode]`'s: name it so.
-                let of_entry = |err: EpisodeError| err.of_entry(e);
+                // A start or goal a crowd's pattern puts down is the pattern's (a team of one's);
+                // a fixed one is the entry's, not `[episode]`'s: name them so.
+                let of_entry = |err: EpisodeError| err.of_config(cfg, scene).of_entry(e);
                 let placement = if k == 0 {
                     let mut first = stream(seed, Stream::Placement);
                     sample_placement_with(cfg, scene, grid, seed, &mut first, clear)
@@ -516,27 +517,38 @@ mod tests {
         }
     }
 
-    /// A lone robot's configuration and the same robot as a team of one (`[[robots]]` with one
-    /// robot of one entry), with `moving` obstacles, laser noise `sigma` and `history` frames
+    /// A lone robot's configuration and the same robot as a team of one
+    /// ([`ValidConfig::as_team`]: `[[robots]]` with one robot of one entry), with `moving` obstacles, laser noise `sigma` and `history` frames
     /// observed.
     fn lone_and_one(
         moving: Vec<crate::config::MovingConfig>,
         sigma: f64,
         history: u32,
     ) -> (ValidConfig, ValidConfig) {
+        lone_and_one_at(moving, sigma, history, None)
+    }
+
+    /// [`lone_and_one`] with `[episode]`'s start and goal fixed at `fixed`.
+    fn lone_and_one_at(
+        moving: Vec<crate::config::MovingConfig>,
+        sigma: f64,
+        history: u32,
+        fixed: Option<([f64; 3], [f64; 2])>,
+    ) -> (ValidConfig, ValidConfig) {
         let mut lone = crate::SimConfig {
             moving,
             ..Default::default()
         };
+        lone.episode.start = fixed.map(|f| f.0);
+        lone.episode.goal = fixed.map(|f| f.1);
         lone.laser.noise_sigma_px = sigma;
         lone.observation.history = history;
         lone.episode.max_steps = 400;
-        let mut one = lone.clone();
-        one.robots = vec![TeamRobotConfig::default()];
-        (
-            lone.validate().expect("valid"),
-            one.validate().expect("valid"),
-        )
+        let lone = lone.validate().expect("valid");
+        let one = lone.as_team();
+        assert_eq!(one.team_size(), 1);
+        assert_eq!(one.as_team(), one);
+        (lone, one)
     }
 
     #[test]
@@ -563,7 +575,20 @@ mod tests {
             // Frames and actions remembered, with and without the obstacles (whose steps the
             // team makes for its robots).
             lone_and_one(Vec::new(), 0.0, 3),
-            lone_and_one(vec![walkers, appearing], 0.0, 3),
+            lone_and_one(vec![walkers.clone(), appearing], 0.0, 3),
+            // Placed by `[episode]`, which the team of one's entry takes over.
+            lone_and_one_at(
+                Vec::new(),
+                0.0,
+                1,
+                Some(([150.0, 150.0, 0.0], [450.0, 150.0])),
+            ),
+            lone_and_one_at(
+                vec![walkers],
+                0.0,
+                1,
+                Some(([150.0, 150.0, 90.0], [450.0, 350.0])),
+            ),
         ];
         let mut steps = 0;
         for (case, (lone_config, one_config)) in cases.iter().enumerate() {

@@ -1,0 +1,134 @@
+//! The one core of `Env` and `MultiEnv`: a team episode stepped from Python, a lone robot's
+//! configuration being its team of one ([`ValidConfig::as_team`]), whose episodes are the lone
+//! robot's step for step. `Env` shows its one robot, `MultiEnv` every robot.
+
+use crate::conv;
+use crate::errors;
+use pyo3::prelude::*;
+use ronap_core::run::{Shaper, TeamRollout};
+use ronap_core::sim::{Action, Team, Worlds};
+use ronap_core::{Point, ValidConfig};
+
+/// A team's episodes, one at a time: the rollout, each robot's reward shaping (under
+/// `reward.shaping`) and its path so far (for pictures).
+pub(crate) struct TeamEnv {
+    worlds: Worlds,
+    rollout: Option<TeamRollout>,
+    /// Each robot's shaping of its reward, when the configuration asks for it.
+    shapers: Vec<Option<Shaper>>,
+    /// Each robot's centre at every step it moved, from its start.
+    paths: Vec<Vec<Point>>,
+    /// Whether actions are continuous commands.
+    pub(crate) continuous: bool,
+}
+
+impl TeamEnv {
+    /// The team of `config` (its one robot as a team of one when it has no `[[robots]]`);
+    /// `maze_seed` fixes one maze for every episode and `map_path` uses an image or ROS map.
+    pub(crate) fn new(
+        config: &ValidConfig,
+        maze_seed: Option<u64>,
+        map_path: Option<&str>,
+        continuous: bool,
+    ) -> PyResult<Self> {
+        let team = config.as_team();
+        let (_, scenes, _) = conv::scenes(&team, maze_seed, map_path)?;
+        Ok(Self {
+            worlds: Worlds::new(team, scenes),
+            rollout: None,
+            shapers: Vec::new(),
+            paths: Vec::new(),
+            continuous,
+        })
+    }
+
+    /// The team's configuration.
+    pub(crate) fn config(&self) -> &ValidConfig {
+        self.worlds.config()
+    }
+
+    /// Robots in the team.
+    pub(crate) fn robots(&self) -> usize {
+        self.config().team_size()
+    }
+
+    /// Starts the team episode of `seed` (the same as `ronap run` seed `seed`).
+    pub(crate) fn reset(&mut self, py: Python<'_>, seed: u64) -> PyResult<&Team> {
+        let worlds = self.worlds.team(seed);
+        let config = self.worlds.config();
+        let rollout = py
+            .allow_threads(|| TeamRollout::placed(config, worlds, seed))
+            .map_err(|e| errors::run(&e))?;
+        let team = rollout.team();
+        self.shapers = (0..team.robots().len())
+            .map(|k| Shaper::start(rollout.world(k).clone(), team.robot(k)))
+            .collect();
+        self.paths = team
+            .robots()
+            .iter()
+            .map(|r| vec![r.pose().position()])
+            .collect();
+        Ok(self.rollout.insert(rollout).team())
+    }
+
+    /// The episode under way: `what` (the call) raises before the first reset.
+    pub(crate) fn team(&self, what: &str) -> PyResult<&Team> {
+        self.rollout
+            .as_ref()
+            .map(TeamRollout::team)
+            .ok_or_else(|| errors::RonapError::new_err(format!("{what}() before reset()")))
+    }
+
+    /// The episode under way, to step: `what` raises before the first reset.
+    pub(crate) fn rollout_mut(&mut self, what: &str) -> PyResult<&mut TeamRollout> {
+        self.rollout
+            .as_mut()
+            .ok_or_else(|| errors::RonapError::new_err(format!("{what}() before reset()")))
+    }
+
+    /// Reads robot `k`'s action from Python (a continuous one by its own kinematics); the error
+    /// says what was expected.
+    pub(crate) fn action(&self, k: usize, value: &Bound<'_, PyAny>) -> Result<Action, String> {
+        let robot = self
+            .continuous
+            .then(|| self.config().team_robot(k).robot.clone());
+        conv::action(value, robot.as_ref())
+    }
+
+    /// One step of the team, `actions[k]` robot `k`'s (None: it stands still); each robot's
+    /// reward (shaped, for a robot that was running, when the configuration asks for it).
+    pub(crate) fn step(
+        &mut self,
+        py: Python<'_>,
+        actions: &[Option<Action>],
+    ) -> PyResult<(&Team, Vec<f64>)> {
+        let rollout = self
+            .rollout
+            .as_mut()
+            .ok_or_else(|| errors::RonapError::new_err("step() before reset()"))?;
+        let running: Vec<bool> = (0..actions.len())
+            .map(|k| rollout.team().running(k))
+            .collect();
+        py.allow_threads(|| rollout.step(actions));
+        let team = rollout.team();
+        let mut rewards = team.rewards().to_vec();
+        for (k, shaper) in self.shapers.iter_mut().enumerate() {
+            if let (Some(s), true) = (shaper, running.get(k) == Some(&true)) {
+                rewards[k] = s.step(team.robot(k), rewards[k]);
+            }
+        }
+        for (path, r) in self.paths.iter_mut().zip(team.robots()) {
+            let p = r.pose().position();
+            if path.last() != Some(&p) {
+                path.push(p);
+            }
+        }
+        Ok((team, rewards))
+    }
+
+    /// The whole scene of `team` (this environment's, as it stands): every robot with its goal,
+    /// start and path so far (a team of one as a lone robot is drawn), `scale` pixels per px.
+    pub(crate) fn top_view(&self, team: &Team, scale: f64) -> image::RgbImage {
+        ronap_core::render::team_frame(team, &self.paths, scale)
+    }
+}
