@@ -5,7 +5,7 @@
 use crate::conv;
 use crate::errors;
 use pyo3::prelude::*;
-use ronap_core::run::{Shaper, TeamRollout};
+use ronap_core::run::{TeamRollout, TeamShaper};
 use ronap_core::sim::{Action, Team, Worlds};
 use ronap_core::{Point, ValidConfig};
 
@@ -14,8 +14,8 @@ use ronap_core::{Point, ValidConfig};
 pub(crate) struct TeamEnv {
     worlds: Worlds,
     rollout: Option<TeamRollout>,
-    /// Each robot's shaping of its reward, when the configuration asks for it.
-    shapers: Vec<Option<Shaper>>,
+    /// Its robots' reward shaping, under `reward.shaping`.
+    shaping: TeamShaper,
     /// Each robot's centre at every step it moved, from its start.
     paths: Vec<Vec<Point>>,
     /// Whether actions are continuous commands.
@@ -36,7 +36,7 @@ impl TeamEnv {
         Ok(Self {
             worlds: Worlds::new(team, scenes),
             rollout: None,
-            shapers: Vec::new(),
+            shaping: TeamShaper::default(),
             paths: Vec::new(),
             continuous,
         })
@@ -60,9 +60,7 @@ impl TeamEnv {
             .allow_threads(|| TeamRollout::placed(config, worlds, seed))
             .map_err(|e| errors::run(&e))?;
         let team = rollout.team();
-        self.shapers = (0..team.robots().len())
-            .map(|k| Shaper::start(rollout.world(k).clone(), team.robot(k)))
-            .collect();
+        self.shaping = TeamShaper::start(&rollout);
         self.paths = team
             .robots()
             .iter()
@@ -112,9 +110,9 @@ impl TeamEnv {
         py.allow_threads(|| rollout.step(actions));
         let team = rollout.team();
         let mut rewards = team.rewards().to_vec();
-        for (k, shaper) in self.shapers.iter_mut().enumerate() {
-            if let (Some(s), true) = (shaper, running.get(k) == Some(&true)) {
-                rewards[k] = s.step(team.robot(k), rewards[k]);
+        for (k, reward) in rewards.iter_mut().enumerate() {
+            if running.get(k) == Some(&true) {
+                *reward = self.shaping.shaped(k, team.robot(k), *reward);
             }
         }
         for (path, r) in self.paths.iter_mut().zip(team.robots()) {

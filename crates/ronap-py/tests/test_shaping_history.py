@@ -104,18 +104,29 @@ def test_a_team_of_one_plays_the_lone_robots_episodes(config) -> None:
                 break
 
 
-def test_a_team_s_rewards_are_shaped_robot_by_robot() -> None:
-    shaped = ronap.MultiNavEnv(config={"robots": [{"count": 3}], "reward": {"shaping": "geodesic"}})
-    plain = ronap.MultiNavEnv(config={"robots": [{"count": 3}]})
+def test_a_team_s_rewards_are_shaped_robot_by_robot_alike_in_both_forms() -> None:
+    team = {"robots": [{"count": 3}]}
+    shaped = ronap.MultiNavEnv(config={**team, "reward": {"shaping": "geodesic"}})
+    plain = ronap.MultiNavEnv(config=team)
+    vec = ronap.VecMultiNavEnv(2, config={**team, "reward": {"shaping": "geodesic"}})
     shaped.reset(seed=1)
     plain.reset(seed=1)
+    vec.reset(seed=0)  # environment 1 plays seed 1
+    rng = np.random.default_rng(3)
     differ = 0
-    for _ in range(20):
-        actions = {a: 1 for a in shaped.agents}
+    for _ in range(40):
+        chosen = rng.integers(3, size=3)
+        actions = {a: int(chosen[k]) for k, a in enumerate(shaped.possible_agents) if a in shaped.agents}
         _, r_shaped, *_ = shaped.step(actions)
         _, r_plain, *_ = plain.step(actions)
+        _, r_vec, *_ = vec.step(np.stack([chosen, chosen]))
         assert r_shaped.keys() == r_plain.keys()
+        for k, a in enumerate(shaped.possible_agents):
+            if a in r_shaped:
+                assert r_vec[1, k] == pytest.approx(r_shaped[a], abs=1e-12)
         differ += sum(abs(r_shaped[a] - r_plain[a]) > 1e-9 for a in r_shaped)
+        if not shaped.agents:
+            break
     assert differ > 0
 
 

@@ -14,7 +14,7 @@ mod team_batch;
 
 pub use batch::{Autoreset, Batch, BatchOptions, EnvStep, SeedOrder};
 pub use rollout::{Rollout, Stepped};
-pub use shaping::Shaper;
+pub use shaping::{Shaper, TeamShaper};
 pub(crate) use team::robot_worlds;
 pub use team::{TeamRollout, TourLengths};
 pub use team_batch::{RobotStep, TeamBatch};

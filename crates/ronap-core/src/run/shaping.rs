@@ -13,6 +13,7 @@
 
 use crate::config::Shaping;
 use crate::plan::LazyField;
+use crate::run::TeamRollout;
 use crate::sim::{Episode, World};
 use std::sync::Arc;
 
@@ -81,6 +82,35 @@ impl Shaper {
             .distance_at(self.world.grid(), p)
             .unwrap_or_else(|| (episode.goal() - p).norm());
         -self.world.config().reward.progress_per_px * distance
+    }
+}
+
+/// The shaping of a team episode's robots: each one's reward shaped towards its own current goal
+/// ([`Shaper`]) while it runs; none when the configuration asks for no shaping.
+#[derive(Debug, Default)]
+pub struct TeamShaper {
+    robots: Vec<Option<Shaper>>,
+}
+
+impl TeamShaper {
+    /// The shaping of `rollout`'s robots, just placed.
+    pub fn start(rollout: &TeamRollout) -> Self {
+        let team = rollout.team();
+        Self {
+            robots: (0..team.robots().len())
+                .map(|k| Shaper::start(rollout.world(k).clone(), team.robot(k)))
+                .collect(),
+        }
+    }
+
+    /// Robot `k`'s reward for the step it just took in `episode` (its own episode in the team),
+    /// whose reward was `reward`: shaped, or as it was without shaping. Call it only for a robot
+    /// that was running before the step.
+    pub fn shaped(&mut self, k: usize, episode: &Episode, reward: f64) -> f64 {
+        match self.robots.get_mut(k) {
+            Some(Some(shaper)) => shaper.step(episode, reward),
+            _ => reward,
+        }
     }
 }
 

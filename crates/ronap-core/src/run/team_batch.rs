@@ -10,7 +10,7 @@
 
 use crate::config::ValidConfig;
 use crate::run::team::TeamRollout;
-use crate::run::RunError;
+use crate::run::{RunError, TeamShaper};
 use crate::sim::{Action, Status, Worlds};
 use rayon::prelude::*;
 
@@ -42,6 +42,8 @@ type Lane<'a> = ((&'a mut Env, &'a mut [f32]), &'a mut [RobotStep]);
 /// One environment: its team episode and where its next seed comes from.
 struct Env {
     rollout: Option<TeamRollout>,
+    /// Its robots' reward shaping, under `reward.shaping`.
+    shaping: TeamShaper,
     next_seed: u64,
     /// Whether the latest call was a reset of this environment.
     reset: bool,
@@ -83,6 +85,7 @@ impl TeamBatch {
             envs: (0..n)
                 .map(|_| Env {
                     rollout: None,
+                    shaping: TeamShaper::default(),
                     next_seed: 0,
                     reset: false,
                 })
@@ -147,6 +150,9 @@ impl TeamBatch {
             }
             rollout.step(&chosen);
             ctx.write(rollout, obs, out);
+            for (k, o) in out.iter_mut().enumerate().filter(|(_, o)| o.acted) {
+                o.reward = env.shaping.shaped(k, rollout.team().robot(k), o.reward);
+            }
             Ok(())
         })
     }
@@ -255,6 +261,7 @@ impl Ctx<'_> {
         env.next_seed = seed.wrapping_add(self.stride);
         env.reset = true;
         self.write(&rollout, obs, out);
+        env.shaping = TeamShaper::start(&rollout);
         for o in out.iter_mut() {
             o.reward = 0.0;
             o.acted = false;
