@@ -79,7 +79,7 @@ pub fn robot_columns(kinds: &[Kind]) -> Vec<String> {
         .collect()
 }
 
-/// The `robots.csv` rows of `r`: one per robot ([`robot_row`]), with the metrics of `kinds`.
+/// The `robots.csv` rows of `r`: one per robot, with the metrics of `kinds`.
 pub fn robot_rows(r: &TeamRecord, kinds: &[Kind]) -> Vec<Vec<String>> {
     r.robots.iter().map(|x| robot_row(x, kinds)).collect()
 }
