@@ -80,8 +80,9 @@ pub fn drive(config: ValidConfig, scenes: Scenes) {
                 // The figures every output file is written from.
                 let _ = ronap_core::eval::TeamFigures::of(&record);
                 for robot in &record.robots {
-                    let _ = robot.as_episode(seed);
+                    let _ = ronap_core::eval::Figures::of(robot);
                 }
+                let _ = ronap_core::io::robot_rows(&record, &[]);
             }
         } else {
             let mut p = policy(None);

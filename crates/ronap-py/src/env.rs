@@ -2,7 +2,7 @@
 //! core `MultiEnv` shares ([`TeamEnv`]).
 
 use crate::conv::{self, Config};
-use crate::errors::ActionError;
+use crate::errors::{self, ActionError};
 use crate::team_env::TeamEnv;
 use numpy::{PyArray1, PyArray3};
 use pyo3::prelude::*;
@@ -21,6 +21,9 @@ type Stepped<'py> = (
 #[pyclass(module = "ronap._ronap")]
 pub struct Env {
     core: TeamEnv,
+    /// Robots of the configuration's `[[robots]]` (0 for the one robot it drives; a team is
+    /// refused at reset, as `VecEnv` refuses it).
+    team: usize,
 }
 
 #[pymethods]
@@ -37,6 +40,7 @@ impl Env {
     ) -> PyResult<Self> {
         Ok(Self {
             core: TeamEnv::new(config.valid(), maze_seed, map_path, continuous)?,
+            team: config.valid().team_size(),
         })
     }
 
@@ -46,6 +50,10 @@ impl Env {
         py: Python<'py>,
         seed: u64,
     ) -> PyResult<(Bound<'py, PyArray1<f32>>, Bound<'py, PyDict>)> {
+        if self.team > 0 {
+            let e = ronap_core::sim::EpisodeError::Team { robots: self.team };
+            return Err(errors::scene(format!("seed {seed}: {e}")));
+        }
         let team = self.core.reset(py, seed)?;
         let robot = team.robot(0);
         let obs = PyArray1::from_slice(py, robot.observation());
@@ -67,15 +75,15 @@ impl Env {
             .core
             .action(0, action)
             .map_err(|why| ActionError::new_err(format!("action {action}: {why}")))?;
-        let (team, rewards) = self.core.step(py, &[Some(chosen)])?;
-        let robot = team.robot(0);
+        let s = self.core.step(py, &[Some(chosen)])?;
+        let robot = s.team.robot(0);
         let (terminated, truncated) = conv::ends(robot.status());
         Ok((
             PyArray1::from_slice(py, robot.observation()),
-            rewards[0],
+            s.rewards[0],
             terminated,
             truncated,
-            conv::info(py, robot, team.collided(0))?,
+            conv::info(py, robot, s.collided[0])?,
         ))
     }
 

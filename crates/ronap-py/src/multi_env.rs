@@ -154,7 +154,8 @@ impl MultiEnv {
                 }
             }
         }
-        let (team, rewards) = self.core.step(py, &chosen)?;
+        let stepped = self.core.step(py, &chosen)?;
+        let (team, rewards) = (stepped.team, stepped.rewards);
         let terminated = team
             .robots()
             .iter()

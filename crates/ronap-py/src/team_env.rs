@@ -5,9 +5,17 @@
 use crate::conv;
 use crate::errors;
 use pyo3::prelude::*;
+use ronap_core::config::RobotConfig;
 use ronap_core::run::{TeamRollout, TeamShaper};
 use ronap_core::sim::{Action, Team, Worlds};
 use ronap_core::{Point, ValidConfig};
+
+/// What a step gives: the team after it, and each robot's reward and whether it collided.
+pub(crate) struct Stepped<'a> {
+    pub(crate) team: &'a Team,
+    pub(crate) rewards: Vec<f64>,
+    pub(crate) collided: Vec<bool>,
+}
 
 /// A team's episodes, one at a time: the rollout, each robot's reward shaping (under
 /// `reward.shaping`) and its path so far (for pictures).
@@ -18,8 +26,9 @@ pub(crate) struct TeamEnv {
     shaping: TeamShaper,
     /// Each robot's centre at every step it moved, from its start.
     paths: Vec<Vec<Point>>,
-    /// Whether actions are continuous commands.
-    pub(crate) continuous: bool,
+    /// Each robot's body, when actions are continuous commands (its kinematics say what they
+    /// hold); empty for discrete actions.
+    continuous: Vec<RobotConfig>,
 }
 
 impl TeamEnv {
@@ -33,6 +42,10 @@ impl TeamEnv {
     ) -> PyResult<Self> {
         let team = config.as_team();
         let (_, scenes, _) = conv::scenes(&team, maze_seed, map_path)?;
+        let continuous = (0..team.team_size())
+            .filter(|_| continuous)
+            .map(|k| team.team_robot(k).robot.clone())
+            .collect();
         Ok(Self {
             worlds: Worlds::new(team, scenes),
             rollout: None,
@@ -87,32 +100,35 @@ impl TeamEnv {
     /// Reads robot `k`'s action from Python (a continuous one by its own kinematics); the error
     /// says what was expected.
     pub(crate) fn action(&self, k: usize, value: &Bound<'_, PyAny>) -> Result<Action, String> {
-        let robot = self
-            .continuous
-            .then(|| self.config().team_robot(k).robot.clone());
-        conv::action(value, robot.as_ref())
+        conv::action(value, self.continuous.get(k))
     }
 
-    /// One step of the team, `actions[k]` robot `k`'s (None: it stands still); each robot's
-    /// reward (shaped, for a robot that was running, when the configuration asks for it).
+    /// One step of the team, `actions[k]` robot `k`'s (None: it stands still). Gives each
+    /// robot's reward and whether it collided: for a robot that acted (it was running and had
+    /// an action), the step's, its reward shaped when the configuration asks for it; 0 and no
+    /// collision for any other.
     pub(crate) fn step(
         &mut self,
         py: Python<'_>,
         actions: &[Option<Action>],
-    ) -> PyResult<(&Team, Vec<f64>)> {
+    ) -> PyResult<Stepped<'_>> {
         let rollout = self
             .rollout
             .as_mut()
             .ok_or_else(|| errors::RonapError::new_err("step() before reset()"))?;
-        let running: Vec<bool> = (0..actions.len())
-            .map(|k| rollout.team().running(k))
+        let acted: Vec<bool> = actions
+            .iter()
+            .enumerate()
+            .map(|(k, a)| a.is_some() && rollout.team().running(k))
             .collect();
         py.allow_threads(|| rollout.step(actions));
         let team = rollout.team();
-        let mut rewards = team.rewards().to_vec();
-        for (k, reward) in rewards.iter_mut().enumerate() {
-            if running.get(k) == Some(&true) {
-                *reward = self.shaping.shaped(k, team.robot(k), *reward);
+        let mut rewards = vec![0.0; team.robots().len()];
+        let mut collided = vec![false; team.robots().len()];
+        for (k, &acted) in acted.iter().enumerate() {
+            if acted {
+                rewards[k] = self.shaping.shaped(k, team.robot(k), team.rewards()[k]);
+                collided[k] = team.collided(k);
             }
         }
         for (path, r) in self.paths.iter_mut().zip(team.robots()) {
@@ -121,7 +137,11 @@ impl TeamEnv {
                 path.push(p);
             }
         }
-        Ok((team, rewards))
+        Ok(Stepped {
+            team,
+            rewards,
+            collided,
+        })
     }
 
     /// The whole scene of `team` (this environment's, as it stands): every robot with its goal,

@@ -230,3 +230,23 @@ def test_make_vec_vector_entry_point_steps_in_rust():
     obs, _ = vec.reset(seed=3)
     direct = ronap.VecNavEnv(4, maze_cols=5)
     np.testing.assert_array_equal(obs, direct.reset(seed=3)[0])
+
+
+def test_nav_env_drives_one_robot_and_names_its_own_keys():
+    """NavEnv steps its robot as a team of one; what it refuses and reports stays the lone
+    robot's: a team scenario at reset, a blocked fixed start by `episode.start`, nothing after
+    the end."""
+    from pathlib import Path
+
+    team = Path(__file__).resolve().parents[3] / "scenarios" / "warehouse-team.toml"
+    with pytest.raises(ronap.SceneError, match=r"seed 0: the scenario has \d+ robots \(\[\[robots\]\]\)"):
+        ronap.NavEnv(scenario=team).reset(seed=0)
+    with pytest.raises(ronap.SceneError, match=r"episode\.start = \(0, 0\) is not free"):
+        ronap.NavEnv(episode_start=[0.0, 0.0, 0.0]).reset(seed=0)
+    env = ronap.NavEnv(episode_max_steps=5)
+    env.reset(seed=3)
+    for _ in range(5):
+        *_, terminated, truncated, info = env.step(1)
+    assert truncated and info["status"] == "timeout"
+    _, reward, terminated, truncated, info = env.step(1)
+    assert reward == 0.0 and not info["collided"] and truncated

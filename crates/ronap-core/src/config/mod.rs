@@ -226,20 +226,15 @@ impl ValidConfig {
     }
 
     /// This configuration as a team's: itself when it has `[[robots]]`, else its one robot as a
-    /// team of one (one `[[robots]]` entry, which takes over `[episode]`'s fixed start and goal
-    /// if any), whose episodes are the lone robot's, step for step (docs/model.md "Several
-    /// robots").
+    /// team of one (one `[[robots]]` entry that sets nothing; `[episode]`'s fixed start and goal,
+    /// if any, place it as they place the lone robot), whose episodes are the lone robot's, step
+    /// for step (docs/model.md "Several robots").
     pub fn as_team(&self) -> ValidConfig {
         let mut team = self.clone();
-        if team.team_size() > 0 {
-            return team;
-        }
-        for c in std::iter::once(&mut team.effective).chain(team.written.as_deref_mut()) {
-            c.robots = vec![TeamRobotConfig {
-                start: c.episode.start.take(),
-                goal: c.episode.goal.take(),
-                ..TeamRobotConfig::default()
-            }];
+        if team.team_size() == 0 {
+            for c in std::iter::once(&mut team.effective).chain(team.written.as_deref_mut()) {
+                c.robots = vec![TeamRobotConfig::default()];
+            }
         }
         team
     }
@@ -281,8 +276,9 @@ impl ValidConfig {
             if let Some(v) = e.laser_fov_deg {
                 c.laser.fov_deg = v;
             }
-            c.episode.start = e.start;
-            c.episode.goal = e.goal.or(e.goals.first().copied());
+            // `[episode]`'s are set only in a lone robot's team of one (`as_team`).
+            c.episode.start = e.start.or(c.episode.start);
+            c.episode.goal = e.goal.or(e.goals.first().copied()).or(c.episode.goal);
         }
         // Only a team of one follows a crowd's pattern (validated), as the lone robot does.
         ValidConfig {
@@ -511,7 +507,7 @@ mod tests {
         let lone = lone.validate().expect("valid");
         let one = lone.as_team();
         assert_eq!(one.team_size(), 1);
-        assert_eq!((one.episode.start, one.episode.goal), (None, None));
+        assert_eq!(one.team_entry(0), Some(&TeamRobotConfig::default()));
         let robot = one.team_robot(0);
         assert_eq!(
             (robot.episode.start, robot.episode.goal),

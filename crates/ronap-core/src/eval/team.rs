@@ -49,8 +49,8 @@ pub struct TeamRecord {
     /// Whether it ended in a deadlock.
     pub deadlock: bool,
     /// Each robot's record (each with its [`InTeam`]), in robot order: its poses (while it is in
-    /// the scene) and last readings when the trajectory was recorded, the steps it acted when
-    /// steps were.
+    /// the scene) when the trajectory was recorded, the steps it acted when steps were, and its
+    /// last readings when either was.
     pub robots: Vec<EpisodeRecord>,
     /// Wall time, seconds.
     pub wall_time_s: f64,
@@ -65,13 +65,13 @@ pub struct TeamRecord {
 pub struct TeamPicture {
     /// The scene.
     pub scene: Arc<crate::Scene>,
-    /// Each robot's body, laser, goal tolerance and last readings, in robot order.
+    /// Each robot's body, laser and goal tolerance, in robot order.
     pub robots: Vec<RobotLook>,
     /// Each moving obstacle's body and centre at every team step.
     pub mover_tracks: Vec<Track>,
 }
 
-/// A robot of a team as its episode's picture draws it.
+/// A robot as an episode's picture draws it (a team's robot, or the lone robot).
 #[derive(Clone, Debug)]
 pub struct RobotLook {
     /// Its body.
@@ -748,8 +748,9 @@ impl Evaluator {
     }
 
     /// Runs `options.seeds` as team episodes as [`Evaluator::stream`] runs lone ones: each record
-    /// to `on_finish` as it ends (any order), then without its paths to `sink` in seed order, with
-    /// flat memory; `sink` returning `false` or `cancel` stops the run after a prefix of seeds.
+    /// to `on_finish` as it ends (any order), then to `sink` in seed order without its picture
+    /// and with its robots' records stripped ([`EpisodeRecord::strip`]), with flat memory; `sink`
+    /// returning `false` or `cancel` stops the run after a prefix of seeds.
     pub fn stream_team(
         &self,
         factory: &dyn TeamPolicyFactory,

@@ -18,8 +18,8 @@ pub fn write_steps(record: &EpisodeRecord, out: &mut dyn Write) -> std::io::Resu
 }
 
 /// Writes `steps` of the episode of `seed`, taken by a robot whose laser has `beams` beams, in
-/// the data-log format of [`write_steps`] (a team's robots get a log each).
-pub fn write_step_log(
+/// the data-log format of [`write_steps`].
+fn write_step_log(
     seed: u64,
     beams: usize,
     steps: &[StepLog],

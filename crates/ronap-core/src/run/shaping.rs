@@ -86,7 +86,7 @@ impl Shaper {
 }
 
 /// The shaping of a team episode's robots: each one's reward shaped towards its own current goal
-/// ([`Shaper`]) while it runs; none when the configuration asks for no shaping.
+/// ([`Shaper`]) at each step it acts; none when the configuration asks for no shaping.
 #[derive(Debug, Default)]
 pub struct TeamShaper {
     robots: Vec<Option<Shaper>>,
@@ -105,7 +105,7 @@ impl TeamShaper {
 
     /// Robot `k`'s reward for the step it just took in `episode` (its own episode in the team),
     /// whose reward was `reward`: shaped, or as it was without shaping. Call it only for a robot
-    /// that was running before the step.
+    /// that acted in the step (it was running and had an action).
     pub fn shaped(&mut self, k: usize, episode: &Episode, reward: f64) -> f64 {
         match self.robots.get_mut(k) {
             Some(Some(shaper)) => shaper.step(episode, reward),

@@ -180,8 +180,18 @@ impl Team {
                     })
                 };
                 // A start or goal a crowd's pattern puts down is the pattern's (a team of one's);
-                // a fixed one is the entry's, not `[episode]`'s: name them so.
-                let of_entry = |err: EpisodeError| err.of_config(cfg, scene).of_entry(e);
+                // a fixed one is the entry's, or `[episode]`'s for a lone robot's team of one
+                // (an entry that fixes none): name them so.
+                let fixes =
+                    entry.start.is_some() || entry.goal.is_some() || !entry.goals.is_empty();
+                let of_entry = |err: EpisodeError| {
+                    let err = err.of_config(cfg, scene);
+                    if fixes {
+                        err.of_entry(e)
+                    } else {
+                        err
+                    }
+                };
                 let placement = if k == 0 {
                     let mut first = stream(seed, Stream::Placement);
                     sample_placement_with(cfg, scene, grid, seed, &mut first, clear)
@@ -576,7 +586,7 @@ mod tests {
             // team makes for its robots).
             lone_and_one(Vec::new(), 0.0, 3),
             lone_and_one(vec![walkers.clone(), appearing], 0.0, 3),
-            // Placed by `[episode]`, which the team of one's entry takes over.
+            // Placed by `[episode]`, as the team of one is.
             lone_and_one_at(
                 Vec::new(),
                 0.0,
