@@ -423,3 +423,45 @@ fn every_write_boundary_failing_resumes_to_the_same_bytes() {
         }
     }
 }
+
+#[test]
+fn what_a_killed_write_left_is_gone_once_the_run_finishes() {
+    // A process killed while writing a file leaves its temporary (`.ronap-*.partial`, renamed
+    // into place only when whole): the kill test above met one after finishing a run.
+    let dir = tempfile::tempdir().unwrap();
+    let left = ".ronap-k1ll3d.partial";
+    let whole = ["episodes.csv", "run.json", "summary.json", "timing.csv"];
+
+    // A directory holding nothing else is empty to a new run, which removes it.
+    let out = dir.path().join("new");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join(left), b"half a fi").unwrap();
+    ok(&run_into(
+        &["run", "--policy", "geodesic", "--seeds", "5"],
+        &out,
+    ));
+    assert_eq!(names(&out), whole);
+
+    // A run stopped short (a failed write) and resumed.
+    let out = dir.path().join("stopped");
+    let o = Command::new(BIN)
+        .args([
+            "run",
+            "--policy",
+            "geodesic",
+            "--seeds",
+            "50",
+            "--threads",
+            "1",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .env("RONAP_FAULT", "rename:2")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    std::fs::write(out.join(left), b"half a fi").unwrap();
+    let o = ronap(&["run", "--resume", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(names(&out), whole);
+}

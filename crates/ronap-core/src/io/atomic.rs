@@ -79,12 +79,43 @@ pub enum OutputError {
     },
 }
 
+/// The start and end of the name of every temporary file [`write_atomic`] makes beside its
+/// target (`.ronap-XXXXXX.partial`): renamed into place when whole, left behind only by a process
+/// killed while writing.
+const TEMP_PREFIX: &str = ".ronap-";
+const TEMP_SUFFIX: &str = ".partial";
+
+/// Whether `name` is one of [`write_atomic`]'s temporary files.
+pub(crate) fn is_temporary(name: &str) -> bool {
+    name.starts_with(TEMP_PREFIX) && name.ends_with(TEMP_SUFFIX)
+}
+
+/// Removes the temporary files that processes killed in [`write_atomic`] left in `dir` (never a
+/// whole file: a target is only ever written by the rename). For a run that holds `dir`'s lock.
+pub(crate) fn remove_temporaries(dir: &Path) -> Result<(), OutputError> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Ok(());
+    };
+    for entry in entries.flatten() {
+        if is_temporary(&entry.file_name().to_string_lossy()) {
+            let removed =
+                fault::check(Op::Remove).and_then(|()| std::fs::remove_file(entry.path()));
+            removed.map_err(|source| OutputError::Io {
+                path: entry.path(),
+                source,
+            })?;
+        }
+    }
+    Ok(())
+}
+
 /// Whether files can be written in `dir` the way [`write_atomic`] writes them (through a
 /// temporary file there), tried with an empty temporary file that is removed at once: for checks
 /// before a long job whose results would otherwise be lost at the end.
 pub fn check_writable(dir: &Path) -> Result<(), OutputError> {
     tempfile::Builder::new()
-        .prefix(".ronap-")
+        .prefix(TEMP_PREFIX)
+        .suffix(TEMP_SUFFIX)
         .tempfile_in(dir)
         .map(drop)
         .map_err(|source| OutputError::Io {
@@ -113,7 +144,7 @@ pub fn write_atomic(
         });
     }
     let mut builder = tempfile::Builder::new();
-    builder.prefix(".ronap-").suffix(".partial");
+    builder.prefix(TEMP_PREFIX).suffix(TEMP_SUFFIX);
     // Temporary files are private (0600); the finished output gets the usual 0644.
     #[cfg(unix)]
     builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o644));

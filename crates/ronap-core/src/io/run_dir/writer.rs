@@ -5,7 +5,7 @@ use super::episode_files::{remove_stale_files, write_episode_files, write_team_f
 use super::{Pictures, ResumeError, RunFiles, RunInfo, RUN_FILES};
 use crate::config::ValidConfig;
 use crate::eval::{EpisodeRecord, EvalOptions, Outcome, Recording, RunResult, Seeds, TeamRecord};
-use crate::io::atomic::{write_atomic, OutputError};
+use crate::io::atomic::{is_temporary, remove_temporaries, write_atomic, OutputError};
 use crate::io::fault::{self, Op};
 use crate::io::figures::FIGURES_FILE;
 use crate::io::lock::{RunLock, LOCK_FILE};
@@ -113,7 +113,8 @@ impl Holding {
         if dir.join(PLAN_FILE).exists() {
             return Self::StoppedShort(format!("its {PLAN_FILE} has no summary.json beside it"));
         }
-        // The lock, and the empty folders a run that failed at once made, are nothing.
+        // The lock, what a run killed while writing a file left, and the empty folders a run
+        // that failed at once made, are nothing.
         let empty_folder = |e: &std::fs::DirEntry| {
             ["png", "steps", "gif", "html"]
                 .iter()
@@ -121,7 +122,12 @@ impl Holding {
                 && std::fs::read_dir(e.path()).is_ok_and(|mut d| d.next().is_none())
         };
         let mut entries = std::fs::read_dir(dir).into_iter().flatten().flatten();
-        match entries.find(|e| e.file_name() != LOCK_FILE && !empty_folder(e)) {
+        let nothing = |e: &std::fs::DirEntry| {
+            e.file_name() == LOCK_FILE
+                || is_temporary(&e.file_name().to_string_lossy())
+                || empty_folder(e)
+        };
+        match entries.find(|e| !nothing(e)) {
             Some(e) => Self::Other(e.file_name().to_string_lossy().into_owned()),
             None => Self::Nothing,
         }
@@ -650,6 +656,10 @@ pub(crate) fn finish(
     // summary holds what they made (a run stopped by this removal failing resumes to the end).
     if complete {
         remove_if_there(&writer.dir.join(FIGURES_FILE))?;
+        // What a run killed while writing a file left (this run's own files are whole).
+        for sub in ["", "png", "steps", "gif", "html"] {
+            remove_temporaries(&writer.dir.join(sub))?;
+        }
     }
     match writer.episode_errors() {
         Some(e) => Err(e),
