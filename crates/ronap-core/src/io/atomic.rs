@@ -93,11 +93,20 @@ pub(crate) fn is_temporary(name: &str) -> bool {
 /// Removes the temporary files that processes killed in [`write_atomic`] left in `dir` (never a
 /// whole file: a target is only ever written by the rename). For a run that holds `dir`'s lock.
 pub(crate) fn remove_temporaries(dir: &Path) -> Result<(), OutputError> {
+    remove_files_in(dir, is_temporary)
+}
+
+/// Removes every file in `dir` whose name `matches` (none when `dir` cannot be read), each
+/// through the test hook's `remove` fault point.
+pub(crate) fn remove_files_in(
+    dir: &Path,
+    matches: impl Fn(&str) -> bool,
+) -> Result<(), OutputError> {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return Ok(());
     };
     for entry in entries.flatten() {
-        if is_temporary(&entry.file_name().to_string_lossy()) {
+        if matches(&entry.file_name().to_string_lossy()) {
             let removed =
                 fault::check(Op::Remove).and_then(|()| std::fs::remove_file(entry.path()));
             removed.map_err(|source| OutputError::Io {

@@ -2,8 +2,7 @@
 //! (`steps/`), and the removal of those an earlier run left.
 
 use crate::eval::{EpisodeRecord, TeamRecord};
-use crate::io::atomic::{save_image, write_atomic, OutputError};
-use crate::io::fault::{self, Op};
+use crate::io::atomic::{remove_files_in, save_image, write_atomic, OutputError};
 use crate::io::steplog::write_steps;
 use crate::render::trajectory_image;
 use std::path::Path;
@@ -76,21 +75,9 @@ pub(super) fn remove_stale_files(dir: &Path) -> Result<(), OutputError> {
         ("gif", ".gif"),
         ("html", ".html"),
     ] {
-        let Ok(entries) = std::fs::read_dir(dir.join(sub)) else {
-            continue;
-        };
-        for entry in entries.flatten() {
-            let name = entry.file_name();
-            let name = name.to_string_lossy();
-            if name.starts_with("seed-") && name.ends_with(ext) {
-                let removed =
-                    fault::check(Op::Remove).and_then(|()| std::fs::remove_file(entry.path()));
-                removed.map_err(|source| OutputError::Io {
-                    path: entry.path(),
-                    source,
-                })?;
-            }
-        }
+        remove_files_in(&dir.join(sub), |name| {
+            name.starts_with("seed-") && name.ends_with(ext)
+        })?;
     }
     Ok(())
 }
