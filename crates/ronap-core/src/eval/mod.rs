@@ -11,6 +11,7 @@
 pub(crate) mod metric;
 mod ordered;
 mod record;
+mod recorder;
 mod side_by_side;
 mod summary;
 mod team;
@@ -32,11 +33,11 @@ pub(crate) use summary::wilson95;
 pub(crate) use team::team_outcome;
 
 use crate::config::ValidConfig;
-use crate::plan::shortest_path_px;
 use crate::policy::{Policy, PolicyError, PolicyFactory};
-use crate::run::{Rollout, RunError};
-use crate::sim::{Action, Episode, Pose, Scenes, SeedRanges, Track, World, Worlds};
+use crate::run::RunError;
+use crate::sim::{Scenes, SeedRanges, World, Worlds};
 use ordered::{run_in_order, Ordered, Window};
+pub(crate) use recorder::Recorder;
 use side_by_side::SideBySide;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -231,89 +232,6 @@ impl Evaluator {
         self.worlds.world(seed)
     }
 
-    /// Runs the episode of `seed` with `policy`.
-    pub fn run_episode(
-        &self,
-        policy: &mut dyn Policy,
-        seed: u64,
-        recording: Recording,
-    ) -> Result<EpisodeRecord, RunError> {
-        let clock = Instant::now();
-        let mut rollout = Rollout::start(self.world(seed), seed, policy)?;
-        let mut recorder = Recorder::start(recording, clock, &rollout);
-        while let Some(action) = rollout.decide(policy)? {
-            recorder.take(&mut rollout, action);
-        }
-        Ok(self.record(rollout, recorder))
-    }
-
-    /// The record of a finished rollout.
-    pub(crate) fn record(&self, rollout: Rollout, recorder: Recorder) -> EpisodeRecord {
-        let Recorder {
-            clock,
-            trajectory,
-            step_log,
-            tracks,
-            gauges,
-            ..
-        } = recorder;
-        let (world, episode, reason) = rollout.into_parts();
-        let seed = episode.seed();
-        let outcome = Outcome::of(episode.status());
-        // The shortest path is only needed to score a success, and costs more than a random
-        // policy's whole episode, so failures are not charged for it.
-        let tolerance = self.config().episode.goal_tolerance_px;
-        let shortest_px = (outcome == Outcome::Success)
-            .then(|| shortest_path_px(&world, episode.start().position(), episode.goal()))
-            .flatten()
-            .map(|l| (l - tolerance).max(0.0));
-        let path_length_px = episode.path_length_px();
-        let spl = match shortest_px {
-            Some(l) if outcome == Outcome::Success => {
-                if path_length_px > 0.0 {
-                    l / l.max(path_length_px)
-                } else {
-                    1.0
-                }
-            }
-            _ => 0.0,
-        };
-        let metrics = gauges.map_or_else(Vec::new, |g| {
-            g.values(
-                0,
-                &metric::End {
-                    outcome,
-                    steps: episode.steps(),
-                    arrived_at: (outcome == Outcome::Success).then(|| episode.steps()),
-                    path_length_px,
-                },
-            )
-        });
-        EpisodeRecord {
-            seed,
-            outcome,
-            reason,
-            steps: episode.steps(),
-            collisions: episode.collisions(),
-            path_length_px,
-            shortest_px,
-            spl,
-            total_reward: episode.total_reward(),
-            wall_time_s: clock.elapsed().as_secs_f64(),
-            start: episode.start(),
-            goal: episode.goal(),
-            end: episode.pose(),
-            last_readings: episode.readings().to_vec(),
-            trajectory,
-            mover_tracks: tracks,
-            dynamic: episode.dynamic_metrics(),
-            metrics,
-            step_log,
-            world: Some(world),
-            team: None,
-        }
-    }
-
     /// Runs `options.seeds` with policies from `factory`, keeping every record (stripped of its
     /// trajectory and steps) in seed order: [`Evaluator::stream`] into a vector.
     pub fn run(
@@ -391,65 +309,6 @@ pub(crate) fn stream_seeds<S, R: Send>(
     let window = Window::for_threads(pool.current_num_threads());
     let ended = run_in_order(&pool, count, window, cancel, work, sink);
     RunEnd::of(ended, count, clock)
-}
-
-/// What an evaluation keeps of an episode as it runs: its clock, the trajectory, obstacle
-/// tracks and step log its [`Recording`] asks for, and the metrics its configuration asks for.
-pub(crate) struct Recorder {
-    clock: Instant,
-    recording: Recording,
-    trajectory: Vec<Pose>,
-    step_log: Vec<StepLog>,
-    tracks: Vec<Track>,
-    gauges: Option<metric::Gauges>,
-}
-
-impl Recorder {
-    /// Starts recording `rollout`'s episode (begun at `clock`) as `recording` asks.
-    pub(crate) fn start(recording: Recording, clock: Instant, rollout: &Rollout) -> Self {
-        let mut recorder = Self {
-            clock,
-            recording,
-            trajectory: Vec::new(),
-            step_log: Vec::new(),
-            tracks: Vec::new(),
-            gauges: metric::Gauges::start(rollout.episode().config(), 1),
-        };
-        if let Some(g) = &mut recorder.gauges {
-            g.watch_episode(rollout.episode());
-        }
-        if recording.trajectory {
-            recorder.trajectory.push(rollout.episode().pose());
-            recorder.track(rollout.episode());
-        }
-        recorder
-    }
-
-    fn track(&mut self, episode: &Episode) {
-        if let Some(movers) = episode.movers() {
-            movers.record(&mut self.tracks);
-        }
-    }
-
-    /// Takes `action` in `rollout`, keeping what the recording asks for.
-    pub(crate) fn take(&mut self, rollout: &mut Rollout, action: Action) {
-        let before = self
-            .recording
-            .steps
-            .then(|| record::Before::of(rollout.episode()));
-        let s = rollout.take(action);
-        if let Some(b) = before {
-            self.step_log
-                .push(b.logged(s.step, action, s.collided, s.reward));
-        }
-        if self.recording.trajectory {
-            self.trajectory.push(s.pose);
-            self.track(rollout.episode());
-        }
-        if let Some(g) = &mut self.gauges {
-            g.watch_episode(rollout.episode());
-        }
-    }
 }
 
 /// How a streamed evaluation ended; its records went to the sink.

@@ -8,7 +8,7 @@ use crate::eval::{
     worker_pool, EpisodeRecord, EvalOptions, Evaluator, Failure, Recorder, Recording, RunEnd,
 };
 use crate::policy::{Policy, PolicyError, PolicyFactory};
-use crate::run::{Rollout, RunError};
+use crate::run::{RunError, TeamRollout};
 use crate::sim::Episode;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
@@ -22,7 +22,8 @@ struct Live {
     /// Its place in the seeds.
     index: usize,
     lane: usize,
-    rollout: Rollout,
+    /// The episode, as its robot's team of one.
+    rollout: TeamRollout,
     recorder: Recorder,
 }
 
@@ -75,9 +76,17 @@ impl Evaluator {
                 let (index, seed) = (next, seeds[next]);
                 next += 1;
                 let clock = Instant::now();
-                match Rollout::start_lane(self.world(seed), seed, policy, lane) {
+                let started = TeamRollout::placed(self.config(), self.worlds().team(seed), seed)
+                    .and_then(|rollout| {
+                        policy
+                            .reset_lane(lane, rollout.world(0), rollout.team().robot(0))
+                            .map_err(|e| RunError::reset(seed, e))?;
+                        Ok(rollout)
+                    });
+                match started {
                     Ok(rollout) => {
-                        let recorder = Recorder::start(recording(seed), clock, &rollout);
+                        let recorder =
+                            Recorder::start(self.config(), recording(seed), clock, &rollout);
                         live.push(Live {
                             index,
                             lane,
@@ -98,7 +107,7 @@ impl Evaluator {
                     let l = live.remove(k);
                     free.push(l.lane);
                     if failed.as_ref().is_none_or(|(f, _)| l.index < *f) {
-                        finished(l.index, self.record(l.rollout, l.recorder));
+                        finished(l.index, l.recorder.lone(l.rollout));
                     }
                 } else {
                     k += 1;
@@ -111,8 +120,10 @@ impl Evaluator {
                 continue;
             }
             decisions.clear();
-            let asked: Vec<(usize, &Episode)> =
-                live.iter().map(|l| (l.lane, l.rollout.episode())).collect();
+            let asked: Vec<(usize, &Episode)> = live
+                .iter()
+                .map(|l| (l.lane, l.rollout.team().robot(0)))
+                .collect();
             let mut refused = policy.act_lanes(&asked, &mut decisions).err();
             // One decision per episode asked, up to the one whose decision failed: anything
             // else would hand actions to the wrong episodes (or ask again for ever).
@@ -140,8 +151,12 @@ impl Evaluator {
                     // Not asked (the policy stopped at an earlier episode's error): asked again.
                     continue;
                 };
-                match l.rollout.decided(decision) {
-                    Ok(Some(action)) => l.recorder.take(&mut l.rollout, action),
+                match decision.and_then(|d| l.rollout.decided(0, d)) {
+                    Ok(Some(action)) => {
+                        l.recorder.before(l.rollout.team());
+                        l.rollout.step(&[Some(action)]);
+                        l.recorder.after(&l.rollout);
+                    }
                     Ok(None) => {}
                     Err(e) => fail(&mut failed, l.index, e),
                 }

@@ -1,23 +1,13 @@
-//! Evaluating teams (docs/model.md "Several robots", metrics): per-robot records beside team figures
-//! (team success: every robot arrived; makespan; summed path length; robot collisions;
-//! deadlocks), and their summary.
+//! A team's records (docs/model.md "Several robots", metrics): per-robot records beside team
+//! figures (team success: every robot arrived; makespan; summed path length; robot collisions;
+//! deadlocks), and their summary. The episodes run in `recorder`.
 
 use crate::config::RobotConfig;
-use crate::eval::record::Before;
 use crate::eval::summary::{wilson95, AmongRobots};
-use crate::eval::{
-    stream_seeds, EpisodeRecord, EvalOptions, Evaluator, Failure, InTeam, Outcome, Recording,
-    RunEnd, Runs, StepLog,
-};
-use crate::geometry::Point;
-use crate::plan::shortest_path_px;
-use crate::policy::{PolicyError, TeamPolicy, TeamPolicyFactory};
-use crate::run::{RunError, TeamRollout};
-use crate::sim::{Laser, Pose, Track};
+use crate::eval::{EpisodeRecord, Outcome, Runs};
+use crate::sim::{Laser, Track};
 use serde::{Deserialize, Serialize};
-use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
-use std::time::Instant;
 
 /// One finished team episode.
 #[derive(Clone, Debug)]
@@ -507,275 +497,6 @@ impl TeamSummary {
 /// A team's evaluation.
 pub type TeamRunResult = Runs<TeamRecord>;
 
-impl Evaluator {
-    /// Runs the team episode of `seed` with `policy`, robot `k`'s policy named `names[k]`.
-    /// Keeps what `recording` asks for: every robot's path and the scene (for a picture), every
-    /// robot's steps (step logs).
-    pub fn run_team_episode(
-        &self,
-        policy: &mut dyn TeamPolicy,
-        names: &[String],
-        seed: u64,
-        recording: Recording,
-    ) -> Result<TeamRecord, RunError> {
-        self.watch_team_episode(policy, names, seed, recording, &mut |_| {})
-    }
-
-    /// [`Evaluator::run_team_episode`], showing `watch` the team at its start and after every
-    /// step (for an animation).
-    pub fn watch_team_episode(
-        &self,
-        policy: &mut dyn TeamPolicy,
-        names: &[String],
-        seed: u64,
-        recording: Recording,
-        watch: &mut dyn FnMut(&crate::sim::Team),
-    ) -> Result<TeamRecord, RunError> {
-        let clock = Instant::now();
-        let worlds = self.worlds().team(seed);
-        let mut rollout = TeamRollout::start(self.config(), worlds, seed, policy)?;
-        watch(rollout.team());
-        let n = rollout.team().robots().len();
-        let mut gauges = crate::eval::metric::Gauges::start(self.config(), n);
-        if let Some(g) = &mut gauges {
-            g.watch_team(rollout.team());
-        }
-        let paths = recording.trajectory;
-        let mut tracks: Vec<Vec<Pose>> = vec![Vec::new(); if paths { n } else { 0 }];
-        let mut step_logs: Vec<Vec<StepLog>> =
-            vec![Vec::new(); if recording.steps { n } else { 0 }];
-        let note = |team: &crate::sim::Team, tracks: &mut Vec<Vec<Pose>>| {
-            for (k, t) in tracks.iter_mut().enumerate() {
-                if team.present(k) {
-                    t.push(team.robot(k).pose());
-                }
-            }
-        };
-        note(rollout.team(), &mut tracks);
-        let mut mover_tracks = Vec::new();
-        let note_movers = |team: &crate::sim::Team, mover_tracks: &mut Vec<Track>| {
-            if let (true, Some(movers)) = (paths, team.movers()) {
-                movers.record(mover_tracks);
-            }
-        };
-        note_movers(rollout.team(), &mut mover_tracks);
-        let mut waiting = vec![0u32; n];
-        let mut at: Vec<Point> = Vec::with_capacity(n);
-        loop {
-            at.clear();
-            at.extend(rollout.team().robots().iter().map(|r| r.pose().position()));
-            // Each running robot's state before the step, for its step log.
-            let before: Vec<Option<Before>> = if recording.steps {
-                let team = rollout.team();
-                (0..n)
-                    .map(|k| team.running(k).then(|| Before::of(team.robot(k))))
-                    .collect()
-            } else {
-                Vec::new()
-            };
-            if !rollout.advance(policy)? {
-                break;
-            }
-            let team = rollout.team();
-            for (k, w) in waiting.iter_mut().enumerate() {
-                if rollout.last_actions()[k].is_some() && team.robot(k).pose().position() == at[k] {
-                    *w += 1;
-                }
-            }
-            for (k, b) in before.into_iter().enumerate() {
-                if let (Some(b), Some(action)) = (b, rollout.last_actions()[k]) {
-                    let step = team.robot(k).steps();
-                    step_logs[k].push(b.logged(step, action, team.collided(k), team.rewards()[k]));
-                }
-            }
-            note(team, &mut tracks);
-            note_movers(team, &mut mover_tracks);
-            if let Some(g) = &mut gauges {
-                g.watch_team(team);
-            }
-            watch(team);
-        }
-        let team = rollout.team();
-        let mut tracks = tracks.into_iter();
-        let mut step_logs = step_logs.into_iter();
-        let mut robots = Vec::new();
-        for (k, r) in team.robots().iter().enumerate() {
-            let outcome = if rollout.infeasible().is_some() {
-                Outcome::Infeasible
-            } else if team.retired(k) {
-                Outcome::Stuck
-            } else {
-                Outcome::of(r.status())
-            };
-            let tolerance = r.config().episode.goal_tolerance_px;
-            let tour = rollout.tour(k);
-            // Each goal counts as reached within the tolerance: a tour of n goals can be cut by
-            // up to the tolerance on arriving at each and on leaving each but the last.
-            let goals = team.goals(k).len().max(1) as f64;
-            // Its own task's length: on success for SPL, whatever the outcome for the bound.
-            let own_px = match tour {
-                Some(t) => Some(t.optimal).filter(|l| l.is_finite()),
-                None => shortest_path_px(rollout.world(k), r.start().position(), r.goal()),
-            }
-            .map(|l| (l - tolerance * (2.0 * goals - 1.0)).max(0.0));
-            let shortest_px = own_px.filter(|_| outcome == Outcome::Success);
-            let robot = &r.config().robot;
-            let step_px = robot.move_speed_px.max(robot.max_linear_speed_px);
-            let lower_bound_steps = own_px.map(|l| (l / step_px).ceil() as u32);
-            let spl = match shortest_px {
-                Some(l) if r.path_length_px() > 0.0 => l / l.max(r.path_length_px()),
-                Some(_) => 1.0,
-                None => 0.0,
-            };
-            let end = crate::eval::metric::End {
-                outcome,
-                steps: r.steps(),
-                arrived_at: team.arrived_at(k),
-                path_length_px: r.path_length_px(),
-            };
-            robots.push(EpisodeRecord {
-                seed,
-                outcome,
-                reason: rollout
-                    .infeasible()
-                    .or(rollout.gave_up(k))
-                    .map(str::to_string),
-                steps: r.steps(),
-                collisions: r.collisions(),
-                path_length_px: r.path_length_px(),
-                shortest_px,
-                spl,
-                total_reward: r.total_reward(),
-                wall_time_s: 0.0,
-                start: r.start(),
-                goal: r.goal(),
-                end: r.pose(),
-                last_readings: if recording.trajectory || recording.steps {
-                    r.readings().to_vec()
-                } else {
-                    Vec::new()
-                },
-                trajectory: tracks.next().unwrap_or_default(),
-                mover_tracks: Vec::new(),
-                dynamic: r.dynamic_metrics(),
-                metrics: gauges.as_ref().map_or_else(Vec::new, |g| g.values(k, &end)),
-                step_log: step_logs.next().unwrap_or_default(),
-                world: None,
-                team: Some(InTeam {
-                    robot: k,
-                    policy: names.get(k).cloned().unwrap_or_default(),
-                    arrived_at: team.arrived_at(k),
-                    robot_collisions: r.robot_collisions(),
-                    goals: team.goals(k).len() as u32,
-                    goals_reached: r.goals_reached(),
-                    tour,
-                    lower_bound_steps,
-                    waiting_steps: waiting[k],
-                }),
-            });
-        }
-        let places: Vec<&InTeam> = robots.iter().filter_map(|r| r.team.as_ref()).collect();
-        let all_arrived = robots.iter().all(|r| r.outcome == Outcome::Success);
-        let makespan = all_arrived.then(|| {
-            places
-                .iter()
-                .filter_map(|t| t.arrived_at)
-                .max()
-                .unwrap_or(0)
-        });
-        let sum_of_costs = all_arrived.then(|| {
-            places
-                .iter()
-                .filter_map(|t| t.arrived_at)
-                .map(u64::from)
-                .sum()
-        });
-        let makespan_lower_bound = places
-            .iter()
-            .map(|t| t.lower_bound_steps)
-            .collect::<Option<Vec<u32>>>()
-            .map(|b| b.into_iter().max().unwrap_or(0));
-        let sum_of_costs_lower_bound = places
-            .iter()
-            .map(|t| t.lower_bound_steps.map(u64::from))
-            .sum();
-        let waiting_steps = places.iter().map(|t| u64::from(t.waiting_steps)).sum();
-        let robot_collisions = places.iter().map(|t| t.robot_collisions).sum();
-        let deadlock = team.deadlocked();
-        let outcomes: Vec<Outcome> = robots.iter().map(|r| r.outcome).collect();
-        let outcome = team_outcome(&outcomes);
-        Ok(TeamRecord {
-            seed,
-            outcome,
-            steps: team.steps(),
-            makespan,
-            sum_of_costs,
-            makespan_lower_bound,
-            sum_of_costs_lower_bound,
-            waiting_steps,
-            path_length_px: robots.iter().map(|r| r.path_length_px).sum(),
-            collisions: robots.iter().map(|r| r.collisions).sum(),
-            robot_collisions,
-            deadlock,
-            robots,
-            wall_time_s: clock.elapsed().as_secs_f64(),
-            picture: paths.then(|| TeamPicture {
-                scene: team.robot(0).scene().clone(),
-                robots: team
-                    .robots()
-                    .iter()
-                    .map(|r| RobotLook {
-                        body: r.config().robot.clone(),
-                        laser: r.laser().clone(),
-                        goal_tolerance_px: r.config().episode.goal_tolerance_px,
-                    })
-                    .collect(),
-                mover_tracks,
-            }),
-        })
-    }
-
-    /// Runs `options.seeds` as team episodes, each driven by a team policy from `factory`,
-    /// keeping every record in seed order: [`Evaluator::stream_team`] into a vector.
-    pub fn run_team(
-        &self,
-        factory: &dyn TeamPolicyFactory,
-        options: &EvalOptions,
-        cancel: &AtomicBool,
-        on_record: &(dyn Fn(&TeamRecord) + Sync),
-    ) -> Result<TeamRunResult, PolicyError> {
-        Runs::collect(|sink| self.stream_team(factory, options, cancel, on_record, sink))
-    }
-
-    /// Runs `options.seeds` as team episodes as [`Evaluator::stream`] runs lone ones: each record
-    /// to `on_finish` as it ends (any order), then to `sink` in seed order without its picture
-    /// and with its robots' records stripped ([`EpisodeRecord::strip`]), with flat memory; `sink`
-    /// returning `false` or `cancel` stops the run after a prefix of seeds.
-    pub fn stream_team(
-        &self,
-        factory: &dyn TeamPolicyFactory,
-        options: &EvalOptions,
-        cancel: &AtomicBool,
-        on_finish: &(dyn Fn(&TeamRecord) + Sync),
-        sink: &mut dyn FnMut(TeamRecord) -> bool,
-    ) -> Result<RunEnd, PolicyError> {
-        let names = factory.names();
-        // A team's policy is made afresh for every episode.
-        let work = |_: &mut Option<()>, i: usize| {
-            let mut policy = factory.make().map_err(Failure::Policy)?;
-            let seed = options.seeds.get(i).unwrap_or_default();
-            let mut r = self
-                .run_team_episode(policy.as_mut(), &names, seed, options.recording_of(seed))
-                .map_err(Failure::Run)?;
-            on_finish(&r);
-            r.robots.iter_mut().for_each(EpisodeRecord::strip);
-            r.picture = None;
-            Ok(r)
-        };
-        stream_seeds(options, cancel, &work, sink)
-    }
-}
-
 /// A team's outcome from its robots' `outcomes`: success when every robot arrived, else the
 /// worst of theirs (infeasible, deadlock, time-out, collision, reward floor, stuck, in that order).
 pub(crate) fn team_outcome(outcomes: &[Outcome]) -> Outcome {
@@ -799,8 +520,10 @@ pub(crate) fn team_outcome(outcomes: &[Outcome]) -> Outcome {
 mod tests {
     use super::*;
     use crate::config::TeamRobotConfig;
+    use crate::eval::{EvalOptions, Evaluator};
     use crate::policy::{factory, PerRobotFactory};
     use crate::sim::Scenes;
+    use std::sync::atomic::AtomicBool;
 
     fn evaluator(count: u32) -> Evaluator {
         let config = crate::SimConfig {

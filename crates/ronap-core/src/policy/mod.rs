@@ -24,7 +24,8 @@ mod team;
 pub use batched::{BatchPolicy, Batched, Rows};
 pub use name::{factory, Builtin, PolicyNameError};
 pub use team::{
-    Joint, JointFactory, PerRobot, PerRobotFactory, RobotError, TeamPolicy, TeamPolicyFactory,
+    Alone, Joint, JointFactory, PerRobot, PerRobotFactory, RobotError, TeamPolicy,
+    TeamPolicyFactory,
 };
 // The team planner; its name and `drives` are aliased here, as the policy layer holds many names.
 pub use coordinated::{

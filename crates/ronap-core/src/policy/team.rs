@@ -118,6 +118,28 @@ impl TeamPolicy for PerRobot {
     }
 }
 
+/// A lone robot's policy as the team policy of its team of one (the evaluator runs a lone robot
+/// so): it decides from its robot's view of the team, which holds the moving obstacles
+/// ([`Policy::act_in_team`]), and hears and says nothing, as it would alone.
+pub struct Alone<'a>(pub &'a mut dyn Policy);
+
+impl TeamPolicy for Alone<'_> {
+    fn reset(&mut self, team: &Team, worlds: &[Arc<World>]) -> Result<(), RobotError> {
+        self.0.reset(&worlds[0], team.robot(0)).map_err(|e| (0, e))
+    }
+
+    fn act(&mut self, team: &Team, decisions: &mut [Option<Decision>]) -> Result<(), RobotError> {
+        if team.running(0) {
+            decisions[0] = Some(self.0.act_in_team(team, 0).map_err(|e| (0, e))?);
+        }
+        Ok(())
+    }
+
+    fn next_goal(&mut self, _: usize, world: &World, episode: &Episode) -> Result<(), PolicyError> {
+        self.0.reset(world, episode)
+    }
+}
+
 /// Makes [`PerRobot`] team policies: robot `k`'s policy from `factories[k]`, named `names[k]`.
 pub struct PerRobotFactory<'a> {
     factories: Vec<&'a dyn PolicyFactory>,

@@ -231,6 +231,59 @@ impl TeamRollout {
         &self.actions
     }
 
+    /// Robot `k`'s `decision` for the next step, checked: the action to take, or `None` when
+    /// the policy gave up (the robot is then out of the running, [`TeamRollout::gave_up`] says
+    /// why). An action that is not finite, or one the robot does not take, is an error.
+    /// [`TeamRollout::advance`] checks every decision so; a caller asking the policy itself
+    /// (episodes side by side) does, then [steps](TeamRollout::step).
+    pub fn decided(&mut self, k: usize, decision: Decision) -> Result<Option<Action>, RunError> {
+        match decision {
+            Decision::Act(action) if self.accepts(k, action) => Ok(Some(action)),
+            Decision::Act(action) => Err(self.invalid(action)),
+            Decision::GiveUp(why) => {
+                self.give_up(k, why);
+                Ok(None)
+            }
+        }
+    }
+
+    /// Whether robot `k` takes `action`: finite, and of its kinematics.
+    fn accepts(&self, k: usize, action: Action) -> bool {
+        let kind = self.team.robot(k).config().robot.kinematics;
+        action.is_finite() && crate::sim::accepts(kind, action)
+    }
+
+    /// The error of a policy deciding `action`, which its robot does not take.
+    #[cold]
+    fn invalid(&self, action: Action) -> RunError {
+        RunError::InvalidAction {
+            seed: self.seed(),
+            step: self.team.steps() + 1,
+            action,
+        }
+    }
+
+    /// Takes robot `k` out of the running, its policy having given up for `why`.
+    fn give_up(&mut self, k: usize, why: String) {
+        self.gave_up[k] = Some(why);
+        self.team.retire(k);
+    }
+
+    /// The error of the policy failing to decide the next step.
+    #[cold]
+    pub fn policy_error(&self, source: crate::policy::PolicyError) -> RunError {
+        RunError::Policy {
+            seed: self.seed(),
+            step: self.team.steps() + 1,
+            source,
+        }
+    }
+
+    /// The episode's seed.
+    pub fn seed(&self) -> u64 {
+        self.team.robot(0).seed()
+    }
+
     /// Whether every robot is done.
     pub fn finished(&self) -> bool {
         self.team.is_done()
@@ -243,8 +296,11 @@ impl TeamRollout {
             return Ok(false);
         }
         let n = self.team.robots().len();
+        if n == 1 && self.message_size == 0 {
+            return self.advance_alone(policy);
+        }
         let step = self.team.steps() + 1;
-        let seed = self.team.robot(0).seed();
+        let seed = self.seed();
         let mut decisions = std::mem::take(&mut self.decisions);
         decisions.clear();
         decisions.resize(n, None);
@@ -262,11 +318,10 @@ impl TeamRollout {
                 break;
             }
             match decision {
-                Some(Decision::Act(action)) if self.team.running(k) => {
-                    let kind = self.team.robot(k).config().robot.kinematics;
-                    if !action.is_finite() || !crate::sim::accepts(kind, action) {
-                        return Err(RunError::InvalidAction { seed, step, action });
-                    }
+                Some(decision) if self.team.running(k) => {
+                    let Some(action) = self.decided(k, decision)? else {
+                        continue;
+                    };
                     actions[k] = Some(action);
                     if !message.is_empty() {
                         message.fill(0.0);
@@ -274,20 +329,8 @@ impl TeamRollout {
                         self.team.set_message(k, &message);
                     }
                 }
-                Some(Decision::GiveUp(why)) if self.team.running(k) => {
-                    self.gave_up[k] = Some(why);
-                    self.team.retire(k);
-                }
                 // A running robot left without a decision would never step nor end.
-                None if self.team.running(k) => {
-                    return Err(RunError::Policy {
-                        seed,
-                        step,
-                        source: crate::policy::PolicyError::Failed(format!(
-                            "the team policy decided nothing for robot {k}, which is running"
-                        )),
-                    });
-                }
+                None if self.team.running(k) => return Err(self.undecided(k)),
                 _ => {}
             }
         }
@@ -317,6 +360,48 @@ impl TeamRollout {
         Ok(true)
     }
 
+    /// [`TeamRollout::advance`] for a team of one that sends no messages (a lone robot's), without
+    /// the buffers a team's step needs: the same step at a lone robot's speed.
+    fn advance_alone(&mut self, policy: &mut dyn TeamPolicy) -> Result<bool, RunError> {
+        let mut decisions = [None];
+        if let Err((_, source)) = policy.act(&self.team, &mut decisions) {
+            return Err(self.policy_error(source));
+        }
+        let action = match decisions[0].take() {
+            Some(Decision::Act(action)) if self.accepts(0, action) => action,
+            Some(Decision::Act(action)) => return Err(self.invalid(action)),
+            Some(Decision::GiveUp(why)) => {
+                self.give_up(0, why);
+                return Ok(false);
+            }
+            None => return Err(self.undecided(0)),
+        };
+        let reached = self.team.robot(0).goals_reached();
+        self.team.step(&[Some(action)]);
+        self.actions.clear();
+        self.actions.push(Some(action));
+        let r = self.team.robot(0);
+        if self.team.running(0) && r.goals_reached() > reached {
+            policy
+                .next_goal(0, &self.worlds[0], r)
+                .map_err(|source| RunError::Policy {
+                    seed: self.seed(),
+                    step: self.team.steps(),
+                    source,
+                })?;
+        }
+        Ok(true)
+    }
+
+    /// The error of the team policy leaving running robot `k` without a decision, which would
+    /// never step nor end.
+    #[cold]
+    fn undecided(&self, k: usize) -> RunError {
+        self.policy_error(crate::policy::PolicyError::Failed(format!(
+            "the team policy decided nothing for robot {k}, which is running"
+        )))
+    }
+
     /// The team, and each robot's reason for giving up.
     pub fn into_parts(self) -> (Team, Vec<Arc<World>>, Vec<Option<String>>) {
         (self.team, self.worlds, self.gave_up)
@@ -326,7 +411,7 @@ impl TeamRollout {
 /// Each robot's world: its entry's.
 pub(crate) fn robot_worlds(config: &crate::ValidConfig, worlds: &[Arc<World>]) -> Vec<Arc<World>> {
     config
-        .robots
+        .entries()
         .iter()
         .zip(worlds)
         .flat_map(|(e, w)| std::iter::repeat_n(w.clone(), e.count as usize))

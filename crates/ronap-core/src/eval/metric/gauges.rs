@@ -43,11 +43,6 @@ impl Gauges {
         })
     }
 
-    /// Shows a lone robot's episode, at its start and after each step.
-    pub(crate) fn watch_episode(&mut self, episode: &Episode) {
-        self.watch(std::slice::from_ref(episode), |_| true, episode.movers());
-    }
-
     /// Shows a team, at its start and after each step.
     pub(crate) fn watch_team(&mut self, team: &Team) {
         self.watch(team.robots(), |k| team.present(k), team.movers());

@@ -133,13 +133,15 @@ const JITTER_TRIES: usize = 100;
 impl Team {
     /// The team `config.robots` describes for episode `seed`: robot `k` in `worlds[e]`, where
     /// `e` is its `[[robots]]` entry (each world holds the entry's configuration and the shared
-    /// scene).
+    /// scene). A configuration without `[[robots]]` makes its lone robot's team of one
+    /// ([`ValidConfig::entries`]), in its one world: the lone robot's episode, step for step.
     pub fn new(
         config: &ValidConfig,
         worlds: &[Arc<World>],
         seed: u64,
     ) -> Result<Self, EpisodeError> {
-        let n = config.team_size();
+        let entries = config.entries();
+        let n = entries.iter().map(|e| e.count as usize).sum();
         let mut robots: Vec<Episode> = Vec::with_capacity(n);
         let mut on_arrival = Vec::with_capacity(n);
         let mut others = stream(seed, Stream::Team);
@@ -147,7 +149,7 @@ impl Team {
         let mut taken: Vec<(Point, Point, f64)> = Vec::new();
         let mut goal_lists: Vec<Vec<Point>> = Vec::with_capacity(n);
         let mut k = 0;
-        for (e, entry) in config.robots.iter().enumerate() {
+        for (e, entry) in entries.iter().enumerate() {
             let world = &worlds[e];
             let scene = world.scene();
             let radius = world.config().robot.radius_px;
@@ -602,12 +604,17 @@ mod tests {
         ];
         let mut steps = 0;
         for (case, (lone_config, one_config)) in cases.iter().enumerate() {
-            for seed in 0..12 {
-                let mut lone = World::maze(lone_config.clone(), seed)
-                    .episode(seed)
-                    .expect("placed");
-                let mut team =
-                    Team::new(one_config, &worlds(one_config, seed), seed).expect("placed");
+            for (seed, form) in (0..12).flat_map(|seed| [(seed, 0), (seed, 1)]) {
+                let lone_world = Arc::new(World::maze(lone_config.clone(), seed));
+                let mut lone = lone_world.episode(seed).expect("placed");
+                // The team of one of the lone configuration itself (as the evaluator runs a
+                // lone robot), or of its `[[robots]]` form (`as_team`).
+                let mut team = if form == 0 {
+                    Team::new(lone_config, std::slice::from_ref(&lone_world), seed)
+                } else {
+                    Team::new(one_config, &worlds(one_config, seed), seed)
+                }
+                .expect("placed");
                 // Mostly ahead, so the robot goes places, meets walls and obstacles.
                 let mut rng = crate::sim::rng::stream(seed, crate::sim::rng::Stream::Policy);
                 let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
@@ -623,7 +630,7 @@ mod tests {
                     let (pose, reward, collided, status) = (r.pose, r.reward, r.collided, r.status);
                     team.step(&[Some(action)]);
                     let t = team.robot(0);
-                    let at = format!("case {case}, seed {seed}, step {}", lone.steps());
+                    let at = format!("case {case}/{form}, seed {seed}, step {}", lone.steps());
                     assert_eq!(t.pose(), pose, "{at}");
                     assert_eq!(team.rewards()[0].to_bits(), reward.to_bits(), "{at}");
                     assert_eq!(team.collided(0), collided, "{at}");
@@ -645,7 +652,7 @@ mod tests {
                 );
             }
         }
-        assert!(steps > 5000, "only {steps} steps compared");
+        assert!(steps > 10_000, "only {steps} steps compared");
     }
 
     #[test]

@@ -203,8 +203,9 @@ impl Team {
     /// robot to block it, sense or send to), at a lone robot's speed.
     fn step_alone(&mut self, action: Action) {
         let at = self.robots[0].pose().position();
-        // What it broadcasts, which no one receives.
-        self.sent = self.broadcasts(std::iter::once(0));
+        // What it broadcasts no one receives; its next message starts from zeros.
+        self.sent.clear();
+        self.outbox[0].fill(0.0);
         let r = self.robots[0].step(action);
         let (reward, collided) = (r.reward, r.collided);
         self.rewards[0] = reward;
