@@ -59,7 +59,6 @@ pub fn collect_episode(
             }
             // Re-posed onto the goal, or somewhere the planner cannot leave: draw again.
             if rollout
-                .episode_mut()
                 .repose(Some(world.grid()), &mut repose_rng)
                 .is_none()
             {
@@ -87,7 +86,6 @@ pub fn collect_episode(
                 rollout = Rollout::new(world.clone(), seed)?;
             }
             if rollout
-                .episode_mut()
                 .repose(Some(world.grid()), &mut repose_rng)
                 .is_none()
             {

@@ -126,7 +126,19 @@ impl Recorder {
         policy: &mut dyn TeamPolicy,
         watch: &mut dyn FnMut(&Team),
     ) -> Result<TeamRollout, RunError> {
+        // A lone robot's episode that keeps nothing step by step (its figures are its episode's).
+        let keeps_nothing = self.lone
+            && !self.recording.trajectory
+            && !self.recording.steps
+            && self.gauges.is_none();
         loop {
+            if keeps_nothing {
+                if !rollout.advance(policy)? {
+                    return Ok(rollout);
+                }
+                watch(rollout.team());
+                continue;
+            }
             self.before(rollout.team());
             if !rollout.advance(policy)? {
                 return Ok(rollout);

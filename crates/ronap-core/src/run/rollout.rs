@@ -1,11 +1,13 @@
-//! A rollout: one episode driven by one policy, a step at a time. The evaluator, `ronap view` and
-//! driven data collection all step episodes through it, so they agree on what a policy's answer
-//! means: an action is taken (a non-finite continuous one is an error), giving up ends the episode
-//! as a failure with the policy's reason.
+//! A rollout: one robot's episode driven by one policy, a step at a time, for callers that follow
+//! a single robot (`ronap view`, driven data collection). It is the robot's team of one
+//! ([`TeamRollout`]) seen as one robot, so it steps and judges a policy's answer exactly as an
+//! evaluation does: an action is taken (a non-finite one, or one the robot does not take, is an
+//! error), and giving up ends the episode as a failure with the policy's reason.
 
-use crate::policy::{Decision, Policy, PolicyError};
-use crate::run::RunError;
-use crate::sim::{Action, Episode, Pose, World};
+use crate::policy::{Alone, Policy};
+use crate::run::{RunError, TeamRollout};
+use crate::scene::FreeGrid;
+use crate::sim::{Action, Episode, EpisodeError, Pose, Rng, World};
 use std::sync::Arc;
 
 /// What one step of a rollout did.
@@ -23,59 +25,44 @@ pub struct Stepped {
     pub pose: Pose,
 }
 
-/// One episode in its world, driven by a policy.
+/// One robot's episode in its world, driven by a policy.
 #[derive(Clone, Debug)]
 pub struct Rollout {
-    world: Arc<World>,
-    episode: Episode,
-    gave_up: Option<String>,
+    /// The robot's team of one.
+    one: TeamRollout,
 }
 
 impl Rollout {
     /// The episode of `seed` in `world`, with `policy` reset for it.
     pub fn start(world: Arc<World>, seed: u64, policy: &mut dyn Policy) -> Result<Self, RunError> {
-        Self::reset_by(world, seed, |world, episode| policy.reset(world, episode))
-    }
-
-    /// The episode of `seed` in `world`, with lane `lane` of `policy` reset for it (episodes run
-    /// [side by side](crate::policy::PolicyFactory::side_by_side)).
-    pub fn start_lane(
-        world: Arc<World>,
-        seed: u64,
-        policy: &mut dyn Policy,
-        lane: usize,
-    ) -> Result<Self, RunError> {
-        Self::reset_by(world, seed, |world, episode| {
-            policy.reset_lane(lane, world, episode)
-        })
-    }
-
-    /// The episode of `seed` in `world`, with `reset` (a policy's) called for it.
-    fn reset_by(
-        world: Arc<World>,
-        seed: u64,
-        reset: impl FnOnce(&World, &Episode) -> Result<(), PolicyError>,
-    ) -> Result<Self, RunError> {
-        let rollout = Self::new(world, seed)?;
-        reset(&rollout.world, &rollout.episode).map_err(|e| RunError::reset(seed, e))?;
-        Ok(rollout)
+        Self::lone(&world, seed)?;
+        let config = world.config().clone();
+        let one = TeamRollout::start(&config, vec![world], seed, &mut Alone(policy))?;
+        Ok(Self { one })
     }
 
     /// The episode of `seed` in `world`, for a caller that chooses every action itself.
     pub fn new(world: Arc<World>, seed: u64) -> Result<Self, RunError> {
-        let episode = world
-            .episode(seed)
-            .map_err(|source| RunError::Episode { seed, source })?;
-        Ok(Self {
-            world,
-            episode,
-            gave_up: None,
-        })
+        Self::lone(&world, seed)?;
+        let config = world.config().clone();
+        let one = TeamRollout::placed(&config, vec![world], seed)?;
+        Ok(Self { one })
+    }
+
+    /// Refuses a world of a team's configuration, which holds more than one robot.
+    fn lone(world: &World, seed: u64) -> Result<(), RunError> {
+        match world.config().team_size() {
+            0 => Ok(()),
+            robots => Err(RunError::Episode {
+                seed,
+                source: EpisodeError::Team { robots },
+            }),
+        }
     }
 
     /// Whether the episode is over: its status says so, or the policy gave up.
     pub fn finished(&self) -> bool {
-        self.episode.status().is_done() || self.gave_up.is_some()
+        self.one.finished()
     }
 
     /// The policy's next action, checked; `None` once the episode is over (the policy giving up
@@ -84,53 +71,23 @@ impl Rollout {
         if self.finished() {
             return Ok(None);
         }
-        let decision = policy.act(&self.episode);
-        self.decided(decision.map_err(|source| self.policy_error(source)))
-    }
-
-    /// The error of the policy failing to decide this step.
-    pub fn policy_error(&self, source: PolicyError) -> RunError {
-        RunError::Policy {
-            seed: self.episode.seed(),
-            step: self.episode.steps() + 1,
-            source,
+        match policy.act_in_team(self.one.team(), 0) {
+            Ok(decision) => self.one.decided(0, decision),
+            Err(source) => Err(self.one.policy_error(source)),
         }
     }
 
-    /// [`Rollout::decide`] for a decision already made (with the others of episodes side by
-    /// side) for this episode while not [finished](Rollout::finished): the action, checked;
-    /// `None` when the policy gave up.
-    pub fn decided(
-        &mut self,
-        decision: Result<Decision, RunError>,
-    ) -> Result<Option<Action>, RunError> {
-        let action = match decision? {
-            Decision::Act(action) => action,
-            Decision::GiveUp(why) => {
-                self.gave_up = Some(why);
-                return Ok(None);
-            }
-        };
-        let kind = self.episode.config().robot.kinematics;
-        if !action.is_finite() || !crate::sim::accepts(kind, action) {
-            return Err(RunError::InvalidAction {
-                seed: self.episode.seed(),
-                step: self.episode.steps() + 1,
-                action,
-            });
-        }
-        Ok(Some(action))
-    }
-
-    /// Takes `action`.
+    /// Takes `action`; on a finished episode nothing moves and the reward is 0.
     pub fn take(&mut self, action: Action) -> Stepped {
-        let r = self.episode.step(action);
+        let moves = !self.finished();
+        self.one.step(&[Some(action)]);
+        let team = self.one.team();
         Stepped {
-            step: r.step,
+            step: team.robot(0).steps(),
             action,
-            collided: r.collided,
-            reward: r.reward,
-            pose: r.pose,
+            collided: moves && team.collided(0),
+            reward: if moves { team.rewards()[0] } else { 0.0 },
+            pose: team.robot(0).pose(),
         }
     }
 
@@ -141,26 +98,22 @@ impl Rollout {
 
     /// The episode as it stands.
     pub fn episode(&self) -> &Episode {
-        &self.episode
+        self.one.team().robot(0)
     }
 
-    /// The episode, for callers that move the robot by other means (re-posing in data collection).
-    pub fn episode_mut(&mut self) -> &mut Episode {
-        &mut self.episode
+    /// Puts the robot down elsewhere ([`Episode::repose`]: the paper's re-posing in data
+    /// collection); the pose, or `None` when no free pose turned up.
+    pub fn repose(&mut self, grid: Option<&FreeGrid>, rng: &mut Rng) -> Option<Pose> {
+        self.one.lone_mut()?.repose(grid, rng)
     }
 
     /// The world the episode runs in.
     pub fn world(&self) -> &Arc<World> {
-        &self.world
+        self.one.world(0)
     }
 
     /// Why the policy gave up, when it did.
     pub fn gave_up(&self) -> Option<&str> {
-        self.gave_up.as_deref()
-    }
-
-    /// The world, the episode and the reason the policy gave up.
-    pub fn into_parts(self) -> (Arc<World>, Episode, Option<String>) {
-        (self.world, self.episode, self.gave_up)
+        self.one.gave_up(0)
     }
 }

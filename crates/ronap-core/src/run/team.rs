@@ -191,6 +191,12 @@ impl TeamRollout {
         &self.worlds[k]
     }
 
+    /// The episode of a team of one whose moving obstacles (if any) are in it, as a lone robot's
+    /// are ([`Team::lone_mut`]); `None` for any other team.
+    pub fn lone_mut(&mut self) -> Option<&mut crate::sim::Episode> {
+        self.team.lone_mut()
+    }
+
     /// Robot `k`'s tour lengths, when it has a goal list.
     pub fn tour(&self, k: usize) -> Option<TourLengths> {
         self.tours[k]

@@ -140,6 +140,12 @@ impl Team {
         worlds: &[Arc<World>],
         seed: u64,
     ) -> Result<Self, EpisodeError> {
+        if config.robots.is_empty() {
+            let world = worlds.first().ok_or(EpisodeError::Moving(
+                "a lone robot's team of one needs its world".into(),
+            ))?;
+            return Ok(Self::of_one(config, world.episode(seed)?));
+        }
         let entries = config.entries();
         let n = entries.iter().map(|e| e.count as usize).sum();
         let mut robots: Vec<Episode> = Vec::with_capacity(n);
@@ -305,6 +311,45 @@ impl Team {
         Ok(team)
     }
 
+    /// The team of one of a lone robot's `episode` under `config`: the episode whole, its moving
+    /// obstacles in it, stepping as it steps alone ([`Team::lone_mut`]).
+    fn of_one(config: &ValidConfig, episode: Episode) -> Self {
+        let scene = episode.scene().clone();
+        Self {
+            arrived_at: vec![(episode.status() == Status::Success).then_some(0)],
+            rewards: vec![0.0],
+            collided: vec![false],
+            retired: vec![false],
+            goal_lists: vec![vec![episode.goal()]],
+            comm: config.team.clone(),
+            outbox: vec![vec![0.0; config.team.message_size as usize]],
+            sent: Vec::new(),
+            inbox: Vec::new(),
+            inbox_starts: vec![0; 2],
+            on_arrival: vec![OnArrival::Stay],
+            movers: None,
+            steps: 0,
+            still_for: 0,
+            deadlock_steps: config.episode.deadlock_steps,
+            touched: Vec::new(),
+            grid_before: PointGrid::new(scene.width(), scene.height(), NEAR_CELL_PX),
+            grid_after: PointGrid::new(scene.width(), scene.height(), NEAR_CELL_PX),
+            max_radius: episode.config().robot.radius_px,
+            scratch: None,
+            robots: vec![episode],
+        }
+    }
+
+    /// The episode of a team of one whose moving obstacles (if any) are in it, as a lone
+    /// robot's are, so that it may be moved by other means (re-posing in data collection);
+    /// `None` for any other team.
+    pub fn lone_mut(&mut self) -> Option<&mut Episode> {
+        match self.robots.as_mut_slice() {
+            [episode] if self.movers.is_none() => Some(episode),
+            _ => None,
+        }
+    }
+
     /// The robots, in `[[robots]]` order.
     pub fn robots(&self) -> &[Episode] {
         &self.robots
@@ -317,7 +362,10 @@ impl Team {
 
     /// The moving obstacles, when there are some.
     pub fn movers(&self) -> Option<&Movers> {
-        self.movers.as_deref()
+        // A lone robot's team of one leaves them in its episode.
+        self.movers
+            .as_deref()
+            .or_else(|| self.robots.first().and_then(Episode::movers))
     }
 
     /// Steps taken.
