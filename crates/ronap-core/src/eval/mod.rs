@@ -37,7 +37,7 @@ use crate::policy::{Policy, PolicyError, PolicyFactory};
 use crate::run::RunError;
 use crate::sim::{Scenes, SeedRanges, World, Worlds};
 use ordered::{run_in_order, Ordered, Window};
-pub(crate) use recorder::Recorder;
+use recorder::Recorder;
 use side_by_side::SideBySide;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;

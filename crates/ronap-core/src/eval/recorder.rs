@@ -32,8 +32,8 @@ pub(crate) struct Recorder {
     before: Vec<Option<Before>>,
     mover_tracks: Vec<Track>,
     gauges: Option<Gauges>,
-    /// Whether the episode is a lone robot's, whose record has no place in a team (so no
-    /// waiting steps to count).
+    /// Whether the record is a lone robot's, which has no place in a team (so no waiting steps
+    /// to count).
     lone: bool,
     /// Steps each robot acted without moving.
     waiting: Vec<u32>,
@@ -43,12 +43,13 @@ pub(crate) struct Recorder {
 
 impl Recorder {
     /// Starts recording `rollout`'s episode under `config` (begun at `clock`) as `recording`
-    /// asks.
+    /// asks, for a lone robot's record ([`Recorder::lone`]) or a team's ([`Recorder::team`]).
     pub(crate) fn start(
         config: &ValidConfig,
         recording: Recording,
         clock: Instant,
         rollout: &TeamRollout,
+        lone: bool,
     ) -> Self {
         let team = rollout.team();
         let n = team.robots().len();
@@ -60,7 +61,7 @@ impl Recorder {
             before: Vec::new(),
             mover_tracks: Vec::new(),
             gauges: Gauges::start(config, n),
-            lone: config.robots.is_empty(),
+            lone,
             waiting: vec![0; n],
             at: Vec::with_capacity(n),
         };
@@ -337,9 +338,10 @@ impl Evaluator {
         recording: Recording,
     ) -> Result<EpisodeRecord, RunError> {
         let clock = Instant::now();
+        RunError::refuse_team(self.config(), seed)?;
         let mut policy = Alone(policy);
         let rollout = TeamRollout::start(self.config(), self.worlds.team(seed), seed, &mut policy)?;
-        let mut recorder = Recorder::start(self.config(), recording, clock, &rollout);
+        let mut recorder = Recorder::start(self.config(), recording, clock, &rollout, true);
         let rollout = recorder.run(rollout, &mut policy, &mut |_| {})?;
         Ok(recorder.lone(rollout))
     }
@@ -371,7 +373,7 @@ impl Evaluator {
         let worlds = self.worlds().team(seed);
         let rollout = TeamRollout::start(self.config(), worlds, seed, policy)?;
         watch(rollout.team());
-        let mut recorder = Recorder::start(self.config(), recording, clock, &rollout);
+        let mut recorder = Recorder::start(self.config(), recording, clock, &rollout, false);
         let rollout = recorder.run(rollout, policy, watch)?;
         Ok(recorder.team(&rollout, names))
     }
@@ -423,6 +425,51 @@ mod tests {
     use crate::config::{MotionKind, MovingConfig};
     use crate::policy::factory;
     use crate::sim::Scenes;
+
+    /// A team's configuration is refused by the lone entry points, one episode at a time and
+    /// side by side, with the error a lone episode of it gives (not a policy that left robot 1
+    /// without a decision, nor a panic).
+    #[test]
+    fn a_team_is_refused_where_a_lone_robot_runs() {
+        let config = crate::SimConfig {
+            robots: vec![crate::config::TeamRobotConfig {
+                count: 2,
+                ..Default::default()
+            }],
+            ..Default::default()
+        }
+        .validate()
+        .expect("valid");
+        let ev = Evaluator::new(config.clone(), Scenes::MazePerSeed);
+        let f = factory("geodesic", config.observation_size()).expect("built in");
+        let mut p = f.make().expect("made");
+        let team = |e: &RunError| {
+            matches!(
+                e,
+                RunError::Episode {
+                    seed: 3,
+                    source: crate::sim::EpisodeError::Team { robots: 2 }
+                }
+            )
+        };
+        let e = ev
+            .run_episode(p.as_mut(), 3, Recording::default())
+            .expect_err("a team");
+        assert!(team(&e), "{e}");
+        let failed = ev.run_side_by_side(
+            p.as_mut(),
+            &[3, 4],
+            2,
+            &|_| Recording::default(),
+            &mut |_, _| panic!("no episode runs"),
+        );
+        assert!(
+            failed.as_ref().is_some_and(|(i, e)| *i == 0 && team(e)),
+            "{failed:?}"
+        );
+        let e = crate::run::Rollout::new(ev.world(3), 3).expect_err("a team");
+        assert!(team(&e), "{e}");
+    }
 
     /// A lone robot's record is its team of one's robot's (the `[[robots]]` form of its
     /// configuration), figure for figure, path for path and step for step, among moving

@@ -76,7 +76,10 @@ impl Evaluator {
                 let (index, seed) = (next, seeds[next]);
                 next += 1;
                 let clock = Instant::now();
-                let started = TeamRollout::placed(self.config(), self.worlds().team(seed), seed)
+                let started = RunError::refuse_team(self.config(), seed)
+                    .and_then(|()| {
+                        TeamRollout::placed(self.config(), self.worlds().team(seed), seed)
+                    })
                     .and_then(|rollout| {
                         policy
                             .reset_lane(lane, rollout.world(0), rollout.team().robot(0))
@@ -86,7 +89,7 @@ impl Evaluator {
                 match started {
                     Ok(rollout) => {
                         let recorder =
-                            Recorder::start(self.config(), recording(seed), clock, &rollout);
+                            Recorder::start(self.config(), recording(seed), clock, &rollout, true);
                         live.push(Live {
                             index,
                             lane,

@@ -1,7 +1,8 @@
-//! Running policies, above `policy`: one episode driven by one policy ([`Rollout`]), and many
-//! episodes stepped side by side with automatic resets ([`Batch`]), the engine of the vectorised
-//! Python environment and of DQN, and a team of robots driven by a team policy
-//! ([`TeamRollout`]). Uses every layer up to `policy`.
+//! Running policies, above `policy`: one episode of a team driven by a team policy
+//! ([`TeamRollout`]), a lone robot's episode being its team of one; that team of one seen as
+//! one robot driven by one policy ([`Rollout`]); and many episodes stepped side by side with
+//! automatic resets ([`Batch`], the engine of the vectorised Python environment and of DQN;
+//! [`TeamBatch`] for teams). Uses every layer up to `policy`.
 //!
 //! The files are private: what other crates use is re-exported here (`pub use`), and what the
 //! layers above use beside it, `pub(crate) use`, so a file can move without breaking anyone.
@@ -87,6 +88,18 @@ pub enum RunError {
 }
 
 impl RunError {
+    /// Refuses `config` for a lone robot's episode of `seed` when it is a team's (it has
+    /// `[[robots]]`): such an episode runs as a team ([`TeamRollout`]).
+    pub fn refuse_team(config: &crate::ValidConfig, seed: u64) -> Result<(), Self> {
+        match config.team_size() {
+            0 => Ok(()),
+            robots => Err(Self::Episode {
+                seed,
+                source: EpisodeError::Team { robots },
+            }),
+        }
+    }
+
     /// The policy failing to prepare for the episode of `seed` (step 0).
     pub(crate) fn reset(seed: u64, source: PolicyError) -> Self {
         Self::Policy {

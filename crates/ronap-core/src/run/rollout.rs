@@ -7,7 +7,7 @@
 use crate::policy::{Alone, Policy};
 use crate::run::{RunError, TeamRollout};
 use crate::scene::FreeGrid;
-use crate::sim::{Action, Episode, EpisodeError, Pose, Rng, World};
+use crate::sim::{Action, Episode, Pose, Rng, World};
 use std::sync::Arc;
 
 /// What one step of a rollout did.
@@ -35,29 +35,18 @@ pub struct Rollout {
 impl Rollout {
     /// The episode of `seed` in `world`, with `policy` reset for it.
     pub fn start(world: Arc<World>, seed: u64, policy: &mut dyn Policy) -> Result<Self, RunError> {
-        Self::lone(&world, seed)?;
-        let config = world.config().clone();
-        let one = TeamRollout::start(&config, vec![world], seed, &mut Alone(policy))?;
+        let w = world.clone();
+        RunError::refuse_team(w.config(), seed)?;
+        let one = TeamRollout::start(w.config(), vec![world], seed, &mut Alone(policy))?;
         Ok(Self { one })
     }
 
     /// The episode of `seed` in `world`, for a caller that chooses every action itself.
     pub fn new(world: Arc<World>, seed: u64) -> Result<Self, RunError> {
-        Self::lone(&world, seed)?;
-        let config = world.config().clone();
-        let one = TeamRollout::placed(&config, vec![world], seed)?;
+        let w = world.clone();
+        RunError::refuse_team(w.config(), seed)?;
+        let one = TeamRollout::placed(w.config(), vec![world], seed)?;
         Ok(Self { one })
-    }
-
-    /// Refuses a world of a team's configuration, which holds more than one robot.
-    fn lone(world: &World, seed: u64) -> Result<(), RunError> {
-        match world.config().team_size() {
-            0 => Ok(()),
-            robots => Err(RunError::Episode {
-                seed,
-                source: EpisodeError::Team { robots },
-            }),
-        }
     }
 
     /// Whether the episode is over: its status says so, or the policy gave up.
@@ -77,7 +66,8 @@ impl Rollout {
         }
     }
 
-    /// Takes `action`; on a finished episode nothing moves and the reward is 0.
+    /// Takes `action`; on a finished episode (or one the policy gave up) nothing moves and the
+    /// reward is 0.
     pub fn take(&mut self, action: Action) -> Stepped {
         let moves = !self.finished();
         self.one.step(&[Some(action)]);

@@ -1,7 +1,8 @@
 //! A team rollout: one episode of several robots, each driven by its own policy, a step at a
 //! time. Every policy decides from the same state (its robot's own episode view: pose, laser with
 //! the other robots in it, goal), then the team moves at once. A policy that gives up takes its
-//! robot out of the running; it stays where it is, an obstacle to the others.
+//! robot out of the running; it stays where it is, an obstacle to the others. A lone robot's
+//! episode is its team of one (a configuration without `[[robots]]`), stepped here too.
 
 use crate::geometry::Point;
 use crate::plan::{path_length, smooth, CostMatrix, DistanceField, Order};
@@ -117,8 +118,8 @@ fn plan_tour(
 }
 
 impl TeamRollout {
-    /// The team episode of `seed` under `config` (with its `[[robots]]`) in `worlds` (one per
-    /// entry, [`crate::sim::Worlds::team`]), with `policy` reset for it.
+    /// The team episode of `seed` under `config` in `worlds` (one per `[[robots]]` entry, or the
+    /// lone robot's one world: [`crate::sim::Worlds::team`]), with `policy` reset for it.
     pub fn start(
         config: &crate::ValidConfig,
         worlds: Vec<Arc<World>>,

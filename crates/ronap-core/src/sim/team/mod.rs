@@ -74,6 +74,8 @@ pub struct Team {
     max_radius: f64,
     /// A step's buffers (`None` only while a step uses them).
     scratch: Option<Box<step::Scratch>>,
+    /// Whether this is a lone robot's team of one, its episode whole ([`Team::lone_mut`]).
+    lone: bool,
 }
 
 /// Whether discs of radii summing to `reach`, moving at once from `a0` to `a1` and from `b0` to
@@ -133,8 +135,9 @@ const JITTER_TRIES: usize = 100;
 impl Team {
     /// The team `config.robots` describes for episode `seed`: robot `k` in `worlds[e]`, where
     /// `e` is its `[[robots]]` entry (each world holds the entry's configuration and the shared
-    /// scene). A configuration without `[[robots]]` makes its lone robot's team of one
-    /// ([`ValidConfig::entries`]), in its one world: the lone robot's episode, step for step.
+    /// scene). A configuration without `[[robots]]` makes its lone robot's team of one in its
+    /// one world (`worlds[0]`): the lone robot's episode whole, its moving obstacles in it, which
+    /// steps only when its robot acts ([`Team::step`]).
     pub fn new(
         config: &ValidConfig,
         worlds: &[Arc<World>],
@@ -264,37 +267,7 @@ impl Team {
         let movers = Movers::among(config, &scene, &discs, &goals, seed)
             .map_err(|e| EpisodeError::Moving(e.to_string()))?
             .map(Box::new);
-        let mut team = Self {
-            arrived_at: robots
-                .iter()
-                .map(|r| (r.status() == Status::Success).then_some(0))
-                .collect(),
-            rewards: vec![0.0; robots.len()],
-            collided: vec![false; robots.len()],
-            retired: vec![false; robots.len()],
-            goal_lists,
-            comm: config.team.clone(),
-            outbox: vec![vec![0.0; config.team.message_size as usize]; robots.len()],
-            sent: Vec::new(),
-            inbox: Vec::new(),
-            inbox_starts: vec![0; robots.len() + 1],
-            robots,
-            on_arrival,
-            movers,
-            steps: 0,
-            still_for: 0,
-            deadlock_steps: config.episode.deadlock_steps,
-            touched: Vec::new(),
-            grid_before: PointGrid::new(scene.width(), scene.height(), NEAR_CELL_PX),
-            grid_after: PointGrid::new(scene.width(), scene.height(), NEAR_CELL_PX),
-            max_radius: 0.0,
-            scratch: None,
-        };
-        team.max_radius = team
-            .robots
-            .iter()
-            .map(|r| r.config().robot.radius_px)
-            .fold(0.0, f64::max);
+        let mut team = Self::assemble(config, robots, on_arrival, goal_lists, movers);
         let among = team.movers.is_some();
         for (k, r) in team.robots.iter_mut().enumerate() {
             r.set_among_movers(among);
@@ -314,40 +287,62 @@ impl Team {
     /// The team of one of a lone robot's `episode` under `config`: the episode whole, its moving
     /// obstacles in it, stepping as it steps alone ([`Team::lone_mut`]).
     fn of_one(config: &ValidConfig, episode: Episode) -> Self {
-        let scene = episode.scene().clone();
+        let goals = vec![vec![episode.goal()]];
         Self {
-            arrived_at: vec![(episode.status() == Status::Success).then_some(0)],
-            rewards: vec![0.0],
-            collided: vec![false],
-            retired: vec![false],
-            goal_lists: vec![vec![episode.goal()]],
+            lone: true,
+            ..Self::assemble(config, vec![episode], vec![OnArrival::Stay], goals, None)
+        }
+    }
+
+    /// The team of `robots` placed, before its first step.
+    fn assemble(
+        config: &ValidConfig,
+        robots: Vec<Episode>,
+        on_arrival: Vec<OnArrival>,
+        goal_lists: Vec<Vec<Point>>,
+        movers: Option<Box<Movers>>,
+    ) -> Self {
+        let n = robots.len();
+        let (width, height) = robots
+            .first()
+            .map_or((0.0, 0.0), |r| (r.scene().width(), r.scene().height()));
+        Self {
+            arrived_at: robots
+                .iter()
+                .map(|r| (r.status() == Status::Success).then_some(0))
+                .collect(),
+            rewards: vec![0.0; n],
+            collided: vec![false; n],
+            retired: vec![false; n],
+            goal_lists,
             comm: config.team.clone(),
-            outbox: vec![vec![0.0; config.team.message_size as usize]],
+            outbox: vec![vec![0.0; config.team.message_size as usize]; n],
             sent: Vec::new(),
             inbox: Vec::new(),
-            inbox_starts: vec![0; 2],
-            on_arrival: vec![OnArrival::Stay],
-            movers: None,
+            inbox_starts: vec![0; n + 1],
+            max_radius: robots
+                .iter()
+                .map(|r| r.config().robot.radius_px)
+                .fold(0.0, f64::max),
+            robots,
+            on_arrival,
+            movers,
             steps: 0,
             still_for: 0,
             deadlock_steps: config.episode.deadlock_steps,
             touched: Vec::new(),
-            grid_before: PointGrid::new(scene.width(), scene.height(), NEAR_CELL_PX),
-            grid_after: PointGrid::new(scene.width(), scene.height(), NEAR_CELL_PX),
-            max_radius: episode.config().robot.radius_px,
+            grid_before: PointGrid::new(width, height, NEAR_CELL_PX),
+            grid_after: PointGrid::new(width, height, NEAR_CELL_PX),
             scratch: None,
-            robots: vec![episode],
+            lone: false,
         }
     }
 
-    /// The episode of a team of one whose moving obstacles (if any) are in it, as a lone
-    /// robot's are, so that it may be moved by other means (re-posing in data collection);
-    /// `None` for any other team.
+    /// The episode of a lone robot's team of one (made from a configuration without
+    /// `[[robots]]`), which holds all of it, its moving obstacles too, so that it may be moved by
+    /// other means (re-posing in data collection); `None` for any other team.
     pub fn lone_mut(&mut self) -> Option<&mut Episode> {
-        match self.robots.as_mut_slice() {
-            [episode] if self.movers.is_none() => Some(episode),
-            _ => None,
-        }
+        self.robots.first_mut().filter(|_| self.lone)
     }
 
     /// The robots, in `[[robots]]` order.
@@ -363,9 +358,11 @@ impl Team {
     /// The moving obstacles, when there are some.
     pub fn movers(&self) -> Option<&Movers> {
         // A lone robot's team of one leaves them in its episode.
-        self.movers
-            .as_deref()
-            .or_else(|| self.robots.first().and_then(Episode::movers))
+        if self.lone {
+            self.robots[0].movers()
+        } else {
+            self.movers.as_deref()
+        }
     }
 
     /// Steps taken.
@@ -701,6 +698,42 @@ mod tests {
             }
         }
         assert!(steps > 10_000, "only {steps} steps compared");
+    }
+
+    /// A lone robot's team of one is its episode whole: its moving obstacles stay in it, and it
+    /// steps only when the robot acts (a lone episode has no step without an action).
+    #[test]
+    fn a_lone_robots_team_of_one_steps_only_when_it_acts() {
+        use crate::config::{MotionKind, MovingConfig};
+        let config = crate::SimConfig {
+            moving: vec![MovingConfig {
+                count: 8,
+                motion: MotionKind::RandomWalk,
+                ..Default::default()
+            }],
+            ..Default::default()
+        }
+        .validate()
+        .expect("valid");
+        let world = Arc::new(World::maze(config.clone(), 2));
+        let mut team = Team::new(&config, std::slice::from_ref(&world), 2).expect("placed");
+        let lone = world.episode(2).expect("placed");
+        let at = |t: &Team| {
+            t.movers()
+                .map(|m| m.items().map(|o| o.position()).collect::<Vec<_>>())
+        };
+        let before = at(&team);
+        assert!(before.is_some() && team.movers().is_some());
+        team.step(&[None]);
+        assert_eq!((team.steps(), team.robot(0).steps()), (0, 0));
+        assert_eq!(at(&team), before);
+        assert_eq!(team.robot(0).pose(), lone.pose());
+        team.step(&[Some(DiscreteAction::Ahead.into())]);
+        assert_eq!((team.steps(), team.robot(0).steps()), (1, 1));
+        assert!(team.lone_mut().is_some());
+        let one = config.as_team();
+        let mut as_team = Team::new(&one, &worlds(&one, 2), 2).expect("placed");
+        assert!(as_team.lone_mut().is_none());
     }
 
     #[test]

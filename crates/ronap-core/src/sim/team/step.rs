@@ -9,9 +9,17 @@ use crate::sim::robot::{Action, Motion};
 
 impl Team {
     /// One step: `actions[k]` for each robot (`None`: it does nothing, as a robot whose episode
-    /// is over). Moving obstacles move first, then every running robot at once.
+    /// is over). Moving obstacles move first, then every running robot at once. A lone robot's
+    /// team of one steps only when its robot acts, as its episode has no step without an action.
     pub fn step(&mut self, actions: &[Option<Action>]) {
         if self.is_done() {
+            return;
+        }
+        if self.lone {
+            if let Some(action) = actions.first().copied().flatten() {
+                self.steps += 1;
+                self.step_alone(action);
+            }
             return;
         }
         self.steps += 1;
