@@ -22,6 +22,15 @@ pub trait TeamPolicy: Send {
     /// robot). On an error, the failing robot; the decisions set before it stand.
     fn act(&mut self, team: &Team, decisions: &mut [Option<Decision>]) -> Result<(), RobotError>;
 
+    /// The decision for the one robot of a team of one (a lone robot's episode), which runs:
+    /// what [`TeamPolicy::act`] would decide for it, without a step's buffers. The default asks
+    /// `act`.
+    fn act_alone(&mut self, team: &Team) -> Result<Option<Decision>, PolicyError> {
+        let mut decisions = [None];
+        self.act(team, &mut decisions).map_err(|(_, e)| e)?;
+        Ok(decisions[0].take())
+    }
+
     /// Why the team's task cannot be done, when the policy found out at [`TeamPolicy::reset`]
     /// (no plan can bring every robot to its goals): the episode then ends before its first
     /// step, every robot's outcome `infeasible`. The default finds nothing.
@@ -133,6 +142,10 @@ impl TeamPolicy for Alone<'_> {
             decisions[0] = Some(self.0.act_in_team(team, 0).map_err(|e| (0, e))?);
         }
         Ok(())
+    }
+
+    fn act_alone(&mut self, team: &Team) -> Result<Option<Decision>, PolicyError> {
+        self.0.act_in_team(team, 0).map(Some)
     }
 
     fn next_goal(&mut self, _: usize, world: &World, episode: &Episode) -> Result<(), PolicyError> {

@@ -370,11 +370,11 @@ impl TeamRollout {
     /// [`TeamRollout::advance`] for a team of one that sends no messages (a lone robot's), without
     /// the buffers a team's step needs: the same step at a lone robot's speed.
     fn advance_alone(&mut self, policy: &mut dyn TeamPolicy) -> Result<bool, RunError> {
-        let mut decisions = [None];
-        if let Err((_, source)) = policy.act(&self.team, &mut decisions) {
-            return Err(self.policy_error(source));
-        }
-        let action = match decisions[0].take() {
+        let decision = match policy.act_alone(&self.team) {
+            Ok(decision) => decision,
+            Err(source) => return Err(self.policy_error(source)),
+        };
+        let action = match decision {
             Some(Decision::Act(action)) if self.accepts(0, action) => action,
             Some(Decision::Act(action)) => return Err(self.invalid(action)),
             Some(Decision::GiveUp(why)) => {

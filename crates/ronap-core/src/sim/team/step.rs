@@ -211,9 +211,14 @@ impl Team {
     /// robot to block it, sense or send to), at a lone robot's speed.
     fn step_alone(&mut self, action: Action) {
         let at = self.robots[0].pose().position();
-        // What it broadcasts no one receives; its next message starts from zeros.
-        self.sent.clear();
-        self.outbox[0].fill(0.0);
+        // What it broadcasts no one receives, its next message starts from zeros and it hears
+        // nothing (a lone robot's team of one never talks).
+        if !self.lone {
+            self.sent.clear();
+            self.outbox[0].fill(0.0);
+            self.inbox.clear();
+            self.inbox_starts.fill(0);
+        }
         let r = self.robots[0].step(action);
         let (reward, collided) = (r.reward, r.collided);
         self.rewards[0] = reward;
@@ -223,8 +228,6 @@ impl Team {
         }
         let moved = self.robots[0].pose().position() != at;
         self.still_for = if moved { 0 } else { self.still_for + 1 };
-        self.inbox.clear();
-        self.inbox_starts.fill(0);
     }
 
     /// Every running robot reads its sensors among the others (discs) and the obstacles.
