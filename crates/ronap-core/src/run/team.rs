@@ -192,8 +192,8 @@ impl TeamRollout {
         &self.worlds[k]
     }
 
-    /// The episode of a team of one whose moving obstacles (if any) are in it, as a lone robot's
-    /// are ([`Team::lone_mut`]); `None` for any other team.
+    /// The episode of a lone robot's team of one, which holds all of it ([`Team::lone_mut`]);
+    /// `None` for any other team.
     pub fn lone_mut(&mut self) -> Option<&mut crate::sim::Episode> {
         self.team.lone_mut()
     }

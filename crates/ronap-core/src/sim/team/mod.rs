@@ -149,7 +149,7 @@ impl Team {
             ))?;
             return Ok(Self::of_one(config, world.episode(seed)?));
         }
-        let entries = config.entries();
+        let entries = &config.robots;
         let n = entries.iter().map(|e| e.count as usize).sum();
         let mut robots: Vec<Episode> = Vec::with_capacity(n);
         let mut on_arrival = Vec::with_capacity(n);
