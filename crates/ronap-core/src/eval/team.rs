@@ -24,7 +24,7 @@ pub struct TeamRecord {
     /// Flow: each robot's arrival step, summed, when all arrived.
     pub sum_of_costs: Option<u64>,
     /// The makespan's lower bound: the longest of the robots' own lower bounds
-    /// ([`InTeam::lower_bound_steps`]), when each has one.
+    /// ([`InTeam::lower_bound_steps`](crate::eval::InTeam::lower_bound_steps)), when each has one.
     pub makespan_lower_bound: Option<u32>,
     /// The flow's lower bound: the robots' own lower bounds summed, when each has one.
     pub sum_of_costs_lower_bound: Option<u64>,
@@ -38,7 +38,7 @@ pub struct TeamRecord {
     pub robot_collisions: u32,
     /// Whether it ended in a deadlock.
     pub deadlock: bool,
-    /// Each robot's record (each with its [`InTeam`]), in robot order: its poses (while it is in
+    /// Each robot's record (each with its [`InTeam`](crate::eval::InTeam)), in robot order: its poses (while it is in
     /// the scene) when the trajectory was recorded, the steps it acted when steps were, and its
     /// last readings when either was.
     pub robots: Vec<EpisodeRecord>,
