@@ -128,7 +128,7 @@ impl TeamPolicy for PerRobot {
 }
 
 /// A lone robot's policy as the team policy of its team of one (the evaluator runs a lone robot
-/// so): it decides from its robot's view of the team, which holds the moving obstacles
+/// so): it decides from its robot's view of the team, which shows the moving obstacles
 /// ([`Policy::act_in_team`]), and hears and says nothing, as it would alone.
 pub struct Alone<'a>(pub &'a mut dyn Policy);
 
