@@ -225,18 +225,6 @@ impl ValidConfig {
         self.robots.iter().map(|r| r.count as usize).sum()
     }
 
-    /// The `[[robots]]` entries of the team this configuration runs: its own, or for a lone
-    /// robot the one entry of its team of one, which sets nothing ([`ValidConfig::as_team`]).
-    pub fn entries(&self) -> &[TeamRobotConfig] {
-        static ALONE: std::sync::LazyLock<[TeamRobotConfig; 1]> =
-            std::sync::LazyLock::new(|| [TeamRobotConfig::default()]);
-        if self.robots.is_empty() {
-            &*ALONE
-        } else {
-            &self.robots
-        }
-    }
-
     /// This configuration as a team's: itself when it has `[[robots]]`, else its one robot as a
     /// team of one (one `[[robots]]` entry that sets nothing; `[episode]`'s fixed start and goal,
     /// if any, place it as they place the lone robot), whose episodes are the lone robot's, step

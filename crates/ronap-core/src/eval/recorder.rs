@@ -152,7 +152,8 @@ impl Recorder {
     /// Robot `k`'s record of the finished `rollout`. A team's robot computes its own task's
     /// length whatever its outcome (for the lower bounds); a lone robot's only on success, as
     /// it costs more than a random policy's whole episode and scores nothing else.
-    fn robot(&mut self, rollout: &TeamRollout, k: usize, lone: bool) -> EpisodeRecord {
+    fn robot(&mut self, rollout: &TeamRollout, k: usize) -> EpisodeRecord {
+        let lone = self.lone;
         let team = rollout.team();
         let r = team.robot(k);
         let outcome = if rollout.infeasible().is_some() {
@@ -248,7 +249,7 @@ impl Recorder {
     /// The record of a lone robot's finished episode (its team of one's robot), with its world
     /// and the moving obstacles' tracks.
     pub(crate) fn lone(mut self, rollout: TeamRollout) -> EpisodeRecord {
-        let mut record = self.robot(&rollout, 0, true);
+        let mut record = self.robot(&rollout, 0);
         record.mover_tracks = std::mem::take(&mut self.mover_tracks);
         record.world = Some(rollout.world(0).clone());
         record.wall_time_s = self.clock.elapsed().as_secs_f64();
@@ -261,7 +262,7 @@ impl Recorder {
         let team = rollout.team();
         let robots: Vec<EpisodeRecord> = (0..team.robots().len())
             .map(|k| {
-                let mut r = self.robot(rollout, k, false);
+                let mut r = self.robot(rollout, k);
                 if let (Some(place), Some(name)) = (&mut r.team, names.get(k)) {
                     place.policy = name.clone();
                 }

@@ -374,6 +374,9 @@ impl TeamRollout {
             Ok(decision) => decision,
             Err(source) => return Err(self.policy_error(source)),
         };
+        // `decided`'s checks, matched here: a lone robot's every step passes this way, and
+        // handing its answer back through `decided`'s result cost 2% more instructions
+        // (`--policy random`, callgrind).
         let action = match decision {
             Some(Decision::Act(action)) if self.accepts(0, action) => action,
             Some(Decision::Act(action)) => return Err(self.invalid(action)),
@@ -415,10 +418,13 @@ impl TeamRollout {
     }
 }
 
-/// Each robot's world: its entry's.
+/// Each robot's world: its entry's (a lone robot's team of one: its one world).
 pub(crate) fn robot_worlds(config: &crate::ValidConfig, worlds: &[Arc<World>]) -> Vec<Arc<World>> {
+    if config.robots.is_empty() {
+        return worlds.to_vec();
+    }
     config
-        .entries()
+        .robots
         .iter()
         .zip(worlds)
         .flat_map(|(e, w)| std::iter::repeat_n(w.clone(), e.count as usize))

@@ -257,8 +257,8 @@ impl Worlds {
 
     /// A team's worlds for episode `seed`: one per `[[robots]]` entry, each with the entry's
     /// configuration ([`ValidConfig::team_robot`]) in the seed's scene (made once for a scene
-    /// every seed shares, so each entry's free-space grid is built once).
-    /// A lone robot's team of one has its world.
+    /// every seed shares, so each entry's free-space grid is built once). A lone robot's team of
+    /// one has the lone robot's world.
     pub fn team(&self, seed: u64) -> Vec<Arc<World>> {
         if self.config.robots.is_empty() {
             return vec![self.world(seed)];
