@@ -28,18 +28,13 @@ pub struct Env {
 
 #[pymethods]
 impl Env {
-    /// An environment under `config`; `maze_seed` fixes one maze for every episode and
-    /// `map_path` uses an image or ROS map instead of mazes.
+    /// An environment under `config`, with the keyword options of [`TeamEnv::new`]
+    /// (`maze_seed`, `map_path`, `continuous`).
     #[new]
-    #[pyo3(signature = (config, maze_seed = None, map_path = None, continuous = false))]
-    fn new(
-        config: &Config,
-        maze_seed: Option<u64>,
-        map_path: Option<&str>,
-        continuous: bool,
-    ) -> PyResult<Self> {
+    #[pyo3(signature = (config, **options))]
+    fn new(config: &Config, options: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
         Ok(Self {
-            core: TeamEnv::new(config.valid(), maze_seed, map_path, continuous)?,
+            core: TeamEnv::new("Env", config.valid(), options)?,
             team: config.valid().team_size(),
         })
     }

@@ -5,6 +5,7 @@
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use ronap_core::run::Autoreset;
 
 /// The options left to take.
 pub struct Options<'py> {
@@ -45,6 +46,19 @@ impl<'py> Options<'py> {
             self.take("map_path", None)?,
             self.take("threads", 0)?,
         ))
+    }
+
+    /// `autoreset` ("next_step" unless given; "same_step", "disabled") as the batch's mode.
+    pub fn autoreset(&self) -> PyResult<Autoreset> {
+        let mode: String = self.take("autoreset", "next_step".to_string())?;
+        match mode.as_str() {
+            "next_step" => Ok(Autoreset::NextStep),
+            "same_step" => Ok(Autoreset::SameStep),
+            "disabled" => Ok(Autoreset::Disabled),
+            other => Err(crate::errors::ConfigError::new_err(format!(
+                "autoreset_mode {other:?}: expected \"next_step\", \"same_step\" or \"disabled\""
+            ))),
+        }
     }
 
     /// Fails naming any option not taken.

@@ -7,7 +7,7 @@ use crate::team_env::TeamEnv;
 use numpy::{PyArray1, PyArray3, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use ronap_core::run::{RobotStep, TeamBatch};
+use ronap_core::run::{Autoreset, BatchOptions, RobotStep, SeedOrder, TeamBatch};
 use ronap_core::sim::{Action, Team, Worlds};
 
 /// Several robots in one scene, an episode at a time, on the core `Env` shares ([`TeamEnv`]).
@@ -77,16 +77,11 @@ fn observe<'py>(py: Python<'py>, team: &Team) -> PyResult<Observed<'py>> {
 
 #[pymethods]
 impl MultiEnv {
-    /// The team of `config`'s `[[robots]]`; `maze_seed` fixes one maze for every episode and
-    /// `map_path` uses an image or ROS map instead of mazes.
+    /// The team of `config`'s `[[robots]]`, with the keyword options of [`TeamEnv::new`]
+    /// (`maze_seed`, `map_path`, `continuous`).
     #[new]
-    #[pyo3(signature = (config, maze_seed = None, map_path = None, continuous = false))]
-    fn new(
-        config: &Config,
-        maze_seed: Option<u64>,
-        map_path: Option<&str>,
-        continuous: bool,
-    ) -> PyResult<Self> {
+    #[pyo3(signature = (config, **options))]
+    fn new(config: &Config, options: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
         if config.valid().team_size() == 0 {
             return Err(errors::ConfigError::new_err(
                 "MultiNavEnv needs a team: a scenario with [[robots]] entries \
@@ -94,7 +89,7 @@ impl MultiEnv {
             ));
         }
         Ok(Self {
-            core: TeamEnv::new(config.valid(), maze_seed, map_path, continuous)?,
+            core: TeamEnv::new("MultiEnv", config.valid(), options)?,
         })
     }
 
@@ -266,16 +261,20 @@ impl VecMultiEnv {
 
 #[pymethods]
 impl VecMultiEnv {
-    /// `num_envs` team environments under `config`, stepped on `threads` threads (0: all cores).
+    /// `num_envs` team environments under `config`, stepped on `threads` threads (0: all cores),
+    /// with `autoreset` "next_step", "same_step" or "disabled".
     #[new]
-    #[pyo3(signature = (num_envs, config, maze_seed = None, map_path = None, threads = 0))]
+    #[pyo3(signature = (num_envs, config, **options))]
     fn new(
         num_envs: usize,
         config: &Config,
-        maze_seed: Option<u64>,
-        map_path: Option<&str>,
-        threads: usize,
+        options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
+        // maze_seed, map_path, threads and autoreset.
+        let o = crate::kwargs::Options::new("VecMultiEnv", options);
+        let (maze_seed, map_path, threads) = o.scene_and_threads()?;
+        let autoreset = o.autoreset()?;
+        o.finish()?;
         if num_envs == 0 {
             return Err(errors::ConfigError::new_err(
                 "num_envs = 0: must be at least 1",
@@ -287,9 +286,17 @@ impl VecMultiEnv {
                 "VecMultiNavEnv needs a team: a scenario with [[robots]] entries",
             ));
         }
-        let (_, scenes, _) = conv::scenes(valid, maze_seed, map_path)?;
-        let batch = TeamBatch::new(Worlds::new(valid.clone(), scenes), num_envs, threads)
-            .map_err(|e| errors::run(&e))?;
+        let (_, scenes, _) = conv::scenes(valid, maze_seed, map_path.as_deref())?;
+        let batch = TeamBatch::new(
+            Worlds::new(valid.clone(), scenes),
+            BatchOptions {
+                envs: num_envs,
+                threads,
+                autoreset,
+                seed_order: SeedOrder::Strided,
+            },
+        )
+        .map_err(|e| errors::run(&e))?;
         Ok(Self { batch })
     }
 
@@ -302,6 +309,19 @@ impl VecMultiEnv {
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyDict>)> {
         py.allow_threads(|| self.batch.reset(seed))
             .map_err(|e| errors::run(&e))?;
+        self.arrays(py)
+    }
+
+    /// Starts afresh the environments `mask` selects, each with its seed from `seeds` (one per
+    /// environment) or, for None, the next seed of its sequence. Returns (observations, infos).
+    fn restart<'py>(
+        &mut self,
+        py: Python<'py>,
+        seeds: Vec<Option<u64>>,
+        mask: Vec<bool>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyDict>)> {
+        py.allow_threads(|| self.batch.restart(&mask, &seeds))
+            .map_err(|e| crate::vec_env::run_error(&e))?;
         self.arrays(py)
     }
 
@@ -359,7 +379,7 @@ impl VecMultiEnv {
             None => None,
         };
         py.allow_threads(|| self.batch.step(&actions, messages))
-            .map_err(|e| errors::run(&e))?;
+            .map_err(|e| crate::vec_env::run_error(&e))?;
         let steps = self.batch.steps();
         let rewards = PyArray1::from_iter(py, steps.iter().map(|s| s.reward)).reshape([n, r])?;
         let terminated =
@@ -367,6 +387,18 @@ impl VecMultiEnv {
         let truncated =
             PyArray1::from_iter(py, steps.iter().map(|s| s.truncated)).reshape([n, r])?;
         let (obs, infos) = self.arrays(py)?;
+        // Same-step autoreset: the episodes this step ended have restarted; their last
+        // observations go in the infos.
+        let restarted: Vec<bool> = (0..n)
+            .map(|i| self.batch.options().autoreset == Autoreset::SameStep && self.batch.ended(i))
+            .collect();
+        if restarted.contains(&true) {
+            let d = self.batch.observation_size();
+            let last =
+                PyArray1::from_slice(py, self.batch.final_observations()).reshape([n, r, d])?;
+            infos.set_item("final_obs", last)?;
+            infos.set_item("_final_obs", PyArray1::from_vec(py, restarted))?;
+        }
         Ok((
             obs,
             rewards.into_any(),

@@ -5,6 +5,7 @@
 use crate::conv;
 use crate::errors;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 use ronap_core::config::RobotConfig;
 use ronap_core::run::{TeamRollout, TeamShaper};
 use ronap_core::sim::{Action, Team, Worlds};
@@ -32,14 +33,21 @@ pub(crate) struct TeamEnv {
 }
 
 impl TeamEnv {
-    /// The team of `config` (its one robot as a team of one when it has no `[[robots]]`);
-    /// `maze_seed` fixes one maze for every episode and `map_path` uses an image or ROS map.
+    /// The team of `config` (its one robot as a team of one when it has no `[[robots]]`) for
+    /// `function` (`Env` or `MultiEnv`, named in errors), with its keyword `options`:
+    /// `maze_seed` fixes one maze for every episode, `map_path` uses an image or ROS map instead
+    /// of mazes, `continuous` takes each robot's continuous command instead of 0/1/2.
     pub(crate) fn new(
+        function: &'static str,
         config: &ValidConfig,
-        maze_seed: Option<u64>,
-        map_path: Option<&str>,
-        continuous: bool,
+        options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
+        let o = crate::kwargs::Options::new(function, options);
+        let maze_seed: Option<u64> = o.take("maze_seed", None)?;
+        let map_path: Option<String> = o.take("map_path", None)?;
+        let continuous: bool = o.take("continuous", false)?;
+        o.finish()?;
+        let map_path = map_path.as_deref();
         let team = config.as_team();
         let (_, scenes, _) = conv::scenes(&team, maze_seed, map_path)?;
         let continuous = (0..team.team_size())

@@ -123,7 +123,7 @@ fn status_name(status: Status) -> PyFixedUnicode<STATUS_CHARS> {
 
 /// A batch's error: stepping an ended environment is the caller's mistake (`RonapError`), the
 /// rest as [`errors::run`] says.
-fn run_error(e: &RunError) -> PyErr {
+pub(crate) fn run_error(e: &RunError) -> PyErr {
     match e {
         RunError::Ended { env } => errors::RonapError::new_err(format!(
             "environment {env}: its episode ended and autoreset is disabled: reset it first \
@@ -216,27 +216,16 @@ impl VecEnv {
         // maze_seed, map_path, threads, autoreset, continuous and render.
         let o = crate::kwargs::Options::new("VecEnv", options);
         let (maze_seed, map_path, threads) = o.scene_and_threads()?;
-        let autoreset: String = o.take("autoreset", "next_step".to_string())?;
+        let autoreset = o.autoreset()?;
         let continuous: bool = o.take("continuous", false)?;
         let render: bool = o.take("render", false)?;
         o.finish()?;
-        let (map_path, autoreset) = (map_path.as_deref(), autoreset.as_str());
+        let map_path = map_path.as_deref();
         if num_envs == 0 {
             return Err(errors::ConfigError::new_err(
                 "num_envs = 0: must be at least 1",
             ));
         }
-        let autoreset = match autoreset {
-            "next_step" => Autoreset::NextStep,
-            "same_step" => Autoreset::SameStep,
-            "disabled" => Autoreset::Disabled,
-            other => {
-                return Err(errors::ConfigError::new_err(format!(
-                    "autoreset_mode {other:?}: expected \"next_step\", \"same_step\" or \
-                     \"disabled\""
-                )))
-            }
-        };
         let (_, scenes, _) = conv::scenes(config.valid(), maze_seed, map_path)?;
         let options = BatchOptions {
             envs: num_envs,

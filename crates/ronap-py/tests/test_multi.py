@@ -277,3 +277,71 @@ def test_spaces_by_agent_and_a_vector_reset_without_a_seed():
     assert obs.shape[:2] == (2, 8) and isinstance(vec.seed_used, int)
     again, _ = ronap.VecMultiNavEnv(2, scenario=WAREHOUSE).reset(seed=vec.seed_used)
     assert np.array_equal(obs, again)
+
+
+def _team_episodes(mode, n=3, steps=120):
+    """Every episode a VecMultiNavEnv in autoreset ``mode`` plays with every robot AHEAD: per
+    seed, its steps' (rewards, terminated, truncated) rows and its last observations."""
+    vec = ronap.VecMultiNavEnv(n, scenario=CORRIDOR, episode_max_steps=25, autoreset_mode=mode)
+    assert vec.metadata["autoreset_mode"].name.lower() == mode
+    obs, infos = vec.reset(seed=10)
+    seed = infos["seed"].copy()
+    played = {int(s): [] for s in seed}
+    last = {}
+    ahead = np.ones((n, vec.num_agents), np.int64)
+    for _ in range(steps):
+        obs, rew, term, trunc, infos = vec.step(ahead)
+        ended = ~infos["active"].any(axis=1)
+        for i in range(n):
+            if infos["acted"][i].any():
+                played[int(seed[i])].append((rew[i].tolist(), term[i].tolist(), trunc[i].tolist()))
+            if mode == "same_step" and infos.get("_final_obs", np.zeros(n, bool))[i]:
+                last[int(seed[i])] = infos["final_obs"][i]
+            elif ended[i] and infos["acted"][i].any():
+                last[int(seed[i])] = obs[i].copy()
+        if mode == "disabled" and ended.any():
+            with pytest.raises(ronap.RonapError, match="reset_mask"):
+                vec.step(ahead)
+            obs, infos = vec.reset(options={"reset_mask": ended})
+        for i in np.flatnonzero(infos["reset"]):
+            seed[i] = infos["seed"][i]
+            played.setdefault(int(seed[i]), [])
+    return {s: (p, last[s]) for s, p in played.items() if s in last}
+
+
+def test_vector_teams_play_the_same_episodes_in_every_autoreset_mode():
+    runs = {mode: _team_episodes(mode) for mode in ("next_step", "same_step", "disabled")}
+    common = set.intersection(*(set(r) for r in runs.values()))
+    assert len(common) >= 6
+    for s in common:
+        steps, last = runs["next_step"][s]
+        for mode in ("same_step", "disabled"):
+            assert runs[mode][s][0] == steps, (mode, s)
+            np.testing.assert_array_equal(runs[mode][s][1], last)
+    vec = ronap.VecMultiNavEnv(2, scenario=CORRIDOR, autoreset_mode="disabled")
+    with pytest.raises(ronap.ConfigError, match="first reset"):
+        vec.reset(options={"reset_mask": np.array([True, False])})
+    with pytest.raises(ronap.ConfigError, match="only 'reset_mask'"):
+        vec.reset(options={"mask": np.ones(2, bool)})
+    with pytest.raises(ronap.ConfigError, match="autoreset_mode 'later'"):
+        ronap.VecMultiNavEnv(2, scenario=CORRIDOR, autoreset_mode="later")
+
+
+def test_a_vector_team_copy_replays_its_masked_resets():
+    import copy
+
+    vec = ronap.VecMultiNavEnv(2, scenario=CORRIDOR, episode_max_steps=5, autoreset_mode="disabled")
+    vec.reset(seed=4)
+    for _ in range(5):
+        vec.step(np.ones((2, 2), np.int64))
+    obs, infos = vec.reset(options={"reset_mask": np.array([True, False])})
+    assert list(infos["seed"]) == [6, 5] and list(infos["reset"]) == [True, False]
+    twin = copy.deepcopy(vec)
+    with pytest.raises(ronap.RonapError, match="environment 1"):
+        twin.step(np.ones((2, 2), np.int64))
+    vec.reset(options={"reset_mask": np.array([False, True])})
+    twin.reset(options={"reset_mask": np.array([False, True])})
+    a = vec.step(np.ones((2, 2), np.int64))
+    b = twin.step(np.ones((2, 2), np.int64))
+    for x, y in zip(a[:4], b[:4]):
+        np.testing.assert_array_equal(x, y)

@@ -1,8 +1,8 @@
 //! Running policies, above `policy`: one episode of a team driven by a team policy
 //! ([`TeamRollout`]), a lone robot's episode being its team of one; that team of one seen as
 //! one robot driven by one policy ([`Rollout`]); and many episodes stepped side by side with
-//! automatic resets ([`Batch`], the engine of the vectorised Python environment and of DQN;
-//! [`TeamBatch`] for teams). Uses every layer up to `policy`.
+//! automatic resets, lone robots' or teams' ([`Batch`], the one engine of the vectorised Python
+//! environments and of DQN; [`TeamBatch`] is its team kind). Uses every layer up to `policy`.
 //!
 //! The files are private: what other crates use is re-exported here (`pub use`), and what the
 //! layers above use beside it, `pub(crate) use`, so a file can move without breaking anyone.
@@ -11,14 +11,15 @@ mod batch;
 mod rollout;
 mod shaping;
 mod team;
-mod team_batch;
 
-pub use batch::{Autoreset, Batch, BatchOptions, EnvStep, SeedOrder};
+pub use batch::{
+    Autoreset, Batch, BatchOf, BatchOptions, EnvStep, Lane, Lone, RobotStep, SeedOrder, TeamBatch,
+    Teams,
+};
 pub use rollout::{Rollout, Stepped};
 pub use shaping::{Shaper, TeamShaper};
 pub(crate) use team::robot_worlds;
 pub use team::{TeamRollout, TourLengths};
-pub use team_batch::{RobotStep, TeamBatch};
 
 // For the layers above only.
 

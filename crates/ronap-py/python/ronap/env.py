@@ -92,7 +92,7 @@ class NavEnv(gym.Env[np.ndarray, Any]):
         self._index: int | None = None
         checked = checked_config(config, fields, scenario)
         self._checked = checked
-        self._env = _ronap.Env(checked, maze_seed, checked_path("map", map), continuous)
+        self._env = _ronap.Env(checked, maze_seed=maze_seed, map_path=checked_path("map", map), continuous=continuous)
         self._episode: tuple[int, list[Any]] | None = None
         self.config = json.loads(checked.json)
         self.render_mode = render_mode
@@ -212,6 +212,33 @@ def _autoreset_mode(mode: AutoresetMode | str) -> AutoresetMode:
     raise _ronap.ConfigError(f"autoreset_mode {mode!r}: expected 'next_step', 'same_step' or 'disabled' (or a gymnasium AutoresetMode)")
 
 
+def reset_mask(owner: str, options: dict[str, Any] | None, num_envs: int, started: bool) -> np.ndarray | None:
+    """The ``reset_mask`` of a vector environment's ``reset(options=...)``, checked: ``num_envs``
+    bools, and every environment on the first reset (``owner`` names the class in errors)."""
+    if not options:
+        return None
+    unknown = sorted(set(options) - {"reset_mask"})
+    if unknown:
+        raise _ronap.ConfigError(f"options {unknown}: {owner} takes only 'reset_mask'")
+    if "reset_mask" not in options:
+        return None
+    mask = np.asarray(options["reset_mask"])
+    if mask.dtype != np.bool_ or mask.shape != (num_envs,):
+        raise _ronap.ConfigError(f"reset_mask of dtype {mask.dtype} and shape {mask.shape}: expected {num_envs} bools")
+    if not started and not mask.all():
+        raise _ronap.ConfigError("reset_mask: the first reset() starts every environment")
+    return mask
+
+
+def kept_call(calls: list[Any] | None, call: Any) -> list[Any] | None:
+    """``calls`` with ``call`` added, for a copy of a vector environment to replay; None (none
+    kept) once ``COPY_LIMIT`` calls are."""
+    if calls is None or len(calls) >= COPY_LIMIT:
+        return None
+    calls.append(call)
+    return calls
+
+
 class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
     """``num_envs`` RoNAP environments stepped together in Rust, across cores, with the GIL
     released; observations, rewards and flags come back as numpy arrays.
@@ -319,12 +346,7 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
 
     def _logged(self, call: tuple[str, Any, Any], full_reset: bool = False) -> None:
         """Keeps `call` for copies, up to ``COPY_LIMIT`` steps since the last full reset."""
-        if full_reset:
-            self._calls = []
-        if self._calls is not None and len(self._calls) >= COPY_LIMIT:
-            self._calls = None
-        if self._calls is not None:
-            self._calls.append(call)
+        self._calls = kept_call([] if full_reset else self._calls, call)
 
     def _infos(self, infos: dict[str, Any], mask: np.ndarray) -> dict[str, Any]:
         """Gymnasium's vector infos: every value an array over the environments, and beside each
@@ -365,19 +387,7 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
     def reset(
         self, *, seed: int | list[int | None] | None = None, options: dict[str, Any] | None = None
     ) -> tuple[np.ndarray, dict[str, Any]]:
-        mask: np.ndarray | None = None
-        if options:
-            unknown = sorted(set(options) - {"reset_mask"})
-            if unknown:
-                raise _ronap.ConfigError(f"options {unknown}: VecNavEnv takes only 'reset_mask'")
-            if "reset_mask" in options:
-                mask = np.asarray(options["reset_mask"])
-                if mask.dtype != np.bool_ or mask.shape != (self.num_envs,):
-                    raise _ronap.ConfigError(
-                        f"reset_mask of dtype {mask.dtype} and shape {mask.shape}: expected {self.num_envs} bools"
-                    )
-                if not self._started and not mask.all():
-                    raise _ronap.ConfigError("reset_mask: the first reset() starts every environment")
+        mask = reset_mask("VecNavEnv", options, self.num_envs, self._started)
         seeds = self._seeds(seed, mask)
         flags = None if mask is None else [bool(m) for m in mask]
         try:

@@ -7,10 +7,11 @@ from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
 from gymnasium import spaces
+from gymnasium.vector import AutoresetMode
 
 from . import _ronap
 from .config import ScenarioLike, checked_config, checked_path, checked_int, init_arguments, checked_split, split_draw_limit, split_seed, check_split_seeds, COPY_LIMIT
-from .env import discrete_actions
+from .env import _AUTORESET, _autoreset_mode, discrete_actions, kept_call, reset_mask
 
 if TYPE_CHECKING:
     from pettingzoo import ParallelEnv
@@ -86,7 +87,7 @@ class MultiNavEnv(_Base):
         self.text_infos: bool = bool(text_infos)
         self._status: dict[str, str] = {}
         self._inbox: dict[str, list[dict[str, Any]]] = {}
-        self._env = _ronap.MultiEnv(checked, maze_seed, checked_path("map", map), continuous)
+        self._env = _ronap.MultiEnv(checked, maze_seed=maze_seed, map_path=checked_path("map", map), continuous=continuous)
         self._episode: tuple[int, list[tuple[list[Any], Any]]] | None = None
         self.config = json.loads(checked.json)
         self.render_mode = render_mode
@@ -312,12 +313,20 @@ class VecMultiNavEnv:
     whose action counted, ``infos["reset"]`` which environments started a new episode,
     ``infos["seed"]`` and ``infos["steps"]`` each environment's episode.
 
-    Next-step autoreset: the step after every robot of an environment is done starts its next
-    episode (its actions are ignored, rewards 0). Environment ``i``'s episodes have seeds
-    ``seed + i``, ``seed + i + num_envs``, ...: the same episodes ``MultiNavEnv`` plays with those
-    seeds, on any number of threads.
+    ``autoreset_mode`` (Gymnasium's ``AutoresetMode`` or "next_step", "same_step", "disabled"),
+    as ``VecNavEnv``'s: next-step (default) starts an environment's next episode on the step
+    after every robot of it is done (its actions are ignored, rewards 0); same-step starts it
+    within the ending step, whose rewards, flags and ``active``/``acted``/``collided``/``success``
+    infos stay the ending step's while the observations, ``seed``, ``steps`` and ``reset`` are the
+    new episode's, the last observations in ``infos["final_obs"]`` (``[num_envs]`` of
+    ``[num_agents, obs_size]`` arrays, None for the others; ``infos["_final_obs"]`` the mask);
+    disabled leaves it to ``reset(options={"reset_mask": mask})``, which restarts the environments
+    ``mask`` selects with their next seeds (stepping an ended environment raises ``RonapError``).
+    Environment ``i``'s episodes have seeds ``seed + i``, ``seed + i + num_envs``, ...: the same
+    episodes ``MultiNavEnv`` plays with those seeds, in every mode, on any number of threads.
     """
 
+    metadata: dict[str, Any] = {"autoreset_mode": AutoresetMode.NEXT_STEP}
     config: dict[str, Any]
     possible_agents: list[str]
     render_mode: str | None = None
@@ -333,6 +342,7 @@ class VecMultiNavEnv:
         maze_seed: int | None = None,
         map: str | None = None,
         threads: int = 0,
+        autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
         split: str | None = None,
         **fields: Any,
     ) -> None:
@@ -340,9 +350,18 @@ class VecMultiNavEnv:
         self._init_args = init_arguments(locals())
         num_envs = checked_int("num_envs", num_envs, least=1, below=2**31)
         threads = checked_int("threads", threads, below=2**16)
+        mode = _autoreset_mode(autoreset_mode)
+        self.metadata = {"autoreset_mode": mode}
         self.split: str | None = checked_split(split)
         checked = checked_config(config, fields, scenario)
-        self._vec = _ronap.VecMultiEnv(int(num_envs), checked, maze_seed, checked_path("map", map), int(threads))
+        self._vec = _ronap.VecMultiEnv(
+            int(num_envs),
+            checked,
+            maze_seed=maze_seed,
+            map_path=checked_path("map", map),
+            threads=int(threads),
+            autoreset=_AUTORESET[mode],
+        )
         self.config = json.loads(checked.json)
         self.num_envs: int = self._vec.num_envs
         self.num_agents: int = self._vec.robots
@@ -353,13 +372,25 @@ class VecMultiNavEnv:
         self.single_action_space = spaces.Discrete(3)
         self._started = False
         self.seed_used: int | None = None
-        self._calls: list[tuple[Any, Any]] | None = []
+        self._calls: list[tuple[str, Any, Any]] | None = []
 
-    def reset(self, seed: int | None = None) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    def reset(
+        self, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
         """Restarts every environment: environment ``i`` plays seeds ``seed + i``, ``seed + i +
         num_envs``, ... (counted from the split's first seed with ``split=``); ``seed=None``
         draws the first seed at random (as Gymnasium's vector environments do); the episode seed
-        of environment 0 is reported as ``seed_used``."""
+        of environment 0 is reported as ``seed_used``. ``options={"reset_mask": mask}`` restarts
+        only the environments the ``[num_envs]`` bools select, each with its next seed (what
+        ``autoreset_mode="disabled"`` leaves to the caller)."""
+        mask = reset_mask("VecMultiNavEnv", options, self.num_envs, self._started)
+        if mask is not None and self._started:
+            if seed is not None:
+                raise _ronap.ConfigError("reset(seed=..., options={'reset_mask': ...}): a masked reset takes each environment's next seed, not a seed")
+            flags = [bool(m) for m in mask]
+            obs, infos = self._vec.restart([None] * self.num_envs, flags)
+            self._logged(("restart", flags, None))
+            return obs, infos
         if seed is None:
             seed = int(np.random.default_rng().integers(0, min(2**62, split_draw_limit(self.split, self.num_envs))))
         seed = split_seed(self.split, checked_int("seed", seed))
@@ -367,6 +398,10 @@ class VecMultiNavEnv:
         self._started = True
         self._calls = []
         return self._vec.reset(seed)
+
+    def _logged(self, call: tuple[str, Any, Any]) -> None:
+        """Keeps `call` for copies, up to ``COPY_LIMIT`` calls since the last full reset."""
+        self._calls = kept_call(self._calls, call)
 
     def step(
         self, actions: Any, messages: Any = None
@@ -381,22 +416,23 @@ class VecMultiNavEnv:
             if m.shape != (*shape, self.message_size):
                 raise _ronap.ActionError(f"messages of shape {m.shape}: expected {(*shape, self.message_size)}")
             flat_messages = m.reshape(-1)
-        if self._calls is not None:
-            kept = (a.reshape(-1).copy(), None if flat_messages is None else flat_messages.copy())
-            if len(self._calls) < COPY_LIMIT:
-                self._calls.append(kept)
-            else:
-                self._calls = None
-        stepped = self._vec.step(a.reshape(-1), flat_messages)
-        check_split_seeds(self.split, stepped[4]["seed"])
-        return stepped
+        obs, rewards, terminated, truncated, infos = self._vec.step(a.reshape(-1), flat_messages)
+        self._logged(("step", a.reshape(-1).copy(), None if flat_messages is None else flat_messages.copy()))
+        check_split_seeds(self.split, infos["seed"])
+        if "final_obs" in infos:
+            ended = infos["_final_obs"]
+            final_obs = np.full(self.num_envs, None, dtype=object)
+            for i in np.flatnonzero(ended):
+                final_obs[i] = infos["final_obs"][i].copy()
+            infos["final_obs"] = final_obs
+        return obs, rewards, terminated, truncated, infos
 
     def __getstate__(self) -> dict[str, Any]:
         """Its arguments, seed and the actions since the last reset, replayed where the copy is
         made (``pickle``, ``copy.deepcopy``): the copy continues exactly where this one is."""
         if self._calls is None:
             raise _ronap.RonapError(
-                f"cannot copy a VecMultiNavEnv more than {COPY_LIMIT} steps after its reset(): a copy "
+                f"cannot copy a VecMultiNavEnv more than {COPY_LIMIT} steps or masked resets after its reset(): a copy "
                 "replays them, and so many are not kept; reset() first"
             )
         return {"init": self._init_args, "seed": self.seed_used if self._started else None, "calls": self._calls}
@@ -407,8 +443,11 @@ class VecMultiNavEnv:
             self._vec.reset(state["seed"])
             self.seed_used = state["seed"]
             self._started = True
-            for actions, messages in state["calls"]:
-                self._vec.step(actions, messages)
+            for kind, first, second in state["calls"]:
+                if kind == "step":
+                    self._vec.step(first, second)
+                else:
+                    self._vec.restart([None] * self.num_envs, first)
             self._calls = list(state["calls"])
 
     def close(self) -> None:

@@ -1,23 +1,32 @@
-//! A batch: N episodes stepped side by side, across cores, each starting its next episode when
-//! one ends. Observations live in one flat row-major buffer (`N x observation_size`) and each
-//! environment's step in one small record, so a binding hands them over as arrays with no object
-//! per environment. The vectorised Python environment and DQN's actors are both this type.
+//! A batch: N environments stepped side by side, across cores, each starting its next episode
+//! when one ends, in one of Gymnasium's three autoreset modes. One engine for the two kinds of
+//! environment (its [`Lane`]): a lone robot's ([`Batch`], the vectorised Python environment and
+//! DQN's actors) and a team's ([`TeamBatch`], the vectorised multi-robot environment). Both get
+//! the same seeds, restarts, autoreset modes and threads from it.
+//!
+//! Observations live in one flat row-major buffer (`N x R x observation_size`: R rows an
+//! environment, one for a lone robot, one per robot for a team) and each row's step in one small
+//! record, so a binding hands them over as arrays with no object per environment.
 //!
 //! Every environment's episodes and random numbers follow from their seeds, and seeds are handed
 //! out in environment order, so a batch steps the same bits on any number of threads.
 
-use crate::geometry::Point;
-use crate::run::shaping::Shaper;
+mod lone;
+mod team;
+
+pub use lone::{Batch, EnvStep, Lone};
+pub use team::{RobotStep, TeamBatch, Teams};
+
 use crate::run::RunError;
-use crate::sim::{stream, Action, Episode, Pose, Rng, Status, Stream, Worlds, PREFETCH_STAGES};
+use crate::sim::{Worlds, PREFETCH_STAGES};
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
 use std::time::Duration;
 
-/// Environments per parallel task: enough work to outweigh handing it to a thread.
+/// Rows (robots) per parallel task: enough work to outweigh handing it to a thread.
 const MIN_PER_TASK: usize = 16;
 
-/// Most environments in one parallel task (a run stepped in order, see [`Lanes::for_each`]).
+/// Most rows in one parallel task (a run stepped in order, see [`Lanes::for_each`]).
 const RUN: usize = 64;
 
 /// Longest the calling thread waits awake for the pool's last runs (a run of [`RUN`]
@@ -72,93 +81,85 @@ pub struct BatchOptions {
     pub seed_order: SeedOrder,
 }
 
-/// One environment's latest reset or step.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct EnvStep {
-    /// The seed of the episode the step belongs to (the one that ended, for a step that ended it).
-    pub seed: u64,
-    /// The action taken (`None` for a reset).
-    pub action: Option<Action>,
-    /// The step's reward (0 for a reset).
-    pub reward: f64,
-    /// The episode's status after the step.
-    pub status: Status,
-    /// Whether the step's motion would have touched an obstacle.
-    pub collided: bool,
-    /// Distance to the goal after the step, px.
-    pub distance_px: f64,
-    /// Pose after the step.
-    pub pose: Pose,
-    /// The episode's (current) goal.
-    pub goal: Point,
-    /// Steps taken in the episode so far.
-    pub steps: u32,
-    /// Steps of the episode so far that collided with a wall or a static obstacle.
-    pub collisions: u32,
-    /// Steps of the episode so far with contact between the robot and a moving obstacle (`None`
-    /// when the scene has none).
-    pub dynamic_collisions: Option<u32>,
-    /// Summed reward of the episode so far, as given (with `reward.shaping`, the shaped one).
-    pub total_reward: f64,
-    /// Whether this was a reset: the environment started a new episode and did not step.
-    pub reset: bool,
+/// What a batch steps in each environment: a lone robot's episode ([`Lone`]) or a team's
+/// ([`Teams`]). The batch hands out their seeds, restarts them and spreads them over threads; a
+/// kind starts an episode and says where it stands (its step is the kind's own method of
+/// [`BatchOf`], with what the caller gives it).
+pub trait Lane: Send + Sized {
+    /// What a reset or step reports for each of an environment's rows.
+    type Record: Copy + Default + Send + std::fmt::Debug;
+
+    /// The environment before its first episode, in a batch of `worlds`.
+    fn idle(worlds: &Worlds) -> Self;
+
+    /// Rows an environment of `worlds` takes (its robots), and the values in a row.
+    fn shape(worlds: &Worlds) -> (usize, usize);
+
+    /// Starts the episode of `seed` in `worlds`, writing its observation rows and records.
+    fn start(
+        &mut self,
+        worlds: &Worlds,
+        seed: u64,
+        obs: &mut [f32],
+        out: &mut [Self::Record],
+    ) -> Result<(), RunError>;
+
+    /// Whether an episode has started.
+    fn started(&self) -> bool;
+
+    /// Whether its episode is over (every robot done).
+    fn done(&self) -> bool;
+
+    /// Asks for the memory the next step reads, stage by stage: a batch calls each stage a few
+    /// environments ahead of the one it steps.
+    fn prefetch(&self, _stage: usize) {}
 }
 
-impl EnvStep {
-    fn of(episode: &Episode, action: Option<Action>, reward: f64, collided: bool) -> Self {
-        Self {
-            seed: episode.seed(),
-            action,
-            reward,
-            status: episode.status(),
-            collided,
-            distance_px: episode.distance_px(),
-            pose: episode.pose(),
-            goal: episode.goal(),
-            steps: episode.steps(),
-            collisions: episode.collisions(),
-            dynamic_collisions: episode.dynamic_metrics().map(|m| m.collisions),
-            total_reward: episode.total_reward(),
-            reset: false,
-        }
-    }
-
-    /// The record of `episode` just started: what a reset reports.
-    pub fn start(episode: &Episode) -> Self {
-        Self {
-            reset: true,
-            ..Self::of(episode, None, 0.0, false)
-        }
-    }
-}
-
-/// One environment: its episode, the random stream a policy may draw from, and the shaping of
-/// its reward when the configuration asks for it.
-struct Env {
-    episode: Option<Episode>,
-    rng: Rng,
+/// One environment: its kind's state and where its next seed comes from.
+struct Env<E> {
+    lane: E,
     next_seed: u64,
-    shaper: Option<Shaper>,
+    /// Its episode ended in the latest step (it was stepped, not started, in it).
+    just_ended: bool,
 }
 
-/// N environments stepped together.
-pub struct Batch {
+impl<E: Lane> Env<E> {
+    /// Starts the next episode into its rows; with a `stride`, the one after it will be `stride`
+    /// seeds later.
+    fn start(
+        &mut self,
+        worlds: &Worlds,
+        stride: Option<u64>,
+        obs: &mut [f32],
+        out: &mut [E::Record],
+    ) -> Result<(), RunError> {
+        let seed = self.next_seed;
+        self.lane.start(worlds, seed, obs, out)?;
+        if let Some(n) = stride {
+            self.next_seed = seed.wrapping_add(n);
+        }
+        Ok(())
+    }
+}
+
+/// N environments of kind `E` stepped together: a [`Batch`] of lone robots or a [`TeamBatch`].
+pub struct BatchOf<E: Lane> {
     worlds: Worlds,
     options: BatchOptions,
-    lanes: Lanes,
+    lanes: Lanes<E>,
     next_seed: u64,
 }
 
 /// A run of environments with their observation rows, final-observation rows and step records.
-struct Run<'a> {
-    envs: &'a mut [Env],
+struct Run<'a, E: Lane> {
+    envs: &'a mut [Env<E>],
     obs: &'a mut [f32],
     last: &'a mut [f32],
-    out: &'a mut [EnvStep],
+    out: &'a mut [E::Record],
 }
 
 /// The environments and their rows in the flat buffers, apart from what a step only reads.
-struct Lanes {
+struct Lanes<E: Lane> {
     /// The threads that step beside the calling thread (`None`: it steps alone).
     pool: Option<rayon::ThreadPool>,
     /// Whether the calling thread may wait awake for the pool's last runs: not when there are
@@ -172,16 +173,18 @@ struct Lanes {
     /// Whether the caller came back within [`LINGER`] of that: the pool's threads linger after
     /// this call's runs only then.
     quick: bool,
-    envs: Vec<Env>,
+    envs: Vec<Env<E>>,
+    /// Rows an environment takes.
+    rows: usize,
     observation_size: usize,
     observations: Vec<f32>,
     final_observations: Vec<f32>,
-    steps: Vec<EnvStep>,
+    steps: Vec<E::Record>,
 }
 
-impl Batch {
+impl<E: Lane> BatchOf<E> {
     /// A batch of `options.envs` environments in `worlds`, none started yet.
-    pub fn new(worlds: Worlds, options: BatchOptions) -> Result<Self, RunError> {
+    fn with_options(worlds: Worlds, options: BatchOptions) -> Result<Self, RunError> {
         let n = options.envs.max(1);
         // The calling thread steps too, so the pool holds one thread fewer than asked for. All
         // cores means rayon's own default: `RAYON_NUM_THREADS` where set, else every core.
@@ -202,10 +205,8 @@ impl Batch {
                     .map_err(|e| RunError::Threads(e.to_string()))
             })
             .transpose()?;
-        let observation_size = worlds.config().observation_size();
+        let (rows, observation_size) = E::shape(&worlds);
         Ok(Self {
-            worlds,
-            options: BatchOptions { envs: n, ..options },
             lanes: Lanes {
                 pool,
                 spin: threads <= cores,
@@ -214,17 +215,19 @@ impl Batch {
                 quick: false,
                 envs: (0..n)
                     .map(|_| Env {
-                        episode: None,
-                        rng: stream(0, Stream::Policy),
+                        lane: E::idle(&worlds),
                         next_seed: 0,
-                        shaper: None,
+                        just_ended: false,
                     })
                     .collect(),
+                rows,
                 observation_size,
-                observations: vec![0.0; n * observation_size],
-                final_observations: vec![0.0; n * observation_size],
-                steps: vec![EnvStep::default(); n],
+                observations: vec![0.0; n * rows * observation_size],
+                final_observations: vec![0.0; n * rows * observation_size],
+                steps: vec![E::Record::default(); n * rows],
             },
+            worlds,
+            options: BatchOptions { envs: n, ..options },
             next_seed: 0,
         })
     }
@@ -244,17 +247,18 @@ impl Batch {
         result
     }
 
-    /// [`Batch::reset`] between the caller's coming and going.
+    /// [`BatchOf::reset`] between the caller's coming and going.
     fn reset_all(&mut self, seed: u64) -> Result<(), RunError> {
         let n = self.lanes.envs.len() as u64;
         for (i, env) in self.lanes.envs.iter_mut().enumerate() {
             env.next_seed = seed.wrapping_add(i as u64);
-            env.episode = None;
+            env.lane = E::idle(&self.worlds);
+            env.just_ended = false;
         }
         self.next_seed = seed.wrapping_add(n);
         let (worlds, stride) = (&self.worlds, self.stride());
         self.lanes
-            .for_each(|_, env, obs, _, out| Self::start(worlds, stride, env, obs, out))
+            .for_each(|_, env, obs, _, out| env.start(worlds, stride, obs, out))
     }
 
     /// Starts afresh the environments `which` selects (one flag per environment): each with its
@@ -265,7 +269,7 @@ impl Batch {
         self.call(|batch| batch.restart_some(which, seeds))
     }
 
-    /// [`Batch::restart`] between the caller's coming and going.
+    /// [`BatchOf::restart`] between the caller's coming and going.
     fn restart_some(&mut self, which: &[bool], seeds: &[Option<u64>]) -> Result<(), RunError> {
         let n = self.lanes.envs.len();
         for (what, given) in [("reset flags", which.len()), ("seeds", seeds.len())] {
@@ -296,7 +300,8 @@ impl Batch {
         let worlds = &self.worlds;
         self.lanes.for_each(|i, env, obs, _, out| {
             if which[i] {
-                Self::start(worlds, stride, env, obs, out)
+                env.just_ended = false;
+                env.start(worlds, stride, obs, out)
             } else {
                 Ok(())
             }
@@ -308,139 +313,86 @@ impl Batch {
         (self.options.seed_order == SeedOrder::Strided).then_some(self.lanes.envs.len() as u64)
     }
 
-    /// Steps every environment: `choose(i, episode, rng)` gives environment `i`'s action for its
-    /// episode's current state, drawing any randomness from `rng` (the episode seed's policy
-    /// stream). Environments waiting for a next-step reset start their next episode instead.
-    pub fn step(
+    /// One step of every environment, `step(i, lane, obs, out)` stepping environment `i` (its
+    /// observation rows and records) as its kind does, with the batch's autoreset around it:
+    /// environments never started start first, and environments whose episode ended start their
+    /// next one on the following step, in the same step or never, as the batch is set.
+    fn step_each(
         &mut self,
-        choose: &(dyn Fn(usize, &Episode, &mut Rng) -> Action + Sync),
+        step: impl Fn(usize, &mut E, &mut [f32], &mut [E::Record]) -> Result<(), RunError> + Sync,
     ) -> Result<(), RunError> {
-        self.call(|batch| batch.step_all(choose))
-    }
-
-    /// [`Batch::step`] between the caller's coming and going (it may run the environments more
-    /// than once: to start missing episodes, to step, to restart ended ones).
-    fn step_all(
-        &mut self,
-        choose: &(dyn Fn(usize, &Episode, &mut Rng) -> Action + Sync),
-    ) -> Result<(), RunError> {
-        if self.lanes.envs.iter().any(|e| e.episode.is_none()) {
+        if self.lanes.envs.iter().any(|e| !e.lane.started()) {
             // Nothing started yet (no reset): start what is missing, as a reset with the seeds
             // the environments hold.
             let (worlds, stride) = (&self.worlds, self.stride());
             self.lanes
-                .for_each(|_, env, obs, _, out| match env.episode {
-                    None => Self::start(worlds, stride, env, obs, out),
-                    Some(_) => Ok(()),
+                .for_each(|_, env, obs, _, out| match env.lane.started() {
+                    false => env.start(worlds, stride, obs, out),
+                    true => Ok(()),
                 })?;
         }
         let autoreset = self.options.autoreset;
         if autoreset == Autoreset::Disabled {
-            let ended = self.lanes.envs.iter().position(|e| {
-                e.episode
-                    .as_ref()
-                    .is_some_and(|episode| episode.status().is_done())
-            });
-            if let Some(env) = ended {
+            if let Some(env) = self.lanes.envs.iter().position(|e| e.lane.done()) {
                 return Err(RunError::Ended { env });
             }
         }
-        let (worlds, stride) = (&self.worlds, self.stride());
+        let (worlds, stride, rows) = (&self.worlds, self.stride(), self.lanes.rows);
         self.lanes.for_each(|i, env, obs, last, out| {
-            let Some(episode) = env.episode.as_mut() else {
-                return Ok(());
-            };
-            if autoreset == Autoreset::NextStep && episode.status().is_done() {
-                return Self::start(worlds, stride, env, obs, out);
+            env.just_ended = false;
+            if autoreset == Autoreset::NextStep && env.lane.done() {
+                return env.start(worlds, stride, obs, out);
             }
-            let action = choose(i, episode, &mut env.rng);
-            let r = episode.step(action);
-            let (reward, collided) = (r.reward, r.collided);
-            obs.copy_from_slice(r.observation);
-            *out = match env.shaper.as_mut() {
-                Some(shaper) => {
-                    let shaped = shaper.step(episode, reward);
-                    EnvStep {
-                        total_reward: shaper.total(),
-                        ..EnvStep::of(episode, Some(action), shaped, collided)
-                    }
-                }
-                None => EnvStep::of(episode, Some(action), reward, collided),
-            };
-            if autoreset == Autoreset::SameStep && out.status.is_done() {
+            step(i, &mut env.lane, obs, out)?;
+            let ended = env.lane.done();
+            if autoreset == Autoreset::SameStep && ended {
                 last.copy_from_slice(obs);
                 if stride.is_some() {
-                    Self::start(worlds, stride, env, obs, &mut EnvStep::default())?;
+                    // The records keep the step that ended the episode.
+                    env.start(worlds, stride, obs, &mut spare(rows))?;
                 }
             }
+            env.just_ended = ended;
             Ok(())
         })?;
-        if autoreset == Autoreset::SameStep && stride.is_none() {
+        if autoreset == Autoreset::SameStep && self.stride().is_none() {
             self.restart_in_order()?;
         }
         Ok(())
     }
 
-    /// Steps every environment with its action from `actions` (one per environment).
-    pub fn step_actions(&mut self, actions: &[Action]) -> Result<(), RunError> {
-        if actions.len() != self.lanes.envs.len() {
-            return Err(RunError::ActionCount {
-                given: actions.len(),
-                envs: self.lanes.envs.len(),
-            });
-        }
-        self.step(&|i, _, _| actions[i])
-    }
-
     /// Starts the episodes that ended in this step, seeds given out in environment order.
     fn restart_in_order(&mut self) -> Result<(), RunError> {
         let mut next = self.next_seed;
-        let mut restart = vec![false; self.lanes.envs.len()];
-        let lanes = &mut self.lanes;
-        for ((env, out), flag) in lanes.envs.iter_mut().zip(&lanes.steps).zip(&mut restart) {
-            if out.status.is_done() && !out.reset {
-                env.next_seed = next;
-                next = next.wrapping_add(1);
-                *flag = true;
-            }
+        for env in self.lanes.envs.iter_mut().filter(|e| e.just_ended) {
+            env.next_seed = next;
+            next = next.wrapping_add(1);
         }
         self.next_seed = next;
-        let worlds = &self.worlds;
-        self.lanes.for_each(|i, env, obs, _, _| {
-            if restart[i] {
-                Self::start(worlds, None, env, obs, &mut EnvStep::default())
+        let (worlds, rows) = (&self.worlds, self.lanes.rows);
+        self.lanes.for_each(|_, env, obs, _, _| {
+            if env.just_ended {
+                env.start(worlds, None, obs, &mut spare(rows))
             } else {
                 Ok(())
             }
         })
     }
 
-    /// Starts `env`'s next episode into its observation row and step record; with a `stride`, the
-    /// one after it will be `stride` seeds later.
-    fn start(
-        worlds: &Worlds,
-        stride: Option<u64>,
-        env: &mut Env,
-        obs: &mut [f32],
-        out: &mut EnvStep,
-    ) -> Result<(), RunError> {
-        let seed = env.next_seed;
-        let world = worlds.world(seed);
-        let episode = world
-            .episode(seed)
-            .map_err(|source| RunError::Episode { seed, source })?;
-        obs.copy_from_slice(episode.observation());
-        *out = EnvStep::start(&episode);
-        env.shaper = Shaper::start(world, &episode);
-        env.rng = stream(seed, Stream::Policy);
-        env.episode = Some(episode);
-        if let Some(n) = stride {
-            env.next_seed = seed.wrapping_add(n);
-        }
-        Ok(())
+    /// Whether environment `i`'s episode ended in the latest step (under
+    /// [`Autoreset::SameStep`] it has restarted since, its last observations in
+    /// [`BatchOf::final_observations`]); false once a reset or restart started it afresh.
+    pub fn ended(&self, i: usize) -> bool {
+        self.lanes.envs.get(i).is_some_and(|e| e.just_ended)
     }
 
-    /// Observations, one row of [`Batch::observation_size`] values per environment.
+    /// Environment `i`'s state, when it exists.
+    fn lane(&self, i: usize) -> Option<&E> {
+        self.lanes.envs.get(i).map(|e| &e.lane)
+    }
+
+    /// Observations, [`BatchOf::rows`] rows of [`BatchOf::observation_size`] values per environment
+    /// (a team robot's row is zeros past its own observation's length).
     pub fn observations(&self) -> &[f32] {
         &self.lanes.observations
     }
@@ -451,14 +403,9 @@ impl Batch {
         &self.lanes.final_observations
     }
 
-    /// Each environment's latest reset or step.
-    pub fn steps(&self) -> &[EnvStep] {
+    /// Each row's latest reset or step: environment `i`'s row `k` at `i R + k`.
+    pub fn steps(&self) -> &[E::Record] {
         &self.lanes.steps
-    }
-
-    /// Environment `i`'s current episode, once started.
-    pub fn episode(&self, i: usize) -> Option<&Episode> {
-        self.lanes.envs.get(i).and_then(|e| e.episode.as_ref())
     }
 
     /// Number of environments.
@@ -471,7 +418,12 @@ impl Batch {
         self.lanes.envs.is_empty()
     }
 
-    /// Length of one observation.
+    /// Rows an environment takes: 1 for a lone robot, its robots for a team.
+    pub fn rows(&self) -> usize {
+        self.lanes.rows
+    }
+
+    /// Length of an observation row.
     pub fn observation_size(&self) -> usize {
         self.lanes.observation_size
     }
@@ -487,52 +439,59 @@ impl Batch {
     }
 }
 
-impl Drop for Lanes {
+/// Records for a start whose own are not kept (an episode restarted in the step that ended the
+/// one before: the step's records stay).
+fn spare<R: Default + Copy>(rows: usize) -> Vec<R> {
+    vec![R::default(); rows]
+}
+
+impl<E: Lane> Drop for Lanes<E> {
     /// Ends a pool thread's lingering (see [`LINGER`]) at once.
     fn drop(&mut self) {
         self.begun.fetch_add(1, Ordering::Release);
     }
 }
 
-impl Lanes {
+impl<E: Lane> Lanes<E> {
     /// Notes whether the caller came back within [`LINGER`] of its last call's end.
     fn arrive(&mut self) {
         self.quick = self.ended.is_some_and(|t| t.elapsed() < LINGER);
     }
 
-    /// Runs `f` on every environment with its index, observation row, final-observation row and
-    /// step record, in runs of [`MIN_PER_TASK`] to [`RUN`] environments: the calling thread
-    /// takes runs one after another, and so do the pool's threads once they wake (without a
-    /// pool, or for a small batch, too little work to wake another thread for, the calling
-    /// thread steps every environment as one run). The calling thread starts
+    /// Runs `f` on every environment with its index, observation rows, final-observation rows
+    /// and step records, in runs of [`MIN_PER_TASK`] to [`RUN`] rows (at least one environment):
+    /// the calling thread takes runs one after another, and so do the pool's threads once they
+    /// wake (without a pool, or for a small batch, too little work to wake another thread for,
+    /// the calling thread steps every environment as one run). The calling thread starts
     /// at once instead of waiting for the pool to wake and then for it to finish. The first
     /// error in environment order wins.
     fn for_each(
         &mut self,
-        f: impl Fn(usize, &mut Env, &mut [f32], &mut [f32], &mut EnvStep) -> Result<(), RunError> + Sync,
+        f: impl Fn(usize, &mut Env<E>, &mut [f32], &mut [f32], &mut [E::Record]) -> Result<(), RunError>
+            + Sync,
     ) -> Result<(), RunError> {
-        let d = self.observation_size;
+        let (rows, d) = (self.rows, self.observation_size);
         let n = self.envs.len();
-        let Some(pool) = self.pool.as_ref().filter(|_| n > MIN_PER_TASK) else {
+        let Some(pool) = self.pool.as_ref().filter(|_| n * rows > MIN_PER_TASK) else {
             let all = Run {
                 envs: &mut self.envs,
                 obs: &mut self.observations,
                 last: &mut self.final_observations,
                 out: &mut self.steps,
             };
-            let first = all.step(0, d, &f);
+            let first = all.step(0, rows, d, &f);
             return first.map_or(Ok(()), |(_, e)| Err(e));
         };
         let helpers = pool.current_num_threads();
         // Runs short enough that every thread gets a few, long enough that the environments
         // asked for ahead at a run's start are few.
-        let len = (n / (4 * (helpers + 1))).clamp(MIN_PER_TASK, RUN);
-        let runs: Vec<(usize, Run<'_>)> = self
+        let len = (n / (4 * (helpers + 1))).clamp(MIN_PER_TASK.div_ceil(rows), (RUN / rows).max(1));
+        let runs: Vec<(usize, Run<'_, E>)> = self
             .envs
             .chunks_mut(len)
-            .zip(self.observations.chunks_mut(len * d))
-            .zip(self.final_observations.chunks_mut(len * d))
-            .zip(self.steps.chunks_mut(len))
+            .zip(self.observations.chunks_mut(len * rows * d))
+            .zip(self.final_observations.chunks_mut(len * rows * d))
+            .zip(self.steps.chunks_mut(len * rows))
             .map(|(((envs, obs), last), out)| Run {
                 envs,
                 obs,
@@ -550,7 +509,7 @@ impl Lanes {
             let Some((r, run)) = next else {
                 return;
             };
-            let failed = run.step(r * len, d, &f);
+            let failed = run.step(r * len, rows, d, &f);
             if let Some((i, e)) = failed {
                 let mut slot = first.lock().unwrap_or_else(PoisonError::into_inner);
                 if slot.as_ref().is_none_or(|(j, _)| i < *j) {
@@ -598,17 +557,24 @@ impl Lanes {
     }
 }
 
-impl Run<'_> {
-    /// [`Lanes::for_each`] over this run of environments (from environment `base`, `d` values
-    /// an observation row), in order, asking for each environment's memory a few environments
-    /// ahead (see [`Episode::prefetch`]): a thousand scenes do not fit the caches, and a step
-    /// would otherwise wait on each link of the chain from the episode to the boxes near its
-    /// robot in turn.
+impl<E: Lane> Run<'_, E> {
+    /// [`Lanes::for_each`] over this run of environments (from environment `base`, `rows` rows
+    /// of `d` values an environment), in order, asking for each environment's memory a few
+    /// environments ahead (see [`Lane::prefetch`]): a thousand scenes do not fit the caches, and
+    /// a step would otherwise wait on each link of the chain from the episode to the boxes near
+    /// its robot in turn.
     fn step(
         self,
         base: usize,
+        rows: usize,
         d: usize,
-        f: &(impl Fn(usize, &mut Env, &mut [f32], &mut [f32], &mut EnvStep) -> Result<(), RunError>
+        f: &(impl Fn(
+            usize,
+            &mut Env<E>,
+            &mut [f32],
+            &mut [f32],
+            &mut [E::Record],
+        ) -> Result<(), RunError>
               + Sync),
     ) -> Option<(usize, RunError)> {
         let Self {
@@ -618,22 +584,20 @@ impl Run<'_> {
             out,
         } = self;
         let mut first = None;
+        let w = rows * d;
         for j in 0..envs.len() {
             for stage in 0..PREFETCH_STAGES {
-                if let Some(e) = envs
-                    .get(j + PREFETCH_STAGES - stage)
-                    .and_then(|e| e.episode.as_ref())
-                {
-                    e.prefetch(stage);
+                if let Some(e) = envs.get(j + PREFETCH_STAGES - stage) {
+                    e.lane.prefetch(stage);
                 }
             }
-            let row = j * d..(j + 1) * d;
+            let row = j * w..(j + 1) * w;
             let result = f(
                 base + j,
                 &mut envs[j],
                 &mut obs[row.clone()],
                 &mut last[row],
-                &mut out[j],
+                &mut out[j * rows..(j + 1) * rows],
             );
             if let (Err(e), None) = (result, &first) {
                 first = Some((base + j, e));
@@ -647,6 +611,7 @@ impl Run<'_> {
 mod tests {
     use super::*;
     use crate::config::SimConfig;
+    use crate::sim::{Action, Status};
     use crate::sim::{DiscreteAction, Scenes};
 
     fn batch(envs: usize, threads: usize, autoreset: Autoreset) -> Batch {
