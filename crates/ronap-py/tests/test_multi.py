@@ -345,3 +345,21 @@ def test_a_vector_team_copy_replays_its_masked_resets():
     b = twin.step(np.ones((2, 2), np.int64))
     for x, y in zip(a[:4], b[:4]):
         np.testing.assert_array_equal(x, y)
+
+
+def test_a_masked_reset_reports_only_its_environments_as_reset():
+    vec = ronap.VecMultiNavEnv(2, scenario=CORRIDOR, episode_max_steps=3)
+    vec.reset(seed=0)
+    infos = {"reset": np.zeros(2, bool)}
+    while not infos["reset"][0]:
+        _, _, _, _, infos = vec.step(np.ones((2, 2), np.int64))
+    # Environment 0 started its next episode in that step; a reset of environment 1 alone does
+    # not report it again.
+    _, infos = vec.reset(options={"reset_mask": np.array([False, True])})
+    assert list(infos["reset"]) == [False, True]
+    # A copy made before masked resets existed, its calls (actions, messages), still replays.
+    state = vec.__getstate__()
+    state["calls"] = [c[1:] for c in state["calls"] if c[0] == "step"]
+    old = ronap.VecMultiNavEnv.__new__(ronap.VecMultiNavEnv)
+    old.__setstate__(state)
+    assert old._calls is not None and all(c[0] == "step" for c in old._calls)

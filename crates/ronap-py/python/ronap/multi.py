@@ -390,6 +390,9 @@ class VecMultiNavEnv:
             flags = [bool(m) for m in mask]
             obs, infos = self._vec.restart([None] * self.num_envs, flags)
             self._logged(("restart", flags, None))
+            check_split_seeds(self.split, infos["seed"])
+            # Only the environments restarted now were reset.
+            infos["reset"] = infos["reset"] & mask
             return obs, infos
         if seed is None:
             seed = int(np.random.default_rng().integers(0, min(2**62, split_draw_limit(self.split, self.num_envs))))
@@ -443,12 +446,14 @@ class VecMultiNavEnv:
             self._vec.reset(state["seed"])
             self.seed_used = state["seed"]
             self._started = True
-            for kind, first, second in state["calls"]:
+            # Each call (kind, ...); a copy made before masked resets holds (actions, messages).
+            calls = [c if len(c) == 3 else ("step", *c) for c in state["calls"]]
+            for kind, first, second in calls:
                 if kind == "step":
                     self._vec.step(first, second)
                 else:
                     self._vec.restart([None] * self.num_envs, first)
-            self._calls = list(state["calls"])
+            self._calls = calls
 
     def close(self) -> None:
         pass

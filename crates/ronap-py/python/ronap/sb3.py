@@ -173,7 +173,9 @@ class TeamVecEnv(_Shared):
     reset_infos: list[dict[str, Any]]
 
     def __init__(self, num_envs: int, split: str | None = "train", **config: Any) -> None:
-        self.venv = VecMultiNavEnv(num_envs, split=split, **config)
+        # Its waiting and terminal observations follow next-step autoreset, whatever is asked.
+        config.pop("autoreset_mode", None)
+        self.venv = VecMultiNavEnv(num_envs, autoreset_mode="next_step", split=split, **config)
         self.teams: int = self.venv.num_envs
         self.robots: int = self.venv.num_agents
         super().__init__(self.teams * self.robots, self.venv.single_observation_space, self.venv.single_action_space)

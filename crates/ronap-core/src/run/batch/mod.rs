@@ -349,7 +349,7 @@ impl<E: Lane> BatchOf<E> {
                 last.copy_from_slice(obs);
                 if stride.is_some() {
                     // The records keep the step that ended the episode.
-                    env.start(worlds, stride, obs, &mut spare(rows))?;
+                    with_spare(rows, |spare| env.start(worlds, stride, obs, spare))?;
                 }
             }
             env.just_ended = ended;
@@ -372,7 +372,7 @@ impl<E: Lane> BatchOf<E> {
         let (worlds, rows) = (&self.worlds, self.lanes.rows);
         self.lanes.for_each(|_, env, obs, _, _| {
             if env.just_ended {
-                env.start(worlds, None, obs, &mut spare(rows))
+                with_spare(rows, |spare| env.start(worlds, None, obs, spare))
             } else {
                 Ok(())
             }
@@ -439,10 +439,14 @@ impl<E: Lane> BatchOf<E> {
     }
 }
 
-/// Records for a start whose own are not kept (an episode restarted in the step that ended the
-/// one before: the step's records stay).
-fn spare<R: Default + Copy>(rows: usize) -> Vec<R> {
-    vec![R::default(); rows]
+/// Runs `f` with `rows` records for a start whose own are not kept (an episode restarted in the
+/// step that ended the one before: the step's records stay), on the stack for up to 8 rows.
+fn with_spare<R: Default + Copy, T>(rows: usize, f: impl FnOnce(&mut [R]) -> T) -> T {
+    if rows <= 8 {
+        f(&mut [R::default(); 8][..rows])
+    } else {
+        f(&mut vec![R::default(); rows])
+    }
 }
 
 impl<E: Lane> Drop for Lanes<E> {
