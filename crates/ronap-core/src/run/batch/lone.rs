@@ -1,9 +1,9 @@
-//! A lone robot's environments in a batch ([`Batch`]): one row each, its
-//! episode stepped by the action a caller's closure chooses from its state (DQN's actors) or
-//! given in an array (the vectorised Python environment). A lone robot is its team of one, and a
+//! A lone robot's environments in a batch ([`Batch`]): one row each, its episode stepped by the
+//! action a caller's closure chooses from its state (DQN's actors) or given in an array (the
+//! vectorised Python environment). A lone robot is its team of one, and a
 //! [`TeamBatch`](super::TeamBatch) over a configuration without `[[robots]]` steps the same bits
-//! (tested in `team.rs`); this kind steps the episode directly, without the team's bookkeeping, which
-//! the vectorised environment's speed does not leave room for.
+//! (tested in `team.rs`). This kind steps the episode directly, without the team's bookkeeping,
+//! which the vectorised environment's speed does not leave room for.
 
 use super::{BatchOf, BatchOptions, Lane};
 use crate::geometry::Point;
