@@ -1,14 +1,16 @@
 //! Criterion benchmark of a big team: 1000 robots, each with a 64-beam 360-degree laser of range
 //! 200 px, in a 40 x 40 maze of 100 px cells (issue target: one step of all robots in at most
 //! 2 ms on one core). Robots drive the `ronap bench` action pattern, each at its own phase, and
-//! stay in the scene; the episode never ends (no time-out, no deadlock).
+//! stay in the scene; the episode never ends (no time-out, no deadlock). Beside it, the engine of
+//! `VecMultiNavEnv`: 64 teams of 8 robots of the default maze stepped side by side, with
+//! next-step autoreset, on one thread and on every core.
 //!
 //! `cargo bench -p ronap-core --bench team`.
 
 use common::{big_maze, PATTERN};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use ronap_core::config::{SimConfig, TeamRobotConfig};
-use ronap_core::run::TeamRollout;
+use ronap_core::run::{Autoreset, BatchOptions, SeedOrder, TeamBatch, TeamRollout};
 use ronap_core::sim::{Action, DiscreteAction, Scenes, Worlds};
 use std::time::Duration;
 
@@ -53,11 +55,53 @@ fn team(c: &mut Criterion) {
     group.finish();
 }
 
+/// `VecMultiNavEnv`'s engine without Python: 64 environments of a team of 8 robots in the default
+/// maze (each environment its own maze), every robot driving the action pattern at its own
+/// phase; the figure is per step of all 512 robots.
+fn batch(c: &mut Criterion) {
+    let mut group = c.benchmark_group("team_batch");
+    group.throughput(Throughput::Elements(512));
+    let mut config = SimConfig::default();
+    config.robots = vec![TeamRobotConfig {
+        count: 8,
+        ..TeamRobotConfig::default()
+    }];
+    let config = config.validate().expect("valid");
+    for (name, threads) in [("step_64x8_one_thread", 1), ("step_64x8_all_threads", 0)] {
+        let worlds = Worlds::new(config.clone(), Scenes::MazePerSeed);
+        let options = BatchOptions {
+            envs: 64,
+            threads,
+            autoreset: Autoreset::NextStep,
+            seed_order: SeedOrder::Strided,
+        };
+        let mut batch = TeamBatch::new(worlds, options).expect("a pool");
+        batch.reset(0).expect("room for every team");
+        let actions: Vec<Vec<Action>> = (0..PATTERN.len())
+            .map(|k| {
+                (0..512)
+                    .map(|j| DiscreteAction::ALL[PATTERN[(k + j) % PATTERN.len()]].into())
+                    .collect()
+            })
+            .collect();
+        let mut k = 0;
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                k += 1;
+                batch
+                    .step(&actions[k % actions.len()], None)
+                    .expect("steps")
+            })
+        });
+    }
+    group.finish();
+}
+
 // The macro defines an undocumented `benches` function.
 #[allow(missing_docs)]
 mod group {
     use super::*;
-    criterion_group!(benches, team);
+    criterion_group!(benches, team, batch);
 }
 use group::benches;
 criterion_main!(benches);
