@@ -61,11 +61,13 @@ fn team(c: &mut Criterion) {
 fn batch(c: &mut Criterion) {
     let mut group = c.benchmark_group("team_batch");
     group.throughput(Throughput::Elements(512));
-    let mut config = SimConfig::default();
-    config.robots = vec![TeamRobotConfig {
-        count: 8,
-        ..TeamRobotConfig::default()
-    }];
+    let config = SimConfig {
+        robots: vec![TeamRobotConfig {
+            count: 8,
+            ..TeamRobotConfig::default()
+        }],
+        ..SimConfig::default()
+    };
     let config = config.validate().expect("valid");
     for (name, threads) in [("step_64x8_one_thread", 1), ("step_64x8_all_threads", 0)] {
         let worlds = Worlds::new(config.clone(), Scenes::MazePerSeed);
