@@ -450,29 +450,15 @@ fn mlp(c: &mut Criterion) {
 /// stepped side by side with a fixed action pattern, on one thread and on every core. The figure
 /// is per step of all 1024; divide 1024 by it for env-steps/s.
 fn batch(c: &mut Criterion) {
-    use ronap_core::run::{Autoreset, Batch, BatchOptions, SeedOrder};
+    use ronap_core::run::Batch;
     use ronap_core::sim::{Scenes, Worlds};
     let mut group = c.benchmark_group("batch");
     group.throughput(Throughput::Elements(1024));
     for (name, threads) in [("step_1024_one_thread", 1), ("step_1024_all_threads", 0)] {
         let worlds = Worlds::new(ValidConfig::default(), Scenes::MazePerSeed);
-        let options = BatchOptions {
-            envs: 1024,
-            threads,
-            autoreset: Autoreset::NextStep,
-            seed_order: SeedOrder::Strided,
-        };
-        let mut batch = Batch::new(worlds, options).expect("a pool");
+        let mut batch = Batch::new(worlds, common::batch_options(1024, threads)).expect("a pool");
         batch.reset(0).expect("places");
-        let actions: Vec<Vec<ronap_core::Action>> = (0..PATTERN.len())
-            .map(|k| {
-                (0..1024)
-                    .map(|i| {
-                        ronap_core::DiscreteAction::ALL[PATTERN[(k + i) % PATTERN.len()]].into()
-                    })
-                    .collect()
-            })
-            .collect();
+        let actions = common::pattern_actions(1024);
         let mut k = 0;
         group.bench_function(name, |b| {
             b.iter(|| {

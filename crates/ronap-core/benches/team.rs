@@ -10,7 +10,7 @@
 use common::{big_maze, PATTERN};
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use ronap_core::config::{SimConfig, TeamRobotConfig};
-use ronap_core::run::{Autoreset, BatchOptions, SeedOrder, TeamBatch, TeamRollout};
+use ronap_core::run::{TeamBatch, TeamRollout};
 use ronap_core::sim::{Action, DiscreteAction, Scenes, Worlds};
 use std::time::Duration;
 
@@ -71,21 +71,10 @@ fn batch(c: &mut Criterion) {
     let config = config.validate().expect("valid");
     for (name, threads) in [("step_64x8_one_thread", 1), ("step_64x8_all_threads", 0)] {
         let worlds = Worlds::new(config.clone(), Scenes::MazePerSeed);
-        let options = BatchOptions {
-            envs: 64,
-            threads,
-            autoreset: Autoreset::NextStep,
-            seed_order: SeedOrder::Strided,
-        };
+        let options = common::batch_options(64, threads);
         let mut batch = TeamBatch::new(worlds, options).expect("a pool");
         batch.reset(0).expect("room for every team");
-        let actions: Vec<Vec<Action>> = (0..PATTERN.len())
-            .map(|k| {
-                (0..512)
-                    .map(|j| DiscreteAction::ALL[PATTERN[(k + j) % PATTERN.len()]].into())
-                    .collect()
-            })
-            .collect();
+        let actions = common::pattern_actions(512);
         let mut k = 0;
         group.bench_function(name, |b| {
             b.iter(|| {

@@ -1,5 +1,5 @@
 //! What the benchmarks share: the `ronap bench` action pattern, the big maze and laser of the
-//! 1000-robot team, and a timed step of one episode after another.
+//! 1000-robot team, a timed step of one episode after another, and a batch's set-up.
 
 // Each benchmark uses a part of this module.
 #![allow(dead_code)]
@@ -12,6 +12,28 @@ use std::sync::Arc;
 
 /// The action pattern `ronap bench` uses too: mostly ahead, some turns.
 pub const PATTERN: [usize; 8] = [1, 1, 1, 0, 1, 1, 2, 1];
+
+/// How the batch benchmarks run `envs` environments on `threads` threads: next-step autoreset,
+/// strided seeds.
+pub fn batch_options(envs: usize, threads: usize) -> ronap_core::run::BatchOptions {
+    ronap_core::run::BatchOptions {
+        envs,
+        threads,
+        autoreset: ronap_core::run::Autoreset::NextStep,
+        seed_order: ronap_core::run::SeedOrder::Strided,
+    }
+}
+
+/// A step's actions for `rows` robots for each phase of [`PATTERN`], row `j` at phase `k + j`.
+pub fn pattern_actions(rows: usize) -> Vec<Vec<ronap_core::Action>> {
+    (0..PATTERN.len())
+        .map(|k| {
+            (0..rows)
+                .map(|j| ronap_core::DiscreteAction::ALL[PATTERN[(k + j) % PATTERN.len()]].into())
+                .collect()
+        })
+        .collect()
+}
 
 /// The default configuration in a 40 x 40 maze with 64-beam 360-degree lasers of range 200 px
 /// (`robots-1000.toml`'s scene and lasers, its robots still to add).
