@@ -2,10 +2,13 @@
 //! defaults: the Python wrappers name every option, and a function of many options keeps a short
 //! Rust signature. An option the function does not know is an error naming it.
 
+use crate::errors::ConfigError;
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use ronap_core::run::Autoreset;
+use ronap_core::run::{Autoreset, BatchOf, BatchOptions, Lane, SeedOrder};
+use ronap_core::sim::Worlds;
+use ronap_core::ValidConfig;
 
 /// The options left to take.
 pub struct Options<'py> {
@@ -48,17 +51,36 @@ impl<'py> Options<'py> {
         ))
     }
 
-    /// `autoreset` ("next_step" unless given; "same_step", "disabled") as the batch's mode.
-    pub fn autoreset(&self) -> PyResult<Autoreset> {
+    /// The batch of `num_envs` environments (at least 1) under `config` a vector class runs on,
+    /// from the options every such class takes: `maze_seed`, `map_path`, `threads` (0: all cores)
+    /// and `autoreset` ("next_step" unless given; "same_step", "disabled"). Takes the last
+    /// options, so the caller takes its own first; seeds are strided.
+    pub fn batch<E: Lane>(self, num_envs: usize, config: &ValidConfig) -> PyResult<BatchOf<E>> {
+        let (maze_seed, map_path, threads) = self.scene_and_threads()?;
         let mode: String = self.take("autoreset", "next_step".to_string())?;
-        match mode.as_str() {
-            "next_step" => Ok(Autoreset::NextStep),
-            "same_step" => Ok(Autoreset::SameStep),
-            "disabled" => Ok(Autoreset::Disabled),
-            other => Err(crate::errors::ConfigError::new_err(format!(
+        self.finish()?;
+        let autoreset = match mode.as_str() {
+            "next_step" => Autoreset::NextStep,
+            "same_step" => Autoreset::SameStep,
+            "disabled" => Autoreset::Disabled,
+            other => {
+                return Err(ConfigError::new_err(format!(
                 "autoreset_mode {other:?}: expected \"next_step\", \"same_step\" or \"disabled\""
-            ))),
+            )))
+            }
+        };
+        if num_envs == 0 {
+            return Err(ConfigError::new_err("num_envs = 0: must be at least 1"));
         }
+        let (_, scenes, _) = crate::conv::scenes(config, maze_seed, map_path.as_deref())?;
+        let options = BatchOptions {
+            envs: num_envs,
+            threads,
+            autoreset,
+            seed_order: SeedOrder::Strided,
+        };
+        BatchOf::new(Worlds::new(config.clone(), scenes), options)
+            .map_err(|e| crate::errors::RonapError::new_err(e.to_string()))
     }
 
     /// Fails naming any option not taken.

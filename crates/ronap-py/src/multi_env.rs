@@ -7,8 +7,8 @@ use crate::team_env::TeamEnv;
 use numpy::{PyArray1, PyArray3, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use ronap_core::run::{Autoreset, BatchOptions, RobotStep, SeedOrder, TeamBatch};
-use ronap_core::sim::{Action, Team, Worlds};
+use ronap_core::run::{RobotStep, TeamBatch};
+use ronap_core::sim::{Action, Team};
 
 /// Several robots in one scene, an episode at a time, on the core `Env` shares ([`TeamEnv`]).
 #[pyclass(module = "ronap._ronap")]
@@ -270,33 +270,14 @@ impl VecMultiEnv {
         config: &Config,
         options: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        // maze_seed, map_path, threads and autoreset.
-        let o = crate::kwargs::Options::new("VecMultiEnv", options);
-        let (maze_seed, map_path, threads) = o.scene_and_threads()?;
-        let autoreset = o.autoreset()?;
-        o.finish()?;
-        if num_envs == 0 {
-            return Err(errors::ConfigError::new_err(
-                "num_envs = 0: must be at least 1",
-            ));
-        }
         let valid = config.valid();
         if valid.team_size() == 0 {
             return Err(errors::ConfigError::new_err(
                 "VecMultiNavEnv needs a team: a scenario with [[robots]] entries",
             ));
         }
-        let (_, scenes, _) = conv::scenes(valid, maze_seed, map_path.as_deref())?;
-        let batch = TeamBatch::new(
-            Worlds::new(valid.clone(), scenes),
-            BatchOptions {
-                envs: num_envs,
-                threads,
-                autoreset,
-                seed_order: SeedOrder::Strided,
-            },
-        )
-        .map_err(|e| errors::run(&e))?;
+        let o = crate::kwargs::Options::new("VecMultiEnv", options);
+        let batch: TeamBatch = o.batch(num_envs, valid)?;
         Ok(Self { batch })
     }
 
@@ -389,9 +370,7 @@ impl VecMultiEnv {
         let (obs, infos) = self.arrays(py)?;
         // Same-step autoreset: the episodes this step ended have restarted; their last
         // observations go in the infos.
-        let restarted: Vec<bool> = (0..n)
-            .map(|i| self.batch.options().autoreset == Autoreset::SameStep && self.batch.ended(i))
-            .collect();
+        let restarted: Vec<bool> = (0..n).map(|i| self.batch.restarted(i)).collect();
         if restarted.contains(&true) {
             let d = self.batch.observation_size();
             let last =

@@ -9,8 +9,8 @@ use numpy::{PyArray1, PyArrayMethods, PyFixedUnicode, PyReadonlyArray1, PyReadon
 use pyo3::intern;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use ronap_core::run::{Autoreset, Batch, BatchOptions, EnvStep, RunError, SeedOrder};
-use ronap_core::sim::{continuous_action, Worlds};
+use ronap_core::run::{Batch, EnvStep, RunError};
+use ronap_core::sim::continuous_action;
 use ronap_core::{Action, Point, Status};
 
 /// Many RoNAP environments stepped together.
@@ -134,23 +134,18 @@ pub(crate) fn run_error(e: &RunError) -> PyErr {
 }
 
 impl VecEnv {
-    /// Whether the step `s` ended an episode that same-step autoreset then restarted.
-    fn restarted(&self, s: &EnvStep) -> bool {
-        self.batch.options().autoreset == Autoreset::SameStep && !s.reset && s.status.is_done()
-    }
-
     /// Each environment's current state: the step it took, or the start of the episode that
     /// replaced the one it ended (the step records themselves, uncopied, when none was).
     fn current(&self) -> std::borrow::Cow<'_, [EnvStep]> {
         let steps = self.batch.steps();
-        if !steps.iter().any(|s| self.restarted(s)) {
+        if !(0..steps.len()).any(|i| self.batch.restarted(i)) {
             return std::borrow::Cow::Borrowed(steps);
         }
         steps
             .iter()
             .enumerate()
             .map(|(i, s)| match self.batch.episode(i) {
-                Some(e) if self.restarted(s) => EnvStep::start(e),
+                Some(e) if self.batch.restarted(i) => EnvStep::start(e),
                 _ => *s,
             })
             .collect()
@@ -181,12 +176,7 @@ impl VecEnv {
         let current = self.current();
         let obs = PyArray1::from_slice(py, self.batch.observations()).reshape([n, d])?;
         let info = infos(py, &current)?;
-        let ended: Vec<bool> = self
-            .batch
-            .steps()
-            .iter()
-            .map(|s| self.restarted(s))
-            .collect();
+        let ended: Vec<bool> = (0..n).map(|i| self.batch.restarted(i)).collect();
         let finals = if ended.contains(&true) {
             let last = PyArray1::from_slice(py, self.batch.final_observations()).reshape([n, d])?;
             Some((
@@ -213,28 +203,11 @@ impl VecEnv {
         config: &Config,
         options: Option<&Bound<'_, pyo3::types::PyDict>>,
     ) -> PyResult<Self> {
-        // maze_seed, map_path, threads, autoreset, continuous and render.
+        // continuous and render, then maze_seed, map_path, threads and autoreset.
         let o = crate::kwargs::Options::new("VecEnv", options);
-        let (maze_seed, map_path, threads) = o.scene_and_threads()?;
-        let autoreset = o.autoreset()?;
         let continuous: bool = o.take("continuous", false)?;
         let render: bool = o.take("render", false)?;
-        o.finish()?;
-        let map_path = map_path.as_deref();
-        if num_envs == 0 {
-            return Err(errors::ConfigError::new_err(
-                "num_envs = 0: must be at least 1",
-            ));
-        }
-        let (_, scenes, _) = conv::scenes(config.valid(), maze_seed, map_path)?;
-        let options = BatchOptions {
-            envs: num_envs,
-            threads,
-            autoreset,
-            seed_order: SeedOrder::Strided,
-        };
-        let batch = Batch::new(Worlds::new(config.valid().clone(), scenes), options)
-            .map_err(|e| errors::RonapError::new_err(e.to_string()))?;
+        let batch: Batch = o.batch(num_envs, config.valid())?;
         Ok(Self {
             batch,
             continuous,

@@ -38,9 +38,9 @@ pub struct TeamRecord {
     pub robot_collisions: u32,
     /// Whether it ended in a deadlock.
     pub deadlock: bool,
-    /// Each robot's record (each with its [`InTeam`](crate::eval::InTeam)), in robot order: its poses (while it is in
-    /// the scene) when the trajectory was recorded, the steps it acted when steps were, and its
-    /// last readings when either was.
+    /// Each robot's record (each with its [`InTeam`](crate::eval::InTeam)), in robot order: its
+    /// poses (while it is in the scene) when the trajectory was recorded, the steps it acted when
+    /// steps were, and its last readings when either was.
     pub robots: Vec<EpisodeRecord>,
     /// Wall time, seconds.
     pub wall_time_s: f64,

@@ -391,8 +391,6 @@ class VecMultiNavEnv:
             obs, infos = self._vec.restart([None] * self.num_envs, flags)
             self._logged(("restart", flags, None))
             check_split_seeds(self.split, infos["seed"])
-            # Only the environments restarted now were reset.
-            infos["reset"] = infos["reset"] & mask
             return obs, infos
         if seed is None:
             seed = int(np.random.default_rng().integers(0, min(2**62, split_draw_limit(self.split, self.num_envs))))

@@ -5,7 +5,7 @@
 //! (tested in `team.rs`). This kind steps the episode directly, without the team's bookkeeping,
 //! which the vectorised environment's speed does not leave room for.
 
-use super::{BatchOf, BatchOptions, Lane};
+use super::{BatchOf, Lane};
 use crate::geometry::Point;
 use crate::run::shaping::Shaper;
 use crate::run::RunError;
@@ -168,11 +168,6 @@ impl Lone {
 }
 
 impl BatchOf<Lone> {
-    /// A batch of `options.envs` lone robots' environments in `worlds`, none started yet.
-    pub fn new(worlds: Worlds, options: BatchOptions) -> Result<Self, RunError> {
-        Self::with_options(worlds, options)
-    }
-
     /// Steps every environment: `choose(i, episode, rng)` gives environment `i`'s action for its
     /// episode's current state, drawing any randomness from `rng` (the episode seed's policy
     /// stream). Environments waiting for a next-step reset start their next episode instead.
@@ -181,10 +176,7 @@ impl BatchOf<Lone> {
         choose: &(dyn Fn(usize, &Episode, &mut Rng) -> Action + Sync),
     ) -> Result<(), RunError> {
         self.call(|batch| {
-            batch.step_each(|i, lone, obs, out| {
-                lone.step(i, choose, obs, &mut out[0]);
-                Ok(())
-            })
+            batch.step_each(|i, lone, obs, out| lone.step(i, choose, obs, &mut out[0]))
         })
     }
 

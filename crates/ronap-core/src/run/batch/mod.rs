@@ -121,6 +121,8 @@ struct Env<E> {
     next_seed: u64,
     /// Its episode ended in the latest step (it was stepped, not started, in it).
     just_ended: bool,
+    /// Its episode started in the latest call (a reset, a restart or an automatic reset).
+    fresh: bool,
 }
 
 impl<E: Lane> Env<E> {
@@ -135,6 +137,7 @@ impl<E: Lane> Env<E> {
     ) -> Result<(), RunError> {
         let seed = self.next_seed;
         self.lane.start(worlds, seed, obs, out)?;
+        self.fresh = true;
         if let Some(n) = stride {
             self.next_seed = seed.wrapping_add(n);
         }
@@ -183,8 +186,10 @@ struct Lanes<E: Lane> {
 }
 
 impl<E: Lane> BatchOf<E> {
-    /// A batch of `options.envs` environments in `worlds`, none started yet.
-    fn with_options(worlds: Worlds, options: BatchOptions) -> Result<Self, RunError> {
+    /// A batch of `options.envs` environments in `worlds`, none started yet (for a
+    /// [`TeamBatch`], a configuration without `[[robots]]` makes each the lone robot's team of
+    /// one).
+    pub fn new(worlds: Worlds, options: BatchOptions) -> Result<Self, RunError> {
         let n = options.envs.max(1);
         // The calling thread steps too, so the pool holds one thread fewer than asked for. All
         // cores means rayon's own default: `RAYON_NUM_THREADS` where set, else every core.
@@ -218,6 +223,7 @@ impl<E: Lane> BatchOf<E> {
                         lane: E::idle(&worlds),
                         next_seed: 0,
                         just_ended: false,
+                        fresh: false,
                     })
                     .collect(),
                 rows,
@@ -299,6 +305,7 @@ impl<E: Lane> BatchOf<E> {
         self.next_seed = next;
         let worlds = &self.worlds;
         self.lanes.for_each(|i, env, obs, _, out| {
+            env.fresh = false;
             if which[i] {
                 env.just_ended = false;
                 env.start(worlds, stride, obs, out)
@@ -314,12 +321,13 @@ impl<E: Lane> BatchOf<E> {
     }
 
     /// One step of every environment, `step(i, lane, obs, out)` stepping environment `i` (its
-    /// observation rows and records) as its kind does, with the batch's autoreset around it:
+    /// observation rows and records) as its kind does (a step cannot fail), with the batch's
+    /// autoreset around it:
     /// environments never started start first, and environments whose episode ended start their
     /// next one on the following step, in the same step or never, as the batch is set.
     fn step_each(
         &mut self,
-        step: impl Fn(usize, &mut E, &mut [f32], &mut [E::Record]) -> Result<(), RunError> + Sync,
+        step: impl Fn(usize, &mut E, &mut [f32], &mut [E::Record]) + Sync,
     ) -> Result<(), RunError> {
         if self.lanes.envs.iter().any(|e| !e.lane.started()) {
             // Nothing started yet (no reset): start what is missing, as a reset with the seeds
@@ -340,10 +348,11 @@ impl<E: Lane> BatchOf<E> {
         let (worlds, stride, rows) = (&self.worlds, self.stride(), self.lanes.rows);
         self.lanes.for_each(|i, env, obs, last, out| {
             env.just_ended = false;
+            env.fresh = false;
             if autoreset == Autoreset::NextStep && env.lane.done() {
                 return env.start(worlds, stride, obs, out);
             }
-            step(i, &mut env.lane, obs, out)?;
+            step(i, &mut env.lane, obs, out);
             let ended = env.lane.done();
             if autoreset == Autoreset::SameStep && ended {
                 last.copy_from_slice(obs);
@@ -384,6 +393,19 @@ impl<E: Lane> BatchOf<E> {
     /// [`BatchOf::final_observations`]); false once a reset or restart started it afresh.
     pub fn ended(&self, i: usize) -> bool {
         self.lanes.envs.get(i).is_some_and(|e| e.just_ended)
+    }
+
+    /// Whether same-step autoreset restarted environment `i` in the latest step: its episode
+    /// ended there, its last observations are in [`BatchOf::final_observations`], and its rows
+    /// show the next episode's start while its records keep the step that ended the last.
+    pub fn restarted(&self, i: usize) -> bool {
+        self.options.autoreset == Autoreset::SameStep && self.ended(i)
+    }
+
+    /// Whether environment `i`'s episode started in the latest call: a reset, a restart that
+    /// chose it, or an automatic reset.
+    pub fn was_reset(&self, i: usize) -> bool {
+        self.lanes.envs.get(i).is_some_and(|e| e.fresh)
     }
 
     /// Environment `i`'s state, when it exists.

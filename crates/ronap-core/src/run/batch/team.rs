@@ -6,7 +6,7 @@
 //! `[[robots]]`, each environment is the lone robot's team of one, and steps the same bits as a
 //! [`Batch`](crate::run::Batch) of lone robots (tested below).
 
-use super::{BatchOf, BatchOptions, Lane};
+use super::{BatchOf, Lane};
 use crate::run::team::TeamRollout;
 use crate::run::{RunError, TeamShaper};
 use crate::sim::{Action, Status, Worlds};
@@ -38,8 +38,6 @@ pub struct Teams {
     rollout: Option<TeamRollout>,
     /// Its robots' reward shaping, under `reward.shaping`.
     shaping: TeamShaper,
-    /// Whether the latest call started this environment's episode.
-    reset: bool,
 }
 
 impl Lane for Teams {
@@ -49,7 +47,6 @@ impl Lane for Teams {
         Self {
             rollout: None,
             shaping: TeamShaper::default(),
-            reset: false,
         }
     }
 
@@ -72,7 +69,6 @@ impl Lane for Teams {
         out: &mut [RobotStep],
     ) -> Result<(), RunError> {
         let rollout = TeamRollout::placed(worlds.config(), worlds.team(seed), seed)?;
-        self.reset = true;
         write(&rollout, obs, out);
         self.shaping = TeamShaper::start(&rollout);
         for o in out.iter_mut() {
@@ -107,7 +103,6 @@ impl Teams {
         let Some(rollout) = self.rollout.as_mut() else {
             return;
         };
-        self.reset = false;
         let m = messages.map_or(0, |all| all.len() / actions.len().max(1));
         let mut chosen = Vec::with_capacity(actions.len());
         for (k, (&a, o)) in actions.iter().zip(out.iter_mut()).enumerate() {
@@ -147,12 +142,6 @@ fn write(rollout: &TeamRollout, obs: &mut [f32], out: &mut [RobotStep]) {
 }
 
 impl BatchOf<Teams> {
-    /// A batch of `options.envs` team environments in `worlds` (a configuration without
-    /// `[[robots]]` makes each the lone robot's team of one), none started yet.
-    pub fn new(worlds: Worlds, options: BatchOptions) -> Result<Self, RunError> {
-        Self::with_options(worlds, options)
-    }
-
     /// Steps every environment: `actions[i R + k]` is robot `k` of environment `i`'s action
     /// (ignored for robots that are done); `messages`, when given, `N x R x message_size`
     /// floats, their messages for the next broadcast. Environments waiting for a next-step
@@ -182,7 +171,6 @@ impl BatchOf<Teams> {
                     .filter(|_| m > 0)
                     .map(|all| &all[mine.start * m..mine.end * m]);
                 teams.step(&actions[mine], said, obs, out);
-                Ok(())
             })
         })
     }
@@ -190,11 +178,6 @@ impl BatchOf<Teams> {
     /// Environment `i`'s current episode, once started.
     pub fn rollout(&self, i: usize) -> Option<&TeamRollout> {
         self.lane(i).and_then(|t| t.rollout.as_ref())
-    }
-
-    /// Whether environment `i`'s latest call started a new episode.
-    pub fn was_reset(&self, i: usize) -> bool {
-        self.lane(i).is_some_and(|t| t.reset)
     }
 
     /// Robots per environment.
@@ -212,7 +195,7 @@ impl BatchOf<Teams> {
 mod tests {
     use super::*;
     use crate::config::{SimConfig, TeamRobotConfig};
-    use crate::run::{Autoreset, SeedOrder};
+    use crate::run::{Autoreset, BatchOptions, SeedOrder};
     use crate::sim::{DiscreteAction, Scenes};
 
     fn options(envs: usize, threads: usize) -> BatchOptions {
