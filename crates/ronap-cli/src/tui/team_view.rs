@@ -11,7 +11,7 @@
 
 use crate::args::TeamPolicies;
 use crate::tui::draw::{self, SceneMode};
-use crate::tui::view::{Controls, Ending, Watched};
+use crate::tui::view::{self, Controls, Ending, Watched};
 use anyhow::Result;
 use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::{Line, Span};
@@ -155,16 +155,19 @@ fn message(state: &TeamViewState) -> Option<(String, Color)> {
     })
 }
 
-/// The keys of the team view and what they do.
-const KEYS: [(&str, &str); 7] = [
-    ("space", "pause / resume"),
-    ("+ -", "faster / slower"),
-    ("tab", "follow the next robot"),
-    ("m", "whole scene / first person"),
-    ("s", "one step, when paused"),
-    ("r n", "restart / next seed"),
-    ("q", "quit"),
-];
+/// The keys of the team view and what they do: the view's, and Tab after the speed keys.
+const KEYS: [(&str, &str); 7] = {
+    let [pause, speed, map, one, restart, quit] = view::KEYS;
+    [
+        pause,
+        speed,
+        ("tab", "follow the next robot"),
+        map,
+        one,
+        restart,
+        quit,
+    ]
+};
 
 /// The side panel: the team, then the followed robot, the legend and the keys.
 fn side_panel(state: &TeamViewState, controls: &Controls) -> draw::SidePanel<'static> {

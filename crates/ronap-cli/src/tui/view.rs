@@ -231,6 +231,16 @@ fn message(state: &ViewState, speed: u32) -> Option<(String, Color)> {
     })
 }
 
+/// The keys of the view and what they do (the team view adds its own to these).
+pub(crate) const KEYS: [(&str, &str); 6] = [
+    ("space", "pause / resume"),
+    ("+ -", "faster / slower"),
+    ("m", "whole scene / first person"),
+    ("s", "one step, when paused"),
+    ("r n", "restart / next seed"),
+    ("q", "quit"),
+];
+
 /// The side panel's lines.
 fn side_lines(state: &ViewState, controls: &Controls) -> Vec<Line<'static>> {
     let e = state.episode();
@@ -248,18 +258,7 @@ fn side_lines(state: &ViewState, controls: &Controls) -> Vec<Line<'static>> {
         draw::field("path", format!("{:.1} px", e.path_length_px())),
         draw::field("speed", format!("{} steps/s", controls.speed)),
     ];
-    draw::side_panel(
-        lines,
-        e.movers().is_some(),
-        &[
-            ("space", "pause / resume"),
-            ("+ -", "faster / slower"),
-            ("m", "whole scene / first person"),
-            ("s", "one step, when paused"),
-            ("r n", "restart / next seed"),
-            ("q", "quit"),
-        ],
-    )
+    draw::side_panel(lines, e.movers().is_some(), &KEYS)
 }
 
 /// Draws the whole screen for `state` as `controls` set it.

@@ -2,12 +2,56 @@
 
 import os
 import pathlib
-from typing import Any
+from typing import Any, TypedDict
 
 import numpy as np
+from typing_extensions import Unpack
 
 __version__: str
 WALL_RGB: tuple[int, int, int]
+
+# The native functions' keyword options (`**options`), each family once; an option left out takes
+# the default in its comment.
+
+class _Scene(TypedDict, total=False):
+    maze_seed: int | None  # None: the configuration's
+    map_path: str | None  # None: the configuration's
+
+class _Threads(_Scene, total=False):
+    threads: int  # 0: all cores
+
+class _Env(_Scene, total=False):
+    continuous: bool  # False
+
+class _VecMultiEnv(_Threads, total=False):
+    autoreset: str  # "next_step"; "same_step", "disabled"
+
+class _VecEnv(_VecMultiEnv, total=False):
+    continuous: bool  # False
+    render: bool  # False
+
+class _BlockRun(_Threads, total=False):
+    force: bool  # False
+
+class _Run(_BlockRun, total=False):
+    continuous: bool  # False
+    out: str | None  # None: nothing written
+    thread_safe: bool  # False
+
+class _Evaluate(_Run, total=False):
+    png: str | None  # None
+    log_steps: bool  # False
+    batch: int  # 0
+    rows: bool  # False
+
+class _Compare(_Run, total=False):
+    runs: list[str]  # []
+    by_difficulty: bool  # False
+    bins: int  # 3
+    resamples: int  # 10000
+    sheet: int  # 6
+    players: int | None  # None: a player for every seed where the policies disagree
+    command: str | None  # None
 
 class RonapError(Exception): ...
 class ConfigError(RonapError, ValueError): ...
@@ -35,7 +79,7 @@ class Config:
     def line_of(self, message: str) -> str | None: ...
 
 class Env:
-    def __init__(self, config: Config, *, maze_seed: int | None = None, map_path: str | None = None, continuous: bool = False) -> None: ...
+    def __init__(self, config: Config, **options: Unpack[_Env]) -> None: ...
     def reset(self, seed: int) -> tuple[np.ndarray, dict[str, Any]]: ...
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]: ...
     def render(self, view: str, scale: float) -> np.ndarray: ...
@@ -45,18 +89,7 @@ class Env:
     def action_scale(self) -> list[float]: ...
 
 class VecEnv:
-    def __init__(
-        self,
-        num_envs: int,
-        config: Config,
-        *,
-        maze_seed: int | None = None,
-        map_path: str | None = None,
-        threads: int = 0,
-        autoreset: str = "next_step",
-        continuous: bool = False,
-        render: bool = False,
-    ) -> None: ...
+    def __init__(self, num_envs: int, config: Config, **options: Unpack[_VecEnv]) -> None: ...
     def reset(
         self, seeds: list[int | None], mask: list[bool] | None = None
     ) -> tuple[np.ndarray, dict[str, Any], tuple[np.ndarray, np.ndarray, dict[str, Any]] | None]: ...
@@ -74,7 +107,7 @@ class VecEnv:
     def action_scale(self) -> list[float]: ...
 
 class MultiEnv:
-    def __init__(self, config: Config, *, maze_seed: int | None = None, map_path: str | None = None, continuous: bool = False) -> None: ...
+    def __init__(self, config: Config, **options: Unpack[_Env]) -> None: ...
     def reset(self, seed: int) -> tuple[list[np.ndarray], list[dict[str, Any]]]: ...
     def step(
         self, actions: list[Any], messages: list[np.ndarray | None] | None = None
@@ -94,7 +127,7 @@ class MultiEnv:
     def steps(self) -> int: ...
 
 class VecMultiEnv:
-    def __init__(self, num_envs: int, config: Config, *, maze_seed: int | None = None, map_path: str | None = None, threads: int = 0, autoreset: str = "next_step") -> None: ...
+    def __init__(self, num_envs: int, config: Config, **options: Unpack[_VecMultiEnv]) -> None: ...
     def reset(self, seed: int) -> tuple[np.ndarray, dict[str, np.ndarray]]: ...
     def restart(self, seeds: list[int | None], mask: list[bool]) -> tuple[np.ndarray, dict[str, np.ndarray]]: ...
     def step(
@@ -113,42 +146,8 @@ def default_config_json() -> str: ...
 def split_range(name: str) -> tuple[int, int]: ...
 def maze_image(seed: int, config: Config, scale: float = 1.0) -> np.ndarray: ...
 def builtin_policies() -> list[tuple[str, str]]: ...
-def evaluate(
-    policy: Any,
-    seeds: list[int],
-    config: Config,
-    *,
-    maze_seed: int | None = None,
-    map_path: str | None = None,
-    threads: int = 0,
-    continuous: bool = False,
-    out: str | None = None,
-    png: str | None = None,
-    log_steps: bool = False,
-    thread_safe: bool = False,
-    batch: int = 0,
-    rows: bool = False,
-    force: bool = False,
-) -> dict[str, Any]: ...
-def compare(
-    policies: list[Any],
-    seeds: list[int],
-    config: Config,
-    *,
-    maze_seed: int | None = None,
-    map_path: str | None = None,
-    threads: int = 0,
-    continuous: bool = False,
-    out: str | None = None,
-    runs: list[str] = ...,
-    by_difficulty: bool = False,
-    bins: int = 3,
-    resamples: int = 10000,
-    sheet: int = 6,
-    thread_safe: bool = False,
-    command: str | None = None,
-    force: bool = False,
-) -> dict[str, Any]: ...
+def evaluate(policy: Any, seeds: list[int], config: Config, **options: Unpack[_Evaluate]) -> dict[str, Any]: ...
+def compare(policies: list[Any], seeds: list[int], config: Config, **options: Unpack[_Compare]) -> dict[str, Any]: ...
 
 def write_mlp(
     path: str, weights: list[np.ndarray], biases: list[np.ndarray], activation: str, metadata: dict[str, str]
@@ -163,17 +162,6 @@ def orca_step(
 def check_policy(policy: Any, config: Config, seeds: list[int] | None = None) -> None: ...
 
 class BlockRun:
-    def __init__(
-        self,
-        out: str | os.PathLike[str],
-        policy: Any,
-        seeds: list[int],
-        config: Config,
-        *,
-        maze_seed: int | None = None,
-        map_path: str | None = None,
-        threads: int = 0,
-        force: bool = False,
-    ) -> None: ...
+    def __init__(self, out: str | os.PathLike[str], policy: Any, seeds: list[int], config: Config, **options: Unpack[_BlockRun]) -> None: ...
     def add(self, rows: list[tuple[int, list[str], list[str], list[str]]]) -> None: ...
     def finish(self, wall_time_s: float) -> tuple[dict[str, Any], str]: ...
