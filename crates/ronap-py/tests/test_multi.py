@@ -362,4 +362,4 @@ def test_a_masked_reset_reports_only_its_environments_as_reset():
     state["calls"] = [c[1:] for c in state["calls"] if c[0] == "step"]
     old = ronap.VecMultiNavEnv.__new__(ronap.VecMultiNavEnv)
     old.__setstate__(state)
-    assert old._calls is not None and all(c[0] == "step" for c in old._calls)
+    assert old._log.calls is not None and all(c[0] == "step" for c in old._log.calls)

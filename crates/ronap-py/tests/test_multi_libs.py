@@ -18,6 +18,7 @@ import ronap
 ROOT = Path(__file__).resolve().parents[3]
 WAREHOUSE = str(ROOT / "scenarios" / "warehouse-team.toml")
 HALL = str(ROOT / "scenarios" / "hall-robots.toml")
+CORRIDOR = str(ROOT / "scenarios" / "corridor-swap.toml")
 
 
 def _roll_multi(env: ronap.MultiNavEnv, actions: list[dict[str, int]]) -> list[tuple]:
@@ -247,3 +248,34 @@ def test_copies_hold_their_own_actions_and_vector_seeds_stay_in_their_split():
 
     made = pickle.loads(pickle.dumps(gym.make("ronap/Nav-v0", episode_max_steps=50, disable_env_checker=True).unwrapped))
     assert made.spec.disable_env_checker is True and made.spec.max_episode_steps == 50
+
+
+def test_a_vector_copy_is_refused_past_its_record_and_allowed_again_after_a_reset(monkeypatch):
+    """A vector environment keeps the actions since its last full reset for copies to replay, a
+    byte per discrete action, up to ``COPY_BYTES``: past it a copy is refused, by name, until the
+    next reset(); the record never grows past the bound."""
+    import ronap.env
+
+    monkeypatch.setattr(ronap.env, "COPY_BYTES", 40)
+    for vec, actions in [
+        (ronap.VecNavEnv(4, maze_cols=4, maze_rows=4), np.ones(4, np.int64)),
+        (ronap.VecMultiNavEnv(2, scenario=CORRIDOR), np.ones((2, 2), np.int64)),
+    ]:
+        vec.reset(seed=3)
+        steps = 40 // actions.size  # a byte an action
+        for _ in range(steps):
+            vec.step(actions)
+        twin = copy.deepcopy(vec)
+        np.testing.assert_array_equal(twin.step(actions)[0], vec.step(actions)[0])
+        with pytest.raises(ronap.RonapError, match=f"cannot copy a {type(vec).__name__} more than"):
+            copy.deepcopy(vec)
+        vec.reset(seed=4)
+        vec.step(actions)
+        twin = copy.deepcopy(vec)
+        np.testing.assert_array_equal(twin.step(actions)[0], vec.step(actions)[0])
+    # Continuous actions are kept whole: 4 environments x 2 float64 a step.
+    vec = ronap.VecNavEnv(4, maze_cols=4, maze_rows=4, continuous=True)
+    vec.reset(seed=3)
+    vec.step(np.full((4, 2), 0.5))
+    with pytest.raises(ronap.RonapError, match="cannot copy"):
+        copy.deepcopy(vec)

@@ -14,7 +14,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_path, checked_int, init_arguments, located, checked_split, split_draw_limit, split_seed, check_split_seeds, COPY_LIMIT
+from .config import ScenarioLike, checked_config, checked_path, checked_int, init_arguments, located, checked_split, split_draw_limit, split_seed, check_split_seeds, COPY_BYTES, COPY_LIMIT
 
 
 class NavEnv(gym.Env[np.ndarray, Any]):
@@ -230,13 +230,39 @@ def reset_mask(owner: str, options: dict[str, Any] | None, num_envs: int, starte
     return mask
 
 
-def kept_call(calls: list[Any] | None, call: Any) -> list[Any] | None:
-    """``calls`` with ``call`` added, for a copy of a vector environment to replay; None (none
-    kept) once ``COPY_LIMIT`` calls are."""
-    if calls is None or len(calls) >= COPY_LIMIT:
-        return None
-    calls.append(call)
-    return calls
+class CallLog:
+    """The calls since a vector environment's last full reset, for a copy to replay (the model is
+    deterministic): each ``(kind, array or flags, array or None)``. ``calls`` is None once more
+    than ``COPY_LIMIT`` calls or ``COPY_BYTES`` bytes of their arrays would be kept."""
+
+    def __init__(self, calls: Any = ()) -> None:
+        self.calls: list[tuple[str, Any, Any]] | None = []
+        self._bytes = 0
+        for call in calls:
+            self.keep(call)
+
+    def keep(self, call: tuple[str, Any, Any]) -> None:
+        if self.calls is None:
+            return
+        size = sum(x.nbytes for x in call[1:] if isinstance(x, np.ndarray))
+        if len(self.calls) >= COPY_LIMIT or self._bytes + size > COPY_BYTES:
+            self.calls = None
+            return
+        self.calls.append(call)
+        self._bytes += size
+
+
+def kept_actions(a: np.ndarray) -> np.ndarray:
+    """A copy of the actions a step took, to replay: discrete ones (0, 1, 2) as bytes, an eighth
+    of their int64 size."""
+    return a.astype(np.int8) if a.dtype == np.int64 else a.copy()
+
+
+def copy_refused(cls: str) -> _ronap.RonapError:
+    return _ronap.RonapError(
+        f"cannot copy a {cls} more than {COPY_LIMIT} steps or {COPY_BYTES >> 20} MiB of actions after its last "
+        "reset() of every environment: a copy replays them, and so many are not kept; reset() first"
+    )
 
 
 class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
@@ -342,11 +368,13 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         self._all = np.ones(num_envs, dtype=bool)
         self._rng = np.random.default_rng()
         self._started = False
-        self._calls: list[tuple[str, Any, Any]] | None = []
+        self._log = CallLog()
 
     def _logged(self, call: tuple[str, Any, Any], full_reset: bool = False) -> None:
-        """Keeps `call` for copies, up to ``COPY_LIMIT`` steps since the last full reset."""
-        self._calls = kept_call([] if full_reset else self._calls, call)
+        """Keeps `call` for copies (``CallLog``), from the last full reset."""
+        if full_reset:
+            self._log = CallLog()
+        self._log.keep(call)
 
     def _infos(self, infos: dict[str, Any], mask: np.ndarray) -> dict[str, Any]:
         """Gymnasium's vector infos: every value an array over the environments, and beside each
@@ -407,7 +435,7 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         else:
             a = discrete_actions(actions, (self.num_envs,))
         obs, rewards, terminated, truncated, infos, finals = self._vec.step(a)
-        self._logged(("step", a.copy(), None))
+        self._logged(("step", kept_actions(a), None))
         check_split_seeds(self.split, infos["seed"])
         infos = self._infos(infos, self._all)
         if finals is not None:
@@ -425,13 +453,11 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         """How to build this vector environment again and bring every environment to where it
         is: its arguments and the resets and actions since the last reset of them all (the
         model is deterministic), for ``pickle`` and ``copy.deepcopy``; refused after more than
-        ``COPY_LIMIT`` steps since the last full reset (the record is not kept that long)."""
-        if self._calls is None:
-            raise _ronap.RonapError(
-                f"cannot copy a VecNavEnv more than {COPY_LIMIT} steps after its last reset() of every "
-                "environment: a copy replays them, and so many are not kept; reset() first"
-            )
-        return {"init": self._init_args, "calls": self._calls, "rng": self._rng, "started": self._started}
+        ``COPY_LIMIT`` steps or ``COPY_BYTES`` bytes of actions since the last full reset (the
+        record is not kept that long)."""
+        if self._log.calls is None:
+            raise copy_refused("VecNavEnv")
+        return {"init": self._init_args, "calls": self._log.calls, "rng": self._rng, "started": self._started}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__init__(**state["init"])  # type: ignore[misc]
@@ -439,8 +465,8 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
             if kind == "reset":
                 self._vec.reset(a, b)
             else:
-                self._vec.step(a)
-        self._calls = list(state["calls"])
+                self._vec.step(a if self.continuous else a.astype(np.int64))
+        self._log = CallLog(state["calls"])
         self._rng = state["rng"]
         self._started = state["started"]
 

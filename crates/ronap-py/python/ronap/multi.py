@@ -10,8 +10,8 @@ from gymnasium import spaces
 from gymnasium.vector import AutoresetMode
 
 from . import _ronap
-from .config import ScenarioLike, checked_config, checked_path, checked_int, init_arguments, checked_split, split_draw_limit, split_seed, check_split_seeds, COPY_LIMIT
-from .env import _AUTORESET, _autoreset_mode, discrete_actions, kept_call, reset_mask
+from .config import ScenarioLike, checked_config, checked_path, checked_int, init_arguments, checked_split, split_draw_limit, split_seed, check_split_seeds
+from .env import _AUTORESET, _autoreset_mode, CallLog, copy_refused, discrete_actions, kept_actions, reset_mask
 
 if TYPE_CHECKING:
     from pettingzoo import ParallelEnv
@@ -372,7 +372,7 @@ class VecMultiNavEnv:
         self.single_action_space = spaces.Discrete(3)
         self._started = False
         self.seed_used: int | None = None
-        self._calls: list[tuple[str, Any, Any]] | None = []
+        self._log = CallLog()
 
     def reset(
         self, seed: int | None = None, options: dict[str, Any] | None = None
@@ -397,12 +397,12 @@ class VecMultiNavEnv:
         seed = split_seed(self.split, checked_int("seed", seed))
         self.seed_used = seed
         self._started = True
-        self._calls = []
+        self._log = CallLog()
         return self._vec.reset(seed)
 
     def _logged(self, call: tuple[str, Any, Any]) -> None:
-        """Keeps `call` for copies, up to ``COPY_LIMIT`` calls since the last full reset."""
-        self._calls = kept_call(self._calls, call)
+        """Keeps `call` for copies (``CallLog``), from the last full reset."""
+        self._log.keep(call)
 
     def step(
         self, actions: Any, messages: Any = None
@@ -418,7 +418,7 @@ class VecMultiNavEnv:
                 raise _ronap.ActionError(f"messages of shape {m.shape}: expected {(*shape, self.message_size)}")
             flat_messages = m.reshape(-1)
         obs, rewards, terminated, truncated, infos = self._vec.step(a.reshape(-1), flat_messages)
-        self._logged(("step", a.reshape(-1).copy(), None if flat_messages is None else flat_messages.copy()))
+        self._logged(("step", kept_actions(a.reshape(-1)), None if flat_messages is None else flat_messages.copy()))
         check_split_seeds(self.split, infos["seed"])
         if "final_obs" in infos:
             ended = infos["_final_obs"]
@@ -431,12 +431,9 @@ class VecMultiNavEnv:
     def __getstate__(self) -> dict[str, Any]:
         """Its arguments, seed and the actions since the last reset, replayed where the copy is
         made (``pickle``, ``copy.deepcopy``): the copy continues exactly where this one is."""
-        if self._calls is None:
-            raise _ronap.RonapError(
-                f"cannot copy a VecMultiNavEnv more than {COPY_LIMIT} steps or masked resets after its reset(): a copy "
-                "replays them, and so many are not kept; reset() first"
-            )
-        return {"init": self._init_args, "seed": self.seed_used if self._started else None, "calls": self._calls}
+        if self._log.calls is None:
+            raise copy_refused("VecMultiNavEnv")
+        return {"init": self._init_args, "seed": self.seed_used if self._started else None, "calls": self._log.calls}
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__init__(**state["init"])  # type: ignore[misc]
@@ -448,10 +445,10 @@ class VecMultiNavEnv:
             calls = [c if len(c) == 3 else ("step", *c) for c in state["calls"]]
             for kind, first, second in calls:
                 if kind == "step":
-                    self._vec.step(first, second)
+                    self._vec.step(first.astype(np.int64), second)
                 else:
                     self._vec.restart([None] * self.num_envs, first)
-            self._calls = calls
+            self._log = CallLog(calls)
 
     def close(self) -> None:
         pass
