@@ -165,7 +165,10 @@ proptest! {
     fn random_command_lines_exit_0_1_or_2(args in command_line()) {
         let dir = tempfile::tempdir().expect("tempdir");
         std::fs::create_dir(dir.path().join("scenarios")).expect("dir");
-        if let Some((code, err)) = run(&args, dir.path(), Duration::from_secs(20)) {
+        // Past 5 s a case is cut short, unjudged: what these lines get wrong they get wrong in
+        // the first moments (a refusal, a panic on a value), and an endless run drawn here
+        // (`run --seeds 18446744073709551615`) took 20 s of both cores under a longer limit.
+        if let Some((code, err)) = run(&args, dir.path(), Duration::from_secs(5)) {
             prop_assert!(
                 matches!(code, 0..=2),
                 "ronap {:?} exited {}; stderr: {}", args, code, err
