@@ -210,12 +210,14 @@ def split_seed(split: str | None, seed: int, name: str = "seed") -> int:
 
 
 COPY_LIMIT = 100_000
-# And at most this many bytes of their actions and messages: a VecNavEnv(1024) kept 800 MB of
-# actions over 100,000 steps, and the fresh memory of each step's copy cost it 4% of its speed.
-COPY_BYTES = 64 * 2**20
 """Most steps since its last full reset a vector environment keeps to be copied by replaying
-them (``pickle``, ``copy.deepcopy``): 8 bytes an environment a step at most; a longer stretch is
-not kept and a copy is refused, naming why."""
+them (``pickle``, ``copy.deepcopy``); a longer stretch is not kept and a copy is refused, naming
+why."""
+
+COPY_BYTES = 64 * 2**20
+"""Most bytes of actions (a byte a discrete action) and messages a vector environment keeps for
+copies, beside ``COPY_LIMIT``: with int64 copies, a ``VecNavEnv(1024)`` kept 800 MB over 100,000
+steps, and each step's fresh memory cost it about 4% of its speed."""
 
 
 def check_split_seeds(split: str | None, seeds: Any) -> None:
