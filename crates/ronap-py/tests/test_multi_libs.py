@@ -253,17 +253,18 @@ def test_copies_hold_their_own_actions_and_vector_seeds_stay_in_their_split():
 def test_a_vector_copy_is_refused_past_its_record_and_allowed_again_after_a_reset(monkeypatch):
     """A vector environment keeps the actions since its last full reset for copies to replay, a
     byte per discrete action, up to ``COPY_BYTES``: past it a copy is refused, by name, until the
-    next reset(); the record never grows past the bound."""
+    next reset(). A copy made before actions were kept as bytes (int64) still replays."""
     import ronap.env
 
-    monkeypatch.setattr(ronap.env, "COPY_BYTES", 40)
-    for vec, actions in [
-        (ronap.VecNavEnv(4, maze_cols=4, maze_rows=4), np.ones(4, np.int64)),
-        (ronap.VecMultiNavEnv(2, scenario=CORRIDOR), np.ones((2, 2), np.int64)),
+    # Room for the reset and ten steps: VecNavEnv keeps its reset's seeds (8 bytes each),
+    # VecMultiNavEnv only its seed.
+    for vec, actions, reset_bytes in [
+        (ronap.VecNavEnv(4, maze_cols=4, maze_rows=4), np.ones(4, np.int64), 32),
+        (ronap.VecMultiNavEnv(2, scenario=CORRIDOR), np.ones((2, 2), np.int64), 0),
     ]:
+        monkeypatch.setattr(ronap.env, "COPY_BYTES", reset_bytes + 10 * actions.size)
         vec.reset(seed=3)
-        steps = 40 // actions.size  # a byte an action
-        for _ in range(steps):
+        for _ in range(10):  # a byte an action
             vec.step(actions)
         twin = copy.deepcopy(vec)
         np.testing.assert_array_equal(twin.step(actions)[0], vec.step(actions)[0])
@@ -273,7 +274,21 @@ def test_a_vector_copy_is_refused_past_its_record_and_allowed_again_after_a_rese
         vec.step(actions)
         twin = copy.deepcopy(vec)
         np.testing.assert_array_equal(twin.step(actions)[0], vec.step(actions)[0])
-    # Continuous actions are kept whole: 4 environments x 2 float64 a step.
+    # An older copy's int64 actions replay, and are kept as bytes from then on.
+    monkeypatch.setattr(ronap.env, "COPY_BYTES", 2**20)
+    vec = ronap.VecNavEnv(4, maze_cols=4, maze_rows=4)
+    vec.reset(seed=5)
+    for t in range(30):
+        vec.step(np.array([t % 3, 1, 2, (t + 1) % 3]))
+    state = vec.__getstate__()
+    state["calls"] = [(k, a.astype(np.int64) if k == "step" else a, b) for k, a, b in state["calls"]]
+    old = ronap.VecNavEnv.__new__(ronap.VecNavEnv)
+    old.__setstate__(state)
+    assert all(a.dtype == np.int8 for k, a, _ in old._log.calls if k == "step")
+    np.testing.assert_array_equal(old.step(np.ones(4, np.int64))[0], vec.step(np.ones(4, np.int64))[0])
+    # Continuous actions are kept whole (4 environments x 2 float64 a step): one step is past
+    # room for ten discrete ones.
+    monkeypatch.setattr(ronap.env, "COPY_BYTES", 32 + 40)
     vec = ronap.VecNavEnv(4, maze_cols=4, maze_rows=4, continuous=True)
     vec.reset(seed=3)
     vec.step(np.full((4, 2), 0.5))

@@ -244,7 +244,8 @@ class CallLog:
     def keep(self, call: tuple[str, Any, Any]) -> None:
         if self.calls is None:
             return
-        size = sum(x.nbytes for x in call[1:] if isinstance(x, np.ndarray))
+        # Arrays by their bytes; a reset's seeds and flags (lists) at 8 bytes an entry.
+        size = sum(x.nbytes if isinstance(x, np.ndarray) else 8 * len(x) if isinstance(x, list) else 0 for x in call[1:])
         if len(self.calls) >= COPY_LIMIT or self._bytes + size > COPY_BYTES:
             self.calls = None
             return
@@ -260,7 +261,7 @@ def kept_actions(a: np.ndarray) -> np.ndarray:
 
 def copy_refused(cls: str) -> _ronap.RonapError:
     return _ronap.RonapError(
-        f"cannot copy a {cls} more than {COPY_LIMIT} steps or {COPY_BYTES >> 20} MiB of actions after its last "
+        f"cannot copy a {cls} more than {COPY_LIMIT} steps or {COPY_BYTES >> 20} MiB of actions and resets after its last "
         "reset() of every environment: a copy replays them, and so many are not kept; reset() first"
     )
 
@@ -461,12 +462,16 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         self.__init__(**state["init"])  # type: ignore[misc]
+        calls = []
         for kind, a, b in state["calls"]:
             if kind == "reset":
                 self._vec.reset(a, b)
             else:
                 self._vec.step(a if self.continuous else a.astype(np.int64))
-        self._log = CallLog(state["calls"])
+                if not self.continuous:
+                    a = a.astype(np.int8)  # a byte an action, an older copy's int64 ones too
+            calls.append((kind, a, b))
+        self._log = CallLog(calls)
         self._rng = state["rng"]
         self._started = state["started"]
 

@@ -443,12 +443,15 @@ class VecMultiNavEnv:
             self._started = True
             # Each call (kind, ...); a copy made before masked resets holds (actions, messages).
             calls = [c if len(c) == 3 else ("step", *c) for c in state["calls"]]
+            kept = []
             for kind, first, second in calls:
                 if kind == "step":
                     self._vec.step(first.astype(np.int64), second)
+                    first = first.astype(np.int8)  # a byte an action, an older copy's int64 ones too
                 else:
                     self._vec.restart([None] * self.num_envs, first)
-            self._log = CallLog(calls)
+                kept.append((kind, first, second))
+            self._log = CallLog(kept)
 
     def close(self) -> None:
         pass
