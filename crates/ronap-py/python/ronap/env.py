@@ -255,8 +255,8 @@ class CallLog:
 
 def kept_actions(a: np.ndarray) -> np.ndarray:
     """A copy of the actions a step took, to replay: discrete ones (0, 1, 2) as bytes, an eighth
-    of their int64 size."""
-    return a.astype(np.int8) if a.dtype == np.int64 else a.copy()
+    of their int64 size (an older copy's int64 ones too, once replayed)."""
+    return a.astype(np.int8) if a.dtype.kind in "iu" else a.copy()
 
 
 def copy_refused(cls: str) -> _ronap.RonapError:
@@ -468,8 +468,7 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
                 self._vec.reset(a, b)
             else:
                 self._vec.step(a if self.continuous else a.astype(np.int64))
-                if not self.continuous:
-                    a = a.astype(np.int8)  # a byte an action, an older copy's int64 ones too
+                a = kept_actions(a)
             calls.append((kind, a, b))
         self._log = CallLog(calls)
         self._rng = state["rng"]

@@ -447,7 +447,7 @@ class VecMultiNavEnv:
             for kind, first, second in calls:
                 if kind == "step":
                     self._vec.step(first.astype(np.int64), second)
-                    first = first.astype(np.int8)  # a byte an action, an older copy's int64 ones too
+                    first = kept_actions(first)
                 else:
                     self._vec.restart([None] * self.num_envs, first)
                 kept.append((kind, first, second))
