@@ -13,7 +13,6 @@ use ronap_core::run::{Batch, EnvStep, RunError};
 use ronap_core::sim::continuous_action;
 use ronap_core::{Action, Point, Status};
 
-/// Many RoNAP environments stepped together.
 /// What `VecEnv.step` returns: observations, rewards, terminations, truncations, infos and the
 /// finals of the episodes same-step autoreset restarted.
 type Stepped<'py> = (
@@ -25,9 +24,13 @@ type Stepped<'py> = (
     Option<Finals<'py>>,
 );
 
+/// Many RoNAP environments stepped together.
 #[pyclass(module = "ronap._ronap")]
 pub struct VecEnv {
     batch: Batch,
+    /// A mask of every environment, the infos' `_key` entries after a step (one array, not one
+    /// a step).
+    all: Py<PyArray1<bool>>,
     continuous: bool,
     /// Each environment's path in its episode so far, kept when it may be drawn.
     paths: Option<Vec<Vec<Point>>>,
@@ -50,8 +53,13 @@ type Finals<'py> = (
 
 /// The info arrays of `records`, one entry per environment, each filled in its own pass over
 /// the records (a tight loop apiece; one pass pushing to all of them at once was slower) and
-/// handed to numpy uncopied.
-fn infos<'py>(py: Python<'py>, records: &[EnvStep]) -> PyResult<Bound<'py, PyDict>> {
+/// handed to numpy uncopied; beside each key `k`, Gymnasium's `_k`: `mask`, the environments it
+/// holds a value for (set here, where the keys are known, rather than by a loop in Python).
+fn infos<'py>(
+    py: Python<'py>,
+    records: &[EnvStep],
+    mask: &Bound<'py, PyArray1<bool>>,
+) -> PyResult<Bound<'py, PyDict>> {
     let n = records.len();
     fn each<T>(records: &[EnvStep], f: impl Fn(&EnvStep) -> T) -> Vec<T> {
         records.iter().map(f).collect()
@@ -72,35 +80,29 @@ fn infos<'py>(py: Python<'py>, records: &[EnvStep]) -> PyResult<Bound<'py, PyDic
     let total_reward = each(records, |s| s.total_reward);
     let any_dynamic = records.iter().any(|s| s.dynamic_collisions.is_some());
     let d = PyDict::new(py);
-    d.set_item(intern!(py, "distance"), PyArray1::from_vec(py, distance))?;
-    d.set_item(intern!(py, "collided"), PyArray1::from_vec(py, collided))?;
-    d.set_item(intern!(py, "success"), PyArray1::from_vec(py, success))?;
-    d.set_item(
-        intern!(py, "pose"),
-        PyArray1::from_vec(py, pose).reshape([n, 3])?,
-    )?;
-    d.set_item(
-        intern!(py, "goal"),
-        PyArray1::from_vec(py, goal).reshape([n, 2])?,
-    )?;
-    d.set_item(intern!(py, "status"), PyArray1::from_vec(py, status))?;
-    d.set_item(intern!(py, "steps"), PyArray1::from_vec(py, steps))?;
-    d.set_item(
-        intern!(py, "collisions"),
-        PyArray1::from_vec(py, collisions),
-    )?;
-    d.set_item(intern!(py, "seed"), PyArray1::from_vec(py, seed))?;
+    macro_rules! put {
+        ($key:literal, $value:expr) => {
+            d.set_item(intern!(py, $key), $value)?;
+            d.set_item(intern!(py, concat!("_", $key)), mask)?;
+        };
+    }
+    put!("distance", PyArray1::from_vec(py, distance));
+    put!("collided", PyArray1::from_vec(py, collided));
+    put!("success", PyArray1::from_vec(py, success));
+    put!("pose", PyArray1::from_vec(py, pose).reshape([n, 3])?);
+    put!("goal", PyArray1::from_vec(py, goal).reshape([n, 2])?);
+    put!("status", PyArray1::from_vec(py, status));
+    put!("steps", PyArray1::from_vec(py, steps));
+    put!("collisions", PyArray1::from_vec(py, collisions));
+    put!("seed", PyArray1::from_vec(py, seed));
     // "return", as every info and result names the summed reward; "total_reward" is its
     // earlier name, kept for code written against it.
     let summed = PyArray1::from_vec(py, total_reward);
-    d.set_item(intern!(py, "return"), &summed)?;
-    d.set_item(intern!(py, "total_reward"), summed)?;
+    put!("return", &summed);
+    put!("total_reward", summed);
     if any_dynamic {
         let dynamic = each(records, |s| u64::from(s.dynamic_collisions.unwrap_or(0)));
-        d.set_item(
-            intern!(py, "dynamic_collisions"),
-            PyArray1::from_vec(py, dynamic),
-        )?;
+        put!("dynamic_collisions", PyArray1::from_vec(py, dynamic));
     }
     Ok(d)
 }
@@ -171,19 +173,23 @@ impl VecEnv {
         }
     }
 
-    fn arrays<'py>(&self, py: Python<'py>) -> PyResult<Arrays<'py>> {
+    /// The arrays of a reset or step; the infos' `_key` masks are `mask` (every environment when
+    /// None).
+    fn arrays<'py>(&self, py: Python<'py>, mask: Option<&[bool]>) -> PyResult<Arrays<'py>> {
         let (n, d) = (self.batch.len(), self.batch.observation_size());
         let current = self.current();
         let obs = PyArray1::from_slice(py, self.batch.observations()).reshape([n, d])?;
-        let info = infos(py, &current)?;
+        let mask = match mask {
+            Some(m) => PyArray1::from_slice(py, m),
+            None => self.all.bind(py).clone(),
+        };
+        let info = infos(py, &current, &mask)?;
         let ended: Vec<bool> = (0..n).map(|i| self.batch.restarted(i)).collect();
         let finals = if ended.contains(&true) {
             let last = PyArray1::from_slice(py, self.batch.final_observations()).reshape([n, d])?;
-            Some((
-                PyArray1::from_vec(py, ended),
-                last.into_any(),
-                infos(py, self.batch.steps())?,
-            ))
+            let ended = PyArray1::from_vec(py, ended);
+            let final_infos = infos(py, self.batch.steps(), &ended)?;
+            Some((ended, last.into_any(), final_infos))
         } else {
             None
         };
@@ -199,6 +205,7 @@ impl VecEnv {
     #[new]
     #[pyo3(signature = (num_envs, config, **options))]
     fn new(
+        py: Python<'_>,
         num_envs: usize,
         config: &Config,
         options: Option<&Bound<'_, pyo3::types::PyDict>>,
@@ -210,6 +217,7 @@ impl VecEnv {
         let batch: Batch = o.batch(num_envs, config.valid())?;
         Ok(Self {
             batch,
+            all: PyArray1::from_vec(py, vec![true; num_envs]).unbind(),
             continuous,
             paths: render.then(|| vec![Vec::new(); num_envs]),
             actions: Vec::with_capacity(num_envs),
@@ -218,7 +226,8 @@ impl VecEnv {
 
     /// Starts the environments `mask` selects (all when None), each with its seed from `seeds`
     /// (one per environment) or, for None, the next seed of its sequence. Returns
-    /// (observations, infos, None).
+    /// (observations, infos, None); beside each info `k`, `_k` is the mask of the environments
+    /// started.
     fn reset<'py>(
         &mut self,
         py: Python<'py>,
@@ -229,7 +238,8 @@ impl VecEnv {
         py.allow_threads(|| self.batch.restart(&which, &seeds))
             .map_err(|e| run_error(&e))?;
         self.track(Some(&which));
-        self.arrays(py)
+        let partial = which.contains(&false);
+        self.arrays(py, partial.then_some(&which[..]))
     }
 
     /// The full value of each dimension of a normalised continuous action (see
@@ -241,9 +251,10 @@ impl VecEnv {
 
     /// Steps every environment with `actions`: one index per environment (0 LEFT, 1 AHEAD,
     /// 2 RIGHT) as an int64 array, or for a continuous batch an (n, k) float64 array of the
-    /// robot's continuous command (k = 2: (v px/step, w deg/step); see `action_scale`). Returns (observations, rewards, terminations, truncations,
-    /// infos, finals): `finals` is None, or for the episodes same-step autoreset restarted
-    /// (ended mask, their last observations, their final infos).
+    /// robot's continuous command (k = 2: (v px/step, w deg/step); see `action_scale`). Returns
+    /// (observations, rewards, terminations, truncations, infos, finals), each info `k` beside
+    /// Gymnasium's mask `_k`: `finals` is None, or for the episodes same-step autoreset restarted
+    /// (ended mask, their last observations, their final infos, masked by it).
     fn step<'py>(
         &mut self,
         py: Python<'py>,
@@ -307,7 +318,7 @@ impl VecEnv {
         let rewards = PyArray1::from_iter(py, steps.iter().map(|s| s.reward));
         let terminated = PyArray1::from_iter(py, steps.iter().map(|s| s.status.is_terminated()));
         let truncated = PyArray1::from_iter(py, steps.iter().map(|s| s.status.is_truncated()));
-        let (obs, infos, finals) = self.arrays(py)?;
+        let (obs, infos, finals) = self.arrays(py, None)?;
         Ok((obs, rewards, terminated, truncated, infos, finals))
     }
 

@@ -242,15 +242,22 @@ class CallLog:
             self.keep(call)
 
     def keep(self, call: tuple[str, Any, Any]) -> None:
-        if self.calls is None:
+        calls = self.calls
+        if calls is None:
             return
-        # Arrays by their bytes; a reset's seeds and flags (lists) at 8 bytes an entry.
-        size = sum(x.nbytes if isinstance(x, np.ndarray) else 8 * len(x) if isinstance(x, list) else 0 for x in call[1:])
-        if len(self.calls) >= COPY_LIMIT or self._bytes + size > COPY_BYTES:
+        # Once a step, so spelt out (a generator over the call took twice as long).
+        size = self._bytes + _kept_bytes(call[1]) + _kept_bytes(call[2])
+        if len(calls) >= COPY_LIMIT or size > COPY_BYTES:
             self.calls = None
             return
-        self.calls.append(call)
-        self._bytes += size
+        calls.append(call)
+        self._bytes = size
+
+
+def _kept_bytes(x: Any) -> int:
+    """What a ``CallLog`` counts for one of a call's values: an array by its bytes, a reset's
+    seeds or flags (a list) at 8 bytes an entry, None as nothing."""
+    return int(x.nbytes) if isinstance(x, np.ndarray) else 8 * len(x) if isinstance(x, list) else 0
 
 
 def kept_actions(a: np.ndarray) -> np.ndarray:
@@ -366,7 +373,6 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
             self.single_action_space = spaces.Discrete(3)
         self.observation_space = batch_space(self.single_observation_space, num_envs)
         self.action_space = batch_space(self.single_action_space, num_envs)
-        self._all = np.ones(num_envs, dtype=bool)
         self._rng = np.random.default_rng()
         self._started = False
         self._log = CallLog()
@@ -376,15 +382,6 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         if full_reset:
             self._log = CallLog()
         self._log.keep(call)
-
-    def _infos(self, infos: dict[str, Any], mask: np.ndarray) -> dict[str, Any]:
-        """Gymnasium's vector infos: every value an array over the environments, and beside each
-        key ``_key``, the mask of environments it holds a value for."""
-        for key in list(infos):
-            if isinstance(infos[key], list):
-                infos[key] = np.asarray(infos[key])
-            infos["_" + key] = mask
-        return infos
 
     def _seeds(self, seed: Any, mask: np.ndarray | None) -> list[int | None]:
         """The episode seeds a reset asks for, in the split when there is one."""
@@ -426,7 +423,7 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         self._logged(("reset", seeds, flags), full_reset=flags is None)
         check_split_seeds(self.split, infos["seed"])
         self._started = True
-        return obs, self._infos(infos, self._all if mask is None else mask.copy())
+        return obs, infos
 
     def step(self, actions: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         if not self._started:
@@ -438,7 +435,6 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
         obs, rewards, terminated, truncated, infos, finals = self._vec.step(a)
         self._logged(("step", kept_actions(a), None))
         check_split_seeds(self.split, infos["seed"])
-        infos = self._infos(infos, self._all)
         if finals is not None:
             ended, last, final_infos = finals
             final_obs = np.full(self.num_envs, None, dtype=object)
@@ -446,7 +442,7 @@ class VecNavEnv(VectorEnv[np.ndarray, Any, np.ndarray]):
                 final_obs[i] = last[i].copy()
             infos["final_obs"] = final_obs
             infos["_final_obs"] = ended
-            infos["final_info"] = self._infos(final_infos, ended)
+            infos["final_info"] = final_infos
             infos["_final_info"] = ended
         return obs, rewards, terminated, truncated, infos
 
