@@ -369,6 +369,19 @@ fn bench_times_a_team_policys_planning_and_steps() {
         &["bench", "--policy", "geodesic", "--seconds", "0.1"],
         &["--policy", "team"],
     );
+    // A policy that ends every episode at its start (the swap's plan is infeasible) has no step
+    // to time: one line says so after a short search, where the bench once looked for ever.
+    let swap = shipped("corridor-swap.toml");
+    let args = [
+        "bench",
+        "--scenario",
+        swap.to_str().unwrap(),
+        "--policy",
+        "coordinated",
+        "--seconds",
+        "0.01",
+    ];
+    assert_rejected(&args, &["--policy coordinated took no step", "ronap run"]);
 }
 
 #[test]

@@ -28,6 +28,10 @@ const SECONDS: f64 = 2.0;
 const SWEEP_SECONDS: f64 = 0.2;
 
 /// Arguments of `ronap bench`.
+
+/// How long past its duration `ronap bench --policy` looks for a first step before it gives up
+/// (thousands of episodes: a policy that ends each at once would otherwise be timed for ever).
+const GIVE_UP: Duration = Duration::from_secs(2);
 #[derive(Args, Debug)]
 pub struct BenchArgs {
     /// Seconds to measure each figure for, at most 3600 [default: 2, or 0.2 with --sweep].
@@ -194,8 +198,14 @@ impl Bench {
         let robots = self.config.team_size();
         let (mut steps, mut stepping, mut teams, mut planning) = (0u64, 0.0, 0u32, 0.0);
         let begin = Instant::now();
+        // At least one step, however short the duration, unless the policy takes none (its
+        // plans may end every episode at its start): given up on `GIVE_UP` after the duration.
+        let more = |steps: u64| {
+            let elapsed = begin.elapsed();
+            elapsed < duration || (steps == 0 && elapsed < duration + GIVE_UP)
+        };
         let mut seed = 0;
-        while steps == 0 || begin.elapsed() < duration {
+        while more(steps) {
             let mut policy = policies.start()?;
             let clock = Instant::now();
             let mut rollout =
@@ -209,6 +219,14 @@ impl Bench {
             }
             stepping += clock.elapsed().as_secs_f64();
             seed += 1;
+        }
+        if steps == 0 {
+            anyhow::bail!(
+                "--policy {name} took no step: it ended each of the {teams} team episodes it \
+                 started (seeds 0 to {}) at once, so there is nothing to time; `ronap run \
+                 --policy {name} --seeds 3` with this scenario shows why",
+                seed - 1
+            );
         }
         let per_step = stepping / steps.max(1) as f64;
         writeln!(
