@@ -1,7 +1,10 @@
 //! End-to-end tests of `ronap compare`: the table and every file read back, the same episodes as
 //! separate `ronap run`s, identical policies, reused runs, difficulty bins and bad input.
 
-use crate::util::{assert_rejected, col, json, ok, repo_root, ronap, rows, run_args, shipped};
+use crate::util::{
+    assert_rejected, assert_rejected_leaving_nothing, col, json, ok, repo_root, ronap, rows,
+    run_args, shipped,
+};
 use std::path::Path;
 
 /// The pair of policies most tests compare.
@@ -157,6 +160,66 @@ fn a_reused_run_gives_the_same_comparison() {
         ]
         .concat();
         assert_rejected(&args, &[&["--run"][..], names].concat());
+    }
+    // A run made under another model, or whose files were edited, is refused by name: its
+    // figures would not be this ronap's, or the two tables would contradict each other.
+    let copy = |name: &str, edit: &dyn Fn(&str, &str) -> (String, String)| {
+        let run = dir.path().join(name);
+        std::fs::create_dir(&run).unwrap();
+        for f in std::fs::read_dir(&geodesic_run).unwrap() {
+            let f = f.unwrap().path();
+            if f.is_file() {
+                std::fs::copy(&f, run.join(f.file_name().unwrap())).unwrap();
+            }
+        }
+        let (summary, episodes) = (run.join("summary.json"), run.join("episodes.csv"));
+        let (s, e) = edit(
+            &std::fs::read_to_string(&summary).unwrap(),
+            &std::fs::read_to_string(&episodes).unwrap(),
+        );
+        std::fs::write(summary, s).unwrap();
+        std::fs::write(episodes, e).unwrap();
+        run
+    };
+    let older = copy("older", &|s, e| {
+        let s = s.replace(
+            &format!("\"model_version\": {}", ronap_core::MODEL_VERSION),
+            "\"model_version\": 1",
+        );
+        (s, e.to_string())
+    });
+    let not_a_number = copy("nan", &|s, e| {
+        let mut lines: Vec<String> = e.lines().map(String::from).collect();
+        let spl = lines[0].split(',').position(|h| h == "spl").unwrap();
+        let mut cells: Vec<&str> = lines[2].split(',').collect();
+        cells[spl] = "nan";
+        lines[2] = cells.join(",");
+        (s.to_string(), lines.join("\n") + "\n")
+    });
+    let edited = copy("edited", &|s, e| {
+        (s.to_string(), e.replacen(",success,", ",stuck,", 1))
+    });
+    for (run, names) in [
+        (
+            &older,
+            &["model version 1", "this ronap runs model version"][..],
+        ),
+        (&not_a_number, &["line 3", "spl", "nan"]),
+        (&edited, &["summary.json", "disagree"]),
+    ] {
+        let out = dir.path().join("never");
+        let args = [
+            "compare",
+            "--seeds",
+            "16",
+            "--policy",
+            "apf",
+            "--run",
+            run.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        assert_rejected_leaving_nothing(&args, &[&["--run"][..], names].concat(), &out);
     }
 }
 

@@ -35,6 +35,14 @@ pub(super) fn read_run(
     }
     let (first, count) = (seeds[0], seeds.len() as u64);
     let last = seeds[seeds.len() - 1];
+    if manifest.model_version != crate::MODEL_VERSION {
+        return Err(mismatch(format!(
+            "recorded under model version {}; this ronap runs model version {}, whose episodes \
+             differ: run it again with this ronap",
+            manifest.model_version,
+            crate::MODEL_VERSION
+        )));
+    }
     if manifest.seed_start != first || manifest.seeds_requested != count {
         return Err(mismatch(format!(
             "seeds {}..{} were run there; this comparison uses {first}..{last}",
@@ -74,6 +82,24 @@ pub(super) fn read_run(
         return Err(mismatch(
             "episodes.csv does not hold exactly this comparison's seeds".into(),
         ));
+    }
+    // The tables take a run's rates from summary.json and the pairs from episodes.csv: the two
+    // must tell the same story (an edited file would make them contradict each other).
+    if !team {
+        let s = &manifest.summary;
+        let successes = rows
+            .iter()
+            .filter(|r| r.outcome == crate::eval::Outcome::Success)
+            .count();
+        if (s.episodes, s.successes) != (rows.len(), successes) {
+            return Err(mismatch(format!(
+                "episodes.csv holds {successes} successes in {} episodes, summary.json {} in \
+                 {}: the two files disagree",
+                rows.len(),
+                s.successes,
+                s.episodes
+            )));
+        }
     }
     // The same seeds in the same scenes start (and a lone robot ends) in the same places: a
     // changed map file or maze generator shows here even when the manifest reads the same.
@@ -170,8 +196,8 @@ fn read_results(dir: &Path, team: bool) -> Result<(Vec<SeedResult>, Places), Str
             outcome,
             steps: row.get(2)?,
             collisions: row.get(3)?,
-            path_length_px: row.get(4)?,
-            spl: if team { 0.0 } else { row.get(5)? },
+            path_length_px: row.finite(4)?,
+            spl: if team { 0.0 } else { row.finite(5)? },
         });
         if team {
             robots.push(row.get(5)?);
@@ -194,7 +220,7 @@ fn read_results(dir: &Path, team: bool) -> Result<(Vec<SeedResult>, Places), Str
             let i = *at
                 .get(&seed)
                 .ok_or_else(|| format!("{}: seed not in episodes.csv", row.bad(0)))?;
-            spl[i] += row.get::<f64>(1)?;
+            spl[i] += row.finite(1)?;
             counted[i] += 1;
             places[i].extend((2..5).map(|k| row.cell(k).to_string()));
             Ok(())
@@ -236,6 +262,17 @@ impl Row<'_> {
     /// Cell `k`, parsed.
     fn get<T: std::str::FromStr>(&self, k: usize) -> Result<T, String> {
         self.cell(k).parse().map_err(|_| self.bad(k))
+    }
+
+    /// Cell `k`, a finite number (`nan` and `inf` parse, but no run writes them).
+    fn finite(&self, k: usize) -> Result<f64, String> {
+        self.get::<f64>(k).and_then(|x| {
+            if x.is_finite() {
+                Ok(x)
+            } else {
+                Err(self.bad(k))
+            }
+        })
     }
 
     /// The error of cell `k`: the file, its line, the column and the value.

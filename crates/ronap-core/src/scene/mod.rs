@@ -715,9 +715,11 @@ impl Scene {
         // are far from every pillar.
         let length = (b - a).norm();
         let far = (length + radius) * (1.0 + 1e-9);
-        if !self.shapes.iter().all(|s| {
-            s.aabb().distance_squared(a) > far * far || s.segment_distance(a, b) >= radius
-        }) {
+        if !self
+            .shapes
+            .iter()
+            .all(|s| s.aabb().distance_squared(a) > far * far || s.segment_distance(a, b) >= radius)
+        {
             return false;
         }
         let Some(piece) = self.piece_px(radius).filter(|&p| length > p) else {
