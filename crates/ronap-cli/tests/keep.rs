@@ -292,6 +292,35 @@ fn a_failed_resume_leaves_the_directory_as_it_was() {
         before,
         "a failed resume changed the directory"
     );
+
+    // Rows edited by hand: a row written twice (a seed lost, another doubled), or an outcome
+    // that no longer matches the exact figures the summary is made from.
+    let out = dir.path().join("edited");
+    interrupted("geodesic", &out);
+    let rows = ["episodes.csv", "episodes.csv.partial"]
+        .map(|f| out.join(f))
+        .into_iter()
+        .find(|f| f.exists())
+        .unwrap();
+    let text = std::fs::read_to_string(&rows).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let twice = [&lines[..3], &lines[2..]].concat().join("\n") + "\n";
+    let outcome = text.replacen("\n1,success,", "\n1,timeout,", 1);
+    assert_ne!(outcome, text, "seed 1 did not succeed: {}", lines[2]);
+    for (edited, names) in [
+        (twice, &["line 4", "seed 1", "seed 2"][..]),
+        (outcome, &["line 3", "outcome timeout", "success"]),
+    ] {
+        std::fs::write(&rows, &edited).unwrap();
+        let before = snapshot(&out);
+        let o = ronap(&["run", "--resume", out.to_str().unwrap()]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        for n in names {
+            assert!(stderr(&o).contains(n), "{n:?} not in {}", stderr(&o));
+        }
+        assert_eq!(snapshot(&out), before, "a refused resume changed the run");
+        std::fs::write(&rows, &text).unwrap();
+    }
 }
 
 /// The run the crash-consistency tests stop and finish.

@@ -275,6 +275,7 @@ impl RunWriter {
             .map(|r| r.count as usize)
             .sum::<usize>();
         let mut done = seeds;
+        let mut files = Vec::new();
         for (name, per_episode) in [
             ("episodes.csv", 1),
             ("timing.csv", 1),
@@ -289,7 +290,12 @@ impl RunWriter {
             let at = if partial.exists() { partial } else { path };
             let rows = whole_rows(&at)?.saturating_sub(1);
             done = done.min(rows / per_episode);
+            files.push((at, per_episode));
         }
+        check_rows(&files, &plan.seeds(), done).map_err(|why| ResumeError::NoRun {
+            dir: dir.to_path_buf(),
+            why,
+        })?;
         let files = RunFiles {
             pictures: plan
                 .pictures
@@ -668,4 +674,79 @@ pub(crate) fn finish(
             Ok(())
         }
     }
+}
+
+/// Checks the rows a resumed run keeps (`done` episodes' worth of each of `files`, with the rows
+/// an episode has in each): each row's seed is the run's seed of its place, in order, and
+/// `episodes.csv` and the exact figures (the summary is made from them) give each episode the
+/// same outcome. A file edited by hand, or holding another run's rows, would otherwise be
+/// finished into a run whose rows and summary disagree. Says what is wrong (file, line, value).
+fn check_rows(files: &[(PathBuf, usize)], seeds: &Seeds, done: usize) -> Result<(), String> {
+    let mut outcomes: Vec<(&PathBuf, Vec<String>)> = Vec::new();
+    for (path, per_episode) in files {
+        let rows = seeds_and_outcomes(path, done * per_episode)?;
+        for (i, (seed, _)) in rows.iter().enumerate() {
+            let expected = seeds.get(i / per_episode);
+            if expected != Some(*seed) {
+                return Err(format!(
+                    "{}: line {}: seed {seed} where the run's seed {} belongs: the file was \
+                     edited or holds another run's rows; start the run again (--force)",
+                    path.display(),
+                    i + 2,
+                    expected.map_or("(none)".to_string(), |s| s.to_string()),
+                ));
+            }
+        }
+        if *per_episode == 1 && rows.iter().all(|(_, o)| o.is_some()) {
+            outcomes.push((path, rows.into_iter().filter_map(|(_, o)| o).collect()));
+        }
+    }
+    if let [(a, first), (b, second)] = &outcomes[..] {
+        if let Some(i) = (0..first.len().min(second.len())).find(|&i| first[i] != second[i]) {
+            return Err(format!(
+                "{}: line {}: outcome {} where {} says {}: the files disagree; start the run \
+                 again (--force)",
+                a.display(),
+                i + 2,
+                first[i],
+                b.display(),
+                second[i]
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The seed and outcome (`None` in a file without that column) of each of the first `rows`
+/// rows of the CSV file `path` (none when `rows` is 0: the file may not have been begun).
+fn seeds_and_outcomes(path: &Path, rows: usize) -> Result<Vec<(u64, Option<String>)>, String> {
+    if rows == 0 {
+        return Ok(Vec::new());
+    }
+    let what = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+    let mut reader = csv::ReaderBuilder::new()
+        .flexible(true)
+        .from_path(path)
+        .map_err(|e| what(&e))?;
+    let headers = reader.headers().map_err(|e| what(&e))?.clone();
+    let column = |name: &str| headers.iter().position(|h| h == name);
+    let seed = column("seed").ok_or_else(|| what(&"no seed column"))?;
+    let outcome = column("outcome");
+    let mut out = Vec::with_capacity(rows);
+    for (i, record) in reader.records().take(rows).enumerate() {
+        let record = record.map_err(|e| what(&e))?;
+        let cell = record.get(seed).unwrap_or("");
+        let value = cell.parse().map_err(|_| {
+            format!(
+                "{}: line {}: seed = {cell:?} is not a seed",
+                path.display(),
+                i + 2
+            )
+        })?;
+        out.push((
+            value,
+            outcome.and_then(|k| record.get(k)).map(str::to_string),
+        ));
+    }
+    Ok(out)
 }
