@@ -27,11 +27,11 @@ const SWEEP_RANGES_PX: [f64; 3] = [50.0, 200.0, 1000.0];
 const SECONDS: f64 = 2.0;
 const SWEEP_SECONDS: f64 = 0.2;
 
-/// Arguments of `ronap bench`.
-
 /// How long past its duration `ronap bench --policy` looks for a first step before it gives up
 /// (thousands of episodes: a policy that ends each at once would otherwise be timed for ever).
 const GIVE_UP: Duration = Duration::from_secs(2);
+
+/// Arguments of `ronap bench`.
 #[derive(Args, Debug)]
 pub struct BenchArgs {
     /// Seconds to measure each figure for, at most 3600 [default: 2, or 0.2 with --sweep].

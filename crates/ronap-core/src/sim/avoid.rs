@@ -132,7 +132,8 @@ pub fn social_force_velocity(
     };
     for (at, radius) in others {
         batch[kept] = (at, radius);
-        kept += usize::from(!((walker.position - at).norm_squared() > bound));
+        let d2 = (walker.position - at).norm_squared();
+        kept += usize::from((d2 <= bound) | d2.is_nan());
         if kept == batch.len() {
             sum(&batch);
             kept = 0;
