@@ -244,6 +244,12 @@ mod tests {
             bad("speed_px = -1.0"),
             "crowd[0].speed_px = -1.0: must be between 0 and 100000 px"
         );
+        // A horizon is a time: in steps, not px.
+        assert_eq!(
+            bad("motion = \"orca\"\norca = { time_horizon_steps = -1 }"),
+            "crowd[0].orca.time_horizon_steps = -1.0: must be a positive number of steps, at most \
+             100000"
+        );
         assert!(bad("motion = \"linear\"").starts_with("crowd[0].motion = \"linear\""));
         assert!(bad("pattern = \"circle\"").starts_with("crowd[0].pattern = \"circle\""));
         let two =

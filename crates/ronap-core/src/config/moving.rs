@@ -379,12 +379,18 @@ pub(super) fn validate_entry(
     )?;
     length(&f("jitter_px"), m.jitter_px, true)?;
     let o = &m.orca;
-    length(&f("orca.time_horizon_steps"), o.time_horizon_steps, false)?;
-    length(
-        &f("orca.obstacle_time_horizon_steps"),
-        o.obstacle_time_horizon_steps,
-        false,
-    )?;
+    for (name, v) in [
+        ("orca.time_horizon_steps", o.time_horizon_steps),
+        ("orca.obstacle_time_horizon_steps", o.obstacle_time_horizon_steps),
+    ] {
+        // A time in steps, held to the bound lengths have.
+        check(
+            v.is_finite() && v > 0.0 && v <= super::MAX_LENGTH_PX,
+            &f(name),
+            format!("{v:?}"),
+            "must be a positive number of steps, at most 100000",
+        )?;
+    }
     length(&f("orca.neighbour_dist_px"), o.neighbour_dist_px, true)?;
     length(&f("orca.safety_margin_px"), o.safety_margin_px, true)?;
     check(
