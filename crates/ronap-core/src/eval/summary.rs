@@ -327,7 +327,7 @@ impl Summary {
 
     /// The summary as an aligned two-column table for a terminal.
     pub fn table(&self) -> String {
-        let pct = |x: f64| format!("{:.1}%", 100.0 * x);
+        let pct = percent;
         let mut rows: Vec<(&str, String)> = vec![
             ("episodes", self.episodes.to_string()),
             (
@@ -428,6 +428,21 @@ impl Summary {
     }
 }
 
+
+/// `x` (0 to 1) as a percentage to one decimal, or to as many more (up to four) as it takes for
+/// a rate short of 1 not to show as 100.0%, nor one above 0 as 0.0% (199,956 successes of
+/// 200,000 are 99.98%, not 100.0%).
+fn percent(x: f64) -> String {
+    let shown = |d: usize| format!("{:.*}", d, 100.0 * x);
+    let d = (1..=4)
+        .find(|&d| {
+            let s = shown(d);
+            !((x < 1.0 && s.starts_with("100.")) || (x > 0.0 && s.parse::<f64>() == Ok(0.0)))
+        })
+        .unwrap_or(4);
+    format!("{}%", shown(d))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -442,6 +457,21 @@ mod tests {
             total_reward: -1.0,
             dynamic: None,
             metrics: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_rate_short_of_all_or_above_none_never_shows_as_all_or_none() {
+        for (x, shown) in [
+            (1.0, "100.0%"),
+            (0.0, "0.0%"),
+            (0.5, "50.0%"),
+            (199_956.0 / 200_000.0, "99.98%"),
+            (44.0 / 200_000.0, "0.02%"),
+            (0.9994, "99.9%"),
+            (0.9996, "99.96%"),
+        ] {
+            assert_eq!(percent(x), shown, "{x}");
         }
     }
 
