@@ -66,7 +66,13 @@ fn arg_name(arg: &clap::Arg) -> String {
     }
     if arg.get_action().takes_values() {
         name.push(' ');
-        name.push_str(&values.join(" "));
+        // A value that may be left out (`ronap config --scenario` alone prints an example).
+        let optional = arg.get_num_args().is_some_and(|n| n.min_values() == 0);
+        if optional {
+            name.push_str(&format!("[{}]", values.join(" ")));
+        } else {
+            name.push_str(&values.join(" "));
+        }
     }
     name
 }
@@ -118,6 +124,15 @@ fn render_command(out: &mut String, cmd: &mut clap::Command, path: &str) {
                 .collect();
             if arg.get_action().takes_values() && !possible.is_empty() {
                 write!(out, " [one of: {}]", possible.join(", ")).unwrap();
+            }
+            let aliases: Vec<String> = arg
+                .get_visible_aliases()
+                .unwrap_or_default()
+                .iter()
+                .map(|a| format!("`--{a}`"))
+                .collect();
+            if !aliases.is_empty() {
+                write!(out, " [aliases: {}]", aliases.join(", ")).unwrap();
             }
             out.push('\n');
         }
