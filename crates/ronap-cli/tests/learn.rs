@@ -330,6 +330,49 @@ fn an_output_directory_is_refused_before_training() {
     }
 }
 
+#[test]
+fn weights_and_data_logs_there_already_are_kept_unless_forced() {
+    let dir = tempfile::tempdir().unwrap();
+    let kept = dir.path().join("kept");
+    std::fs::write(&kept, "made by hand\n").unwrap();
+    let k = kept.to_str().unwrap();
+    // Refused before any training or recording (a million steps would take minutes), the file
+    // as it was.
+    for args in [
+        &["train", "dqn", "--steps", "1000000", "--out", k][..],
+        &[
+            "collect",
+            "--expert",
+            "geodesic",
+            "--samples",
+            "100000",
+            "--out",
+            k,
+        ],
+    ] {
+        let o = ronap(args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        let e = text(&o.stderr);
+        assert!(
+            e.contains("--out") && e.contains("exists") && e.contains("--force"),
+            "{e}"
+        );
+        assert_eq!(std::fs::read_to_string(&kept).unwrap(), "made by hand\n");
+    }
+    let forced = ok(&ronap(&[
+        "collect",
+        "--expert",
+        "geodesic",
+        "--samples",
+        "20",
+        "--out",
+        k,
+        "--force",
+    ]));
+    assert!(forced.contains("20 rows from "), "{forced}");
+    assert_eq!(std::fs::read_to_string(&kept).unwrap().lines().count(), 21);
+}
+
 /// The shipped policies reach, on the first 100 of their 1000 held-out evaluation seeds, the
 /// success rate their evaluation reports, within 12 points: about three standard deviations of a
 /// 100-episode estimate at the rates reported.

@@ -58,10 +58,26 @@ pub struct CollectArgs {
     /// Output CSV [default: <user>_<YYYYmmddHHMMSS>.csv].
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
+    /// Replace --out if it exists (once the rows are recorded) [default: refuse, before
+    /// recording].
+    #[arg(long)]
+    force: bool,
     /// User name for the default file name [default: $USER or `user` with --human,
     /// expert-<PLANNER> otherwise].
     #[arg(long, value_name = "NAME")]
     user: Option<String>,
+}
+
+/// Refuses an `--out` that is there already, unless `force`: a log of labelled rows (at the
+/// keys, with --human) costs time to make again.
+fn check_out(out: &std::path::Path, force: bool) -> Result<()> {
+    if out.exists() && !force {
+        bail!(
+            "--out {}: the file exists; --force replaces it, or give another --out",
+            out.display()
+        );
+    }
+    Ok(())
 }
 
 /// `<user>_<YYYYmmddHHMMSS>.csv`, the paper's data-log name, in local-free UTC.
@@ -94,6 +110,7 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
     let out = args.out.clone().unwrap_or_else(|| {
         default_log_name(args.user.as_deref().unwrap_or(&format!("expert-{expert}")))
     });
+    check_out(&out, args.force)?;
     let posing = match args.mode {
         Mode::Repose => Posing::Repose,
         Mode::Drive => Posing::Drive,
@@ -188,12 +205,14 @@ fn run_human(args: CollectArgs) -> Result<ExitCode> {
         .user
         .clone()
         .unwrap_or_else(crate::tui::collect::default_user);
+    let out = args.out.clone().unwrap_or_else(|| default_log_name(&user));
+    check_out(&out, args.force)?;
     crate::tui::collect::run(crate::tui::collect::Setting {
         evaluator: Evaluator::new(config, scenes),
         seed_start: args.seed_start,
         per_episode: args.per_episode,
         samples: args.samples,
-        out: args.out.clone().unwrap_or_else(|| default_log_name(&user)),
+        out,
         user,
     })
 }

@@ -79,6 +79,9 @@ struct NetArgs {
     /// Weights file to write (safetensors).
     #[arg(long, value_name = "FILE")]
     out: PathBuf,
+    /// Replace --out if it exists (once training is done) [default: refuse, before training].
+    #[arg(long)]
+    force: bool,
 }
 
 /// Arguments of `ronap train bc`.
@@ -305,8 +308,15 @@ fn note_split(seeds: &SeedRanges, split: Split, what: &str) {
     }
 }
 
-/// Checks the output can be written before any training time is spent.
-fn check_out(path: &Path) -> Result<()> {
+/// Checks the output can be written (and, unless `force`, is not there already: weights cost
+/// training time) before any training time is spent.
+fn check_out(path: &Path, force: bool) -> Result<()> {
+    if path.is_file() && !force {
+        bail!(
+            "--out {}: the file exists; --force replaces it, or give another --out",
+            path.display()
+        );
+    }
     if path.is_dir() || path.as_os_str().to_string_lossy().ends_with('/') {
         bail!(
             "--out {}: is a directory; give a file name such as {}",
@@ -372,7 +382,7 @@ impl Finished<'_> {
 }
 
 fn train_bc(args: BcArgs) -> Result<ExitCode> {
-    check_out(&args.net.out)?;
+    check_out(&args.net.out, args.net.force)?;
     let range = args.laser_range;
     let mut data: Option<DataSet> = None;
     let mut described = Vec::new();
@@ -535,7 +545,7 @@ fn train_bc(args: BcArgs) -> Result<ExitCode> {
 }
 
 fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
-    check_out(&args.net.out)?;
+    check_out(&args.net.out, args.net.force)?;
     let (config, scenes) = args.work.resolve_with(|sim| {
         if let Some(n) = args.max_steps {
             sim.episode.max_steps = n;

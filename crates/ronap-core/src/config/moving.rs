@@ -381,7 +381,10 @@ pub(super) fn validate_entry(
     let o = &m.orca;
     for (name, v) in [
         ("orca.time_horizon_steps", o.time_horizon_steps),
-        ("orca.obstacle_time_horizon_steps", o.obstacle_time_horizon_steps),
+        (
+            "orca.obstacle_time_horizon_steps",
+            o.obstacle_time_horizon_steps,
+        ),
     ] {
         // A time in steps, held to the bound lengths have.
         check(

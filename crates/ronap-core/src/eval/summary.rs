@@ -428,7 +428,6 @@ impl Summary {
     }
 }
 
-
 /// `x` (0 to 1) as a percentage to one decimal, or to as many more (up to four) as it takes for
 /// a rate short of 1 not to show as 100.0%, nor one above 0 as 0.0% (199,956 successes of
 /// 200,000 are 99.98%, not 100.0%).
