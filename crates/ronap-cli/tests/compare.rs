@@ -250,6 +250,34 @@ fn by_difficulty_bins_every_seed() {
 }
 
 #[test]
+fn a_comparison_that_stopped_short_says_how_to_use_what_it_finished() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("cmp");
+    let o = out.to_str().unwrap();
+    let script = dir.path().join("p.py");
+    std::fs::write(&script, "def act(obs):\n    raise ValueError('broken')\n").unwrap();
+    let py = format!("py:{}:act", script.display());
+    let args = [
+        "compare", "--policy", "apf", "--policy", &py, "--seeds", "4", "--out", o,
+    ];
+    let failed = ronap(&args);
+    assert_eq!(failed.status.code(), Some(2));
+    // Mended, the same command names the finished run it would replace and the two ways on.
+    std::fs::write(&script, "def act(obs):\n    return 1\n").unwrap();
+    let apf = out.join("runs/apf");
+    let apf = apf.to_str().unwrap();
+    assert_rejected(&args, &[apf, "--run", "--policy apf", "--force"]);
+    let reused = [
+        "compare", "--run", apf, "--policy", &py, "--seeds", "4", "--out", o,
+    ];
+    let table = ok(&ronap(&reused));
+    assert!(
+        table.contains("act vs apf") || table.contains("apf vs act"),
+        "{table}"
+    );
+}
+
+#[test]
 fn bad_input_is_named() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("never");

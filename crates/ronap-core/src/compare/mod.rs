@@ -466,10 +466,25 @@ fn run_one(
     let (evaluator, options, info) = (setting.evaluator, setting.options, setting.info);
     let (out, cancel, progress) = (setting.out, setting.cancel, setting.progress);
     let dir = out.map(|d| d.join("runs").join(label));
-    let writer = dir
-        .as_deref()
-        .map(|d| RunWriter::create(d, RunFiles::default(), options.seeds[0], options.replace))
-        .transpose()?;
+    let writer =
+        dir.as_deref()
+            .map(|d| {
+                RunWriter::create(d, RunFiles::default(), options.seeds[0], options.replace)
+                    .map_err(|e| match e {
+                        // Left by an earlier comparison into this --out that stopped short (one that
+                        // finished is refused before any run): say how to use it.
+                        OutputError::Finished { dir, .. } => CompareError::Input(format!(
+                        "{} holds the finished run of an earlier comparison into this --out that \
+                         stopped short: give --run {} in place of --policy {} to reuse it, or \
+                         --force to run it again",
+                        dir.display(),
+                        dir.display(),
+                        c.name
+                    )),
+                        e => e.into(),
+                    })
+            })
+            .transpose()?;
     progress(Progress::Running {
         index,
         label,
