@@ -278,6 +278,34 @@ fn a_comparison_that_stopped_short_says_how_to_use_what_it_finished() {
 }
 
 #[test]
+fn a_run_and_a_comparison_are_not_written_into_each_other() {
+    let dir = tempfile::tempdir().unwrap();
+    let (run, cmp) = (dir.path().join("run"), dir.path().join("cmp"));
+    let (r, c) = (run.to_str().unwrap(), cmp.to_str().unwrap());
+    ok(&ronap(&run_args("apf", &["--seeds", "2"], &run)));
+    let pair = [
+        "compare", "--policy", "apf", "--policy", "geodesic", "--seeds", "2",
+    ];
+    ok(&ronap(&[&pair[..], &["--out", c]].concat()));
+    assert_rejected(
+        &[&pair[..], &["--out", r]].concat(),
+        &[
+            r,
+            "holds a ronap run (its summary.json), not a comparison",
+            "--force",
+        ],
+    );
+    assert_rejected(
+        &run_args("apf", &["--seeds", "2"], &cmp),
+        &[
+            c,
+            "holds a comparison (its compare.json), not a run",
+            "--force",
+        ],
+    );
+}
+
+#[test]
 fn bad_input_is_named() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("never");

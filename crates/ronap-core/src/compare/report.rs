@@ -558,6 +558,13 @@ pub fn check_empty(dir: &Path) -> Result<(), OutputError> {
             file: "compare.json",
         });
     }
+    // A run is named by its summary (whatever entry comes first).
+    if dir.join("summary.json").exists() {
+        return Err(OutputError::NotARun {
+            dir: dir.to_path_buf(),
+            file: "summary.json".into(),
+        });
+    }
     let mut entries = std::fs::read_dir(dir).into_iter().flatten().flatten();
     let other = entries.find(|e| {
         let name = e.file_name();

@@ -61,8 +61,9 @@ pub enum OutputError {
         /// The file that shows it.
         file: &'static str,
     },
-    /// The directory holds files of no run, among which a run's files would be mixed.
-    #[error("{} is not empty and holds no ronap run (it holds {file})", dir.display())]
+    /// The directory holds files of no run (or of another kind of output: a comparison where a
+    /// run would go, or a run where a comparison would), among which its files would be mixed.
+    #[error("{}", not_this_output(dir, file))]
     NotARun {
         /// The directory.
         dir: PathBuf,
@@ -221,4 +222,14 @@ pub fn save_image(path: &Path, image: &image::RgbImage) -> Result<(), OutputErro
         message: e.to_string(),
     })?;
     write_atomic(path, |out| out.write_all(buffer.get_ref()))
+}
+
+/// [`OutputError::NotARun`]'s message: what `dir` holds, by the entry `file` found there.
+fn not_this_output(dir: &Path, file: &str) -> String {
+    let dir = dir.display();
+    match file {
+        "summary.json" => format!("{dir} holds a ronap run (its summary.json), not a comparison"),
+        "compare.json" => format!("{dir} holds a comparison (its compare.json), not a run"),
+        _ => format!("{dir} is not empty and holds no ronap run (it holds {file})"),
+    }
 }

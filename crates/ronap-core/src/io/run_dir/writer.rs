@@ -127,6 +127,10 @@ impl Holding {
                 || is_temporary(&e.file_name().to_string_lossy())
                 || empty_folder(e)
         };
+        // A comparison is named by its report (whatever entry comes first).
+        if dir.join("compare.json").exists() {
+            return Self::Other("compare.json".into());
+        }
         match entries.find(|e| !nothing(e)) {
             Some(e) => Self::Other(e.file_name().to_string_lossy().into_owned()),
             None => Self::Nothing,
