@@ -21,6 +21,12 @@ pub fn named_policy(
 ) -> Result<Box<dyn PolicyFactory>> {
     let flag = label;
     if name == COORDINATED_NAME {
+        if flag.starts_with("robots[") {
+            anyhow::bail!(
+                "{flag} = \"coordinated\": the team planner drives the whole team, so it is \
+                 chosen for all of it (--policy coordinated), not in one [[robots]] entry"
+            );
+        }
         anyhow::bail!(
             "{flag} coordinated: a team planner, for scenarios with [[robots]]; one robot alone \
              has no one to coordinate with (orca is what it would run)"
@@ -36,7 +42,7 @@ pub fn named_policy(
             let known: Vec<&str> = Builtin::ALL.iter().map(|(_, n, _)| *n).collect();
             anyhow::anyhow!(
                 "{flag} {name:?}: unknown policy (expected one of: {}, mlp:FILE[@RULE], \
-                 py:FILE:FUNCTION)",
+                 py:FILE:FUNCTION; for a team, also coordinated)",
                 known.join(", ")
             )
         }

@@ -53,9 +53,10 @@ pub(super) fn read_run(
         )));
     }
     if manifest.interrupted || manifest.error.is_some() {
-        return Err(mismatch(
-            "that run did not finish every seed; run it again".into(),
-        ));
+        return Err(mismatch(format!(
+            "that run did not finish every seed: `ronap run --resume {}` finishes it",
+            dir.display()
+        )));
     }
     if manifest.scenes != info.scenes {
         return Err(mismatch(format!(
