@@ -193,6 +193,23 @@ fn bad_replays_are_named_and_write_nothing() {
     let out = dir.path().join("x.gif");
     let o = out.to_str().unwrap();
     assert_rejected(&["replay", "/no/such.csv", "--out", o], &["/no/such.csv"]);
+    // A directory where a file goes is named as one, with the file it may mean.
+    let steps = run.join("steps");
+    assert_rejected(
+        &["replay", steps.to_str().unwrap(), "--out", o],
+        &["is a directory", "seed-000000.csv"],
+    );
+    assert_rejected(
+        &[
+            "replay",
+            log,
+            "--summary",
+            run.to_str().unwrap(),
+            "--out",
+            o,
+        ],
+        &["--summary", "is a directory", "summary.json"],
+    );
     let bad = dir.path().join("bad.csv");
     std::fs::write(&bad, "seed,step,x,y,z,action\n6,1,1,2,3,FLY\n").unwrap();
     assert_rejected(

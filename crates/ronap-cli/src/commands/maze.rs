@@ -116,7 +116,10 @@ fn check_size(scene: &ronap_core::Scene, scale: f64) -> Result<()> {
     let pixels = scene.width() * scene.height() * scale * scale;
     anyhow::ensure!(
         pixels <= 4.0e8,
-        "--scale {scale}: the picture would have {pixels:.0} pixels (at most 400 million)"
+        "a scene of {:.0} x {:.0} px at --scale {scale} would be a picture of {pixels:.0} pixels \
+         (at most 400 million): a smaller --scale, or a smaller scene",
+        scene.width(),
+        scene.height()
     );
     Ok(())
 }

@@ -86,6 +86,20 @@ pub fn options(view: View, stride: u64, scale: f64, size: u32, fps: u32) -> GifO
 
 /// Runs `ronap replay`.
 pub fn run(args: ReplayArgs) -> Result<ExitCode> {
+    if args.steps.is_dir() {
+        bail!(
+            "{}: is a directory; give one step log, such as {}",
+            args.steps.display(),
+            args.steps.join("seed-000000.csv").display()
+        );
+    }
+    if let Some(summary) = args.summary.as_ref().filter(|p| p.is_dir()) {
+        bail!(
+            "--summary {}: is a directory; give the run's summary file, such as {}",
+            summary.display(),
+            summary.join("summary.json").display()
+        );
+    }
     let steps = read_steps(&args.steps)?;
     let summary = match &args.summary {
         Some(p) => p.clone(),
