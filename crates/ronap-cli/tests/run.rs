@@ -2,7 +2,7 @@
 //! counts, the success gate, bad input, maps, APF's local minima, and Ctrl-C.
 
 use crate::util::{
-    assert_rejected, assert_rejected_leaving_nothing, col, collect_args, json, ronap, rows,
+    assert_rejected, assert_rejected_leaving_nothing, col, collect_args, json, ok, ronap, rows,
     run_args, shipped, text,
 };
 use std::path::{Path, PathBuf};
@@ -41,6 +41,15 @@ fn run_writes_episodes_summary_pictures_and_step_logs() {
     ] {
         assert!(table.contains(row), "summary lacks {row}: {table}");
     }
+
+    // Asking for no pictures and no players makes no folders for them.
+    let none = dir.path().join("none");
+    ok(&ronap(&run_args(
+        "geodesic",
+        &["--seeds", "2", "--png", "0", "--html", "0"],
+        &none,
+    )));
+    assert!(!none.join("png").exists() && !none.join("html").exists());
 
     let episodes = rows(&out.join("episodes.csv"));
     assert_eq!(episodes.len(), 7);

@@ -63,6 +63,11 @@ impl std::fmt::Display for Pictures {
 }
 
 impl Pictures {
+    /// Whether any episode may get one (`--png 0` asks for none: no folder is made for it).
+    pub fn any(self) -> bool {
+        self != Pictures::First(0)
+    }
+
     /// Whether `record` gets a picture, in a run whose seeds start at `first_seed`.
     pub fn wants(self, record: &EpisodeRecord, first_seed: u64) -> bool {
         self.wants_seed(record.seed, record.outcome, first_seed)

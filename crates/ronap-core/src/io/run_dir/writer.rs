@@ -175,7 +175,7 @@ impl RunWriter {
             return Err(e);
         }
         let subs = [
-            (files.pictures.is_some(), "png"),
+            (files.pictures.is_some_and(Pictures::any), "png"),
             (files.steps, "steps"),
             (files.gifs, "gif"),
         ];
@@ -385,7 +385,7 @@ impl RunWriter {
     /// `html/seed-SEED-OUTCOME.html` as it finishes ([`crate::job::evaluate_into`] and
     /// [`crate::job::evaluate_team_into`] record their steps).
     pub fn playing(mut self, players: Option<Pictures>) -> Result<Self, OutputError> {
-        if players.is_some() {
+        if players.is_some_and(Pictures::any) {
             make_dir(&self.dir.join("html"))?;
         }
         self.players = players;
