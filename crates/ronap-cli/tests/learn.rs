@@ -359,16 +359,11 @@ fn weights_and_data_logs_there_already_are_kept_unless_forced() {
         );
         assert_eq!(std::fs::read_to_string(&kept).unwrap(), "made by hand\n");
     }
-    let forced = ok(&ronap(&[
-        "collect",
-        "--expert",
+    let forced = ok(&ronap(&collect_args(
         "geodesic",
-        "--samples",
-        "20",
-        "--out",
-        k,
-        "--force",
-    ]));
+        &["--samples", "20", "--force"],
+        &kept,
+    )));
     assert!(forced.contains("20 rows from "), "{forced}");
     assert_eq!(std::fs::read_to_string(&kept).unwrap().lines().count(), 21);
 }
