@@ -359,6 +359,16 @@ fn weights_and_data_logs_there_already_are_kept_unless_forced() {
         );
         assert_eq!(std::fs::read_to_string(&kept).unwrap(), "made by hand\n");
     }
+    // A directory is never a log; a session at the keys never replaces one.
+    let d = dir.path().to_str().unwrap();
+    assert_rejected(
+        &["collect", "--expert", "geodesic", "--out", d, "--force"],
+        &["--out", "is a directory"],
+    );
+    assert_rejected(
+        &["collect", "--human", "--out", k, "--force"],
+        &["--force with --human", "another --out"],
+    );
     let forced = ok(&ronap(&collect_args(
         "geodesic",
         &["--samples", "20", "--force"],

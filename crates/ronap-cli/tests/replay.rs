@@ -197,7 +197,7 @@ fn bad_replays_are_named_and_write_nothing() {
     let steps = run.join("steps");
     assert_rejected(
         &["replay", steps.to_str().unwrap(), "--out", o],
-        &["is a directory", "seed-000000.csv"],
+        &["is a directory", "such as", "steps/seed-"],
     );
     assert_rejected(
         &[

@@ -40,9 +40,15 @@ pub fn named_policy(
     ronap_core::policy::factory(name, config.observation_size()).map_err(|e| match e {
         PolicyNameError::Unknown { .. } => {
             let known: Vec<&str> = Builtin::ALL.iter().map(|(_, n, _)| *n).collect();
+            // The team planner is chosen on the command line only.
+            let team = if flag == "--policy" {
+                "; for a team, also coordinated"
+            } else {
+                ""
+            };
             anyhow::anyhow!(
                 "{flag} {name:?}: unknown policy (expected one of: {}, mlp:FILE[@RULE], \
-                 py:FILE:FUNCTION; for a team, also coordinated)",
+                 py:FILE:FUNCTION{team})",
                 known.join(", ")
             )
         }

@@ -224,7 +224,7 @@ impl Bench {
             anyhow::bail!(
                 "--policy {name} took no step: it ended each of the {teams} team episodes it \
                  started (seeds 0 to {}) at once, so there is nothing to time; `ronap run \
-                 --policy {name} --seeds 3` with this scenario shows why",
+                 --scenario FILE --policy {name} --seeds 3` on this scenario shows why",
                 seed - 1
             );
         }

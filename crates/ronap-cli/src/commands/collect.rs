@@ -58,8 +58,8 @@ pub struct CollectArgs {
     /// Output CSV [default: <user>_<YYYYmmddHHMMSS>.csv].
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
-    /// Replace --out if it exists (once the rows are recorded) [default: refuse, before
-    /// recording].
+    /// Replace --out if it exists (once the rows are recorded; not with --human) [default:
+    /// refuse, before recording].
     #[arg(long)]
     force: bool,
     /// User name for the default file name [default: $USER or `user` with --human,
@@ -71,6 +71,13 @@ pub struct CollectArgs {
 /// Refuses an `--out` that is there already, unless `force`: a log of labelled rows (at the
 /// keys, with --human) costs time to make again.
 fn check_out(out: &std::path::Path, force: bool) -> Result<()> {
+    if out.is_dir() {
+        bail!(
+            "--out {}: is a directory; give a file name such as {}",
+            out.display(),
+            out.join("rows.csv").display()
+        );
+    }
     if out.exists() && !force {
         bail!(
             "--out {}: the file exists; --force replaces it, or give another --out",
@@ -205,8 +212,14 @@ fn run_human(args: CollectArgs) -> Result<ExitCode> {
         .user
         .clone()
         .unwrap_or_else(crate::tui::collect::default_user);
+    if args.force {
+        bail!(
+            "--force with --human: a session at the keys never replaces a data log; give \
+             another --out"
+        );
+    }
     let out = args.out.clone().unwrap_or_else(|| default_log_name(&user));
-    check_out(&out, args.force)?;
+    check_out(&out, false)?;
     crate::tui::collect::run(crate::tui::collect::Setting {
         evaluator: Evaluator::new(config, scenes),
         seed_start: args.seed_start,

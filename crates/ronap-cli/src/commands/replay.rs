@@ -87,10 +87,22 @@ pub fn options(view: View, stride: u64, scale: f64, size: u32, fps: u32) -> GifO
 /// Runs `ronap replay`.
 pub fn run(args: ReplayArgs) -> Result<ExitCode> {
     if args.steps.is_dir() {
+        // The first log there, as an example (a team's are seed-SEED-robot-K.csv).
+        let mut logs: Vec<_> = std::fs::read_dir(&args.steps)
+            .into_iter()
+            .flatten()
+            .flatten()
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|e| e == "csv"))
+            .collect();
+        logs.sort();
+        let example = logs.first().map_or_else(
+            || String::from("a step log (ronap run --log-steps writes them)"),
+            |p| format!("such as {}", p.display()),
+        );
         bail!(
-            "{}: is a directory; give one step log, such as {}",
-            args.steps.display(),
-            args.steps.join("seed-000000.csv").display()
+            "{}: is a directory; give one step log, {example}",
+            args.steps.display()
         );
     }
     if let Some(summary) = args.summary.as_ref().filter(|p| p.is_dir()) {

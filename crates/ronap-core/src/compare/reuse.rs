@@ -86,21 +86,20 @@ pub(super) fn read_run(
     }
     // The tables take a run's rates from summary.json and the pairs from episodes.csv: the two
     // must tell the same story (an edited file would make them contradict each other).
-    if !team {
-        let s = &manifest.summary;
-        let successes = rows
-            .iter()
-            .filter(|r| r.outcome == crate::eval::Outcome::Success)
-            .count();
-        if (s.episodes, s.successes) != (rows.len(), successes) {
-            return Err(mismatch(format!(
-                "episodes.csv holds {successes} successes in {} episodes, summary.json {} in \
-                 {}: the two files disagree",
-                rows.len(),
-                s.successes,
-                s.episodes
-            )));
-        }
+    let (episodes, successes) = match &manifest.team {
+        Some(t) => (t.episodes, t.team_successes),
+        None => (manifest.summary.episodes, manifest.summary.successes),
+    };
+    let counted = rows
+        .iter()
+        .filter(|r| r.outcome == crate::eval::Outcome::Success)
+        .count();
+    if (episodes, successes) != (rows.len(), counted) {
+        return Err(mismatch(format!(
+            "episodes.csv holds {counted} successes in {} episodes, summary.json {successes} in \
+             {episodes}: the two files disagree",
+            rows.len(),
+        )));
     }
     // The same seeds in the same scenes start (and a lone robot ends) in the same places: a
     // changed map file or maze generator shows here even when the manifest reads the same.

@@ -244,7 +244,16 @@ mod tests {
             bad("speed_px = -1.0"),
             "crowd[0].speed_px = -1.0: must be between 0 and 100000 px"
         );
-        // A horizon is a time: in steps, not px.
+        // A horizon is a time: in steps, not px (the robot's [orca] as the pedestrians').
+        let robot = SimConfig::from_toml_str("[orca]\ntime_horizon_steps = -1.0\n")
+            .unwrap()
+            .validate()
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            robot,
+            "orca.time_horizon_steps = -1.0: must be a positive number of steps, at most 100000"
+        );
         assert_eq!(
             bad("motion = \"orca\"\norca = { time_horizon_steps = -1 }"),
             "crowd[0].orca.time_horizon_steps = -1.0: must be a positive number of steps, at most \

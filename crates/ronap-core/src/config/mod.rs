@@ -358,6 +358,17 @@ fn length(field: &str, v: f64, zero_ok: bool) -> Result<(), ConfigError> {
         },
     )
 }
+/// Checks that `v` is a time in steps: positive, finite and at most as long as the longest
+/// length (an ORCA horizon).
+fn steps(field: &str, v: f64) -> Result<(), ConfigError> {
+    check(
+        v.is_finite() && v > 0.0 && v <= MAX_LENGTH_PX,
+        field,
+        format!("{v:?}"),
+        "must be a positive number of steps, at most 100000",
+    )
+}
+
 /// Checks that `v` is a fraction, 0 to 1.
 fn fraction(field: &str, v: f64) -> Result<(), ConfigError> {
     check(

@@ -1,7 +1,7 @@
 //! Moving and appearing obstacles (docs/model.md "Moving obstacles"): each `[[moving]]` entry's
 //! shape, start and motion, with its defaults and checks.
 
-use crate::config::{check, finite, length, point, ConfigError, Forces};
+use crate::config::{check, finite, length, point, steps, ConfigError, Forces};
 use serde::{Deserialize, Serialize};
 
 /// The shape of a moving obstacle.
@@ -379,21 +379,11 @@ pub(super) fn validate_entry(
     )?;
     length(&f("jitter_px"), m.jitter_px, true)?;
     let o = &m.orca;
-    for (name, v) in [
-        ("orca.time_horizon_steps", o.time_horizon_steps),
-        (
-            "orca.obstacle_time_horizon_steps",
-            o.obstacle_time_horizon_steps,
-        ),
-    ] {
-        // A time in steps, held to the bound lengths have.
-        check(
-            v.is_finite() && v > 0.0 && v <= super::MAX_LENGTH_PX,
-            &f(name),
-            format!("{v:?}"),
-            "must be a positive number of steps, at most 100000",
-        )?;
-    }
+    steps(&f("orca.time_horizon_steps"), o.time_horizon_steps)?;
+    steps(
+        &f("orca.obstacle_time_horizon_steps"),
+        o.obstacle_time_horizon_steps,
+    )?;
     length(&f("orca.neighbour_dist_px"), o.neighbour_dist_px, true)?;
     length(&f("orca.safety_margin_px"), o.safety_margin_px, true)?;
     check(

@@ -1,7 +1,7 @@
 //! The `orca` policy's settings (docs/model.md "Local planners among moving things"), with their
 //! defaults and checks.
 
-use crate::config::{check, length, ConfigError};
+use crate::config::{check, length, steps, ConfigError};
 use serde::{Deserialize, Serialize};
 
 /// Which actions a local planner turns its velocity into.
@@ -61,11 +61,10 @@ impl OrcaConfig {
 
     /// Checks the horizons and ranges, naming the first one out of range.
     pub(super) fn validate(&self) -> Result<(), ConfigError> {
-        length("orca.time_horizon_steps", self.time_horizon_steps, false)?;
-        length(
+        steps("orca.time_horizon_steps", self.time_horizon_steps)?;
+        steps(
             "orca.obstacle_time_horizon_steps",
             self.obstacle_time_horizon_steps,
-            false,
         )?;
         check(
             (1..=1000).contains(&self.max_neighbours),

@@ -428,17 +428,17 @@ impl Summary {
     }
 }
 
-/// `x` (0 to 1) as a percentage to one decimal, or to as many more (up to four) as it takes for
-/// a rate short of 1 not to show as 100.0%, nor one above 0 as 0.0% (199,956 successes of
-/// 200,000 are 99.98%, not 100.0%).
-fn percent(x: f64) -> String {
+/// `x` (0 to 1) as a percentage to one decimal, or to as many more as it takes for a rate short
+/// of 1 not to show as 100.0%, nor one above 0 as 0.0% (199,956 successes of 200,000 are 99.98%,
+/// not 100.0%).
+pub(crate) fn percent(x: f64) -> String {
     let shown = |d: usize| format!("{:.*}", d, 100.0 * x);
-    let d = (1..=4)
+    let d = (1..=17)
         .find(|&d| {
             let s = shown(d);
             !((x < 1.0 && s.starts_with("100.")) || (x > 0.0 && s.parse::<f64>() == Ok(0.0)))
         })
-        .unwrap_or(4);
+        .unwrap_or(17);
     format!("{}%", shown(d))
 }
 
@@ -468,6 +468,7 @@ mod tests {
             (199_956.0 / 200_000.0, "99.98%"),
             (44.0 / 200_000.0, "0.02%"),
             (0.9994, "99.9%"),
+            (1.0 - 1e-7, "99.99999%"),
             (0.9996, "99.96%"),
         ] {
             assert_eq!(percent(x), shown, "{x}");

@@ -407,7 +407,7 @@ impl TeamSummary {
 
     /// The summary as an aligned two-column table.
     pub fn table(&self) -> String {
-        let pct = |x: f64| format!("{:.1}%", 100.0 * x);
+        let pct = super::summary::percent;
         let mut rows: Vec<(&str, String)> = vec![
             (
                 "episodes",

@@ -29,10 +29,7 @@ pub struct Walker {
 pub fn agent_force(f: &Forces, me: &Walker, desired: Vector, at: Point, radius: f64) -> Vector {
     let away = me.position - at;
     let d2 = away.norm_squared();
-    // Most candidates a walker is handed are out of reach: turned away before the square root,
-    // with room for its rounding, so those within reach are exactly the ones the test below
-    // keeps.
-    if d2 > f.neighbour_dist_px * f.neighbour_dist_px * (1.0 + 1e-9) {
+    if !maybe_in_reach(f, d2) {
         return Vector::zeros();
     }
     let d = d2.sqrt();
@@ -48,6 +45,14 @@ pub fn agent_force(f: &Forces, me: &Walker, desired: Vector, at: Point, radius: 
         f.lambda + (1.0 - f.lambda) * (1.0 + cos_phi) / 2.0
     };
     n * (f.agent_strength_px * weight * push_factor((me.radius + radius - d) / f.agent_range_px))
+}
+
+/// Whether another agent at squared distance `d2` may be within reach: most candidates a walker
+/// is handed are out of reach, turned away on this before the square root, with room for its
+/// rounding, so every one [`agent_force`]'s exact test keeps passes (and NaN does).
+#[inline]
+pub fn maybe_in_reach(f: &Forces, d2: f64) -> bool {
+    (d2 <= f.neighbour_dist_px * f.neighbour_dist_px * (1.0 + 1e-9)) | d2.is_nan()
 }
 
 /// The push of a still obstacle whose nearest point to `me` is `nearest`; none from inside it.

@@ -714,7 +714,8 @@ impl Scene {
         // (with room for rounding) is clear of it without measuring: among many walkers, most
         // are far from every pillar.
         let length = (b - a).norm();
-        let far = (length + radius) * (1.0 + 1e-9);
+        // The margin grows with the coordinates too: their rounding does.
+        let far = (length + radius) * (1.0 + 1e-9) + 1e-9 * (a.x.abs().max(a.y.abs()) + 1.0);
         if !self
             .shapes
             .iter()

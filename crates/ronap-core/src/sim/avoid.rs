@@ -120,9 +120,7 @@ pub fn social_force_velocity(
     // The others within reach are picked out with no branch on each (whether one is within
     // reach is a coin toss the processor mostly guesses wrong), a batch at a time, and their
     // pushes summed in their order: the same sum, to the bit, as over every one (a push from
-    // beyond reach is zero, and adding zero changes no sum that starts at +0). The bound lets
-    // through every one the exact test in `agent_force` keeps, and NaN.
-    let bound = forces.neighbour_dist_px * forces.neighbour_dist_px * (1.0 + 1e-9);
+    // beyond reach is zero, and adding zero changes no sum that starts at +0).
     let mut batch = [(Point::origin(), 0.0); 8];
     let mut kept = 0;
     let mut sum = |batch: &[(Point, f64)]| {
@@ -133,7 +131,7 @@ pub fn social_force_velocity(
     for (at, radius) in others {
         batch[kept] = (at, radius);
         let d2 = (walker.position - at).norm_squared();
-        kept += usize::from((d2 <= bound) | d2.is_nan());
+        kept += usize::from(social_force::maybe_in_reach(forces, d2));
         if kept == batch.len() {
             sum(&batch);
             kept = 0;

@@ -701,8 +701,18 @@ fn check_rows(files: &[(PathBuf, usize)], seeds: &Seeds, done: usize) -> Result<
                 ));
             }
         }
-        if *per_episode == 1 && rows.iter().all(|(_, o)| o.is_some()) {
-            outcomes.push((path, rows.into_iter().filter_map(|(_, o)| o).collect()));
+        // The two files that give each episode's outcome (a team's robots.csv gives each
+        // robot's, even for a team of one).
+        let name = path.file_name().unwrap_or_default().to_string_lossy();
+        if name.starts_with("episodes.csv") || name.starts_with(FIGURES_FILE) {
+            let mut kept = Vec::with_capacity(rows.len());
+            for (i, (_, outcome)) in rows.into_iter().enumerate() {
+                let Some(outcome) = outcome else {
+                    return Err(format!("{}: line {}: no outcome", path.display(), i + 2));
+                };
+                kept.push(outcome);
+            }
+            outcomes.push((path, kept));
         }
     }
     if let [(a, first), (b, second)] = &outcomes[..] {
