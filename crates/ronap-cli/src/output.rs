@@ -155,6 +155,42 @@ pub fn unused_dir(base: String) -> std::path::PathBuf {
         .unwrap_or_else(|| PathBuf::from(base))
 }
 
+/// Checks before any work is spent that `--out` (`path`, a file) can be written: not a
+/// directory (`example` names a file to give instead, such as `policy.safetensors`), in a
+/// directory that exists and takes files, and, unless `force`, not there already (weights and
+/// labelled rows cost time to make again).
+pub fn check_out_file(path: &std::path::Path, force: bool, example: &str) -> anyhow::Result<()> {
+    if path.is_file() && !force {
+        anyhow::bail!(
+            "--out {}: the file exists; --force replaces it, or give another --out",
+            path.display()
+        );
+    }
+    if path.is_dir() || path.as_os_str().to_string_lossy().ends_with('/') {
+        anyhow::bail!(
+            "--out {}: is a directory; give a file name such as {}",
+            path.display(),
+            path.join(example).display()
+        );
+    }
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => std::path::Path::new("."),
+    };
+    if !dir.is_dir() {
+        anyhow::bail!(
+            "--out {}: directory {} does not exist",
+            path.display(),
+            dir.display()
+        );
+    }
+    // The file is written through a temporary file in that directory: try one.
+    if let Err(e) = ronap_core::io::check_writable(dir) {
+        anyhow::bail!("--out {}: {e}", path.display());
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

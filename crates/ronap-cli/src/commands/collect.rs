@@ -68,25 +68,6 @@ pub struct CollectArgs {
     user: Option<String>,
 }
 
-/// Refuses an `--out` that is there already, unless `force`: a log of labelled rows (at the
-/// keys, with --human) costs time to make again.
-fn check_out(out: &std::path::Path, force: bool) -> Result<()> {
-    if out.is_dir() {
-        bail!(
-            "--out {}: is a directory; give a file name such as {}",
-            out.display(),
-            out.join("rows.csv").display()
-        );
-    }
-    if out.exists() && !force {
-        bail!(
-            "--out {}: the file exists; --force replaces it, or give another --out",
-            out.display()
-        );
-    }
-    Ok(())
-}
-
 /// `<user>_<YYYYmmddHHMMSS>.csv`, the paper's data-log name, in local-free UTC.
 pub fn default_log_name(user: &str) -> PathBuf {
     let (y, mo, d, h, mi, s) = crate::output::utc_now();
@@ -117,7 +98,7 @@ pub fn run(args: CollectArgs) -> Result<ExitCode> {
     let out = args.out.clone().unwrap_or_else(|| {
         default_log_name(args.user.as_deref().unwrap_or(&format!("expert-{expert}")))
     });
-    check_out(&out, args.force)?;
+    crate::output::check_out_file(&out, args.force, "rows.csv")?;
     let posing = match args.mode {
         Mode::Repose => Posing::Repose,
         Mode::Drive => Posing::Drive,
@@ -219,7 +200,7 @@ fn run_human(args: CollectArgs) -> Result<ExitCode> {
         );
     }
     let out = args.out.clone().unwrap_or_else(|| default_log_name(&user));
-    check_out(&out, false)?;
+    crate::output::check_out_file(&out, false, "rows.csv")?;
     crate::tui::collect::run(crate::tui::collect::Setting {
         evaluator: Evaluator::new(config, scenes),
         seed_start: args.seed_start,

@@ -308,40 +308,6 @@ fn note_split(seeds: &SeedRanges, split: Split, what: &str) {
     }
 }
 
-/// Checks the output can be written (and, unless `force`, is not there already: weights cost
-/// training time) before any training time is spent.
-fn check_out(path: &Path, force: bool) -> Result<()> {
-    if path.is_file() && !force {
-        bail!(
-            "--out {}: the file exists; --force replaces it, or give another --out",
-            path.display()
-        );
-    }
-    if path.is_dir() || path.as_os_str().to_string_lossy().ends_with('/') {
-        bail!(
-            "--out {}: is a directory; give a file name such as {}",
-            path.display(),
-            path.join("policy.safetensors").display()
-        );
-    }
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    if !dir.is_dir() {
-        bail!(
-            "--out {}: directory {} does not exist",
-            path.display(),
-            dir.display()
-        );
-    }
-    // The weights and the curves are written through temporary files in that directory: try one.
-    if let Err(e) = ronap_core::io::check_writable(dir) {
-        bail!("--out {}: {e}", path.display());
-    }
-    Ok(())
-}
-
 /// The end of a training run, however it stopped.
 struct Finished<'a> {
     mlp: &'a Mlp,
@@ -382,7 +348,7 @@ impl Finished<'_> {
 }
 
 fn train_bc(args: BcArgs) -> Result<ExitCode> {
-    check_out(&args.net.out, args.net.force)?;
+    crate::output::check_out_file(&args.net.out, args.net.force, "policy.safetensors")?;
     let range = args.laser_range;
     let mut data: Option<DataSet> = None;
     let mut described = Vec::new();
@@ -545,7 +511,7 @@ fn train_bc(args: BcArgs) -> Result<ExitCode> {
 }
 
 fn train_dqn(args: DqnArgs) -> Result<ExitCode> {
-    check_out(&args.net.out, args.net.force)?;
+    crate::output::check_out_file(&args.net.out, args.net.force, "policy.safetensors")?;
     let (config, scenes) = args.work.resolve_with(|sim| {
         if let Some(n) = args.max_steps {
             sim.episode.max_steps = n;

@@ -456,6 +456,22 @@ struct Setting<'a> {
     progress: &'a (dyn Fn(Progress) + Sync),
 }
 
+/// A contender's run directory refused: one holding a finished run was left by an earlier
+/// comparison into this --out that stopped short (one that finished is refused before any run),
+/// so the error says how to use it.
+fn earlier_run(e: OutputError, policy: &str) -> CompareError {
+    match e {
+        OutputError::Finished { dir, .. } => CompareError::Input(format!(
+            "{} holds the finished run of an earlier comparison into this --out that stopped \
+             short: give --run {} in place of --policy {policy} to reuse it, or --force to run \
+             it again",
+            dir.display(),
+            dir.display()
+        )),
+        e => e.into(),
+    }
+}
+
 /// Runs contender `c` (the `index`-th) into `out/runs/<label>` (when there is an `out`).
 fn run_one(
     setting: &Setting<'_>,
@@ -466,25 +482,13 @@ fn run_one(
     let (evaluator, options, info) = (setting.evaluator, setting.options, setting.info);
     let (out, cancel, progress) = (setting.out, setting.cancel, setting.progress);
     let dir = out.map(|d| d.join("runs").join(label));
-    let writer =
-        dir.as_deref()
-            .map(|d| {
-                RunWriter::create(d, RunFiles::default(), options.seeds[0], options.replace)
-                    .map_err(|e| match e {
-                        // Left by an earlier comparison into this --out that stopped short (one that
-                        // finished is refused before any run): say how to use it.
-                        OutputError::Finished { dir, .. } => CompareError::Input(format!(
-                        "{} holds the finished run of an earlier comparison into this --out that \
-                         stopped short: give --run {} in place of --policy {} to reuse it, or \
-                         --force to run it again",
-                        dir.display(),
-                        dir.display(),
-                        c.name
-                    )),
-                        e => e.into(),
-                    })
-            })
-            .transpose()?;
+    let writer = dir
+        .as_deref()
+        .map(|d| {
+            RunWriter::create(d, RunFiles::default(), options.seeds[0], options.replace)
+                .map_err(|e| earlier_run(e, &c.name))
+        })
+        .transpose()?;
     progress(Progress::Running {
         index,
         label,
